@@ -1,0 +1,253 @@
+// rbsim simulation core: 2D rigid bodies made of point-mass vertices, no collisions.
+//
+// Units are whatever the scene uses, consistently (FOSSSim scenes are SI-like: m, kg, s).
+// Angles are radians, counter-clockwise positive; torque and angular momentum are the z
+// component of the 3D cross product, so a x b = a.x b.y - a.y b.x.
+//
+// The world keeps its hot state as flat arrays (struct of arrays): one entry per body for
+// position, angle, velocity, angular velocity, force and torque. Hull shapes are stored once and
+// referenced by index. Nothing here knows about files, DDS or MCAP.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace rbsim {
+
+using Vec2 = Eigen::Vector2d;
+
+// ---------------------------------------------------------------------------------------------
+// Errors: an expected-style value. The core reports invalid definitions through it; the I/O
+// layers (scene loader, sinks) use the same type.
+struct Error {
+  std::string message;
+};
+
+template <class T>
+class [[nodiscard]] Result {
+ public:
+  Result(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
+  bool ok() const { return v_.index() == 0; }
+  explicit operator bool() const { return ok(); }
+  T& value() { return std::get<0>(v_); }
+  const T& value() const { return std::get<0>(v_); }
+  T& operator*() { return value(); }
+  T* operator->() { return &value(); }
+  const Error& error() const { return std::get<1>(v_); }
+
+ private:
+  std::variant<T, Error> v_;
+};
+
+struct Ok {};
+using Status = Result<Ok>;
+
+// ---------------------------------------------------------------------------------------------
+// Definitions (what a scene describes). Plain structs with defaults.
+
+enum class Integrator : std::uint8_t {
+  ExplicitEuler,    // x += dt v (old v), v += dt a
+  SymplecticEuler,  // v += dt a, x += dt v (new v): implicit in velocity for the position update
+};
+
+const char* to_string(Integrator integrator);
+
+struct BodyDef {
+  std::vector<Vec2> hull;       // world positions at t = 0, clockwise order; >= 2 vertices
+  std::vector<double> masses;   // one per hull vertex, each > 0
+  Vec2 velocity{0.0, 0.0};      // centre-of-mass velocity
+  double omega = 0.0;           // angular velocity about the centre of mass (rad/s, CCW > 0)
+  double radius = 0.1;          // rendering radius (not used by the dynamics)
+};
+
+inline constexpr std::int32_t kFixed = -1;  // spring end fixed in space
+
+struct SpringDef {
+  std::int32_t body_i = kFixed;  // body index or kFixed
+  Vec2 anchor_i{0.0, 0.0};       // body space offset from the centre of mass, or world point if fixed
+  std::int32_t body_j = kFixed;
+  Vec2 anchor_j{0.0, 0.0};
+  double stiffness = 0.0;        // k
+  double rest_length = 0.0;      // l0
+};
+
+struct GravityDef {
+  Vec2 acceleration{0.0, 0.0};   // g: every vertex feels m_i g (FOSSSim's fx, fy)
+};
+
+struct WindDef {
+  double beta = 1.0;             // drag coefficient per unit edge length
+  Vec2 velocity{0.0, 0.0};       // wind velocity
+  std::int32_t points_per_edge = 2;
+};
+
+struct WorldDef {
+  Integrator integrator = Integrator::SymplecticEuler;
+  double dt = 0.01;
+  std::vector<BodyDef> bodies;
+  std::vector<SpringDef> springs;  // each force kind is applied in this (file) order
+  std::vector<GravityDef> gravity;
+  std::vector<WindDef> winds;
+};
+
+// Handles instead of pointers or raw indices in the public API.
+struct BodyId {
+  std::int32_t index = -1;
+};
+struct SpringId {
+  std::int32_t index = -1;
+};
+
+struct BodyState {
+  Vec2 position{0.0, 0.0};  // centre of mass X
+  double theta = 0.0;       // rotation from body space
+  Vec2 velocity{0.0, 0.0};  // V = dX/dt
+  double omega = 0.0;
+};
+
+// The graded per-body quantities (spec section 4).
+struct BodyQuantities {
+  Vec2 momentum{0.0, 0.0};  // P = M V
+  double l_point = 0.0;     // M (X x V)
+  double l_spin = 0.0;      // I omega
+  double t_point = 0.0;     // M |V|^2 / 2
+  double t_spin = 0.0;      // I omega^2 / 2
+};
+
+struct SpringState {
+  Vec2 end_i{0.0, 0.0};  // world endpoints
+  Vec2 end_j{0.0, 0.0};
+  double length = 0.0;
+  double potential = 0.0;  // k (l - l0)^2 / 2
+};
+
+// Scene-wide energies. Wind is not conservative and has no potential.
+struct Energy {
+  double u_gravity = 0.0;  // sum over bodies of -M g . X
+  double u_spring = 0.0;
+  double t_point = 0.0;
+  double t_spin = 0.0;
+  double potential() const { return u_gravity + u_spring; }
+  double kinetic() const { return t_point + t_spin; }
+  double total() const { return potential() + kinetic(); }
+};
+
+namespace detail {
+// The wind force and torque on a hull are linear in the body-frame relative wind u and in
+// omega; these are their coefficients, summed over the edges once per shape (src/wind.cpp).
+struct WindMoments {
+  double axx = 0, axy = 0, ayy = 0;  // F_body = beta (A u - omega b), A symmetric
+  double bx = 0, by = 0;
+  double cx = 0, cy = 0, d = 0;      // torque = beta (c . u - omega d)
+};
+}  // namespace detail
+
+// ---------------------------------------------------------------------------------------------
+class World {
+ public:
+  // Validates the definition (positive masses, dt > 0, indices in range, non-degenerate bodies)
+  // and computes M, X, I and body-space hulls. Body space has its origin at the centre of mass
+  // and is aligned with world space at t = 0, so theta starts at 0.
+  static Result<World> create(const WorldDef& def);
+
+  // Advances one time step of dt: clears forces, accumulates gravity, springs and wind (each
+  // in definition order), integrates. Does not allocate.
+  void step();
+
+  std::int32_t body_count() const { return static_cast<std::int32_t>(x_.size()); }
+  std::int32_t spring_count() const { return static_cast<std::int32_t>(springs_.size()); }
+  Integrator integrator() const { return integrator_; }
+  double dt() const { return dt_; }
+  std::int64_t step_index() const { return step_; }
+  double time() const { return static_cast<double>(step_) * dt_; }
+
+  // Per-body constants.
+  double mass(BodyId b) const { return mass_[b.index]; }
+  double inertia(BodyId b) const { return inertia_[b.index]; }
+  double radius(BodyId b) const { return radius_[b.index]; }
+  // Hull vertices in body space (relative to the centre of mass at theta = 0).
+  std::span<const Vec2> hull(BodyId b) const;
+  Vec2 world_vertex(BodyId b, std::int32_t vertex) const;
+
+  BodyState state(BodyId b) const;
+  void set_state(BodyId b, const BodyState& s);  // e.g. to restart from a recorded step
+  void set_step_index(std::int64_t step) { step_ = step; }
+  BodyQuantities quantities(BodyId b) const;
+  // Force and torque accumulated by the last step() (zero before the first step).
+  Vec2 force(BodyId b) const { return {fx_[b.index], fy_[b.index]}; }
+  double torque(BodyId b) const { return tau_[b.index]; }
+
+  const SpringDef& spring(SpringId s) const { return springs_[s.index]; }
+  SpringState spring_state(SpringId s) const;
+  std::span<const GravityDef> gravity() const { return gravity_; }
+  std::span<const WindDef> winds() const { return winds_; }
+
+  // U = gravity + springs, as graded by the reference.
+  double potential_energy() const { return energy().potential(); }
+  Energy energy() const;
+
+  // Raw state arrays for adapters that copy whole columns.
+  std::span<const double> x() const { return x_; }
+  std::span<const double> y() const { return y_; }
+  std::span<const double> theta() const { return theta_; }
+  std::span<const double> vx() const { return vx_; }
+  std::span<const double> vy() const { return vy_; }
+  std::span<const double> omega() const { return omega_; }
+
+  // The first non-finite value in the state, if any (checked after each step by runners, so a
+  // diverging scene stops with a clear error instead of writing NaN).
+  struct NonFinite {
+    BodyId body;
+    const char* quantity;  // "x", "y", "theta", "vx", "vy" or "omega"
+  };
+  std::optional<NonFinite> find_nonfinite() const;
+
+  // Heap bytes held by the world (capacity of every array), for the per-body memory budget.
+  std::size_t memory_bytes() const;
+  std::int32_t shape_count() const { return static_cast<std::int32_t>(shapes_.size()); }
+
+ private:
+  // A hull in body space, stored once in shape_vertices_.
+  struct Shape {
+    std::int32_t first = 0;
+    std::int32_t count = 0;
+  };
+  using WindMoments = detail::WindMoments;
+  World() = default;
+
+  void update_rotations();
+  void accumulate_gravity();
+  void accumulate_springs();
+  void accumulate_wind();
+  void integrate();
+
+  Integrator integrator_ = Integrator::SymplecticEuler;
+  double dt_ = 0.0;
+  std::int64_t step_ = 0;
+
+  // Hot state, one entry per body.
+  std::vector<double> x_, y_, theta_, vx_, vy_, omega_;
+  std::vector<double> fx_, fy_, tau_;
+  std::vector<double> cos_, sin_;  // cos/sin of theta, refreshed once per step when needed
+  // Per-body constants.
+  std::vector<double> mass_, inertia_, radius_;
+  std::vector<std::int32_t> shape_;  // index into shapes_
+
+  // Shapes: stored once, shared by bodies whose body-space hulls are bit-identical.
+  std::vector<Shape> shapes_;
+  std::vector<Vec2> shape_vertices_;       // all hulls, body space, concatenated
+  std::vector<WindMoments> wind_moments_;  // [wind * shapes + shape]
+
+  std::vector<SpringDef> springs_;
+  std::vector<GravityDef> gravity_;
+  std::vector<WindDef> winds_;
+};
+
+}  // namespace rbsim

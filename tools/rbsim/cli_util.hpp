@@ -1,0 +1,40 @@
+// Small pieces shared by the rbsim subcommands: Ctrl-C handling and a terminal progress bar.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+namespace rbsim::cli {
+
+// Installs SIGINT/SIGTERM handlers that only raise a flag; long loops poll stop_requested() and
+// shut down cleanly (outputs finished, summary printed).
+void install_stop_handlers();
+bool stop_requested();
+int stop_signal();  // the signal that asked to stop, or 0
+
+// A one-line progress bar on stderr, shown only on a terminal and only once a run has taken
+// longer than `delay`. update() is cheap enough to call every step: it looks at the clock only
+// every few hundred calls.
+class Progress {
+ public:
+  enum class Mode { Auto, Always, Never };
+  Progress(std::int64_t total, Mode mode, std::chrono::milliseconds delay = std::chrono::milliseconds(1000));
+  ~Progress();
+  void update(std::int64_t done) {
+    if (enabled_ && ++calls_ >= stride_) tick(done);
+  }
+  void finish();
+
+ private:
+  void tick(std::int64_t done);
+  std::int64_t total_;
+  bool enabled_ = false, shown_ = false;
+  std::uint32_t calls_ = 0, stride_ = 256;
+  std::chrono::steady_clock::time_point start_, last_draw_;
+  std::chrono::milliseconds delay_;
+};
+
+std::string format_seconds(double seconds);
+
+}  // namespace rbsim::cli

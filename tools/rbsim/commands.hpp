@@ -1,0 +1,18 @@
+// The rbsim subcommands: each adds itself to the CLI11 app and returns how to run it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace rbsim::cli {
+
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int()> run;  // returns the process exit code
+};
+
+Subcommand add_run_command(CLI::App& parent);
+Subcommand add_grade_command(CLI::App& parent);
+
+}  // namespace rbsim::cli
