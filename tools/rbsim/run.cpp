@@ -17,7 +17,7 @@ struct RunOptions {
   std::optional<std::int64_t> steps;
   std::optional<double> duration;
   std::string csv, energy_csv, fosssim_out;
-  Progress::Mode progress = Progress::Mode::Auto;
+  std::string progress = "auto";
   bool quiet = false;
   bool allow_nonfinite = false;
 };
@@ -50,7 +50,9 @@ int run(const RunOptions& o) {
   }
 
   install_stop_handlers();
-  Progress progress(steps, o.progress);
+  Progress progress(steps, o.progress == "always"  ? Progress::Mode::Always
+                          : o.progress == "never" ? Progress::Mode::Never
+                                                  : Progress::Mode::Auto);
   const auto start = std::chrono::steady_clock::now();
   std::optional<std::string> failure;
   while (world.step_index() < steps && !stop_requested()) {
@@ -112,9 +114,8 @@ Subcommand add_run_command(CLI::App& parent) {
                   "FOSSSim reference binary output (raw little-endian doubles), comparable byte for byte "
                   "with the reference solver's");
   app->add_option("--progress", o->progress, "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, Progress::Mode>{{"auto", Progress::Mode::Auto},
-                                                                                {"always", Progress::Mode::Always},
-                                                                                {"never", Progress::Mode::Never}}));
+      ->check(CLI::IsMember({"auto", "always", "never"}))
+      ->default_str("auto");
   app->add_flag("-q,--quiet", o->quiet, "No closing summary line");
   app->add_flag("--allow-nonfinite", o->allow_nonfinite,
                 "Keep going when the state becomes inf/NaN (by default the run stops at the first non-finite value)");
