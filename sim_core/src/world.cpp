@@ -105,7 +105,10 @@ Result<World> World::create(const WorldDef& def) {
       local.push_back(body.hull[v] - com);
       inertia += body.masses[v] * local.back().squaredNorm();
     }
-    if (!(inertia > 0.0 && std::isfinite(inertia))) {
+    if (!std::isfinite(inertia) || !std::isfinite(com.x()) || !std::isfinite(com.y())) {
+      return invalid("body " + std::to_string(b) + ": mass, centre of mass or moment of inertia overflows");
+    }
+    if (!(inertia > 0.0)) {
       return invalid("body " + std::to_string(b) + ": all vertices coincide (moment of inertia is 0)");
     }
     w.mass_[b] = m;

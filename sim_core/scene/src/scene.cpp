@@ -319,7 +319,9 @@ std::string stem_of(const std::string& path) { return std::filesystem::path(path
 }  // namespace
 
 Result<Scene> parse_scene(std::string_view text, const std::string& path) {
-  const std::string rewritten = rename_repeated_attributes(text);
+  Result<std::string> renamed = rename_repeated_attributes(text);
+  if (!renamed) return Error{path + ":" + renamed.error().message};
+  const std::string& rewritten = renamed.value();
   tinyxml2::XMLDocument doc;
   doc.Parse(rewritten.data(), rewritten.size());
   if (doc.Error()) {

@@ -1,7 +1,8 @@
 #include "xml_dialect.hpp"
 
+#include <algorithm>
 #include <string>
-#include <vector>
+#include <unordered_map>
 
 namespace rbsim {
 
@@ -22,11 +23,12 @@ std::size_t copy_through(std::string_view text, std::size_t pos, std::string_vie
 
 // Rewrites one start tag beginning at text[pos] == '<'. Returns the position after the tag, or
 // npos when it does not scan as a start tag (the caller then copies the rest verbatim).
-std::size_t rewrite_start_tag(std::string_view text, std::size_t pos, std::string& out) {
+std::size_t rewrite_start_tag(std::string_view text, std::size_t pos, std::string& out, std::size_t& too_many) {
   std::size_t i = pos + 1;
   while (i < text.size() && is_name_char(text[i])) ++i;
   std::string tag(text.substr(pos, i - pos));
-  std::vector<std::string> seen;
+  std::unordered_map<std::string, int> seen;  // name -> occurrences so far in this tag
+  std::size_t attributes = 0;
   while (true) {
     const std::size_t ws = i;
     while (i < text.size() && is_space(text[i])) ++i;
@@ -42,10 +44,12 @@ std::size_t rewrite_start_tag(std::string_view text, std::size_t pos, std::strin
     while (i < text.size() && is_name_char(text[i])) ++i;
     if (i == name_begin) return std::string_view::npos;
     std::string name(text.substr(name_begin, i - name_begin));
-    std::size_t repeats = 0;
-    for (const std::string& s : seen) repeats += s == name ? 1 : 0;
-    seen.push_back(name);
-    if (repeats > 0) name += std::string(kDuplicateMark) + std::to_string(repeats + 1);
+    if (++attributes > kMaxAttributes) {
+      too_many = pos;
+      return std::string_view::npos;
+    }
+    const int occurrence = ++seen[name];
+    if (occurrence > 1) name += std::string(kDuplicateMark) + std::to_string(occurrence);
     tag += name;
     // = "value" (whitespace allowed around '=')
     const std::size_t eq_begin = i;
@@ -66,7 +70,7 @@ std::size_t rewrite_start_tag(std::string_view text, std::size_t pos, std::strin
 
 }  // namespace
 
-std::string rename_repeated_attributes(std::string_view text) {
+Result<std::string> rename_repeated_attributes(std::string_view text) {
   std::string out;
   out.reserve(text.size() + text.size() / 8);
   std::size_t pos = 0;
@@ -84,7 +88,13 @@ std::string rename_repeated_attributes(std::string_view text) {
     } else if (rest.starts_with("<!") || rest.starts_with("</")) {
       pos = copy_through(text, lt, ">", out);
     } else {
-      const std::size_t next = rewrite_start_tag(text, lt, out);
+      std::size_t too_many = std::string_view::npos;
+      const std::size_t next = rewrite_start_tag(text, lt, out, too_many);
+      if (too_many != std::string_view::npos) {
+        const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(too_many), '\n');
+        return Error{std::to_string(line) + ": a start tag has more than " + std::to_string(kMaxAttributes) +
+                     " attributes (limit of the scene loader)"};
+      }
       if (next == std::string_view::npos) {
         out.append(text.substr(lt));
         return out;
