@@ -21,10 +21,9 @@ void World::step() {
 
 void World::update_rotations() {
   const std::int32_t n = body_count();
-  for (std::int32_t b = 0; b < n; ++b) {
-    cos_[b] = std::cos(theta_[b]);
-    sin_[b] = std::sin(theta_[b]);
-  }
+  // glibc's sincos gives the same bits as separate sin and cos at about half the cost; GCC does
+  // not fuse the two calls itself while errno semantics are on.
+  for (std::int32_t b = 0; b < n; ++b) ::sincos(theta_[b], &sin_[b], &cos_[b]);
 }
 
 // Near-earth gravity, U_i = -m_i g . r_i: the body feels F = M g at its centre of mass and no

@@ -71,8 +71,8 @@ inline constexpr std::int32_t kFixed = -1;  // spring end fixed in space
 
 struct SpringDef {
   std::int32_t body_i = kFixed;  // body index or kFixed
-  Vec2 anchor_i{0.0, 0.0};       // body space offset from the centre of mass, or world point if fixed
   std::int32_t body_j = kFixed;
+  Vec2 anchor_i{0.0, 0.0};       // body space offset from the centre of mass, or world point if fixed
   Vec2 anchor_j{0.0, 0.0};
   double stiffness = 0.0;        // k
   double rest_length = 0.0;      // l0
