@@ -1,0 +1,137 @@
+// rbsim's ROS 2 messages: the topics a run publishes and records, their ros2msg definitions
+// (tools/msgs/definitions, the one source of truth, embedded at build time), rosbag2-style schema
+// texts, and CDR encoders that turn a world snapshot into message bytes.
+//
+// CDR here is what ROS 2 over DDS puts on the wire: a 4-byte encapsulation header
+// (00 01 00 00 = plain CDR, little endian) followed by XCDR1 data, every primitive aligned to its
+// size relative to the end of that header, strings as uint32 length (with the NUL) + bytes + NUL,
+// sequences as uint32 count + elements.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rbsim/core.hpp"
+#include "rbsim/scene.hpp"
+
+namespace rbsim::msgs {
+
+// ---------------------------------------------------------------------------------------------
+// Topics
+
+enum class TopicId : std::uint8_t { Scene, BodyStates, SpringStates, Energy, Poses, Markers, Clock };
+inline constexpr std::size_t kTopicCount = 7;
+
+struct TopicSpec {
+  TopicId id;
+  std::string_view suffix;   // "body_states": the ROS name is /<namespace>/<suffix>
+  std::string_view type;     // "rbsim_msgs/msg/BodyStates"
+  bool transient_local;      // latched: late subscribers get the last sample
+  bool per_step;             // published every (published) step
+};
+std::span<const TopicSpec> topics();
+const TopicSpec& topic(TopicId id);
+// "/rbsim/body_states" for namespace "rbsim"; "/clock" always lives at the root.
+std::string topic_name(const TopicSpec& spec, std::string_view ns);
+// DDS names per ROS 2 conventions: "rt/rbsim/body_states", "rbsim_msgs::msg::dds_::BodyStates_".
+std::string dds_topic_name(std::string_view ros_topic);
+std::string dds_type_name(std::string_view ros_type);
+// The YAML rosbag2 stores in a channel's "offered_qos_profiles" metadata for this topic.
+std::string offered_qos_yaml(const TopicSpec& spec);
+
+// ---------------------------------------------------------------------------------------------
+// Definitions and schemas
+
+// The .msg text of a type ("rbsim_msgs/msg/BodyStates" or "rbsim_msgs/BodyStates"); empty when
+// unknown.
+std::string_view definition(std::string_view type);
+// Every type name we carry, "pkg/msg/Name", sorted.
+std::vector<std::string_view> definition_types();
+// The schema rosbag2 writes for a type with encoding "ros2msg": its .msg text followed by each
+// dependency, depth first, once, as "\n" + 80 '=' + "\nMSG: pkg/Name\n" + text.
+Result<std::string> ros2msg_schema(std::string_view type);
+
+// ---------------------------------------------------------------------------------------------
+// Encoding a world snapshot
+
+struct Time {
+  std::int32_t sec = 0;
+  std::uint32_t nanosec = 0;
+};
+// Simulated time of the world's current step, t = step * dt, rounded to the nanosecond.
+Time sim_time(const World& world);
+std::uint64_t sim_time_ns(const World& world);
+
+using Bytes = std::vector<std::byte>;
+
+// Encodes the messages of one step into reused buffers: after the first step of a world, no
+// call allocates. The frame id of every header is "world".
+class Encoder {
+ public:
+  explicit Encoder(const Scene& scene);
+
+  void scene(const World& world, Bytes& out) const;  // rbsim_msgs/msg/SceneDescription
+  void body_states(const World& world, Bytes& out) const;
+  void spring_states(const World& world, Bytes& out) const;
+  void energy(const World& world, Bytes& out) const;
+  void poses(const World& world, Bytes& out) const;    // geometry_msgs/msg/PoseArray
+  void markers(const World& world, Bytes& out) const;  // visualization_msgs/msg/MarkerArray
+  void clock(const World& world, Bytes& out) const;    // rosgraph_msgs/msg/Clock
+  void encode(TopicId id, const World& world, Bytes& out) const;
+
+ private:
+  const Scene* scene_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Schema-driven decoding: any CDR message whose ros2msg schema is known (e.g. read from an MCAP
+// file) flattened into scalars in field order. Sequence lengths are scalars too, so two messages
+// of one type compare value by value, and a differing length shows up as the first difference.
+
+struct Scalar {
+  enum class Kind : std::uint8_t { Bool, Int, UInt, Float, String, Length };
+  Kind kind = Kind::Float;
+  double f = 0.0;          // Float (float32 widened)
+  std::int64_t i = 0;      // Bool, Int
+  std::uint64_t u = 0;     // UInt, Length
+  std::string_view s;      // String: points into the decoded buffer
+  bool operator==(const Scalar&) const = default;
+  std::string to_string() const;
+};
+
+class MessageDecoder {
+ public:
+  // `type` names the root ("rbsim_msgs/msg/BodyStates"); `schema` is its ros2msg text with its
+  // dependencies appended rosbag2-style. Fails on unknown or unresolvable field types.
+  static Result<MessageDecoder> create(std::string_view type, std::string_view schema);
+
+  // Appends the scalars of one message to `out` (cleared first). Fails cleanly on truncated or
+  // malformed data: every length is checked against the bytes that remain.
+  [[nodiscard]] Status decode(std::span<const std::byte> cdr, std::vector<Scalar>& out) const;
+  // The field path of scalar `index` of that message, e.g. "bodies[3].x" or "bodies.length".
+  std::string path(std::span<const std::byte> cdr, std::size_t index) const;
+
+  struct Field;
+  struct Type;
+
+ private:
+  std::vector<Type> types_;  // types_[0] is the root
+};
+
+struct MessageDecoder::Field {
+  std::string name;
+  int primitive = -1;       // index into the primitive table, or -1 for a nested type
+  std::size_t nested = 0;   // index into types_ when primitive < 0
+  enum class Array : std::uint8_t { None, Fixed, Sequence } array = Array::None;
+  std::uint32_t fixed_size = 0;
+};
+struct MessageDecoder::Type {
+  std::string name;  // "pkg/msg/Name"
+  std::vector<Field> fields;
+};
+
+}  // namespace rbsim::msgs

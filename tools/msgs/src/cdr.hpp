@@ -1,0 +1,62 @@
+// Little-endian XCDR1 writer behind the 4-byte encapsulation header (CDR_LE = 00 01 00 00).
+#pragma once
+
+#include <bit>
+#include <cstring>
+#include <string_view>
+
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::msgs::detail {
+
+static_assert(std::endian::native == std::endian::little, "the CDR writer copies native little-endian values");
+
+class CdrWriter {
+ public:
+  // Clears `out` (keeping its capacity) and writes the encapsulation header.
+  explicit CdrWriter(Bytes& out) : out_(out) {
+    out_.assign(4, std::byte{0});
+    out_[1] = std::byte{1};
+  }
+  void u8(std::uint8_t v) { put(v); }
+  void boolean(bool v) { put(static_cast<std::uint8_t>(v ? 1 : 0)); }
+  void i32(std::int32_t v) { put(v); }
+  void u32(std::uint32_t v) { put(v); }
+  void u64(std::uint64_t v) { put(v); }
+  void f32(float v) { put(v); }
+  void f64(double v) { put(v); }
+  void string(std::string_view s) {
+    u32(static_cast<std::uint32_t>(s.size() + 1));
+    raw(s.data(), s.size());
+    put(std::uint8_t{0});
+  }
+  void sequence_length(std::size_t n) { u32(static_cast<std::uint32_t>(n)); }
+  void time(const Time& t) {
+    i32(t.sec);
+    u32(t.nanosec);
+  }
+  void header(const Time& stamp, std::string_view frame_id) {
+    time(stamp);
+    string(frame_id);
+  }
+
+ private:
+  template <class T>
+  void put(T v) {
+    // Primitives align to their own size, counted from the end of the encapsulation header.
+    const std::size_t offset = out_.size() - 4;
+    const std::size_t pad = (sizeof(T) - offset % sizeof(T)) % sizeof(T);
+    out_.resize(out_.size() + pad + sizeof(T));
+    std::memset(out_.data() + out_.size() - sizeof(T) - pad, 0, pad);
+    std::memcpy(out_.data() + out_.size() - sizeof(T), &v, sizeof(T));
+  }
+  void raw(const void* p, std::size_t n) {
+    if (n == 0) return;
+    const std::size_t at = out_.size();
+    out_.resize(at + n);
+    std::memcpy(out_.data() + at, p, n);
+  }
+  Bytes& out_;
+};
+
+}  // namespace rbsim::msgs::detail

@@ -1,0 +1,276 @@
+// Parsing ros2msg schemas and decoding CDR by them.
+#include <cstring>
+#include <map>
+#include <sstream>
+
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::msgs {
+
+namespace {
+
+struct Primitive {
+  std::string_view name;
+  std::uint8_t size;  // 0 = string
+  Scalar::Kind kind;
+};
+constexpr Primitive kPrimitives[] = {
+    {"bool", 1, Scalar::Kind::Bool},     {"byte", 1, Scalar::Kind::UInt},     {"char", 1, Scalar::Kind::UInt},
+    {"int8", 1, Scalar::Kind::Int},      {"uint8", 1, Scalar::Kind::UInt},    {"int16", 2, Scalar::Kind::Int},
+    {"uint16", 2, Scalar::Kind::UInt},   {"int32", 4, Scalar::Kind::Int},     {"uint32", 4, Scalar::Kind::UInt},
+    {"int64", 8, Scalar::Kind::Int},     {"uint64", 8, Scalar::Kind::UInt},   {"float32", 4, Scalar::Kind::Float},
+    {"float64", 8, Scalar::Kind::Float}, {"string", 0, Scalar::Kind::String},
+};
+
+int primitive_index(std::string_view t) {
+  if (t.starts_with("string<=")) t = "string";
+  for (std::size_t i = 0; i < std::size(kPrimitives); ++i) {
+    if (kPrimitives[i].name == t) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::string canonical(std::string_view type, std::string_view package) {
+  if (type == "Header") return "std_msgs/msg/Header";
+  const auto slash = type.find('/');
+  if (slash == std::string_view::npos) return std::string(package) + "/msg/" + std::string(type);
+  if (type.find('/', slash + 1) != std::string_view::npos) return std::string(type);
+  return std::string(type.substr(0, slash)) + "/msg/" + std::string(type.substr(slash + 1));
+}
+
+// Walks one message; `Visit` is called with each scalar. Returns false on malformed data.
+class Walker {
+ public:
+  Walker(const std::vector<MessageDecoder::Type>& types, std::span<const std::byte> cdr) : types_(types), cdr_(cdr) {}
+  std::string error;
+
+  template <class Visit>
+  bool message(Visit&& visit) {
+    if (cdr_.size() < 4) return fail("shorter than the 4-byte encapsulation header");
+    if (cdr_[0] != std::byte{0} || cdr_[1] != std::byte{1}) {
+      return fail("unsupported CDR encapsulation (only plain little-endian CDR, 00 01, is read)");
+    }
+    pos_ = 4;
+    return type(0, visit);
+  }
+
+ private:
+  template <class Visit>
+  bool type(std::size_t t, Visit& visit) {
+    if (++depth_ > 64) return fail("types nest deeper than 64");
+    for (const MessageDecoder::Field& f : types_[t].fields) {
+      visit.enter(f.name);
+      std::uint64_t count = 1;
+      if (f.array == MessageDecoder::Field::Array::Sequence) {
+        std::uint32_t n = 0;
+        if (!read(4, &n)) return false;
+        if (n > cdr_.size() - pos_) return fail("sequence length " + std::to_string(n) + " exceeds the data");
+        Scalar len;
+        len.kind = Scalar::Kind::Length;
+        len.u = n;
+        visit.scalar(len, true);
+        count = n;
+      } else if (f.array == MessageDecoder::Field::Array::Fixed) {
+        count = f.fixed_size;
+      }
+      for (std::uint64_t k = 0; k < count; ++k) {
+        if (f.array != MessageDecoder::Field::Array::None) visit.index(k);
+        if (f.primitive >= 0 ? !primitive(kPrimitives[f.primitive], visit) : !type(f.nested, visit)) return false;
+        if (f.array != MessageDecoder::Field::Array::None) visit.unindex();
+      }
+      visit.leave();
+    }
+    --depth_;
+    return true;
+  }
+  template <class Visit>
+  bool primitive(const Primitive& p, Visit& visit) {
+    Scalar s;
+    s.kind = p.kind;
+    if (p.size == 0) {
+      std::uint32_t n = 0;
+      if (!read(4, &n)) return false;
+      if (n == 0 || n > cdr_.size() - pos_) return fail("string length " + std::to_string(n) + " invalid");
+      s.s = std::string_view(reinterpret_cast<const char*>(cdr_.data() + pos_), n - 1);
+      pos_ += n;
+    } else {
+      std::uint8_t raw[8] = {};
+      if (!read(p.size, raw)) return false;
+      switch (p.kind) {
+        case Scalar::Kind::Float:
+          if (p.size == 4) {
+            float v;
+            std::memcpy(&v, raw, 4);
+            s.f = v;
+          } else {
+            std::memcpy(&s.f, raw, 8);
+          }
+          break;
+        case Scalar::Kind::Int: {
+          std::uint64_t u = 0;
+          std::memcpy(&u, raw, p.size);
+          const unsigned shift = 64u - 8u * p.size;  // sign-extend
+          s.i = static_cast<std::int64_t>(u << shift) >> shift;
+          break;
+        }
+        case Scalar::Kind::Bool: s.i = raw[0] != 0; break;
+        default: std::memcpy(&s.u, raw, p.size); break;
+      }
+    }
+    visit.scalar(s, false);
+    return true;
+  }
+  bool read(std::size_t size, void* out) {
+    const std::size_t offset = pos_ - 4;
+    const std::size_t pad = (size - offset % size) % size;
+    if (pad + size > cdr_.size() - pos_) return fail("truncated at byte " + std::to_string(pos_));
+    pos_ += pad;
+    std::memcpy(out, cdr_.data() + pos_, size);
+    pos_ += size;
+    return true;
+  }
+  bool fail(std::string why) {
+    error = std::move(why);
+    return false;
+  }
+  const std::vector<MessageDecoder::Type>& types_;
+  std::span<const std::byte> cdr_;
+  std::size_t pos_ = 0;
+  int depth_ = 0;
+};
+
+struct Collect {
+  std::vector<Scalar>* out;
+  void enter(const std::string&) {}
+  void leave() {}
+  void index(std::uint64_t) {}
+  void unindex() {}
+  void scalar(const Scalar& s, bool) { out->push_back(s); }
+};
+
+// Builds the path of scalar number `target` while walking.
+struct PathOf {
+  std::size_t target;
+  std::size_t seen = 0;
+  std::vector<std::string> parts;
+  std::string found;
+  void enter(const std::string& name) { parts.push_back((parts.empty() ? "" : ".") + name); }
+  void leave() { parts.pop_back(); }
+  void index(std::uint64_t k) { parts.push_back("[" + std::to_string(k) + "]"); }
+  void unindex() { parts.pop_back(); }
+  void scalar(const Scalar&, bool is_length) {
+    if (seen++ != target || !found.empty()) return;
+    for (const std::string& p : parts) found += p;
+    if (is_length) found += ".length";
+  }
+};
+
+}  // namespace
+
+std::string Scalar::to_string() const {
+  switch (kind) {
+    case Kind::Bool: return i ? "true" : "false";
+    case Kind::Int: return std::to_string(i);
+    case Kind::UInt:
+    case Kind::Length: return std::to_string(u);
+    case Kind::String: return "\"" + std::string(s) + "\"";
+    case Kind::Float: {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.17g", f);
+      return buf;
+    }
+  }
+  return "?";
+}
+
+Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string_view schema) {
+  // Split "text\n====...\nMSG: pkg/Name\ntext..." into named sections.
+  std::map<std::string, std::string> sections;
+  const std::string root_name = canonical(root, "");
+  std::string current = root_name, body;
+  std::istringstream lines{std::string(schema)};
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.size() >= 3 && line.find_first_not_of('=') == std::string::npos) {
+      sections[current] = std::move(body);
+      body.clear();
+      current.clear();
+      continue;
+    }
+    if (current.empty() && line.starts_with("MSG: ")) {
+      current = canonical(line.substr(5), "");
+      continue;
+    }
+    body += line + "\n";
+  }
+  if (!current.empty()) sections[current] = std::move(body);
+
+  MessageDecoder d;
+  std::map<std::string, std::size_t> index;
+  std::vector<std::string> pending{root_name};
+  index[root_name] = 0;
+  d.types_.push_back(Type{root_name, {}});
+  for (std::size_t t = 0; t < d.types_.size(); ++t) {
+    const std::string name = d.types_[t].name;
+    const auto it = sections.find(name);
+    if (it == sections.end()) return Error{"schema has no definition for " + name};
+    const std::string package = name.substr(0, name.find('/'));
+    std::istringstream def(it->second);
+    std::string text;
+    while (std::getline(def, text)) {
+      if (const auto hash = text.find('#'); hash != std::string::npos) text.resize(hash);
+      std::istringstream words(text);
+      std::string type, field;
+      if (!(words >> type)) continue;
+      if (!(words >> field)) return Error{name + ": field without a name: " + type};
+      if (field.find('=') != std::string::npos) continue;  // constant
+      std::string rest;
+      if (words >> rest && rest.starts_with('=')) continue;  // "int32 X = 3"
+      Field f;
+      f.name = field;
+      if (const auto bracket = type.find('['); bracket != std::string::npos) {
+        const std::string inside = type.substr(bracket + 1, type.size() - bracket - 2);
+        type.resize(bracket);
+        if (inside.empty() || inside.starts_with("<=")) {
+          f.array = Field::Array::Sequence;
+        } else {
+          f.array = Field::Array::Fixed;
+          try {
+            f.fixed_size = static_cast<std::uint32_t>(std::stoul(inside));
+          } catch (...) {
+            return Error{name + ": bad array size in " + text};
+          }
+        }
+      }
+      f.primitive = primitive_index(type);
+      if (type == "wstring") return Error{name + ": wstring fields are not supported"};
+      if (f.primitive < 0) {
+        const std::string nested = canonical(type, package);
+        auto [pos, fresh] = index.try_emplace(nested, d.types_.size());
+        if (fresh) d.types_.push_back(Type{nested, {}});
+        f.nested = pos->second;
+      }
+      d.types_[t].fields.push_back(std::move(f));
+    }
+    // rosidl gives a message without fields one uint8 member, so every element has a size.
+    if (d.types_[t].fields.empty()) d.types_[t].fields.push_back(Field{"structure_needs_at_least_one_member", 4});
+  }
+  return d;
+}
+
+Status MessageDecoder::decode(std::span<const std::byte> cdr, std::vector<Scalar>& out) const {
+  out.clear();
+  Walker w(types_, cdr);
+  Collect c{&out};
+  if (!w.message(c)) return Error{"CDR: " + w.error};
+  return Ok{};
+}
+
+std::string MessageDecoder::path(std::span<const std::byte> cdr, std::size_t index) const {
+  Walker w(types_, cdr);
+  PathOf p{index, 0, {}, {}};
+  w.message(p);
+  return p.found.empty() ? "[" + std::to_string(index) + "]" : p.found;
+}
+
+}  // namespace rbsim::msgs

@@ -1,0 +1,129 @@
+// Topics, names and rosbag2-style ros2msg schemas.
+#include <algorithm>
+#include <functional>
+#include <set>
+#include <sstream>
+
+#include "definitions.hpp"
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::msgs {
+
+namespace {
+constexpr TopicSpec kTopics[kTopicCount] = {
+    {TopicId::Scene, "scene", "rbsim_msgs/msg/SceneDescription", true, false},
+    {TopicId::BodyStates, "body_states", "rbsim_msgs/msg/BodyStates", false, true},
+    {TopicId::SpringStates, "spring_states", "rbsim_msgs/msg/SpringStates", false, true},
+    {TopicId::Energy, "energy", "rbsim_msgs/msg/EnergyTerms", false, true},
+    {TopicId::Poses, "poses", "geometry_msgs/msg/PoseArray", false, true},
+    {TopicId::Markers, "markers", "visualization_msgs/msg/MarkerArray", false, true},
+    {TopicId::Clock, "clock", "rosgraph_msgs/msg/Clock", false, true},
+};
+
+// "pkg/Name" or "pkg/msg/Name" -> "pkg/msg/Name"
+std::string canonical(std::string_view type) {
+  const auto slash = type.find('/');
+  if (slash == std::string_view::npos) return std::string(type);
+  if (type.find('/', slash + 1) != std::string_view::npos) return std::string(type);
+  return std::string(type.substr(0, slash)) + "/msg/" + std::string(type.substr(slash + 1));
+}
+
+bool is_primitive(std::string_view t) {
+  static constexpr std::string_view kPrimitives[] = {"bool",   "byte",   "char",  "float32", "float64",
+                                                     "int8",   "uint8",  "int16", "uint16",  "int32",
+                                                     "uint32", "int64",  "uint64", "string", "wstring"};
+  if (t.starts_with("string<=") || t.starts_with("wstring<=")) return true;
+  return std::find(std::begin(kPrimitives), std::end(kPrimitives), t) != std::end(kPrimitives);
+}
+
+// Non-primitive field types of a .msg text, as rosbag2 names them: as written when they carry a
+// package, else prefixed with the package of the text. Sorted, unique (rosbag2 uses std::set).
+std::set<std::string> dependencies(std::string_view text, std::string_view package) {
+  std::set<std::string> deps;
+  std::istringstream lines{std::string(text)};
+  std::string line;
+  while (std::getline(lines, line)) {
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const auto end = line.find_first_of(" \t", first);
+    std::string type = line.substr(first, end == std::string::npos ? std::string::npos : end - first);
+    if (const auto bracket = type.find('['); bracket != std::string::npos) type.resize(bracket);
+    if (type.empty() || is_primitive(type)) continue;
+    deps.insert(type.find('/') == std::string::npos ? std::string(package) + "/" + type : type);
+  }
+  return deps;
+}
+}  // namespace
+
+std::span<const TopicSpec> topics() { return kTopics; }
+const TopicSpec& topic(TopicId id) { return kTopics[static_cast<std::size_t>(id)]; }
+
+std::string topic_name(const TopicSpec& spec, std::string_view ns) {
+  if (spec.id == TopicId::Clock || ns.empty()) return "/" + std::string(spec.suffix);
+  std::string name = "/" + std::string(ns);
+  while (name.size() > 1 && name.back() == '/') name.pop_back();
+  if (name.size() > 1 && name[1] == '/') name.erase(0, 1);
+  return name + "/" + std::string(spec.suffix);
+}
+
+std::string dds_topic_name(std::string_view ros_topic) {
+  return "rt" + std::string(ros_topic.starts_with('/') ? "" : "/") + std::string(ros_topic);
+}
+
+std::string dds_type_name(std::string_view ros_type) {
+  const std::string full = canonical(ros_type);
+  const auto a = full.find('/'), b = full.rfind('/');
+  return full.substr(0, a) + "::" + full.substr(a + 1, b - a - 1) + "::dds_::" + full.substr(b + 1) + "_";
+}
+
+std::string offered_qos_yaml(const TopicSpec& spec) {
+  // rosbag2's encoding (yaml-cpp dump of a one-element sequence, format version >= 9);
+  // "infinite" durations are RMW_DURATION_INFINITE = {9223372036 s, 854775807 ns}.
+  const char* infinite = "\n    sec: 9223372036\n    nsec: 854775807";
+  std::string y = "- history: keep_last\n  depth: ";
+  y += spec.transient_local ? "1" : "100";
+  y += "\n  reliability: reliable\n  durability: ";
+  y += spec.transient_local ? "transient_local" : "volatile";
+  y += std::string("\n  deadline:") + infinite + "\n  lifespan:" + infinite + "\n  liveliness: automatic" +
+       "\n  liveliness_lease_duration:" + infinite + "\n  avoid_ros_namespace_conventions: false";
+  return y;
+}
+
+std::string_view definition(std::string_view type) {
+  const std::string key = canonical(type);
+  for (const detail::Definition& d : detail::definitions()) {
+    if (d.type == key) return d.text;
+  }
+  return {};
+}
+
+std::vector<std::string_view> definition_types() {
+  std::vector<std::string_view> out;
+  for (const detail::Definition& d : detail::definitions()) out.push_back(d.type);
+  return out;
+}
+
+Result<std::string> ros2msg_schema(std::string_view root) {
+  std::set<std::string> seen;
+  std::string missing;
+  std::function<std::string(std::string_view, int)> expand = [&](std::string_view type, int depth) {
+    const std::string_view text = definition(type);
+    if (text.empty() || depth > 50) {
+      missing = std::string(type);
+      return std::string();
+    }
+    std::string out(text);
+    const std::string package = canonical(type).substr(0, canonical(type).find('/'));
+    for (const std::string& dep : dependencies(text, package)) {
+      if (!seen.insert(dep).second) continue;
+      out += "\n" + std::string(80, '=') + "\nMSG: " + dep + "\n";
+      out += expand(dep, depth + 1);
+    }
+    return out;
+  };
+  std::string schema = expand(root, 0);
+  if (!missing.empty()) return Error{"no message definition for " + missing};
+  return schema;
+}
+
+}  // namespace rbsim::msgs
