@@ -1,0 +1,278 @@
+// Writer round trips through both readers, determinism, and crash-consistency of chunks.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <tuple>
+
+#include "record_json.hpp"
+
+namespace rbsim::mcap::test {
+namespace {
+
+struct Sample {
+  std::uint16_t channel = 0;
+  std::uint32_t sequence = 0;
+  Timestamp log_time = 0;
+  Bytes data;
+};
+
+// Three topics, log times deliberately out of order with ties, payloads of varying size.
+std::vector<Sample> samples() {
+  std::vector<Sample> out;
+  for (std::uint32_t i = 0; i < 300; ++i) {
+    Sample s;
+    s.channel = static_cast<std::uint16_t>(1 + i % 3);
+    s.sequence = i;
+    s.log_time = 1000 + (i * 7919) % 500;  // repeats: equal times must keep file order
+    s.data.resize(1 + (i * 37) % 97);
+    for (std::size_t k = 0; k < s.data.size(); ++k) s.data[k] = static_cast<std::uint8_t>(i + k);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+Bytes write_sample_file(const WriterOptions& options, const std::vector<Sample>& input) {
+  Writer w;
+  EXPECT_TRUE(w.open_buffer(options).ok());
+  const Bytes schema_data = {'i', 'n', 't'};
+  const std::uint16_t schema = w.add_schema("Pose", "ros2msg", schema_data).value();
+  EXPECT_EQ(w.add_channel(schema, "/pose", "cdr", {{"qos", "reliable"}}).value(), 1);
+  EXPECT_EQ(w.add_channel(schema, "/twist", "cdr").value(), 2);
+  EXPECT_EQ(w.add_channel(0, "/log", "json").value(), 3);
+  EXPECT_TRUE(w.add_metadata("robot", {{"name", "rb1"}, {"rev", "3"}}).ok());
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    const Sample& s = input[i];
+    EXPECT_TRUE(w.write_message(s.channel, s.sequence, s.log_time, s.log_time + 1, s.data).ok());
+    if (i == input.size() / 2) {
+      const Bytes blob = {1, 2, 3, 4};
+      EXPECT_TRUE(w.add_attachment(5, 6, "calib.bin", "application/octet-stream", blob).ok());
+    }
+  }
+  EXPECT_TRUE(w.close().ok());
+  return w.buffer();
+}
+
+using Params = std::tuple<Compression, bool /*chunks*/, bool /*indexes*/>;
+class WriterRoundTrip : public ::testing::TestWithParam<Params> {
+ protected:
+  WriterOptions options() const {
+    WriterOptions o;
+    o.compression = std::get<0>(GetParam());
+    o.use_chunks = std::get<1>(GetParam());
+    const bool idx = std::get<2>(GetParam());
+    o.emit_message_indexes = o.emit_chunk_indexes = o.emit_attachment_indexes = o.emit_metadata_indexes = idx;
+    o.emit_statistics = o.emit_summary_offsets = o.repeat_schemas = o.repeat_channels = idx;
+    o.chunk_size = 2048;  // several chunks
+    return o;
+  }
+};
+
+TEST_P(WriterRoundTrip, BothReadersReturnEveryMessage) {
+  const auto input = samples();
+  const Bytes file = write_sample_file(options(), input);
+  EXPECT_EQ(file, write_sample_file(options(), input)) << "writer must be deterministic";
+
+  // Streamed: file order, all CRCs verified.
+  StreamReader stream;
+  ASSERT_TRUE(stream.open_buffer(file).ok());
+  std::vector<Message> streamed;
+  int attachments = 0, metadata = 0;
+  RecordEntry e;
+  while (stream.next(e)) {
+    if (auto* m = std::get_if<Message>(&e.record)) streamed.push_back(*m);
+    attachments += std::holds_alternative<Attachment>(e.record);
+    metadata += std::holds_alternative<Metadata>(e.record);
+  }
+  ASSERT_TRUE(stream.status().ok()) << stream.status().message;
+  ASSERT_EQ(streamed.size(), input.size());
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    EXPECT_EQ(streamed[i].channel_id, input[i].channel);
+    EXPECT_EQ(streamed[i].sequence, input[i].sequence);
+    EXPECT_EQ(streamed[i].log_time, input[i].log_time);
+    EXPECT_EQ(streamed[i].publish_time, input[i].log_time + 1);
+    EXPECT_EQ(streamed[i].data, input[i].data);
+  }
+  EXPECT_EQ(attachments, 1);
+  EXPECT_EQ(metadata, 1);
+
+  // Indexed: same messages, stably sorted by log time.
+  IndexedReader indexed;
+  ASSERT_TRUE(indexed.open_buffer(file).ok());
+  EXPECT_EQ(indexed.indexed(), options().use_chunks && options().emit_chunk_indexes);
+  EXPECT_TRUE(indexed.verify_data_section_crc().ok());
+  auto all = indexed.read_all_messages();
+  ASSERT_TRUE(all.ok()) << all.status().message;
+  std::vector<Message> expected = streamed;
+  std::stable_sort(expected.begin(), expected.end(),
+                   [](const Message& a, const Message& b) { return a.log_time < b.log_time; });
+  ASSERT_EQ(all->size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ((*all)[i].sequence, expected[i].sequence) << i;
+    EXPECT_EQ((*all)[i].data, expected[i].data) << i;
+  }
+  ASSERT_EQ(indexed.channels().size(), 3u);
+  EXPECT_EQ(indexed.channels().at(1).metadata.at("qos"), "reliable");
+  EXPECT_EQ(indexed.schemas().at(1).name, "Pose");
+
+  if (std::get<2>(GetParam())) {
+    ASSERT_TRUE(indexed.statistics().has_value());
+    const Statistics& st = *indexed.statistics();
+    EXPECT_EQ(st.message_count, input.size());
+    EXPECT_EQ(st.channel_count, 3u);
+    EXPECT_EQ(st.schema_count, 1u);
+    EXPECT_EQ(st.attachment_count, 1u);
+    EXPECT_EQ(st.metadata_count, 1u);
+    EXPECT_EQ(st.message_start_time, expected.front().log_time);
+    EXPECT_EQ(st.message_end_time, expected.back().log_time);
+    EXPECT_EQ(st.channel_message_counts.at(2), 100u);
+    EXPECT_EQ(st.chunk_count, options().use_chunks ? indexed.chunk_indexes().size() : 0u);
+    ASSERT_EQ(indexed.attachment_indexes().size(), 1u);
+    auto att = indexed.read_attachment(indexed.attachment_indexes()[0]);
+    ASSERT_TRUE(att.ok()) << att.status().message;
+    EXPECT_EQ(att->data, (Bytes{1, 2, 3, 4}));
+    EXPECT_NE(att->crc, 0u);
+    ASSERT_EQ(indexed.metadata_indexes().size(), 1u);
+    auto md = indexed.read_metadata(indexed.metadata_indexes()[0]);
+    ASSERT_TRUE(md.ok());
+    EXPECT_EQ(md->metadata.at("rev"), "3");
+    EXPECT_FALSE(indexed.summary_offsets().empty());
+  }
+}
+
+TEST_P(WriterRoundTrip, TopicAndTimeFilters) {
+  const auto input = samples();
+  IndexedReader indexed;
+  ASSERT_TRUE(indexed.open_buffer(write_sample_file(options(), input)).ok());
+  ReadMessagesOptions q;
+  q.topics = {"/twist", "/log"};
+  q.start_time = 1100;
+  q.end_time = 1200;
+  std::vector<std::uint32_t> got;
+  ASSERT_TRUE(indexed
+                  .read_messages(q,
+                                 [&](const MessageEntry& e) {
+                                   EXPECT_NE(e.channel, nullptr);
+                                   EXPECT_EQ(e.schema == nullptr, e.message.channel_id == 3);
+                                   got.push_back(e.message.sequence);
+                                   return true;
+                                 })
+                  .ok());
+  std::vector<const Sample*> want;
+  for (const Sample& s : input) {
+    if (s.channel != 1 && s.log_time >= 1100 && s.log_time < 1200) want.push_back(&s);
+  }
+  std::stable_sort(want.begin(), want.end(), [](auto* a, auto* b) { return a->log_time < b->log_time; });
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(got[i], want[i]->sequence);
+
+  std::size_t n = 0;  // returning false stops early
+  ASSERT_TRUE(indexed.read_messages({}, [&](const MessageEntry&) { return ++n < 5; }).ok());
+  EXPECT_EQ(n, 5u);
+}
+
+std::string param_name(const ::testing::TestParamInfo<Params>& info) {
+  const char* c[] = {"None", "Lz4", "Zstd"};
+  return std::string(c[static_cast<int>(std::get<0>(info.param))]) +
+         (std::get<1>(info.param) ? "_Chunked" : "_Unchunked") +
+         (std::get<2>(info.param) ? "_Indexed" : "_NoIndex");
+}
+
+INSTANTIATE_TEST_SUITE_P(All, WriterRoundTrip,
+                         ::testing::Combine(::testing::Values(Compression::None, Compression::Lz4,
+                                                              Compression::Zstd),
+                                            ::testing::Bool(), ::testing::Bool()),
+                         param_name);
+
+TEST(Writer, FileOutputMatchesBufferAndFlushesChunks) {
+  const std::string path = (std::filesystem::temp_directory_path() / "rbsim_mcap_writer_test.mcap").string();
+  WriterOptions o;
+  o.chunk_size = 1024;
+  const auto input = samples();
+  Writer w;
+  ASSERT_TRUE(w.open(path, o).ok());
+  const std::uint16_t ch = w.add_channel(0, "/t", "raw").value();
+  for (const Sample& s : input)
+    ASSERT_TRUE(w.write_message(ch, s.sequence, s.log_time, s.log_time, s.data).ok());
+
+  // Before close: the file holds every completed chunk, as after a killed process.
+  const Bytes partial = read_file(path);
+  StreamReader crashed;
+  ASSERT_TRUE(crashed.open_buffer(partial).ok());
+  std::size_t recovered = 0;
+  RecordEntry e;
+  while (crashed.next(e)) recovered += std::holds_alternative<Message>(e.record);
+  EXPECT_EQ(crashed.status().code, StatusCode::Truncated);
+  EXPECT_GT(recovered, input.size() / 2);
+  EXPECT_LT(recovered, input.size());
+
+  ASSERT_TRUE(w.close().ok());
+  Writer mem;
+  ASSERT_TRUE(mem.open_buffer(o).ok());
+  ASSERT_EQ(mem.add_channel(0, "/t", "raw").value(), ch);
+  for (const Sample& s : input)
+    ASSERT_TRUE(mem.write_message(ch, s.sequence, s.log_time, s.log_time, s.data).ok());
+  ASSERT_TRUE(mem.close().ok());
+  EXPECT_EQ(read_file(path), mem.buffer());
+  std::remove(path.c_str());
+}
+
+TEST(Writer, RejectsBadUse) {
+  Writer w;
+  EXPECT_EQ(w.write_message(1, 0, 0, 0, {}).code, StatusCode::NotOpen);
+  EXPECT_EQ(w.close().code, StatusCode::NotOpen);
+  ASSERT_TRUE(w.open_buffer().ok());
+  EXPECT_EQ(w.open_buffer().code, StatusCode::InvalidArgument);
+  EXPECT_EQ(w.add_channel(7, "/t", "raw").status().code, StatusCode::InvalidArgument);
+  EXPECT_EQ(w.write_message(1, 0, 0, 0, {}).code, StatusCode::InvalidArgument);
+  ASSERT_TRUE(w.close().ok());
+  EXPECT_EQ(w.open("/nonexistent-dir/x.mcap").code, StatusCode::IoError);
+}
+
+// Copying records with their own ids (what a recover tool does) keeps the ids.
+TEST(Writer, KeepsExplicitIds) {
+  Writer w;
+  ASSERT_TRUE(w.open_buffer().ok());
+  const Schema schema{7, "S", "jsonschema", {'{', '}'}};
+  const Channel channel{42, 7, "/x", "json", {{"a", "b"}}};
+  ASSERT_TRUE(w.add_schema(schema).ok());
+  ASSERT_TRUE(w.add_schema(schema).ok());  // identical: no-op
+  EXPECT_EQ(w.add_schema(Schema{7, "T", "", {}}).code, StatusCode::InvalidArgument);
+  EXPECT_EQ(w.add_schema(Schema{0, "S", "", {}}).code, StatusCode::InvalidArgument);
+  ASSERT_TRUE(w.add_channel(channel).ok());
+  EXPECT_EQ(w.add_channel(Channel{43, 9, "/y", "json", {}}).code, StatusCode::InvalidArgument);
+  EXPECT_EQ(w.add_channel(0, "/next", "raw").value(), 43);
+  ASSERT_TRUE(w.write_message(Message{42, 1, 10, 11, {5}}).ok());
+  ASSERT_TRUE(w.close().ok());
+  IndexedReader r;
+  ASSERT_TRUE(r.open_buffer(w.buffer()).ok());
+  EXPECT_EQ(r.schemas().at(7).name, "S");
+  EXPECT_EQ(r.channels().at(42).topic, "/x");
+  auto messages = r.read_all_messages();
+  ASSERT_TRUE(messages.ok());
+  ASSERT_EQ(messages->size(), 1u);
+  EXPECT_EQ((*messages)[0].channel_id, 42);
+  EXPECT_EQ((*messages)[0].publish_time, 11u);
+}
+
+TEST(Writer, EmptyFileIsValid) {
+  Writer w;
+  ASSERT_TRUE(w.open_buffer().ok());
+  ASSERT_TRUE(w.close().ok());
+  IndexedReader r;
+  ASSERT_TRUE(r.open_buffer(w.buffer()).ok());
+  EXPECT_EQ(r.header().library, "rbsim-mcap");
+  ASSERT_TRUE(r.statistics().has_value());
+  EXPECT_EQ(r.statistics()->message_count, 0u);
+}
+
+TEST(Crc32, MatchesZlib) {
+  const std::string s = "123456789";
+  const ByteView v(reinterpret_cast<const std::uint8_t*>(s.data()), s.size());
+  EXPECT_EQ(crc32(v), 0xCBF43926u);
+  EXPECT_EQ(crc32(v.subspan(4), crc32(v.first(4))), 0xCBF43926u);
+  EXPECT_EQ(crc32({}), 0u);
+}
+
+}  // namespace
+}  // namespace rbsim::mcap::test

@@ -1,0 +1,189 @@
+#include "codec.hpp"
+
+#include <lz4frame.h>
+#include <zstd.h>
+
+#include <algorithm>
+
+namespace rbsim::mcap {
+namespace detail {
+
+struct Compressor::Impl {
+  Compression compression = Compression::None;
+  int level = 0;
+  ZSTD_CCtx* zstd = nullptr;  // reused across chunks: creating one costs more than a small chunk
+};
+
+Compressor::Compressor(Compression compression, int level) : impl_(std::make_unique<Impl>()) {
+  impl_->compression = compression;
+  impl_->level = level;
+  if (compression == Compression::Zstd) impl_->zstd = ZSTD_createCCtx();
+}
+
+Compressor::~Compressor() {
+  ZSTD_freeCCtx(impl_->zstd);
+}
+
+Status Compressor::compress(ByteView in, Bytes& out) {
+  switch (impl_->compression) {
+    case Compression::None:
+      out.assign(in.begin(), in.end());
+      return Status::Ok();
+    case Compression::Zstd: {
+      if (impl_->zstd == nullptr) return Status::Error(StatusCode::IoError, "out of memory for zstd context");
+      out.resize(ZSTD_compressBound(in.size()));
+      const std::size_t n =
+          ZSTD_compressCCtx(impl_->zstd, out.data(), out.size(), in.data(), in.size(), impl_->level);
+      if (ZSTD_isError(n)) {
+        return Status::Error(StatusCode::IoError, std::string("zstd: ") + ZSTD_getErrorName(n));
+      }
+      out.resize(n);
+      return Status::Ok();
+    }
+    case Compression::Lz4: {
+      LZ4F_preferences_t prefs{};
+      prefs.compressionLevel = impl_->level;
+      out.resize(LZ4F_compressFrameBound(in.size(), &prefs));
+      const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), in.data(), in.size(), &prefs);
+      if (LZ4F_isError(n)) {
+        return Status::Error(StatusCode::IoError, std::string("lz4: ") + LZ4F_getErrorName(n));
+      }
+      out.resize(n);
+      return Status::Ok();
+    }
+  }
+  return Status::Error(StatusCode::UnsupportedCompression, "unknown compression");
+}
+
+Result<Compression> compression_from_name(std::string_view name) {
+  if (name.empty()) return Compression::None;
+  if (name == "lz4") return Compression::Lz4;
+  if (name == "zstd") return Compression::Zstd;
+  return Status::Error(StatusCode::UnsupportedCompression,
+                       "unsupported chunk compression '" + std::string(name) + "'");
+}
+
+}  // namespace detail
+
+namespace {
+
+Status decompress_error(std::string_view codec, const char* what) {
+  return Status::Error(StatusCode::DecompressionFailed, std::string(codec) + ": " + what);
+}
+
+// Output grows with what the decoder really produces (never to a declared size up front), and
+// stops one byte past `expected`: a corrupt uncompressed_size cannot trigger a huge allocation.
+class GrowingOutput {
+ public:
+  GrowingOutput(Bytes& out, std::uint64_t expected, std::size_t input_size) : out_(out) {
+    limit_ = expected < SIZE_MAX ? expected + 1 : expected;
+    out_.resize(static_cast<std::size_t>(
+        std::min<std::uint64_t>(limit_, std::max<std::size_t>(input_size * 4, 4096))));
+  }
+  // Makes room for more output; false once the output already exceeds `expected`.
+  bool grow_if_full() {
+    if (produced < out_.size()) return true;
+    if (out_.size() >= limit_) return false;
+    out_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(limit_, out_.size() * 2)));
+    return true;
+  }
+  std::uint8_t* data() { return out_.data() + produced; }
+  std::size_t room() const { return out_.size() - produced; }
+  void finish() { out_.resize(produced); }
+
+  std::size_t produced = 0;
+
+ private:
+  Bytes& out_;
+  std::uint64_t limit_ = 0;
+};
+
+Status zstd_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
+  std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> ctx(ZSTD_createDCtx(), &ZSTD_freeDCtx);
+  if (!ctx) return decompress_error("zstd", "cannot allocate context");
+  GrowingOutput o(out, expected, in.size());
+  ZSTD_inBuffer ib{in.data(), in.size(), 0};
+  std::size_t hint = 1;
+  while (ib.pos < ib.size || hint != 0) {
+    if (!o.grow_if_full()) break;  // more output than declared: reported by the size check
+    ZSTD_outBuffer ob{o.data(), o.room(), 0};
+    const std::size_t before_in = ib.pos;
+    hint = ZSTD_decompressStream(ctx.get(), &ob, &ib);
+    if (ZSTD_isError(hint)) return decompress_error("zstd", ZSTD_getErrorName(hint));
+    o.produced += ob.pos;
+    if (hint != 0 && ob.pos == 0 && ib.pos == before_in) return decompress_error("zstd", "truncated frame");
+  }
+  o.finish();
+  return Status::Ok();
+}
+
+Status lz4_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
+  LZ4F_dctx* raw = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
+    return decompress_error("lz4", "cannot allocate context");
+  }
+  std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> ctx(raw,
+                                                                           &LZ4F_freeDecompressionContext);
+  GrowingOutput o(out, expected, in.size());
+  std::size_t consumed = 0;
+  std::size_t hint = 1;
+  while (consumed < in.size() || hint != 0) {
+    if (!o.grow_if_full()) break;
+    std::size_t dst = o.room();
+    std::size_t src = in.size() - consumed;
+    hint = LZ4F_decompress(ctx.get(), o.data(), &dst, in.data() + consumed, &src, nullptr);
+    if (LZ4F_isError(hint)) return decompress_error("lz4", LZ4F_getErrorName(hint));
+    o.produced += dst;
+    consumed += src;
+    if (hint != 0 && dst == 0 && src == 0) return decompress_error("lz4", "truncated frame");
+  }
+  o.finish();
+  return Status::Ok();
+}
+
+}  // namespace
+
+std::string_view compression_name(Compression compression) {
+  switch (compression) {
+    case Compression::Lz4:
+      return "lz4";
+    case Compression::Zstd:
+      return "zstd";
+    case Compression::None:
+      break;
+  }
+  return "";
+}
+
+Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
+  auto compression = detail::compression_from_name(chunk.compression);
+  if (!compression.ok()) return compression.status();
+  Status status;
+  switch (*compression) {
+    case Compression::None:
+      out = chunk.records;
+      break;
+    case Compression::Zstd:
+      status = zstd_decompress(chunk.records, chunk.uncompressed_size, out);
+      break;
+    case Compression::Lz4:
+      status = lz4_decompress(chunk.records, chunk.uncompressed_size, out);
+      break;
+  }
+  if (!status.ok()) return status;
+  if (out.size() != chunk.uncompressed_size) {
+    return Status::Error(StatusCode::Malformed, "chunk decompresses to " + std::to_string(out.size()) +
+                                                    " bytes, header says " +
+                                                    std::to_string(chunk.uncompressed_size));
+  }
+  if (verify_crc && chunk.uncompressed_crc != 0) {
+    const std::uint32_t crc = crc32(out);
+    if (crc != chunk.uncompressed_crc) {
+      return Status::Error(StatusCode::CrcMismatch, "chunk CRC mismatch: computed " + std::to_string(crc) +
+                                                        ", stored " + std::to_string(chunk.uncompressed_crc));
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace rbsim::mcap

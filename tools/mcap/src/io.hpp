@@ -1,0 +1,41 @@
+// Random-access byte sources for the readers and byte sinks for the writer.
+#pragma once
+
+#include <cstdio>
+#include <memory>
+
+#include "rbsim/mcap.hpp"
+
+namespace rbsim::mcap::detail {
+
+class Source {
+ public:
+  virtual ~Source() = default;
+  virtual std::uint64_t size() const = 0;
+  // Views `length` bytes at `offset`; the view stays valid until the next read. Fails (never
+  // allocates) when the range lies outside the source.
+  virtual Status read(std::uint64_t offset, std::uint64_t length, ByteView& out) = 0;
+};
+
+Result<std::unique_ptr<Source>> open_file_source(const std::string& path);
+std::unique_ptr<Source> make_buffer_source(Bytes data);
+
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual Status write(ByteView data) = 0;
+  virtual Status flush() = 0;  // hand buffered bytes to the OS
+  virtual Status close() = 0;
+  virtual const Bytes& buffer() const = 0;  // memory sinks only; empty otherwise
+};
+
+Result<std::unique_ptr<Sink>> open_file_sink(const std::string& path);
+std::unique_ptr<Sink> make_buffer_sink();
+
+inline Status out_of_range(std::uint64_t offset, std::uint64_t length, std::uint64_t size) {
+  return Status::Error(StatusCode::Truncated, "read of " + std::to_string(length) + " bytes at offset " +
+                                                  std::to_string(offset) + " past end of file (size " +
+                                                  std::to_string(size) + ")");
+}
+
+}  // namespace rbsim::mcap::detail

@@ -1,0 +1,243 @@
+#include "stream.hpp"
+
+#include <array>
+
+#include "wire.hpp"
+
+namespace rbsim::mcap {
+namespace detail {
+namespace {
+
+std::uint64_t le64(ByteView v) {
+  std::uint64_t n = 0;
+  for (std::size_t i = 0; i < 8; ++i) n |= std::uint64_t{v[i]} << (8 * i);
+  return n;
+}
+
+std::string at(std::uint64_t offset) {
+  return " at offset " + std::to_string(offset);
+}
+
+}  // namespace
+
+Status read_record_at(Source& source, std::uint64_t offset, std::uint8_t& opcode, ByteView& content) {
+  const std::uint64_t size = source.size();
+  if (offset > size || size - offset < kRecordPrefix) {
+    return Status::Error(StatusCode::Truncated, "record header cut off" + at(offset));
+  }
+  ByteView prefix;
+  if (Status s = source.read(offset, kRecordPrefix, prefix); !s.ok()) return s;
+  opcode = prefix[0];
+  const std::uint64_t length = le64(prefix.subspan(1));
+  if (length > size - offset - kRecordPrefix) {
+    return Status::Error(StatusCode::Truncated,
+                         "record (opcode " + std::to_string(opcode) + ")" + at(offset) + " claims " +
+                             std::to_string(length) + " bytes, only " +
+                             std::to_string(size - offset - kRecordPrefix) + " remain");
+  }
+  return source.read(offset + kRecordPrefix, length, content);
+}
+
+Status check_attachment_crc(ByteView content, const Attachment& a) {
+  if (a.crc == 0) return Status::Ok();
+  const std::size_t covered = 8 + 8 + 4 + a.name.size() + 4 + a.media_type.size() + 8 + a.data.size();
+  const std::uint32_t crc = crc32(content.subspan(0, covered));
+  if (crc == a.crc) return Status::Ok();
+  return Status::Error(StatusCode::CrcMismatch, "attachment '" + a.name + "' CRC mismatch: computed " +
+                                                    std::to_string(crc) + ", stored " +
+                                                    std::to_string(a.crc));
+}
+
+bool Streamer::fail(Status status) {
+  status_ = std::move(status);
+  state_ = State::Done;
+  in_chunk_ = false;
+  return false;
+}
+
+bool Streamer::next(RecordEntry& out) {
+  while (state_ != State::Done) {
+    if (in_chunk_) {
+      if (!chunk_error_.ok()) return fail(std::move(chunk_error_));
+      if (chunk_pos_ < chunk_data_.size()) return next_in_chunk(out);
+      in_chunk_ = false;
+    }
+    bool yield = false;
+    if (!read_top_level(out, yield)) return false;
+    if (yield) return true;
+  }
+  return false;
+}
+
+bool Streamer::next_in_chunk(RecordEntry& out) {
+  Cursor c(ByteView(chunk_data_).subspan(chunk_pos_));
+  std::uint8_t opcode = 0;
+  std::uint64_t length = 0;
+  ByteView content;
+  if (!c.u8(opcode) || !c.u64(length) || !c.view(length, content)) {
+    return fail(Status::Error(StatusCode::Malformed, "record cut off at byte " + std::to_string(chunk_pos_) +
+                                                         " of the chunk" + at(chunk_offset_)));
+  }
+  auto record = parse_record(opcode, content);
+  if (!record.ok()) {
+    return fail(
+        Status::Error(record.status().code, record.status().message + " in chunk" + at(chunk_offset_)));
+  }
+  out.record = std::move(record).value();
+  out.offset = chunk_pos_;
+  out.length = kRecordPrefix + length;
+  out.chunk_offset = chunk_offset_;
+  chunk_pos_ += static_cast<std::size_t>(out.length);
+  return true;
+}
+
+void Streamer::update_crcs(std::uint8_t opcode, ByteView prefix, ByteView content) {
+  if (!options_.verify_crcs) return;
+  if (!seen_data_end_) {
+    data_crc_ = crc32(content, crc32(prefix, data_crc_));
+  } else if (opcode != static_cast<std::uint8_t>(Opcode::Footer)) {
+    summary_crc_ = crc32(content, crc32(prefix, summary_crc_));
+  }
+}
+
+bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
+  const std::uint64_t size = source_.size();
+  ByteView view;
+  if (state_ == State::Start) {
+    const std::uint64_t n = std::min<std::uint64_t>(size, 8);
+    if (Status s = source_.read(0, n, view); !s.ok()) return fail(s);
+    if (n == 0) return fail(Status::Error(StatusCode::Truncated, "empty file"));
+    if (std::memcmp(view.data(), kMagic, view.size()) != 0) {
+      return fail(Status::Error(StatusCode::BadMagic, "not an MCAP file (bad magic)"));
+    }
+    if (n < 8) return fail(Status::Error(StatusCode::Truncated, "file ends inside the magic"));
+    if (options_.verify_crcs) data_crc_ = crc32(view);
+    position_ = 8;
+    state_ = State::Records;
+  }
+  if (position_ == size) return fail(Status::Error(StatusCode::Truncated, "file ends without a Footer"));
+  std::uint8_t opcode = 0;
+  ByteView content;
+  if (Status s = read_record_at(source_, position_, opcode, content); !s.ok()) return fail(s);
+  const std::uint64_t length = content.size();
+  std::array<std::uint8_t, kRecordPrefix> prefix{opcode};
+  for (std::size_t i = 0; i < 8; ++i) prefix[1 + i] = static_cast<std::uint8_t>(length >> (8 * i));
+  if (first_record_ && opcode != static_cast<std::uint8_t>(Opcode::Header)) {
+    return fail(Status::Error(StatusCode::Malformed, "first record is not a Header" + at(position_)));
+  }
+  first_record_ = false;
+  const bool is_data_end = opcode == static_cast<std::uint8_t>(Opcode::DataEnd);
+  const std::uint32_t data_crc = data_crc_;
+  if (!is_data_end) update_crcs(opcode, prefix, content);
+
+  auto parsed = parse_record(opcode, content);
+  if (!parsed.ok()) return fail(Status::Error(parsed.status().code, parsed.status().message + at(position_)));
+  Record& record = parsed.value();
+  const std::uint64_t record_offset = position_;
+  out.offset = record_offset;
+  out.length = kRecordPrefix + length;
+  out.chunk_offset.reset();
+  position_ += out.length;
+  yield = true;
+
+  switch (static_cast<Opcode>(opcode)) {
+    case Opcode::DataEnd: {
+      const std::uint32_t stored = std::get<DataEnd>(record).data_section_crc;
+      if (options_.verify_crcs && stored != 0 && stored != data_crc) {
+        return fail(Status::Error(StatusCode::CrcMismatch, "data section CRC mismatch: computed " +
+                                                               std::to_string(data_crc) + ", stored " +
+                                                               std::to_string(stored)));
+      }
+      seen_data_end_ = true;
+      break;
+    }
+    case Opcode::Chunk:
+      if (options_.descend_into_chunks) {
+        chunk_error_ = decompress_chunk(std::get<Chunk>(record), chunk_data_, options_.verify_crcs);
+        if (!chunk_error_.ok()) chunk_error_.message += " (chunk" + at(record_offset) + ")";
+        chunk_pos_ = 0;
+        chunk_offset_ = record_offset;
+        in_chunk_ = true;
+      }
+      yield = options_.report_chunks || !options_.descend_into_chunks;
+      break;
+    case Opcode::MessageIndex:
+      yield = options_.report_message_indexes;
+      break;
+    case Opcode::Attachment:
+      if (options_.verify_crcs) {
+        if (Status s = check_attachment_crc(content, std::get<Attachment>(record)); !s.ok()) return fail(s);
+      }
+      break;
+    case Opcode::Footer: {
+      // Spec: "The last record in the data section MUST be the Data End record".
+      if (!seen_data_end_) {
+        return fail(Status::Error(StatusCode::Malformed, "Footer without a DataEnd record"));
+      }
+      // The summary CRC runs from the end of DataEnd through Footer.summary_offset_start.
+      const std::uint32_t stored = std::get<Footer>(record).summary_crc;
+      const std::uint32_t computed = crc32(content.subspan(0, 16), crc32(prefix, summary_crc_));
+      if (options_.verify_crcs && stored != 0 && stored != computed) {
+        return fail(Status::Error(StatusCode::CrcMismatch, "summary CRC mismatch: computed " +
+                                                               std::to_string(computed) + ", stored " +
+                                                               std::to_string(stored)));
+      }
+      if (size - position_ < 8) {
+        return fail(Status::Error(StatusCode::Truncated, "file ends inside the trailing magic"));
+      }
+      if (Status s = source_.read(position_, 8, view); !s.ok()) return fail(s);
+      if (!is_magic(view)) {
+        return fail(Status::Error(StatusCode::BadMagic, "bad trailing magic" + at(position_)));
+      }
+      if (size - position_ > 8) {
+        return fail(Status::Error(StatusCode::Malformed, "unexpected bytes after the trailing magic"));
+      }
+      position_ = size;
+      state_ = State::Done;
+      break;
+    }
+    default:
+      break;
+  }
+  if (yield) out.record = std::move(record);
+  return true;
+}
+
+}  // namespace detail
+
+struct StreamReader::Impl {
+  std::unique_ptr<detail::Source> source;
+  std::unique_ptr<detail::Streamer> streamer;
+  Status not_open = Status::Error(StatusCode::NotOpen, "stream reader is not open");
+
+  Status start(std::unique_ptr<detail::Source> s, const StreamOptions& options) {
+    source = std::move(s);
+    streamer = std::make_unique<detail::Streamer>(*source, options);
+    return Status::Ok();
+  }
+};
+
+StreamReader::StreamReader() : impl_(std::make_unique<Impl>()) {}
+StreamReader::~StreamReader() = default;
+
+Status StreamReader::open(const std::string& path, const StreamOptions& options) {
+  auto source = detail::open_file_source(path);
+  if (!source.ok()) return source.status();
+  return impl_->start(std::move(source).value(), options);
+}
+
+Status StreamReader::open_buffer(Bytes data, const StreamOptions& options) {
+  return impl_->start(detail::make_buffer_source(std::move(data)), options);
+}
+
+bool StreamReader::next(RecordEntry& out) {
+  return impl_->streamer && impl_->streamer->next(out);
+}
+const Status& StreamReader::status() const {
+  return impl_->streamer ? impl_->streamer->status() : impl_->not_open;
+}
+std::uint64_t StreamReader::position() const {
+  return impl_->streamer ? impl_->streamer->position() : 0;
+}
+
+}  // namespace rbsim::mcap

@@ -1,0 +1,364 @@
+// Writer: <Magic><Header><Data section><DataEnd>[<Summary>][<Summary Offsets>]<Footer><Magic>.
+#include <algorithm>
+
+#include "codec.hpp"
+#include "io.hpp"
+#include "wire.hpp"
+
+namespace rbsim::mcap {
+
+using namespace detail;
+
+struct Writer::Impl {
+  WriterOptions options;
+  std::unique_ptr<Sink> sink;
+  std::unique_ptr<Compressor> compressor;
+  Status error;  // sticky: the first failure is returned by every later call
+  bool open = false;
+  bool in_summary = false;
+
+  std::uint64_t offset = 0;       // bytes written so far
+  std::uint32_t data_crc = 0;     // over every byte before DataEnd (spec: Data End)
+  std::uint32_t summary_crc = 0;  // from the end of DataEnd through Footer.summary_offset_start
+
+  std::map<std::uint16_t, Schema> schemas;
+  std::map<std::uint16_t, Channel> channels;
+  Statistics stats;
+  std::vector<ChunkIndex> chunk_indexes;
+  std::vector<AttachmentIndex> attachment_indexes;
+  std::vector<MetadataIndex> metadata_indexes;
+
+  // Pending chunk: uncompressed records plus a message index per channel (spec: Message Index
+  // offsets are relative to the start of the uncompressed records).
+  Bytes chunk;
+  std::map<std::uint16_t, std::vector<std::pair<Timestamp, std::uint64_t>>> chunk_message_index;
+  Timestamp chunk_start_time = 0;
+  Timestamp chunk_end_time = 0;
+  bool chunk_has_messages = false;
+
+  Bytes scratch;
+  Bytes compressed;
+
+  Status check_open() const {
+    if (!error.ok()) return error;
+    if (!open) return Status::Error(StatusCode::NotOpen, "writer is not open");
+    return Status::Ok();
+  }
+
+  Status write(ByteView bytes) {
+    if (!error.ok()) return error;
+    if (in_summary) {
+      summary_crc = crc32(bytes, summary_crc);
+    } else {
+      data_crc = crc32(bytes, data_crc);
+    }
+    offset += bytes.size();
+    Status s = sink->write(bytes);
+    if (!s.ok()) error = s;
+    return s;
+  }
+
+  // Serialises into the pending chunk when chunking (Schema/Channel/Message), else to the file.
+  Status emit(const Record& record, bool into_chunk) {
+    if (into_chunk) {
+      serialize_record(record, chunk);
+      return Status::Ok();
+    }
+    scratch.clear();
+    serialize_record(record, scratch);
+    return write(scratch);
+  }
+
+  Status begin(std::unique_ptr<Sink> s, const WriterOptions& opts) {
+    *this = Impl{};
+    options = opts;
+    sink = std::move(s);
+    compressor = std::make_unique<Compressor>(options.compression, options.compression_level);
+    open = true;
+    Status st = write(ByteView(kMagic));
+    if (!st.ok()) return st;
+    return emit(Header{options.profile, options.library}, false);
+  }
+
+  Status flush_chunk() {
+    if (chunk.empty()) return Status::Ok();
+    Status s = compressor->compress(chunk, compressed);
+    if (!s.ok()) return error = s;
+    const std::string_view compression = compression_name(options.compression);
+    // Chunk header written by hand so the (possibly large) records are not copied again.
+    scratch.clear();
+    put_u8(scratch, static_cast<std::uint8_t>(Opcode::Chunk));
+    put_u64(scratch, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + compressed.size());
+    put_u64(scratch, chunk_has_messages ? chunk_start_time : 0);
+    put_u64(scratch, chunk_has_messages ? chunk_end_time : 0);
+    put_u64(scratch, chunk.size());
+    put_u32(scratch, options.enable_crcs ? crc32(chunk) : 0);
+    put_string(scratch, compression);
+    put_u64(scratch, compressed.size());
+    ChunkIndex index;
+    index.message_start_time = chunk_has_messages ? chunk_start_time : 0;
+    index.message_end_time = chunk_has_messages ? chunk_end_time : 0;
+    index.chunk_start_offset = offset;
+    index.compression = std::string(compression);
+    index.compressed_size = compressed.size();
+    index.uncompressed_size = chunk.size();
+    if (!(s = write(scratch)).ok() || !(s = write(compressed)).ok()) return s;
+    index.chunk_length = offset - index.chunk_start_offset;
+    if (options.emit_message_indexes) {
+      const std::uint64_t start = offset;
+      for (auto& [channel_id, entries] : chunk_message_index) {
+        index.message_index_offsets[channel_id] = offset;
+        if (!(s = emit(MessageIndex{channel_id, std::move(entries)}, false)).ok()) return s;
+      }
+      index.message_index_length = offset - start;
+    }
+    if (options.emit_chunk_indexes) chunk_indexes.push_back(std::move(index));
+    ++stats.chunk_count;
+    chunk.clear();
+    chunk_message_index.clear();
+    chunk_has_messages = false;
+    // A completed chunk reaches the OS now, so a killed process leaves it readable.
+    if (!(s = sink->flush()).ok()) error = s;
+    return s;
+  }
+
+  template <typename T>
+  Status write_group(Opcode opcode, const std::vector<T>& records, std::vector<SummaryOffset>& groups) {
+    if (records.empty()) return Status::Ok();
+    const std::uint64_t start = offset;
+    for (const T& r : records) {
+      Status s = emit(r, false);
+      if (!s.ok()) return s;
+    }
+    groups.push_back({static_cast<std::uint8_t>(opcode), start, offset - start});
+    return Status::Ok();
+  }
+
+  Status finish() {
+    Status s = flush_chunk();
+    if (!s.ok()) return s;
+    if (!(s = emit(DataEnd{options.enable_crcs ? data_crc : 0}, false)).ok()) return s;
+    in_summary = true;
+    const std::uint64_t summary_start = offset;
+    // Summary records grouped by opcode (spec: Summary Section), one Summary Offset per group.
+    std::vector<SummaryOffset> groups;
+    std::vector<Schema> schema_group;
+    std::vector<Channel> channel_group;
+    std::vector<Statistics> stats_group;
+    for (const auto& [id, schema] : schemas) {
+      if (options.repeat_schemas) schema_group.push_back(schema);
+    }
+    for (const auto& [id, channel] : channels) {
+      if (options.repeat_channels) channel_group.push_back(channel);
+    }
+    if (options.emit_statistics) stats_group.push_back(stats);
+    if (!(s = write_group(Opcode::Schema, schema_group, groups)).ok() ||
+        !(s = write_group(Opcode::Channel, channel_group, groups)).ok() ||
+        !(s = write_group(Opcode::Statistics, stats_group, groups)).ok() ||
+        !(s = write_group(Opcode::ChunkIndex, chunk_indexes, groups)).ok() ||
+        !(s = write_group(Opcode::AttachmentIndex, attachment_indexes, groups)).ok() ||
+        !(s = write_group(Opcode::MetadataIndex, metadata_indexes, groups)).ok()) {
+      return s;
+    }
+    Footer footer;
+    footer.summary_start = offset > summary_start ? summary_start : 0;
+    if (options.emit_summary_offsets && !groups.empty()) {
+      footer.summary_offset_start = offset;
+      for (const SummaryOffset& g : groups) {
+        if (!(s = emit(g, false)).ok()) return s;
+      }
+    }
+    // The summary CRC ends after summary_offset_start, so the Footer is written in two parts.
+    scratch.clear();
+    put_u8(scratch, static_cast<std::uint8_t>(Opcode::Footer));
+    put_u64(scratch, kFooterContent);
+    put_u64(scratch, footer.summary_start);
+    put_u64(scratch, footer.summary_offset_start);
+    if (!(s = write(scratch)).ok()) return s;
+    scratch.clear();
+    put_u32(scratch, options.enable_crcs ? summary_crc : 0);
+    scratch.insert(scratch.end(), std::begin(kMagic), std::end(kMagic));
+    if (!(s = write(scratch)).ok()) return s;
+    if (!(s = sink->close()).ok()) error = s;
+    return s;
+  }
+};
+
+Writer::Writer() : impl_(std::make_unique<Impl>()) {}
+
+Writer::~Writer() {
+  if (impl_->open) (void)close();
+}
+
+Status Writer::open(const std::string& path, const WriterOptions& options) {
+  if (impl_->open) return Status::Error(StatusCode::InvalidArgument, "writer is already open");
+  auto sink = open_file_sink(path);
+  if (!sink.ok()) return sink.status();
+  return impl_->begin(std::move(sink).value(), options);
+}
+
+Status Writer::open_buffer(const WriterOptions& options) {
+  if (impl_->open) return Status::Error(StatusCode::InvalidArgument, "writer is already open");
+  return impl_->begin(make_buffer_sink(), options);
+}
+
+Status Writer::add_schema(const Schema& schema) {
+  Impl& w = *impl_;
+  if (Status s = w.check_open(); !s.ok()) return s;
+  if (schema.id == 0) return Status::Error(StatusCode::InvalidArgument, "schema id 0 is reserved");
+  // Spec: "Any two schema records sharing a common ID must be identical".
+  if (auto it = w.schemas.find(schema.id); it != w.schemas.end()) {
+    const Schema& old = it->second;
+    if (old.name == schema.name && old.encoding == schema.encoding && old.data == schema.data) {
+      return Status::Ok();
+    }
+    return Status::Error(StatusCode::InvalidArgument,
+                         "schema id " + std::to_string(schema.id) + " redefined");
+  }
+  if (Status s = w.emit(schema, w.options.use_chunks); !s.ok()) return s;
+  w.schemas.emplace(schema.id, schema);
+  w.stats.schema_count = static_cast<std::uint16_t>(w.schemas.size());
+  return Status::Ok();
+}
+
+Result<std::uint16_t> Writer::add_schema(std::string_view name, std::string_view encoding, ByteView data) {
+  const std::uint16_t id =
+      static_cast<std::uint16_t>(impl_->schemas.empty() ? 1 : impl_->schemas.rbegin()->first + 1);
+  if (id == 0) return Status::Error(StatusCode::InvalidArgument, "schema ids exhausted");
+  Status s =
+      add_schema(Schema{id, std::string(name), std::string(encoding), Bytes(data.begin(), data.end())});
+  if (!s.ok()) return s;
+  return id;
+}
+
+Status Writer::add_channel(const Channel& channel) {
+  Impl& w = *impl_;
+  if (Status s = w.check_open(); !s.ok()) return s;
+  if (channel.schema_id != 0 && w.schemas.count(channel.schema_id) == 0) {
+    return Status::Error(StatusCode::InvalidArgument,
+                         "unknown schema id " + std::to_string(channel.schema_id));
+  }
+  if (auto it = w.channels.find(channel.id); it != w.channels.end()) {
+    const Channel& old = it->second;
+    if (old.schema_id == channel.schema_id && old.topic == channel.topic &&
+        old.message_encoding == channel.message_encoding && old.metadata == channel.metadata) {
+      return Status::Ok();
+    }
+    return Status::Error(StatusCode::InvalidArgument,
+                         "channel id " + std::to_string(channel.id) + " redefined");
+  }
+  if (Status s = w.emit(channel, w.options.use_chunks); !s.ok()) return s;
+  w.channels.emplace(channel.id, channel);
+  w.stats.channel_count = static_cast<std::uint32_t>(w.channels.size());
+  return Status::Ok();
+}
+
+Result<std::uint16_t> Writer::add_channel(std::uint16_t schema_id, std::string_view topic,
+                                          std::string_view message_encoding, const KeyValueMap& metadata) {
+  const std::uint16_t id =
+      static_cast<std::uint16_t>(impl_->channels.empty() ? 1 : impl_->channels.rbegin()->first + 1);
+  if (id == 0) return Status::Error(StatusCode::InvalidArgument, "channel ids exhausted");
+  Status s = add_channel(Channel{id, schema_id, std::string(topic), std::string(message_encoding), metadata});
+  if (!s.ok()) return s;
+  return id;
+}
+
+Status Writer::write_message(const Message& message) {
+  return write_message(message.channel_id, message.sequence, message.log_time, message.publish_time,
+                       message.data);
+}
+
+Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, Timestamp log_time,
+                             Timestamp publish_time, ByteView data) {
+  Impl& w = *impl_;
+  if (Status s = w.check_open(); !s.ok()) return s;
+  if (w.channels.count(channel_id) == 0) {
+    return Status::Error(StatusCode::InvalidArgument, "unknown channel id " + std::to_string(channel_id));
+  }
+  Statistics& st = w.stats;
+  st.message_start_time = st.message_count == 0 ? log_time : std::min(st.message_start_time, log_time);
+  st.message_end_time = st.message_count == 0 ? log_time : std::max(st.message_end_time, log_time);
+  ++st.message_count;
+  ++st.channel_message_counts[channel_id];
+  // Message layout by hand: its data is the rest of the record, so no copy into a Message.
+  Bytes& out = w.options.use_chunks ? w.chunk : w.scratch;
+  if (!w.options.use_chunks) out.clear();
+  const std::uint64_t record_offset = out.size();
+  put_u8(out, static_cast<std::uint8_t>(Opcode::Message));
+  put_u64(out, 2 + 4 + 8 + 8 + data.size());
+  put_u16(out, channel_id);
+  put_u32(out, sequence);
+  put_u64(out, log_time);
+  put_u64(out, publish_time);
+  put_raw(out, data);
+  if (!w.options.use_chunks) return w.write(out);
+  w.chunk_message_index[channel_id].emplace_back(log_time, record_offset);
+  w.chunk_start_time = w.chunk_has_messages ? std::min(w.chunk_start_time, log_time) : log_time;
+  w.chunk_end_time = w.chunk_has_messages ? std::max(w.chunk_end_time, log_time) : log_time;
+  w.chunk_has_messages = true;
+  if (w.chunk.size() >= w.options.chunk_size) return w.flush_chunk();
+  return Status::Ok();
+}
+
+Status Writer::add_attachment(Timestamp log_time, Timestamp create_time, std::string_view name,
+                              std::string_view media_type, ByteView data) {
+  Impl& w = *impl_;
+  if (Status s = w.check_open(); !s.ok()) return s;
+  // Attachments never go inside chunks (spec: Attachment); the CRC covers every preceding field.
+  Bytes& out = w.scratch;
+  out.clear();
+  put_u8(out, static_cast<std::uint8_t>(Opcode::Attachment));
+  put_u64(out, 8 + 8 + 4 + name.size() + 4 + media_type.size() + 8 + data.size() + 4);
+  put_u64(out, log_time);
+  put_u64(out, create_time);
+  put_string(out, name);
+  put_string(out, media_type);
+  put_bytes64(out, data);
+  put_u32(out, w.options.enable_crcs ? crc32(ByteView(out).subspan(kRecordPrefix)) : 0);
+  AttachmentIndex index{
+      w.offset, out.size(), log_time, create_time, data.size(), std::string(name), std::string(media_type)};
+  if (Status s = w.write(out); !s.ok()) return s;
+  if (w.options.emit_attachment_indexes) w.attachment_indexes.push_back(std::move(index));
+  ++w.stats.attachment_count;
+  return Status::Ok();
+}
+
+Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) {
+  Impl& w = *impl_;
+  if (Status s = w.check_open(); !s.ok()) return s;
+  const std::uint64_t start = w.offset;
+  if (Status s = w.emit(Metadata{std::string(name), metadata}, false); !s.ok()) return s;
+  if (w.options.emit_metadata_indexes) {
+    w.metadata_indexes.push_back({start, w.offset - start, std::string(name)});
+  }
+  ++w.stats.metadata_count;
+  return Status::Ok();
+}
+
+Status Writer::flush_chunk() {
+  if (Status s = impl_->check_open(); !s.ok()) return s;
+  return impl_->flush_chunk();
+}
+
+Status Writer::close() {
+  if (!impl_->open) return Status::Error(StatusCode::NotOpen, "writer is not open");
+  impl_->open = false;
+  if (!impl_->error.ok()) {
+    (void)impl_->sink->close();
+    return impl_->error;
+  }
+  return impl_->finish();
+}
+
+bool Writer::is_open() const {
+  return impl_->open;
+}
+const Statistics& Writer::statistics() const {
+  return impl_->stats;
+}
+const Bytes& Writer::buffer() const {
+  static const Bytes kEmpty;
+  return impl_->sink ? impl_->sink->buffer() : kEmpty;
+}
+
+}  // namespace rbsim::mcap
