@@ -40,8 +40,8 @@ Subcommand add_grade_command(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
       "grade", "Grade a scene against a FOSSSim reference output the way the reference does: per step, load the "
                "reference state, check the quantities, step once, compare with the next reference state");
-  app->add_option("scene", a->scene, "FOSSSim XML scene file")->required()->check(CLI::ExistingFile);
-  app->add_option("reference", a->reference, "Reference output (.bin, or .bin.zst)")->required()->check(CLI::ExistingFile);
+  app->add_option("scene", a->scene, "FOSSSim XML scene file")->required();  // missing files are errors (exit 2)
+  app->add_option("reference", a->reference, "Reference output (.bin, or .bin.zst)")->required();
   app->footer("Passes when the largest per-step state difference is < 1e-8, their sum < 1e-6, and every quantity "
               "(M, X, I, P, L_point, L_spin, T_point, T_spin, U) is within 1e-8.\n"
               "Exit status: 0 pass, 1 fail, 2 error.");

@@ -10,6 +10,12 @@ int main(int argc, char** argv) {
   const std::vector<rbsim::cli::Subcommand> subcommands = {
       rbsim::cli::add_run_command(app),
       rbsim::cli::add_grade_command(app),
+#ifdef RBSIM_HAVE_LOG_COMMAND
+      rbsim::cli::add_log_command(app),
+#endif
+#ifdef RBSIM_HAVE_CHECK_COMMAND
+      rbsim::cli::add_check_command(app),
+#endif
   };
   try {
     app.parse(argc, argv);
