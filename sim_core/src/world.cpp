@@ -198,20 +198,34 @@ Energy World::energy() const {
 }
 
 std::optional<World::NonFinite> World::find_nonfinite() const {
-  // v * 0 is 0 for every finite v and NaN for inf or NaN, so one branch-free pass decides
-  // whether the exact search below is needed.
+  // v * 0 is 0 for every finite v and NaN for inf or NaN, so one branch-free pass per group
+  // decides whether the exact search is needed. Derived quantities (T = M |V|^2 / 2, U, ...) can
+  // overflow while the state is still finite, so they are checked too: no output may carry inf.
   double sum = 0.0;
   for (const auto* column : {&x_, &y_, &theta_, &vx_, &vy_, &omega_}) {
     for (double v : *column) sum += v * 0.0;
   }
-  if (sum == 0.0) return std::nullopt;
-  static constexpr const char* kNames[] = {"x", "y", "theta", "vx", "vy", "omega"};
-  for (std::int32_t b = 0; b < body_count(); ++b) {
-    const double values[] = {x_[b], y_[b], theta_[b], vx_[b], vy_[b], omega_[b]};
-    for (int q = 0; q < 6; ++q) {
-      if (!std::isfinite(values[q])) return NonFinite{BodyId{b}, kNames[q]};
+  if (sum != 0.0) {
+    static constexpr const char* kNames[] = {"x", "y", "theta", "vx", "vy", "omega"};
+    for (std::int32_t b = 0; b < body_count(); ++b) {
+      const double values[] = {x_[b], y_[b], theta_[b], vx_[b], vy_[b], omega_[b]};
+      for (int q = 0; q < 6; ++q) {
+        if (!std::isfinite(values[q])) return NonFinite{BodyId{b}, kNames[q]};
+      }
     }
   }
+  for (std::int32_t b = 0; b < body_count(); ++b) {
+    const BodyQuantities q = quantities(BodyId{b});
+    const double values[] = {q.momentum.x(), q.momentum.y(), q.l_point, q.l_spin, q.t_point, q.t_spin};
+    static constexpr const char* kNames[] = {"px", "py", "L_point", "L_spin", "T_point", "T_spin"};
+    for (int k = 0; k < 6; ++k) {
+      if (!std::isfinite(values[k])) return NonFinite{BodyId{b}, kNames[k]};
+    }
+  }
+  const Energy e = energy();
+  if (!std::isfinite(e.u_gravity)) return NonFinite{BodyId{-1}, "U_gravity"};
+  if (!std::isfinite(e.u_spring)) return NonFinite{BodyId{-1}, "U_spring"};
+  if (!std::isfinite(e.total())) return NonFinite{BodyId{-1}, "E"};
   return std::nullopt;
 }
 

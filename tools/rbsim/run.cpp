@@ -70,8 +70,8 @@ int run(const RunOptions& o) {
     world.step();
     if (!o.allow_nonfinite) {
       if (const auto bad = world.find_nonfinite()) {
-        failure = "step " + std::to_string(world.step_index()) + ": body " + std::to_string(bad->body.index) + " " +
-                  bad->quantity + " is not finite: the simulation diverged (try a smaller dt or "
+        const std::string where = bad->body.index >= 0 ? "body " + std::to_string(bad->body.index) + " " : "";
+        failure = "step " + std::to_string(world.step_index()) + ": " + where + bad->quantity + " is not finite: the simulation diverged (try a smaller dt or "
                   "symplectic-euler; --allow-nonfinite keeps going). Outputs hold steps 0.." +
                   std::to_string(world.step_index() - 1) + ".";
         break;

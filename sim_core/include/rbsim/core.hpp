@@ -201,11 +201,12 @@ class World {
   std::span<const double> vy() const { return vy_; }
   std::span<const double> omega() const { return omega_; }
 
-  // The first non-finite value in the state, if any (checked after each step by runners, so a
-  // diverging scene stops with a clear error instead of writing NaN).
+  // The first non-finite value in the state or in a quantity derived from it, if any (checked
+  // after each step by runners, so a diverging scene stops with a clear error instead of writing
+  // inf or NaN).
   struct NonFinite {
-    BodyId body;
-    const char* quantity;  // "x", "y", "theta", "vx", "vy" or "omega"
+    BodyId body;           // index -1 for a scene-wide quantity
+    const char* quantity;  // "x" .. "omega", "px" .. "T_spin", "U_gravity", "U_spring" or "E"
   };
   std::optional<NonFinite> find_nonfinite() const;
 

@@ -47,8 +47,30 @@ class Loader {
  public:
   Loader(std::string path) : path_(std::move(path)) {}
 
+  // Messages are one line: control characters in echoed attribute values (a value may span
+  // lines) are shown escaped.
+  static std::string one_line(const std::string& s) {
+    std::string out;
+    for (const char c : s) {
+      if (c == '\n') {
+        out += "\\n";
+      } else if (c == '\r') {
+        out += "\\r";
+      } else if (c == '\t') {
+        out += "\\t";
+      } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+        static constexpr char kHex[] = "0123456789abcdef";
+        out += "\\x";
+        out += kHex[(static_cast<unsigned char>(c) >> 4) & 0xf];
+        out += kHex[static_cast<unsigned char>(c) & 0xf];
+      } else {
+        out += c;
+      }
+    }
+    return out;
+  }
   [[noreturn]] void fail(int line, const std::string& what) const {
-    throw SceneError{path_ + ":" + std::to_string(line) + ": " + what};
+    throw SceneError{path_ + ":" + std::to_string(line) + ": " + one_line(what)};
   }
   [[noreturn]] void fail(const tinyxml2::XMLElement* e, const char* attr, const std::string& rule) const {
     fail(e->GetLineNum(), "<" + std::string(e->Name()) + "> attribute '" + attr + "': " + rule);
@@ -328,7 +350,9 @@ Result<Scene> parse_scene(std::string_view text, const std::string& path) {
     if (doc.ErrorID() == tinyxml2::XML_ERROR_EMPTY_DOCUMENT) return Error{path + ":1: empty file (expected a <scene>)"};
     std::string detail = doc.ErrorStr();
     // tinyxml2 prefixes "Error=XML_ERROR_... ErrorID=n (0x..) Line number=n: "; keep its tail.
-    if (const auto colon = detail.find(": "); colon != std::string::npos) detail = detail.substr(colon + 2);
+    // Without a tail (e.g. XML_ERROR_PARSING_TEXT) it only repeats the name and line: drop it.
+    const auto colon = detail.find(": ");
+    detail = colon == std::string::npos ? std::string() : detail.substr(colon + 2);
     return Error{path + ":" + std::to_string(doc.ErrorLineNum()) + ": not well-formed XML: " +
                  std::string(doc.ErrorName()) + (detail.empty() ? "" : " (" + detail + ")")};
   }
