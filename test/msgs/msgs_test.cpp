@@ -190,3 +190,62 @@ TEST(MessageDecoder, RejectsEveryTruncationAndSurvivesMutation) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(DecodeScene, RoundTripsTheEncodedDescription) {
+  rbsim::Scene scene = spring_wind_scene();
+  scene.viewport = rbsim::Viewport{1.5, -2.0, 7.0};
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  rbsim::msgs::Bytes out;
+  rbsim::msgs::Encoder(scene).scene(w.value(), out);
+  auto m = rbsim::msgs::decode_scene(out);
+  ASSERT_TRUE(m.ok()) << m.error().message;
+  EXPECT_EQ(m->name, "unit");
+  EXPECT_EQ(m->integrator, "symplectic-euler");
+  EXPECT_EQ(m->dt, scene.world.dt);
+  ASSERT_EQ(m->bodies.size(), 3u);
+  for (std::int32_t b = 0; b < 3; ++b) {
+    EXPECT_EQ(m->bodies[b].mass, w->mass(rbsim::BodyId{b}));
+    EXPECT_EQ(m->bodies[b].inertia, w->inertia(rbsim::BodyId{b}));
+    const auto hull = w->hull(rbsim::BodyId{b});
+    ASSERT_EQ(m->bodies[b].hull.size(), hull.size());
+    for (std::size_t v = 0; v < hull.size(); ++v) EXPECT_EQ(m->bodies[b].hull[v], hull[v]);
+    EXPECT_EQ(m->bodies[b].color.r, static_cast<float>(scene.body_colors[b].r));
+  }
+  ASSERT_EQ(m->springs.size(), 3u);
+  EXPECT_EQ(m->springs[2].body_j, rbsim::kFixed);
+  EXPECT_EQ(m->springs[0].stiffness, 10.0);
+  ASSERT_EQ(m->winds.size(), 1u);
+  EXPECT_EQ(m->winds[0].points_per_edge, 4);
+  ASSERT_TRUE(m->viewport.has_value());
+  EXPECT_EQ(m->viewport->size, 7.0);
+  for (std::size_t n = 0; n + 1 < out.size(); n += 7) EXPECT_FALSE(rbsim::msgs::decode_scene(std::span(out).first(n)).ok());
+}
+
+TEST(DecodeBodyStates, RoundTripsAndRejectsTruncation) {
+  rbsim::Scene scene = spring_wind_scene();
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  for (int i = 0; i < 11; ++i) w->step();
+  rbsim::msgs::Bytes out;
+  rbsim::msgs::Encoder(scene).body_states(w.value(), out);
+  rbsim::msgs::BodyStatesMessage m;
+  ASSERT_TRUE(rbsim::msgs::decode_body_states(out, m).ok());
+  EXPECT_EQ(m.step, 11u);
+  ASSERT_EQ(m.bodies.size(), 3u);
+  for (std::int32_t b = 0; b < 3; ++b) {
+    EXPECT_EQ(m.bodies[b].id, b);
+    const auto s = w->state(rbsim::BodyId{b});
+    EXPECT_EQ(m.bodies[b].state.position, s.position);
+    EXPECT_EQ(m.bodies[b].state.theta, s.theta);
+    EXPECT_EQ(m.bodies[b].state.velocity, s.velocity);
+    EXPECT_EQ(m.bodies[b].state.omega, s.omega);
+  }
+  for (std::size_t n = 0; n < out.size() - 3; ++n) {
+    EXPECT_FALSE(rbsim::msgs::decode_body_states(std::span(out).first(n), m).ok()) << n;
+  }
+}
+
+}  // namespace

@@ -1,4 +1,7 @@
 // Little-endian XCDR1 writer behind the 4-byte encapsulation header (CDR_LE = 00 01 00 00).
+// Like Cyclone DDS (and the XTypes/RTPS rule it follows), the finished message is zero-padded to a
+// multiple of 4 bytes and the pad count goes into the low bits of the options (header byte 3), so
+// the bytes are identical to what Cyclone serialises for the same sample.
 #pragma once
 
 #include <bit>
@@ -18,6 +21,14 @@ class CdrWriter {
     out_.assign(4, std::byte{0});
     out_[1] = std::byte{1};
   }
+  // Finishes the message when the encoder is done with it: pads to 4, records the pad count.
+  ~CdrWriter() {
+    const std::size_t pad = (4 - out_.size() % 4) % 4;
+    out_.resize(out_.size() + pad, std::byte{0});
+    out_[3] = static_cast<std::byte>(pad);
+  }
+  CdrWriter(const CdrWriter&) = delete;
+  CdrWriter& operator=(const CdrWriter&) = delete;
   void u8(std::uint8_t v) { put(v); }
   void boolean(bool v) { put(static_cast<std::uint8_t>(v ? 1 : 0)); }
   void i32(std::int32_t v) { put(v); }

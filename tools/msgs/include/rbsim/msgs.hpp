@@ -5,11 +5,13 @@
 // CDR here is what ROS 2 over DDS puts on the wire: a 4-byte encapsulation header
 // (00 01 00 00 = plain CDR, little endian) followed by XCDR1 data, every primitive aligned to its
 // size relative to the end of that header, strings as uint32 length (with the NUL) + bytes + NUL,
-// sequences as uint32 count + elements.
+// sequences as uint32 count + elements; the message is zero-padded to a multiple of 4 bytes with
+// the pad count in the header's last byte (options), exactly as Cyclone DDS serialises it.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -86,6 +88,41 @@ class Encoder {
  private:
   const Scene* scene_;
 };
+
+// ---------------------------------------------------------------------------------------------
+// Typed decoding of our own messages (for tools that draw or export a recording). Colours come
+// back as the float32 the message carries.
+
+struct SceneMessage {
+  Time stamp;
+  std::string name, description, integrator;
+  double dt = 0.0, duration = 0.0;
+  std::uint64_t step_count = 0;
+  struct Body {
+    double mass = 0.0, inertia = 0.0, radius = 0.0;
+    Color color;
+    std::vector<Vec2> hull;  // body space
+  };
+  std::vector<Body> bodies;
+  std::vector<SpringDef> springs;
+  std::vector<Color> spring_colors;
+  std::vector<GravityDef> gravity;
+  std::vector<WindDef> winds;
+  std::optional<Viewport> viewport;
+  Color background;
+};
+struct BodyStatesMessage {
+  Time stamp;
+  std::uint64_t step = 0;
+  struct Body {
+    std::int32_t id = 0;
+    BodyState state;
+  };
+  std::vector<Body> bodies;
+};
+Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
+// Reuses `out`'s storage: decoding a stream of messages does not allocate once warmed up.
+[[nodiscard]] Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out);
 
 // ---------------------------------------------------------------------------------------------
 // Schema-driven decoding: any CDR message whose ros2msg schema is known (e.g. read from an MCAP

@@ -1,0 +1,149 @@
+// Typed decoding of rbsim's own messages (for tools that draw or export a recording).
+#include <cstring>
+
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::msgs {
+
+namespace {
+
+// Bounds-checked XCDR1 little-endian reader; the first failure sticks.
+class Reader {
+ public:
+  explicit Reader(std::span<const std::byte> data) : d_(data) {
+    ok_ = d_.size() >= 4 && d_[0] == std::byte{0} && d_[1] == std::byte{1};
+  }
+  bool ok() const { return ok_; }
+  template <class T>
+  T get() {
+    T v{};
+    const std::size_t offset = pos_ - 4;
+    const std::size_t pad = (sizeof(T) - offset % sizeof(T)) % sizeof(T);
+    if (!ok_ || pad + sizeof(T) > d_.size() - pos_) {
+      ok_ = false;
+      return v;
+    }
+    std::memcpy(&v, d_.data() + pos_ + pad, sizeof(T));
+    pos_ += pad + sizeof(T);
+    return v;
+  }
+  std::string string() {
+    const auto n = get<std::uint32_t>();
+    if (!ok_ || n == 0 || n > d_.size() - pos_) {
+      ok_ = false;
+      return {};
+    }
+    std::string s(reinterpret_cast<const char*>(d_.data() + pos_), n - 1);
+    pos_ += n;
+    return s;
+  }
+  // A sequence length, bounded by the bytes left (every element takes at least `min_size`).
+  std::uint32_t length(std::size_t min_size) {
+    const auto n = get<std::uint32_t>();
+    if (ok_ && static_cast<std::uint64_t>(n) * min_size > d_.size() - pos_) ok_ = false;
+    return ok_ ? n : 0;
+  }
+  Vec2 vec2() {
+    const double x = get<double>();
+    return {x, get<double>()};
+  }
+  Color color() {
+    Color c;
+    c.r = get<float>();
+    c.g = get<float>();
+    c.b = get<float>();
+    (void)get<float>();  // alpha
+    return c;
+  }
+  Time time() {
+    Time t;
+    t.sec = get<std::int32_t>();
+    t.nanosec = get<std::uint32_t>();
+    return t;
+  }
+
+ private:
+  std::span<const std::byte> d_;
+  std::size_t pos_ = 4;
+  bool ok_ = true;
+};
+
+Error bad(const char* type) { return Error{std::string("malformed or truncated ") + type + " message"}; }
+
+}  // namespace
+
+Result<SceneMessage> decode_scene(std::span<const std::byte> cdr) {
+  Reader r(cdr);
+  SceneMessage m;
+  m.stamp = r.time();
+  (void)r.string();  // frame_id
+  m.name = r.string();
+  m.description = r.string();
+  m.integrator = r.string();
+  m.dt = r.get<double>();
+  m.duration = r.get<double>();
+  m.step_count = r.get<std::uint64_t>();
+  m.bodies.resize(r.length(44));
+  for (auto& b : m.bodies) {
+    b.mass = r.get<double>();
+    b.inertia = r.get<double>();
+    b.radius = r.get<double>();
+    b.color = r.color();
+    b.hull.resize(r.length(16));
+    for (auto& v : b.hull) v = r.vec2();
+  }
+  const std::uint32_t springs = r.length(64);
+  m.springs.resize(springs);
+  m.spring_colors.resize(springs);
+  for (std::uint32_t k = 0; k < springs; ++k) {
+    SpringDef& s = m.springs[k];
+    s.body_i = r.get<std::int32_t>();
+    s.anchor_i = r.vec2();
+    s.body_j = r.get<std::int32_t>();
+    s.anchor_j = r.vec2();
+    s.stiffness = r.get<double>();
+    s.rest_length = r.get<double>();
+    m.spring_colors[k] = r.color();
+  }
+  m.gravity.resize(r.length(16));
+  for (auto& g : m.gravity) g.acceleration = r.vec2();
+  m.winds.resize(r.length(28));
+  for (auto& w : m.winds) {
+    w.beta = r.get<double>();
+    w.velocity = r.vec2();
+    w.points_per_edge = r.get<std::int32_t>();
+  }
+  const bool has_viewport = r.get<std::uint8_t>() != 0;
+  Viewport vp;
+  vp.cx = r.get<double>();
+  vp.cy = r.get<double>();
+  vp.size = r.get<double>();
+  if (has_viewport) m.viewport = vp;
+  m.background = r.color();
+  if (!r.ok()) return bad("SceneDescription");
+  for (const SpringDef& s : m.springs) {
+    for (std::int32_t end : {s.body_i, s.body_j}) {
+      if (end < kFixed || end >= static_cast<std::int32_t>(m.bodies.size())) return bad("SceneDescription");
+    }
+  }
+  return m;
+}
+
+Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out) {
+  Reader r(cdr);
+  out.stamp = r.time();
+  (void)r.string();
+  out.step = r.get<std::uint64_t>();
+  out.bodies.resize(r.length(52));
+  for (auto& b : out.bodies) {
+    b.id = r.get<std::int32_t>();
+    b.state.position = r.vec2();
+    b.state.theta = r.get<double>();
+    b.state.velocity = r.vec2();
+    b.state.omega = r.get<double>();
+  }
+  if (!r.ok()) return bad("BodyStates");
+  return Ok{};
+}
+
+}  // namespace rbsim::msgs
