@@ -10,6 +10,8 @@ int main(int argc, char** argv) {
   const std::vector<rbsim::cli::Subcommand> subcommands = {
       rbsim::cli::add_run_command(app),
       rbsim::cli::add_grade_command(app),
+      rbsim::cli::add_render_command(app),
+      rbsim::cli::add_plot_command(app),
 #ifdef RBSIM_HAVE_LOG_COMMAND
       rbsim::cli::add_log_command(app),
 #endif

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "rbsim/io.hpp"
 #include "rbsim/log.hpp"
+#include "rbsim/render.hpp"
 
 namespace rbsim::cli {
 
@@ -21,6 +22,8 @@ struct RunOptions {
   std::int64_t record_every = 1;
   std::string compression = "zstd";
   std::string ns = "rbsim";
+  std::string frames, size = "1280x720";
+  double fps = 24.0;
   std::string progress = "auto";
   bool quiet = false;
   bool allow_nonfinite = false;
@@ -55,6 +58,12 @@ int run(const RunOptions& o) {
     ro.ns = o.ns;
     if (!log::parse_compression(o.compression, ro.compression)) return fail("unknown compression " + o.compression);
     sinks.push_back(log::make_mcap_sink(o.record, ro));
+  }
+  if (!o.frames.empty()) {
+    int width = 0, height = 0;
+    if (!render::parse_size(o.size, width, height)) return fail("invalid --size \"" + o.size + "\" (expected WxH)");
+    if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
+    sinks.push_back(render::make_frame_sink(o.frames, width, height, o.fps));
   }
   for (auto& sink : sinks) {
     if (Status st = sink->begin(scene, world); !st) return fail(st.error().message);
@@ -134,6 +143,9 @@ Subcommand add_run_command(CLI::App& parent) {
       ->default_str("zstd");
   app->add_option("--namespace", o->ns, "ROS namespace of the recorded topics (/<namespace>/body_states ...)")
       ->default_str("rbsim");
+  app->add_option("--frames", o->frames, "Draw PNG frames into this folder during the run (see rbsim render)");
+  app->add_option("--fps", o->fps, "Frames per simulated second for --frames")->default_str("24");
+  app->add_option("--size", o->size, "Frame size WxH for --frames")->default_str("1280x720");
   app->add_option("--progress", o->progress, "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
       ->check(CLI::IsMember({"auto", "always", "never"}))
       ->default_str("auto");

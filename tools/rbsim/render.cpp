@@ -1,0 +1,90 @@
+// rbsim render / rbsim plot: pictures of a scene or a recording.
+#include <cstdio>
+#include <memory>
+
+#include "commands.hpp"
+#include "rbsim/render.hpp"
+
+namespace rbsim::cli {
+
+namespace {
+struct RenderArgs {
+  std::string input, out, size = "1280x720", mp4;
+  double fps = 24.0;
+  std::optional<double> duration;
+};
+
+int render_command(const RenderArgs& a) {
+  auto fail = [](const std::string& m) {
+    std::fprintf(stderr, "rbsim render: error: %s\n", m.c_str());
+    return 1;
+  };
+  render::RenderOptions o;
+  if (!render::parse_size(a.size, o.width, o.height)) {
+    return fail("invalid --size \"" + a.size + "\" (expected WxH, e.g. 1280x720, each 16..16384)");
+  }
+  if (!(a.fps > 0.0 && a.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
+  o.out_dir = a.out;
+  o.fps = a.fps;
+  o.duration = a.duration;
+  Result<std::int64_t> frames = render::render(a.input, o);
+  if (!frames) return fail(frames.error().message);
+  std::fprintf(stderr, "rbsim render: %lld frames (%dx%d at %g fps) in %s\n", static_cast<long long>(frames.value()),
+               o.width, o.height, o.fps, a.out.c_str());
+  if (!a.mp4.empty()) {
+    if (Status st = render::make_movie(a.out, a.fps, a.mp4); !st) return fail(st.error().message);
+    std::fprintf(stderr, "rbsim render: movie %s\n", a.mp4.c_str());
+  }
+  return 0;
+}
+
+struct PlotArgs {
+  std::string input, out, size = "1200x900";
+  std::optional<double> duration;
+};
+
+int plot_command(const PlotArgs& a) {
+  render::PlotOptions o;
+  o.out_png = a.out;
+  o.duration = a.duration;
+  if (!render::parse_size(a.size, o.width, o.height)) {
+    std::fprintf(stderr, "rbsim plot: error: invalid --size \"%s\" (expected WxH)\n", a.size.c_str());
+    return 1;
+  }
+  if (Status st = render::plot(a.input, o); !st) {
+    std::fprintf(stderr, "rbsim plot: error: %s\n", st.error().message.c_str());
+    return 1;
+  }
+  return 0;
+}
+}  // namespace
+
+Subcommand add_render_command(CLI::App& parent) {
+  auto a = std::make_shared<RenderArgs>();
+  CLI::App* app = parent.add_subcommand("render", "Draw a scene (simulated on the fly) or an MCAP recording as PNG frames");
+  app->add_option("input", a->input, "FOSSSim XML scene, or an rbsim MCAP recording")->required();
+  app->add_option("--out", a->out, "Folder for frame00000.png, frame00001.png, ... (created if needed)")->required();
+  app->add_option("--fps", a->fps, "Frames per simulated second")->default_str("24");
+  app->add_option("--size", a->size, "Frame size WxH in pixels")->default_str("1280x720");
+  app->add_option("--duration", a->duration, "Simulated seconds to draw (default: the scene's duration)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--mp4", a->mp4, "Also assemble the frames into an H.264 (yuv420p) movie with ffmpeg");
+  app->footer("Frame k shows time k / fps (the first step at or after it); duration x fps frames in all. Bodies are "
+              "filled hulls grown by their radius r in their scene colours, springs are lines in theirs (fixed ends "
+              "ringed), on the scene's background, framed by its viewport (or fitted to the bodies).");
+  return {app, [a] { return render_command(*a); }};
+}
+
+Subcommand add_plot_command(CLI::App& parent) {
+  auto a = std::make_shared<PlotArgs>();
+  CLI::App* app = parent.add_subcommand(
+      "plot", "Plot kinetic (centre of mass, spin), potential and total energy and total momentum over time (gnuplot)");
+  app->add_option("input", a->input, "FOSSSim XML scene (simulated), or an rbsim MCAP recording")->required();
+  app->add_option("--out", a->out, "PNG file to write")->required();
+  app->add_option("--size", a->size, "Image size WxH in pixels")->default_str("1200x900");
+  app->add_option("--duration", a->duration, "Simulated seconds (scenes only; default: the scene's duration)")
+      ->check(CLI::PositiveNumber);
+  return {app, [a] { return plot_command(*a); }};
+}
+
+}  // namespace rbsim::cli

@@ -1,0 +1,130 @@
+// Energy and momentum over time, drawn by gnuplot.
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "process.hpp"
+#include "rbsim/mcap.hpp"
+#include "rbsim/render.hpp"
+
+namespace rbsim::render {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Sample {
+  double t, t_point, t_spin, u, e, px, py, l;
+};
+
+Result<std::vector<Sample>> samples_from_scene(const std::string& path, std::optional<double> duration) {
+  Result<Scene> scene = load_scene(path);
+  if (!scene) return scene.error();
+  Result<World> created = World::create(scene->world);
+  if (!created) return created.error();
+  World& w = created.value();
+  const std::int64_t steps = steps_for(duration.value_or(scene->duration), w.dt());
+  const std::int64_t every = std::max<std::int64_t>(1, steps / 4000);
+  std::vector<Sample> out;
+  while (true) {
+    if (w.step_index() % every == 0 || w.step_index() == steps) {
+      const Energy e = w.energy();
+      Vec2 p(0.0, 0.0);
+      double l = 0.0;
+      for (std::int32_t b = 0; b < w.body_count(); ++b) {
+        const BodyQuantities q = w.quantities(BodyId{b});
+        p += q.momentum;
+        l += q.l_point + q.l_spin;
+      }
+      out.push_back({w.time(), e.t_point, e.t_spin, e.potential(), e.total(), p.x(), p.y(), l});
+    }
+    if (w.step_index() >= steps) break;
+    w.step();
+    if (w.find_nonfinite()) return Error{path + ": the simulation diverged at step " + std::to_string(w.step_index())};
+  }
+  return out;
+}
+
+// The totals at the end of rbsim_msgs/msg/EnergyTerms, found by name in the file's schema.
+Result<std::vector<Sample>> samples_from_log(const std::string& path) {
+  mcap::IndexedReader reader;
+  if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
+  std::vector<Sample> out;
+  std::optional<msgs::MessageDecoder> decoder;
+  std::vector<msgs::Scalar> v;
+  std::string failure;
+  auto st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+    if (e.schema == nullptr || e.schema->name != "rbsim_msgs/msg/EnergyTerms") return true;
+    const std::span<const std::byte> data(reinterpret_cast<const std::byte*>(e.message.data.data()),
+                                          e.message.data.size());
+    if (!decoder) {
+      auto d = msgs::MessageDecoder::create(
+          e.schema->name, std::string_view(reinterpret_cast<const char*>(e.schema->data.data()), e.schema->data.size()));
+      if (!d) return failure = d.error().message, false;
+      decoder = std::move(d.value());
+    }
+    if (Status s = decoder->decode(data, v); !s || v.size() < 9) {
+      return failure = "bad EnergyTerms message", false;
+    }
+    const std::size_t n = v.size();
+    if (decoder->path(data, n - 7) != "momentum.x" || decoder->path(data, n - 1) != "total") {
+      return failure = "EnergyTerms schema is not the one this rbsim writes", false;
+    }
+    const double t = static_cast<double>(v[0].i) + 1e-9 * static_cast<double>(v[1].u);
+    out.push_back({t, v[n - 3].f, v[n - 2].f, v[n - 4].f, v[n - 1].f, v[n - 7].f, v[n - 6].f, v[n - 5].f});
+    return true;
+  });
+  if (!st.ok()) return Error{path + ": " + st.message};
+  if (!failure.empty()) return Error{path + ": " + failure};
+  if (out.empty()) return Error{path + ": the log has no energy terms (topic of type rbsim_msgs/msg/EnergyTerms)"};
+  return out;
+}
+
+}  // namespace
+
+Status plot(const std::string& input, const PlotOptions& o) {
+  Result<std::vector<Sample>> samples = detail::is_mcap(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
+  if (!samples) return samples.error();
+
+  const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp", temp = o.out_png + ".tmp";
+  {
+    std::ofstream f(data);
+    for (const Sample& s : samples.value()) {
+      char line[256];
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t, s.t_point, s.t_spin,
+                    s.u, s.e, s.px, s.py, s.l);
+      f << line;
+    }
+    if (!f) return Error{o.out_png + ": cannot write temporary data beside it"};
+  }
+  {
+    std::ofstream f(script);
+    f << "set terminal pngcairo size " << o.width << "," << o.height << " enhanced font 'DejaVu Sans,11'\n"
+      << "set output '" << temp << "'\n"
+      << "set datafile separator ','\nset grid\nset key outside right top\nset xlabel 'time (s)'\n"
+      << "set multiplot layout 2,1 title '" << fs::path(input).filename().string() << "'\n"
+      << "set title 'Energy'\nset ylabel 'energy'\n"
+      << "plot '" << data << "' using 1:2 with lines lw 1.5 title 'T_{point} (centre of mass)', "
+      << "'' using 1:3 with lines lw 1.5 title 'T_{spin}', '' using 1:4 with lines lw 1.5 title 'U (potential)', "
+      << "'' using 1:5 with lines lw 2.5 title 'E = T + U'\n"
+      << "set title 'Momentum'\nset ylabel 'momentum'\n"
+      << "plot '" << data << "' using 1:6 with lines lw 1.5 title 'P_x', '' using 1:7 with lines lw 1.5 title 'P_y', "
+      << "'' using 1:8 with lines lw 2 title 'L = L_{point} + L_{spin}'\n"
+      << "unset multiplot\n";
+  }
+  Result<int> code = detail::run_process({"gnuplot", script});
+  std::remove(data.c_str());
+  std::remove(script.c_str());
+  if (!code) return Error{"gnuplot: " + code.error().message};
+  if (code.value() != 0) {
+    std::remove(temp.c_str());
+    return Error{"gnuplot failed drawing " + o.out_png};
+  }
+  std::error_code ec;
+  fs::rename(temp, o.out_png, ec);
+  if (ec) return Error{o.out_png + ": " + ec.message()};
+  return Ok{};
+}
+
+}  // namespace rbsim::render

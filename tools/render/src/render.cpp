@@ -1,0 +1,217 @@
+// Frames, movies and plots of a scene or a recording.
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "rbsim/log.hpp"
+#include "process.hpp"
+#include "rbsim/render.hpp"
+
+extern char** environ;
+
+namespace rbsim::render {
+
+namespace fs = std::filesystem;
+
+bool parse_size(const std::string& text, int& width, int& height) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) return false;
+  if (w < 16 || h < 16 || w > 16384 || h > 16384) return false;
+  width = w;
+  height = h;
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+FrameWriter::FrameWriter(std::string dir, int width, int height, double fps)
+    : dir_(std::move(dir)), fps_(fps), canvas_(width, height) {}
+
+Status FrameWriter::open() {
+  std::error_code ec;
+  fs::create_directories(dir_, ec);
+  if (ec || !fs::is_directory(dir_)) return Error{dir_ + ": cannot create output folder: " + ec.message()};
+  const std::string probe = (fs::path(dir_) / ".rbsim-write-test").string();
+  std::FILE* f = std::fopen(probe.c_str(), "wb");
+  if (f == nullptr) return Error{dir_ + ": output folder is not writable: " + std::strerror(errno)};
+  std::fclose(f);
+  std::remove(probe.c_str());
+  return Ok{};
+}
+
+Status FrameWriter::offer(const Stage& stage, std::int64_t step, double dt, std::span<const Pose> poses) {
+  while (frame_step(next_, fps_, dt) <= step && next_ < frame_count(stage.duration, fps_)) {
+    if (!camera_) camera_ = camera_for(stage, poses, canvas_.width(), canvas_.height());
+    canvas_.draw(stage, poses, static_cast<double>(step) * dt, *camera_);
+    char name[32];
+    std::snprintf(name, sizeof name, "frame%05lld.png", static_cast<long long>(next_));
+    if (Status st = canvas_.write_png((fs::path(dir_) / name).string()); !st) return st;
+    ++next_;
+  }
+  return Ok{};
+}
+
+namespace {
+
+void poses_of(const World& world, std::vector<Pose>& out) {
+  out.resize(static_cast<std::size_t>(world.body_count()));
+  for (std::int32_t b = 0; b < world.body_count(); ++b) out[b] = {world.x()[b], world.y()[b], world.theta()[b]};
+}
+
+class FrameSink final : public Sink {
+ public:
+  FrameSink(std::string dir, int width, int height, double fps) : frames_(std::move(dir), width, height, fps) {}
+  Status begin(const Scene& scene, const World& world) override {
+    stage_ = stage_of(scene, world);
+    stage_.duration = INFINITY;  // a run decides its own length (--steps / --duration)
+    if (Status st = frames_.open(); !st) return st;
+    return write(world);
+  }
+  Status write(const World& world) override {
+    poses_of(world, poses_);
+    return frames_.offer(stage_, world.step_index(), world.dt(), poses_);
+  }
+  Status finish() override { return Ok{}; }
+
+ private:
+  FrameWriter frames_;
+  Stage stage_;
+  std::vector<Pose> poses_;
+};
+
+std::span<const std::byte> bytes_of(const mcap::Message& m) {
+  return {reinterpret_cast<const std::byte*>(m.data.data()), m.data.size()};
+}
+
+// Calls on_scene once, then on_states for each recorded body-state message in step order.
+Status read_recording(const std::string& path, const std::function<Status(const msgs::SceneMessage&)>& on_scene,
+                      const std::function<Status(const msgs::BodyStatesMessage&)>& on_states) {
+  mcap::IndexedReader reader;
+  if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
+  std::optional<msgs::SceneMessage> scene;
+  msgs::BodyStatesMessage states;
+  Status result = Ok{};
+  auto st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+    if (e.schema == nullptr) return true;
+    if (e.schema->name == "rbsim_msgs/msg/SceneDescription" && !scene) {
+      auto decoded = msgs::decode_scene(bytes_of(e.message));
+      if (!decoded) return result = Error{path + ": " + decoded.error().message}, false;
+      scene = decoded.value();
+      if (Status s = on_scene(*scene); !s) return result = s, false;
+    } else if (e.schema->name == "rbsim_msgs/msg/BodyStates") {
+      if (!scene) return result = Error{path + ": body states before any scene description"}, false;
+      if (Status s = msgs::decode_body_states(bytes_of(e.message), states); !s) {
+        return result = Error{path + ": " + s.error().message}, false;
+      }
+      if (states.bodies.size() != scene->bodies.size()) {
+        return result = Error{path + ": body states do not match the scene description"}, false;
+      }
+      if (Status s = on_states(states); !s) return result = s, false;
+    }
+    return true;
+  });
+  if (!st.ok()) return Error{path + ": " + st.message};
+  if (!result) return result;
+  if (!scene) return Error{path + ": the log has no scene description (topic of type rbsim_msgs/msg/SceneDescription)"};
+  return Ok{};
+}
+
+}  // namespace
+
+namespace detail {
+bool is_mcap(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, 8);
+  return in.gcount() == 8 && std::memcmp(magic, mcap::kMagic, 8) == 0;
+}
+
+Result<int> run_process(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int err = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ);
+  if (err != 0) {
+    return Error{args[0] + " could not be started (" + std::strerror(err) + "): install it (scripts/setup installs it)"};
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace detail
+
+std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, double fps) {
+  return std::make_unique<FrameSink>(std::move(dir), width, height, fps);
+}
+
+Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
+  FrameWriter frames(o.out_dir, o.width, o.height, o.fps);
+  std::vector<Pose> poses;
+  if (detail::is_mcap(input)) {
+    Stage stage;
+    Status st = read_recording(
+        input,
+        [&](const msgs::SceneMessage& m) {
+          stage = stage_of(m);
+          if (o.duration) stage.duration = *o.duration;
+          return frames.open();
+        },
+        [&](const msgs::BodyStatesMessage& m) {
+          poses.clear();
+          for (const auto& b : m.bodies) poses.push_back({b.state.position.x(), b.state.position.y(), b.state.theta});
+          return frames.offer(stage, static_cast<std::int64_t>(m.step), stage.dt, poses);
+        });
+    if (!st) return st.error();
+    return frames.frames();
+  }
+  Result<Scene> scene = load_scene(input);
+  if (!scene) return scene.error();
+  Result<World> created = World::create(scene->world);
+  if (!created) return created.error();
+  World& world = created.value();
+  Stage stage = stage_of(scene.value(), world);
+  if (o.duration) stage.duration = *o.duration;
+  if (Status st = frames.open(); !st) return st.error();
+  const std::int64_t frames_wanted = frame_count(stage.duration, o.fps);
+  const std::int64_t last_step = frame_step(frames_wanted - 1, o.fps, world.dt());
+  while (true) {
+    poses_of(world, poses);
+    if (Status st = frames.offer(stage, world.step_index(), world.dt(), poses); !st) return st.error();
+    if (world.step_index() >= last_step) break;
+    world.step();
+    if (const auto bad = world.find_nonfinite()) {
+      return Error{"step " + std::to_string(world.step_index()) + ": " + bad->quantity + " is not finite: the simulation diverged"};
+    }
+  }
+  return frames.frames();
+}
+
+Status make_movie(const std::string& frames_dir, double fps, const std::string& mp4) {
+  const std::string temp = mp4 + ".tmp.mp4";
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%g", fps);
+  Result<int> code = detail::run_process({"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i",
+                                  (fs::path(frames_dir) / "frame%05d.png").string(), "-c:v", "libx264", "-pix_fmt",
+                                  "yuv420p", "-crf", "20", "-movflags", "+faststart", temp});
+  if (!code) return Error{"ffmpeg: " + code.error().message};
+  if (code.value() != 0) {
+    std::remove(temp.c_str());
+    return Error{"ffmpeg failed (exit " + std::to_string(code.value()) + ") making " + mp4};
+  }
+  std::error_code ec;
+  fs::rename(temp, mp4, ec);
+  if (ec) return Error{mp4 + ": " + ec.message()};
+  return Ok{};
+}
+
+}  // namespace rbsim::render
