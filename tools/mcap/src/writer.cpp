@@ -82,27 +82,32 @@ struct Writer::Impl {
 
   Status flush_chunk() {
     if (chunk.empty()) return Status::Ok();
-    Status s = compressor->compress(chunk, compressed);
-    if (!s.ok()) return error = s;
+    // An uncompressed chunk is written straight from `chunk`, without a copy through the compressor.
+    Status s;
+    ByteView payload = chunk;
+    if (options.compression != Compression::None) {
+      if (!(s = compressor->compress(chunk, compressed)).ok()) return error = s;
+      payload = compressed;
+    }
     const std::string_view compression = compression_name(options.compression);
     // Chunk header written by hand so the (possibly large) records are not copied again.
     scratch.clear();
     put_u8(scratch, static_cast<std::uint8_t>(Opcode::Chunk));
-    put_u64(scratch, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + compressed.size());
+    put_u64(scratch, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + payload.size());
     put_u64(scratch, chunk_has_messages ? chunk_start_time : 0);
     put_u64(scratch, chunk_has_messages ? chunk_end_time : 0);
     put_u64(scratch, chunk.size());
     put_u32(scratch, options.enable_crcs ? crc32(chunk) : 0);
     put_string(scratch, compression);
-    put_u64(scratch, compressed.size());
+    put_u64(scratch, payload.size());
     ChunkIndex index;
     index.message_start_time = chunk_has_messages ? chunk_start_time : 0;
     index.message_end_time = chunk_has_messages ? chunk_end_time : 0;
     index.chunk_start_offset = offset;
     index.compression = std::string(compression);
-    index.compressed_size = compressed.size();
+    index.compressed_size = payload.size();
     index.uncompressed_size = chunk.size();
-    if (!(s = write(scratch)).ok() || !(s = write(compressed)).ok()) return s;
+    if (!(s = write(scratch)).ok() || !(s = write(payload)).ok()) return s;
     index.chunk_length = offset - index.chunk_start_offset;
     if (options.emit_message_indexes) {
       const std::uint64_t start = offset;

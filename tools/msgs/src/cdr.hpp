@@ -4,6 +4,7 @@
 // the bytes are identical to what Cyclone serialises for the same sample.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <string_view>
@@ -20,9 +21,11 @@ class CdrWriter {
   explicit CdrWriter(Bytes& out) : out_(out) {
     out_.assign(4, std::byte{0});
     out_[1] = std::byte{1};
+    n_ = 4;
   }
   // Finishes the message when the encoder is done with it: pads to 4, records the pad count.
   ~CdrWriter() {
+    out_.resize(n_);  // drop the unused workspace past the last value written
     const std::size_t pad = (4 - out_.size() % 4) % 4;
     out_.resize(out_.size() + pad, std::byte{0});
     out_[3] = static_cast<std::byte>(pad);
@@ -52,22 +55,35 @@ class CdrWriter {
   }
 
  private:
+  // The vector serves as workspace: values go to [n_, ...) and out_ grows geometrically (within its
+  // capacity first), so a value costs a bounds check and a copy instead of a resize each; the
+  // destructor trims out_ to n_. Bytes are the same as appending value by value.
   template <class T>
   void put(T v) {
     // Primitives align to their own size, counted from the end of the encapsulation header.
-    const std::size_t offset = out_.size() - 4;
-    const std::size_t pad = (sizeof(T) - offset % sizeof(T)) % sizeof(T);
-    out_.resize(out_.size() + pad + sizeof(T));
-    std::memset(out_.data() + out_.size() - sizeof(T) - pad, 0, pad);
-    std::memcpy(out_.data() + out_.size() - sizeof(T), &v, sizeof(T));
+    static_assert(std::has_single_bit(sizeof(T)));
+    const std::size_t pad = (0 - (n_ - 4)) & (sizeof(T) - 1);
+    std::byte* p = room(pad + sizeof(T));
+    std::memset(p, 0, pad);
+    std::memcpy(p + pad, &v, sizeof(T));
   }
   void raw(const void* p, std::size_t n) {
     if (n == 0) return;
-    const std::size_t at = out_.size();
-    out_.resize(at + n);
-    std::memcpy(out_.data() + at, p, n);
+    std::memcpy(room(n), p, n);
+  }
+  // Pointer to `n` writable bytes at the end of the message; advances the end past them.
+  std::byte* room(std::size_t n) {
+    if (n_ + n > out_.size()) grow(n_ + n);
+    std::byte* p = out_.data() + n_;
+    n_ += n;
+    return p;
+  }
+  void grow(std::size_t need) {
+    const std::size_t doubled = std::max<std::size_t>(2 * out_.size(), 256);
+    out_.resize(std::max(need, out_.capacity() > need ? std::min(doubled, out_.capacity()) : doubled));
   }
   Bytes& out_;
+  std::size_t n_ = 0;  // bytes of the message written so far
 };
 
 }  // namespace rbsim::msgs::detail

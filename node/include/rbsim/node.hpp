@@ -1,0 +1,176 @@
+// rbsim over DDS: the node that streams a running scene, the recorder and the replay, on
+// Eclipse Cyclone DDS with ROS 2 conventions (topics "rt/<namespace>/<name>", types
+// "pkg::msg::dds_::Name_", CDR with the 4-byte encapsulation header), so a ROS 2 system using
+// rmw_cyclonedds_cpp sees the topics. Payloads are the exact bytes rbsim_msgs encodes: the same
+// bytes go to DDS, to MCAP and back.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rbsim/io.hpp"
+#include "rbsim/mcap.hpp"
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::node {
+
+// Domain ids that map onto valid UDP ports with the default port mapping.
+inline constexpr std::uint32_t kMaxDomainId = 232;
+
+// A DDS participant. Without CYCLONEDDS_URI in the environment the domain runs on rbsim's
+// loopback configuration (127.0.0.1 only, no multicast, ParticipantIndex auto); with it, on
+// whatever that configuration says.
+class Participant {
+ public:
+  static Result<Participant> create(std::uint32_t domain);
+  Participant(Participant&& other) noexcept;
+  Participant& operator=(Participant&&) = delete;
+  ~Participant();
+  std::int32_t handle() const { return handle_; }
+  std::uint32_t domain() const { return domain_; }
+
+ private:
+  Participant(std::int32_t handle, std::uint32_t domain) : handle_(handle), domain_(domain) {}
+  std::int32_t handle_ = 0;
+  std::uint32_t domain_ = 0;
+};
+
+// The loopback configuration compiled into rbsim (node/config/cyclonedds-loopback.xml).
+std::string_view loopback_config();
+
+struct QosSpec {
+  bool transient_local = false;  // late joiners get the last sample (the scene description)
+  std::int32_t depth = 1000;     // keep-last depth
+};
+QosSpec qos_for(const msgs::TopicSpec& spec);
+
+// Publishes pre-encoded CDR messages on one topic.
+class Publisher {
+ public:
+  static Result<Publisher> create(const Participant& participant, const msgs::TopicSpec& spec, std::string_view ros_topic,
+                                  const QosSpec& qos);
+  Publisher(Publisher&&) noexcept;
+  Publisher& operator=(Publisher&&) = delete;
+  ~Publisher();
+  [[nodiscard]] Status publish(std::span<const std::byte> cdr);
+  std::int32_t matched() const;  // subscriptions currently matched
+  const std::string& ros_topic() const { return ros_topic_; }
+
+ private:
+  Publisher() = default;
+  std::int32_t writer_ = 0, topic_ = 0;
+  std::string ros_topic_;
+};
+
+// Takes raw CDR samples from one topic.
+struct Received {
+  std::vector<std::byte> cdr;
+  std::int64_t source_time_ns = 0;
+};
+class Subscription {
+ public:
+  static Result<Subscription> create(const Participant& participant, const msgs::TopicSpec& spec,
+                                     std::string_view ros_topic, const QosSpec& qos);
+  Subscription(Subscription&&) noexcept;
+  Subscription& operator=(Subscription&&) = delete;
+  ~Subscription();
+  // Takes one sample if there is one.
+  bool take(Received& out);
+  std::int32_t reader() const { return reader_; }
+  std::uint64_t lost() const;  // samples DDS reports lost or rejected
+  const std::string& ros_topic() const { return ros_topic_; }
+  const msgs::TopicSpec& spec() const { return *spec_; }
+
+ private:
+  Subscription() = default;
+  std::int32_t reader_ = 0, topic_ = 0;
+  std::string ros_topic_;
+  const msgs::TopicSpec* spec_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The node: a Sink that publishes every topic of a step over DDS.
+
+struct NodeOptions {
+  std::uint32_t domain = 0;
+  std::string ns = "rbsim";
+  double rate = 1.0;               // real-time factor; 0: as fast as possible
+  std::int64_t publish_every = 1;  // publish every k-th step
+};
+// Publishes the scene description at begin() and the per-step topics on every k-th step,
+// pacing steps to wall time by `rate`.
+class DdsSink final : public Sink {
+ public:
+  static Result<std::unique_ptr<DdsSink>> create(const Participant& participant, const NodeOptions& options);
+  Status begin(const Scene& scene, const World& world) override;
+  Status write(const World& world) override;
+  Status finish() override { return Ok{}; }
+  // Waits until `count` subscriptions match the body-state topic; false when `stop` turned true.
+  bool wait_for_subscribers(std::int32_t count, bool (*stop)());
+  // Restarts the pacing clock (e.g. when --loop starts the scene again).
+  void restart_clock();
+  std::uint64_t published() const { return published_; }
+
+ private:
+  DdsSink() = default;
+  Status publish(msgs::TopicId id, const World& world);
+  NodeOptions options_;
+  std::vector<std::optional<Publisher>> publishers_;  // by TopicId
+  std::unique_ptr<msgs::Encoder> encoder_;
+  msgs::Bytes buffer_;
+  std::int64_t start_ns_ = 0;       // monotonic clock at the paced step
+  std::int64_t start_step_ = 0;
+  std::uint64_t published_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The recorder: subscribes to rbsim topics and writes the exact CDR payloads to MCAP (rosbag2
+// layout), log_time = receive time, publish_time = the sample's source timestamp (both ns since
+// the Unix epoch). Chunks are flushed as they fill, so a killed recorder leaves a file
+// `rbsim log recover` repairs.
+
+struct RecorderOptions {
+  std::string path;
+  std::string ns = "rbsim";
+  std::vector<std::string> topics;  // names ("body_states" or "/rbsim/body_states"); empty: all
+  mcap::Compression compression = mcap::Compression::Zstd;
+  std::uint64_t chunk_size = 1 << 20;
+  std::uint64_t max_messages = 0;   // 0: no limit
+};
+
+class Recorder {
+ public:
+  static Result<std::unique_ptr<Recorder>> create(const Participant& participant, const RecorderOptions& options);
+  ~Recorder();
+  // Waits up to `timeout_ns` for data and records everything available; true if anything came.
+  Result<bool> poll(std::int64_t timeout_ns);
+  [[nodiscard]] Status close();  // finishes a valid, indexed file
+  std::uint64_t received() const { return received_; }
+  struct TopicCount {
+    std::string topic;
+    std::uint64_t received = 0, lost = 0;
+  };
+  std::vector<TopicCount> counts() const;
+
+ private:
+  Recorder() = default;
+  struct Topic {
+    Subscription subscription;
+    std::uint16_t channel;
+    std::uint32_t received;
+  };
+  RecorderOptions options_;
+  mcap::Writer writer_;
+  std::int32_t waitset_ = 0;
+  std::vector<Topic> topics_;
+  std::uint64_t received_ = 0;
+};
+
+// Looks up a TopicSpec by ROS topic suffix ("body_states") or full name ("/rbsim/body_states").
+const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns);
+
+}  // namespace rbsim::node

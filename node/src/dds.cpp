@@ -1,0 +1,171 @@
+// Cyclone DDS plumbing: participants, raw-CDR publishers and subscriptions.
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
+#include <dds/ddsi/ddsi_sertype.h>
+
+#include <cstdlib>
+#include <cstring>
+
+#include "raw_serdata.hpp"
+#include "rbsim/node.hpp"
+#include "topics.hpp"
+
+namespace rbsim::node {
+
+namespace {
+Error dds_error(const std::string& what, dds_return_t rc) { return Error{what + ": " + dds_strretcode(rc)}; }
+
+dds_qos_t* make_qos(const QosSpec& q, bool reader) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+  if (reader && !q.transient_local) {
+    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);  // the recorder keeps everything it is sent
+  } else {
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.depth);
+  }
+  return qos;
+}
+
+Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec& spec, std::string_view ros_topic) {
+  const dds_topic_descriptor_t* desc = descriptor(spec.id);
+  const std::string name = msgs::dds_topic_name(ros_topic);
+  const dds_entity_t topic = dds_create_topic(participant, desc, name.c_str(), nullptr, nullptr);
+  if (topic < 0) return dds_error("cannot create DDS topic " + name, topic);
+  return topic;
+}
+}  // namespace
+
+std::string_view loopback_config() { return kLoopbackConfig; }
+
+Result<Participant> Participant::create(std::uint32_t domain) {
+  if (domain > kMaxDomainId) {
+    return Error{"domain id " + std::to_string(domain) + " out of range [0, " + std::to_string(kMaxDomainId) + "]"};
+  }
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (uri == nullptr || *uri == '\0') {
+    // No configuration given: rbsim's loopback one. dds_create_domain fails harmlessly when the
+    // domain already exists in this process.
+    const std::string config(loopback_config());
+    const dds_entity_t d = dds_create_domain(domain, config.c_str());
+    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) return dds_error("cannot create DDS domain", d);
+  }
+  const dds_entity_t p = dds_create_participant(domain, nullptr, nullptr);
+  if (p < 0) {
+    std::string hint = uri != nullptr && *uri != '\0' ? std::string(" (check CYCLONEDDS_URI=") + uri + ")" : "";
+    return dds_error("cannot create a DDS participant on domain " + std::to_string(domain) + hint, p);
+  }
+  return Participant(p, domain);
+}
+
+Participant::Participant(Participant&& o) noexcept : handle_(o.handle_), domain_(o.domain_) { o.handle_ = 0; }
+Participant::~Participant() {
+  if (handle_ > 0) dds_delete(handle_);
+}
+
+QosSpec qos_for(const msgs::TopicSpec& spec) {
+  QosSpec q;
+  q.transient_local = spec.transient_local;
+  q.depth = spec.transient_local ? 1 : 1000;
+  return q;
+}
+
+// ---------------------------------------------------------------------------------------------
+Result<Publisher> Publisher::create(const Participant& participant, const msgs::TopicSpec& spec,
+                                    std::string_view ros_topic, const QosSpec& q) {
+  auto topic = make_topic(participant.handle(), spec, ros_topic);
+  if (!topic) return topic.error();
+  dds_qos_t* qos = make_qos(q, false);
+  const dds_entity_t writer = dds_create_writer(participant.handle(), topic.value(), qos, nullptr);
+  dds_delete_qos(qos);
+  if (writer < 0) return dds_error("cannot create DDS writer for " + std::string(ros_topic), writer);
+  Publisher p;
+  p.writer_ = writer;
+  p.topic_ = topic.value();
+  p.ros_topic_ = std::string(ros_topic);
+  return p;
+}
+
+Publisher::Publisher(Publisher&& o) noexcept : writer_(o.writer_), topic_(o.topic_), ros_topic_(std::move(o.ros_topic_)) {
+  o.writer_ = o.topic_ = 0;
+}
+Publisher::~Publisher() {
+  if (writer_ > 0) dds_delete(writer_);
+  if (topic_ > 0) dds_delete(topic_);
+}
+
+Status Publisher::publish(std::span<const std::byte> cdr) {
+  ddsi_serdata* d = make_raw_serdata(cdr);
+  const dds_return_t rc = dds_writecdr(writer_, d);  // takes the reference
+  if (rc < 0) return dds_error("publishing on " + ros_topic_ + " failed", rc);
+  return Ok{};
+}
+
+std::int32_t Publisher::matched() const {
+  dds_publication_matched_status_t st{};
+  if (dds_get_publication_matched_status(writer_, &st) < 0) return 0;
+  return static_cast<std::int32_t>(st.current_count);
+}
+
+// ---------------------------------------------------------------------------------------------
+Result<Subscription> Subscription::create(const Participant& participant, const msgs::TopicSpec& spec,
+                                          std::string_view ros_topic, const QosSpec& q) {
+  auto topic = make_topic(participant.handle(), spec, ros_topic);
+  if (!topic) return topic.error();
+  dds_qos_t* qos = make_qos(q, true);
+  const dds_entity_t reader = dds_create_reader(participant.handle(), topic.value(), qos, nullptr);
+  dds_delete_qos(qos);
+  if (reader < 0) return dds_error("cannot create DDS reader for " + std::string(ros_topic), reader);
+  dds_set_status_mask(reader, DDS_DATA_AVAILABLE_STATUS | DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS);
+  Subscription s;
+  s.reader_ = reader;
+  s.topic_ = topic.value();
+  s.ros_topic_ = std::string(ros_topic);
+  s.spec_ = &spec;
+  return s;
+}
+
+Subscription::Subscription(Subscription&& o) noexcept
+    : reader_(o.reader_), topic_(o.topic_), ros_topic_(std::move(o.ros_topic_)), spec_(o.spec_) {
+  o.reader_ = o.topic_ = 0;
+}
+Subscription::~Subscription() {
+  if (reader_ > 0) dds_delete(reader_);
+  if (topic_ > 0) dds_delete(topic_);
+}
+
+bool Subscription::take(Received& out) {
+  while (true) {
+    ddsi_serdata* d = nullptr;
+    dds_sample_info_t info{};
+    const dds_return_t n = dds_takecdr(reader_, &d, 1, &info, DDS_ANY_STATE);
+    if (n <= 0) return false;
+    if (!info.valid_data) {
+      ddsi_serdata_unref(d);
+      continue;
+    }
+    const std::uint32_t size = ddsi_serdata_size(d);
+    out.cdr.resize(size);
+    ddsi_serdata_to_ser(d, 0, size, out.cdr.data());
+    out.source_time_ns = info.source_timestamp;
+    ddsi_serdata_unref(d);
+    return true;
+  }
+}
+
+std::uint64_t Subscription::lost() const {
+  dds_sample_lost_status_t lost{};
+  dds_sample_rejected_status_t rejected{};
+  dds_get_sample_lost_status(reader_, &lost);
+  dds_get_sample_rejected_status(reader_, &rejected);
+  return static_cast<std::uint64_t>(lost.total_count) + static_cast<std::uint64_t>(rejected.total_count);
+}
+
+const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns) {
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (name == spec.suffix || name == msgs::topic_name(spec, ns)) return &spec;
+  }
+  return nullptr;
+}
+
+}  // namespace rbsim::node

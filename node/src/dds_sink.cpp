@@ -1,0 +1,76 @@
+// The node's output: every topic of a step published over DDS, paced to wall time.
+#include <time.h>
+
+#include <cmath>
+
+#include "rbsim/node.hpp"
+
+namespace rbsim::node {
+
+namespace {
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+void sleep_until(std::int64_t deadline_ns) {
+  timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  // Interrupted by a signal (Ctrl-C): return early and let the caller look at its stop flag.
+  (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+}
+}  // namespace
+
+Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant, const NodeOptions& options) {
+  std::unique_ptr<DdsSink> sink(new DdsSink());
+  sink->options_ = options;
+  if (sink->options_.publish_every < 1) sink->options_.publish_every = 1;
+  sink->publishers_.resize(msgs::kTopicCount);
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns), qos_for(spec));
+    if (!pub) return pub.error();
+    sink->publishers_[static_cast<std::size_t>(spec.id)].emplace(std::move(pub.value()));
+  }
+  return sink;
+}
+
+Status DdsSink::publish(msgs::TopicId id, const World& world) {
+  encoder_->encode(id, world, buffer_);
+  Status st = publishers_[static_cast<std::size_t>(id)]->publish(buffer_);
+  if (st) ++published_;
+  return st;
+}
+
+Status DdsSink::begin(const Scene& scene, const World& world) {
+  encoder_ = std::make_unique<msgs::Encoder>(scene);
+  restart_clock();
+  start_step_ = world.step_index();
+  if (Status st = publish(msgs::TopicId::Scene, world); !st) return st;
+  return write(world);
+}
+
+void DdsSink::restart_clock() { start_ns_ = monotonic_ns(); }
+
+Status DdsSink::write(const World& world) {
+  if (world.step_index() % options_.publish_every != 0) return Ok{};
+  if (options_.rate > 0.0) {
+    // Step n is due at start + (n - n0) dt / rate of wall time.
+    const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / options_.rate;
+    sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
+  }
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (!spec.per_step) continue;
+    if (Status st = publish(spec.id, world); !st) return st;
+  }
+  return Ok{};
+}
+
+bool DdsSink::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
+  const auto& states = publishers_[static_cast<std::size_t>(msgs::TopicId::BodyStates)];
+  while (states->matched() < count) {
+    if (stop()) return false;
+    sleep_until(monotonic_ns() + 20'000'000);
+  }
+  return true;
+}
+
+}  // namespace rbsim::node
