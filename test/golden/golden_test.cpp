@@ -1,0 +1,707 @@
+// Golden logs: every bundled scene rerun and checked against its golden with `rbsim check`, the
+// goldens re-verified independently of the simulator, and the check itself exercised: perturbed
+// runs, topic selection, tolerances, missing/extra messages, bad input, scripts/golden.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "rbsim/log.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace rbsim;
+
+const fs::path kSource = RBSIM_SOURCE_DIR;
+const fs::path kScenes = RBSIM_SCENES_DIR;
+const fs::path kGoldens = RBSIM_GOLDEN_DIR;
+const fs::path kFosssim = RBSIM_FOSSSIM_DIR;
+constexpr std::uintmax_t kMaxGoldenBytes = 2u << 20;
+constexpr std::uintmax_t kMaxGoldenTotal = 6u << 20;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers: files, temporary directories, running rbsim (or scripts/golden) with a time limit.
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  fs::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  ASSERT_TRUE(out.good()) << path;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() / ("rbsim_golden_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+struct Outcome {
+  int exit_code = -1;  // -1: killed by a signal or the time limit
+  int signal = 0;
+  bool timed_out = false;
+  std::string out, err;
+};
+
+std::ostream& operator<<(std::ostream& os, const Outcome& o) {
+  return os << "exit " << o.exit_code << " signal " << o.signal << (o.timed_out ? " (timed out)" : "")
+            << "\n--- stdout\n" << o.out << "--- stderr\n" << o.err;
+}
+
+Outcome run_process(const std::string& exe, const std::vector<std::string>& args,
+                    const std::vector<std::string>& extra_env = {},
+                    std::chrono::seconds timeout = std::chrono::seconds(240)) {
+  TempDir capture;
+  const std::string out_path = (capture / "stdout").string(), err_path = (capture / "stderr").string();
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  std::vector<std::string> argv_storage{exe};
+  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_storage;
+  for (char** e = environ; *e != nullptr; ++e) env_storage.emplace_back(*e);
+  env_storage.insert(env_storage.end(), extra_env.begin(), extra_env.end());
+  std::vector<char*> envp;
+  for (std::string& e : env_storage) envp.push_back(e.data());
+  envp.push_back(nullptr);
+
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  Outcome o;
+  if (rc != 0) {
+    o.err = "posix_spawn " + exe + ": " + std::strerror(rc);
+    return o;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  for (;;) {
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) break;
+    if (std::chrono::steady_clock::now() >= deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      o.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (!o.timed_out && WIFEXITED(status)) o.exit_code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) o.signal = WTERMSIG(status);
+  o.out = read_text(out_path);
+  o.err = read_text(err_path);
+  return o;
+}
+
+Outcome rbsim(const std::vector<std::string>& args) { return run_process(RBSIM_EXE, args); }
+
+// Records `scene` to `out` (all topics, zstd) with the given extra options; asserts success.
+void record(const fs::path& scene, const fs::path& out, const std::vector<std::string>& extra) {
+  std::vector<std::string> args{"run", scene.string(), "--record", out.string(), "--progress", "never", "--quiet"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const Outcome o = rbsim(args);
+  ASSERT_EQ(o.exit_code, 0) << o;
+}
+
+// A copy of `scene` with `from` replaced by `to` (exactly once), under `dir` with the same file
+// name (the recorded scene name is the file stem, so only the edited value differs).
+fs::path edited(const fs::path& dir, const fs::path& scene, const std::string& from, const std::string& to) {
+  std::string text = read_text(scene);
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " not in " << scene;
+  EXPECT_EQ(text.find(from, at + 1), std::string::npos) << from << " more than once in " << scene;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const fs::path out = dir / scene.filename();
+  write_text(out, text);
+  return out;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Scenes under scenes/ (subfolders included), as paths relative to it without ".xml".
+std::vector<std::string> scene_names() {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(kScenes, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_regular_file() && it->path().extension() == ".xml") {
+      names.push_back(it->path().lexically_relative(kScenes).replace_extension().generic_string());
+    }
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+fs::path scene_path(const std::string& name) { return kScenes / (name + ".xml"); }
+fs::path golden_path(const std::string& name) { return kGoldens / (name + ".mcap"); }
+
+std::string to_string(const log::GoldenVerification& v) {
+  std::string s = "rule " + v.rule + "\n";
+  for (const std::string& line : v.lines) s += "  " + line + "\n";
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Every scene: rerun and check against its golden; the golden verified; its size.
+
+class GoldenScene : public testing::TestWithParam<std::string> {};
+
+TEST_P(GoldenScene, RerunMatchesGolden) {
+  const fs::path golden = golden_path(GetParam());
+  ASSERT_TRUE(fs::exists(golden)) << "no golden for " << scene_path(GetParam()) << ": run scripts/golden "
+                                  << scene_path(GetParam());
+  Result<std::int64_t> every = log::read_record_every(golden.string());
+  ASSERT_TRUE(every) << every.error().message;
+  TempDir tmp;
+  const fs::path run = tmp / "run.mcap";
+  record(scene_path(GetParam()), run, {"--record-every", std::to_string(every.value())});
+  const Outcome o = rbsim({"check", run.string(), golden.string()});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, ": MATCH")) << o;
+  EXPECT_FALSE(contains(o.out, "first divergence")) << o;
+}
+
+TEST_P(GoldenScene, GoldenIsVerified) {
+  const fs::path golden = golden_path(GetParam());
+  ASSERT_TRUE(fs::exists(golden)) << "no golden for " << scene_path(GetParam());
+  log::GoldenVerifyOptions options;
+  options.fosssim_dir = kFosssim.string();
+  Result<log::GoldenVerification> v = log::verify_golden(scene_path(GetParam()).string(), golden.string(), options);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_TRUE(v->passed) << to_string(v.value());
+  // Every golden is re-integrated independently; against the FOSSSim reference when there is one,
+  // else, for conservative symplectic scenes, checked for energy conservation.
+  const log::FosssimMatch match = log::find_fosssim_reference(scene_path(GetParam()).string(), kFosssim.string());
+  Result<Scene> scene = load_scene(scene_path(GetParam()).string());
+  ASSERT_TRUE(scene) << scene.error().message;
+  const bool conservative =
+      scene->world.integrator == Integrator::SymplecticEuler && scene->world.winds.empty() && match.reference.empty();
+  EXPECT_TRUE(contains(v->rule, "independent-integration")) << to_string(v.value());
+  EXPECT_EQ(contains(v->rule, "fosssim-reference"), !match.reference.empty()) << to_string(v.value());
+  EXPECT_EQ(contains(v->rule, "symplectic-energy"), conservative) << to_string(v.value());
+  // A golden covers its whole run: steps 0, K, 2K, ... up to the scene's last step.
+  EXPECT_GT(v->record_every, 0);
+  EXPECT_LT(v->steps - v->last_step, v->record_every);
+}
+
+TEST_P(GoldenScene, GoldenIsSmall) {
+  const fs::path golden = golden_path(GetParam());
+  ASSERT_TRUE(fs::exists(golden));
+  EXPECT_LE(fs::file_size(golden), kMaxGoldenBytes);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GoldenScene, testing::ValuesIn(scene_names()),
+                         [](const testing::TestParamInfo<std::string>& param_info) {
+                           std::string name = param_info.param;
+                           for (char& c : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           }
+                           return name;
+                         });
+
+TEST(GoldenDir, OneGoldenPerSceneAndSmallInTotal) {
+  const std::vector<std::string> scenes = scene_names();
+  ASSERT_FALSE(scenes.empty());
+  std::set<std::string> goldens;
+  std::uintmax_t total = 0;
+  for (fs::recursive_directory_iterator it(kGoldens), end; it != end; ++it) {
+    if (it->is_regular_file() && it->path().extension() == ".mcap") {
+      goldens.insert(it->path().lexically_relative(kGoldens).replace_extension().generic_string());
+      total += it->file_size();
+    }
+  }
+  EXPECT_EQ(goldens, std::set<std::string>(scenes.begin(), scenes.end()))
+      << "every scene in scenes/ needs test/golden/<name>.mcap (scripts/golden), and no golden may outlive its scene";
+  EXPECT_LE(total, kMaxGoldenTotal);
+}
+
+// ---------------------------------------------------------------------------------------------
+// rbsim check
+
+const fs::path kChain = kScenes / "chain.xml";
+const fs::path kCantilever = kScenes / "cantilever.xml";
+const fs::path kChainGolden = kGoldens / "chain.mcap";
+constexpr const char* kChainEvery = "200";  // chain's golden: --record-every 200 (checked below)
+
+TEST(Check, ChainGoldenIsRecordedEvery200Steps) {
+  Result<std::int64_t> every = log::read_record_every(kChainGolden.string());
+  ASSERT_TRUE(every) << every.error().message;
+  EXPECT_EQ(std::to_string(every.value()), kChainEvery);
+}
+
+TEST(Check, IdenticalFilesMatch) {
+  Outcome o = rbsim({"check", kChainGolden.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, ": MATCH")) << o;
+  EXPECT_TRUE(contains(o.out, "fields identical")) << o;
+  TempDir tmp;
+  fs::copy_file(kChainGolden, tmp / "copy.mcap");
+  o = rbsim({"check", (tmp / "copy.mcap").string(), kChainGolden.string(), "--all-fields"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(/rbsim/body_states +bodies\[\]\.x +float)"))) << o;  // all fields
+}
+
+TEST(Check, ChangedTimeStepDivergesAtTheSceneDescription) {
+  TempDir tmp;
+  const fs::path scene = edited(tmp.path(), kChain, "dt=\"0.001\"", "dt=\"0.0009\"");
+  const fs::path run = tmp / "run.mcap";
+  record(scene, run, {"--record-every", kChainEvery});
+  Outcome o = rbsim({"check", run.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, ": DIVERGED")) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/scene, message 0, field dt: expected 0.001, actual "
+                              "0.0009, difference -0.0001"))
+      << o;
+  // Without the scene description, the first difference is the stamp of the first step recorded.
+  o = rbsim({"check", run.string(), kChainGolden.string(), "--exclude-topics", "/rbsim/scene"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 200, field header.stamp.nanosec: "
+                              "expected 200000000, actual 180000000, difference -20000000"))
+      << o;
+  EXPECT_TRUE(contains(o.out, "/rbsim/body_states")) << o;  // in the per-field table
+}
+
+TEST(Check, ChangedMassDivergesInTheBodyStates) {
+  // The first vertex of body 0 gets half as much mass again: M, I and the centre of mass move.
+  TempDir tmp;
+  const fs::path scene = edited(tmp.path(), kChain, "<rigidbodyvertex x=\"0\" y=\"0\" m=\"1\"/>",
+                                "<rigidbodyvertex x=\"0\" y=\"0\" m=\"1.5\"/>");
+  const fs::path run = tmp / "run.mcap";
+  record(scene, run, {"--record-every", kChainEvery});
+  Outcome o = rbsim({"check", run.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/scene, message 0, field bodies[0].mass: expected 2, "
+                              "actual 2.5, difference 0.5"))
+      << o;
+  o = rbsim({"check", run.string(), kChainGolden.string(), "--topics", "/rbsim/body_states"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 0, field bodies[0].x: expected 0.5, "
+                              "actual 0.4, difference -0.1"))
+      << o;
+  // Table rows: topic, collapsed field path, kind, values, max |diff|, max rel, at, over tol.
+  const std::regex row(R"(/rbsim/body_states +bodies\[\]\.y +float +(\d+) +(\S+) +\S+ +step \d+ +(\d+))");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(o.out, m, row)) << o;
+  EXPECT_EQ(std::stoul(m[1]), 501u * 5u);  // 501 recorded steps x 5 bodies
+  EXPECT_GT(std::stod(m[2]), 0.0);
+  EXPECT_GT(std::stoul(m[3]), 0u);
+  // With gravity changed instead, the scene description aside, the states part at step 200.
+  const fs::path heavier = edited(tmp / "g", kChain, "fy=\"-1.0\"", "fy=\"-1.5\"");
+  const fs::path run2 = tmp / "run2.mcap";
+  record(heavier, run2, {"--record-every", kChainEvery});
+  o = rbsim({"check", run2.string(), kChainGolden.string(), "--topics", "/rbsim/body_states"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  const std::regex first(R"(first divergence: topic /rbsim/body_states, step 200, field bodies\[[0-4]\]\.(x|y|theta|vx|vy|omega): expected \S+, actual \S+, difference \S+)");
+  EXPECT_TRUE(std::regex_search(o.out, first)) << o;
+  // Topics the change does not reach still match when they are all that is compared.
+  o = rbsim({"check", run.string(), kChainGolden.string(), "--topics", "/clock"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+}
+
+// Copies an MCAP file leaving out one topic.
+void copy_without(const fs::path& in, const fs::path& out, const std::string& topic) {
+  mcap::IndexedReader reader;
+  ASSERT_TRUE(reader.open(in.string()).ok());
+  mcap::Writer writer;
+  ASSERT_TRUE(writer.open(out.string(), log::writer_options(mcap::Compression::Zstd)).ok());
+  for (const auto& [id, schema] : reader.schemas()) ASSERT_TRUE(writer.add_schema(schema).ok());
+  for (const auto& [id, channel] : reader.channels()) {
+    if (channel.topic != topic) {
+      ASSERT_TRUE(writer.add_channel(channel).ok());
+    }
+  }
+  const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+    if (e.channel->topic != topic) {
+      EXPECT_TRUE(writer.write_message(e.message).ok());
+    }
+    return true;
+  });
+  ASSERT_TRUE(st.ok()) << st.message;
+  ASSERT_TRUE(writer.close().ok());
+}
+
+TEST(Check, TopicInOnlyOneFileAndTopicSelection) {
+  TempDir tmp;
+  const fs::path partial = tmp / "partial.mcap";
+  copy_without(kChainGolden, partial, "/rbsim/markers");
+  Outcome o = rbsim({"check", partial.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/markers: topic only in the golden (501 messages)")) << o;
+  o = rbsim({"check", kChainGolden.string(), partial.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "topic /rbsim/markers: topic only in the run")) << o;
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "/rbsim/markers"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/body_states,/rbsim/energy"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, "2 topics")) << o;
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/nope"});
+  EXPECT_EQ(o.exit_code, 2) << o;
+  EXPECT_TRUE(contains(o.err, "/rbsim/nope is in neither log")) << o;
+}
+
+// Two recordings of the cantilever for 2000 steps whose first vertex mass differs by `dm`.
+struct Pair {
+  TempDir tmp;
+  fs::path base, other;
+  explicit Pair(const std::string& mass) {
+    const std::vector<std::string> opts{"--steps", "2000", "--record-every", "20"};
+    base = tmp / "base.mcap";
+    other = tmp / "other.mcap";
+    record(kCantilever, base, opts);
+    fs::create_directories(tmp / "edited");
+    const fs::path scene = edited(tmp / "edited", kCantilever, "<rigidbodyvertex x=\"0\" y=\"0\" m=\"1\"/>",
+                                  "<rigidbodyvertex x=\"0\" y=\"0\" m=\"" + mass + "\"/>");
+    record(scene, other, opts);
+  }
+};
+
+TEST(Check, TolerancesAcceptSmallDifferencesAndRejectLargeOnes) {
+  const Pair tiny("1.000000001"), large("1.01");
+  // Exact by default.
+  Outcome o = rbsim({"check", tiny.other.string(), tiny.base.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  // An absolute tolerance covering the tiny change, not the large one.
+  o = rbsim({"check", tiny.other.string(), tiny.base.string(), "--atol", "1e-5"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, ": MATCH")) << o;
+  o = rbsim({"check", large.other.string(), large.base.string(), "--atol", "1e-5"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/scene, message 0, field bodies[0].mass")) << o;
+  // Tighter than the tiny change: rejected, and the table still reports every maximum.
+  o = rbsim({"check", tiny.other.string(), tiny.base.string(), "--atol", "1e-13"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  // A relative tolerance: the scene description's mass and inertia differ by 2.5e-10 relative.
+  o = rbsim({"check", tiny.other.string(), tiny.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-9"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  o = rbsim({"check", tiny.other.string(), tiny.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-11"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  o = rbsim({"check", large.other.string(), large.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-9"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+}
+
+TEST(Check, MissingAndExtraMessages) {
+  TempDir tmp;
+  const fs::path shorter = tmp / "shorter.mcap";
+  record(kChain, shorter, {"--steps", "99800", "--record-every", kChainEvery});
+  Outcome o = rbsim({"check", shorter.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 100000: message missing from the "
+                              "run: the golden has 501 messages on this topic, the run 500"))
+      << o;
+  o = rbsim({"check", kChainGolden.string(), shorter.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 100000: extra message in the run"))
+      << o;
+}
+
+TEST(Check, BadInputIsAnErrorWithExitStatus2) {
+  TempDir tmp;
+  const std::string golden = read_text(kChainGolden);
+  std::map<std::string, fs::path> bad;
+  bad["empty"] = tmp / "empty.mcap";
+  write_text(bad["empty"], "");
+  bad["not MCAP"] = tmp / "text.mcap";
+  write_text(bad["not MCAP"], "<scene>this is not an MCAP file</scene>\n");
+  bad["truncated"] = tmp / "truncated.mcap";
+  write_text(bad["truncated"], golden.substr(0, golden.size() / 2));
+  bad["flipped byte"] = tmp / "flipped.mcap";
+  std::string flipped = golden;
+  flipped[flipped.size() / 3] = static_cast<char>(flipped[flipped.size() / 3] ^ 0x5a);
+  write_text(bad["flipped byte"], flipped);
+  bad["missing"] = tmp / "missing.mcap";
+  bad["directory"] = tmp / "dir.mcap";
+  fs::create_directories(bad["directory"]);
+  for (const auto& [what, path] : bad) {
+    for (bool as_run : {true, false}) {
+      const Outcome o = as_run ? rbsim({"check", path.string(), kChainGolden.string()})
+                               : rbsim({"check", kChainGolden.string(), path.string()});
+      SCOPED_TRACE(what + (as_run ? " run" : " golden"));
+      EXPECT_EQ(o.exit_code, 2) << o;
+      EXPECT_EQ(o.signal, 0) << o;
+      EXPECT_FALSE(o.timed_out) << o;
+      EXPECT_EQ(o.err.rfind("rbsim check: error: " + std::string(as_run ? "run" : "golden") + " log " + path.string(), 0),
+                0u)
+          << o;
+    }
+  }
+  EXPECT_TRUE(contains(rbsim({"check", bad["not MCAP"].string(), kChainGolden.string()}).err, "not an MCAP file"));
+  EXPECT_TRUE(contains(rbsim({"check", bad["truncated"].string(), kChainGolden.string()}).err, "truncated"));
+  EXPECT_TRUE(contains(rbsim({"check", bad["flipped byte"].string(), kChainGolden.string()}).err, "corrupted"));
+  // Usage errors are errors too.
+  EXPECT_EQ(rbsim({"check", kChainGolden.string()}).exit_code, 2);
+  EXPECT_EQ(rbsim({"check", kChainGolden.string(), kChainGolden.string(), "--atol", "-1"}).exit_code, 2);
+}
+
+// Prefixes and single flipped bytes of a small recording are reported as errors (never a match,
+// a divergence, a crash or a hang): every byte of the header and of the file's last 640 bytes
+// (summary, summary offsets, footer, magic), every 13th byte elsewhere.
+TEST(CheckLibrary, TruncatedAndFlippedBytesAreErrors) {
+  TempDir tmp;
+  const fs::path base = tmp / "base.mcap";
+  record(kChain, base, {"--steps", "2"});
+  const std::string bytes = read_text(base);
+  ASSERT_GT(bytes.size(), 2000u);
+  const fs::path bad = tmp / "bad.mcap";
+  std::size_t n = 0;
+  auto expect_error = [&](const std::string& what) {
+    ++n;
+    Result<log::CheckReport> r = log::check_logs(base.string(), bad.string());
+    EXPECT_FALSE(r.ok()) << what << ": " << (r ? (r->passed() ? "match" : "divergence " + r->first->line()) : "");
+  };
+  auto sampled = [&](std::size_t i) { return i < 64 || i + 640 >= bytes.size() || i % 13 == 0; };
+  for (std::size_t len = 0; len < bytes.size(); ++len) {
+    if (!sampled(len)) continue;
+    write_text(bad, bytes.substr(0, len));
+    expect_error("prefix of " + std::to_string(len) + " bytes");
+  }
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (!sampled(i)) continue;
+    std::string flipped = bytes;
+    flipped[i] = static_cast<char>(flipped[i] ^ (1 << (i % 8)));
+    write_text(bad, flipped);
+    expect_error("bit " + std::to_string(i % 8) + " of byte " + std::to_string(i) + " flipped");
+  }
+  EXPECT_GT(n, 2500u);
+}
+
+// Any valid MCAP file matches itself and every other layout of the same messages (chunked or not,
+// with or without indexes, summaries and repeated records): the official conformance inputs.
+TEST(CheckLibrary, ConformanceFilesMatchTheirOtherLayouts) {
+  const fs::path dir = kSource / "test" / "data" / "mcap-conformance";
+  std::size_t files = 0;
+  for (const auto& group : fs::directory_iterator(dir)) {
+    if (!group.is_directory()) continue;
+    std::vector<fs::path> layouts;
+    for (const auto& f : fs::directory_iterator(group.path())) {
+      if (f.path().extension() == ".mcap") layouts.push_back(f.path());
+    }
+    std::sort(layouts.begin(), layouts.end());
+    for (const fs::path& f : layouts) {
+      ++files;
+      for (const fs::path& golden : {f, layouts.front()}) {
+        Result<log::CheckReport> r = log::check_logs(f.string(), golden.string());
+        ASSERT_TRUE(r) << f << " vs " << golden << ": " << r.error().message;
+        EXPECT_TRUE(r->passed()) << f << " vs " << golden << ": " << r->first->line();
+      }
+    }
+  }
+  EXPECT_GT(files, 400u);
+}
+
+// The per-field maxima agree with an independent decode of both files (msgs::MessageDecoder and
+// path(), nothing of the checker's own walking).
+std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs::path& run, const fs::path& golden) {
+  auto read = [](const fs::path& path) {
+    std::map<std::string, std::vector<mcap::Bytes>> messages;
+    std::map<std::string, std::pair<std::string, std::string>> schemas;
+    mcap::IndexedReader reader;
+    EXPECT_TRUE(reader.open(path.string()).ok());
+    const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+      messages[e.channel->topic].push_back(e.message.data);
+      schemas[e.channel->topic] = {e.schema->name, std::string(e.schema->data.begin(), e.schema->data.end())};
+      return true;
+    });
+    EXPECT_TRUE(st.ok()) << st.message;
+    return std::pair{messages, schemas};
+  };
+  const auto [run_msgs, schemas] = read(run);
+  const auto golden_msgs = read(golden).first;
+  std::map<std::string, std::pair<double, std::uint64_t>> out;  // "topic field" -> (max |diff|, values)
+  const std::regex index(R"(\[\d+\])");
+  for (const auto& [topic, msgs] : golden_msgs) {
+    auto decoder = msgs::MessageDecoder::create(schemas.at(topic).first, schemas.at(topic).second);
+    EXPECT_TRUE(decoder.ok());
+    for (std::size_t m = 0; m < msgs.size(); ++m) {
+      std::vector<msgs::Scalar> a, b;
+      const auto as = [](const mcap::Bytes& v) { return std::as_bytes(std::span<const std::uint8_t>(v)); };
+      EXPECT_TRUE(decoder->decode(as(run_msgs.at(topic)[m]), a).ok());
+      EXPECT_TRUE(decoder->decode(as(msgs[m]), b).ok());
+      EXPECT_EQ(a.size(), b.size());
+      for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+        if (b[i].kind != msgs::Scalar::Kind::Float) continue;
+        const std::string field = std::regex_replace(decoder->path(as(msgs[m]), i), index, "[]");
+        auto& [max, values] = out[topic + " " + field];
+        max = std::max(max, std::fabs(a[i].f - b[i].f));
+        ++values;
+      }
+    }
+  }
+  return out;
+}
+
+TEST(CheckLibrary, FieldMaximaMatchAnIndependentDecode) {
+  const Pair tiny("1.000000001");
+  Result<log::CheckReport> r = log::check_logs(tiny.other.string(), tiny.base.string());
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->passed());
+  const auto expected = independent_max(tiny.other, tiny.base);
+  std::size_t checked = 0, nonzero = 0;
+  for (const log::FieldStats& f : r->fields) {
+    if (f.kind != "float") continue;
+    const auto it = expected.find(f.topic + " " + f.field);
+    ASSERT_NE(it, expected.end()) << f.topic << " " << f.field;
+    EXPECT_EQ(f.max_abs, it->second.first) << f.topic << " " << f.field;
+    EXPECT_EQ(f.values, it->second.second) << f.topic << " " << f.field;
+    ++checked;
+    if (f.max_abs > 0) ++nonzero;
+  }
+  EXPECT_EQ(checked, expected.size());
+  EXPECT_GT(nonzero, 20u);  // body states, spring states, energies, poses and markers all differ
+}
+
+// ---------------------------------------------------------------------------------------------
+// Verification
+
+TEST(Verify, WrongPhysicsFailsVerification) {
+  // A recording made with 5% more gravity, verified as a golden of the real scene: the scene
+  // description, the recorded energies and energy conservation all give it away.
+  TempDir tmp;
+  const fs::path scene = edited(tmp.path(), kChain, "fy=\"-1.0\"", "fy=\"-1.05\"");
+  const fs::path log_path = tmp / "chain.mcap";
+  record(scene, log_path, {"--record-every", kChainEvery});
+  log::GoldenVerifyOptions options;
+  options.fosssim_dir = kFosssim.string();
+  Result<log::GoldenVerification> v = log::verify_golden(kChain.string(), log_path.string(), options);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_FALSE(v->passed) << to_string(v.value());
+  auto line = [&](const std::string& prefix) {
+    for (const std::string& l : v->lines) {
+      if (l.rfind(prefix, 0) == 0) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(line("FAIL scene description")) << to_string(v.value());
+  EXPECT_TRUE(line("FAIL energy terms")) << to_string(v.value());
+  EXPECT_TRUE(line("FAIL energy conservation")) << to_string(v.value());
+  EXPECT_GT(v->energy_error, 10 * v->energy_bound);
+  // The same recording is a fine golden of the scene it was made from.
+  v = log::verify_golden(scene.string(), log_path.string(), options);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_TRUE(v->passed) << to_string(v.value());
+  EXPECT_LT(v->energy_error, v->energy_bound);
+}
+
+TEST(Verify, WrongWindFailsTheIndependentIntegration) {
+  // A FOSSSim wind scene recorded with the wind 10% stronger, verified as a golden of the real
+  // scene: wind has no potential, so only the re-integration can tell (and it does).
+  TempDir tmp;
+  const fs::path original = kFosssim / "scenes" / "windtests" / "test00sym.xml";
+  const std::string text = read_text(original);
+  const std::size_t at = text.find("beta=\"");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t end = text.find('"', at + 6);
+  const double beta = std::stod(text.substr(at + 6, end - at - 6));
+  std::ostringstream stronger;
+  stronger.precision(17);
+  stronger << "beta=\"" << beta * 1.1;
+  const fs::path scene = edited(tmp.path(), original, text.substr(at, end - at), stronger.str());
+  const fs::path log_path = tmp / "windy.mcap";
+  record(scene, log_path, {"--record-every", "10"});
+  Result<log::GoldenVerification> v = log::verify_golden(original.string(), log_path.string());
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_FALSE(v->passed) << to_string(v.value());
+  EXPECT_TRUE(contains(to_string(v.value()), "PASS energy terms")) << to_string(v.value());
+  EXPECT_TRUE(contains(to_string(v.value()), "FAIL independent integration")) << to_string(v.value());
+  v = log::verify_golden(scene.string(), log_path.string());
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_TRUE(v->passed) << to_string(v.value());
+  EXPECT_EQ(v->rule, "independent-integration");
+}
+
+TEST(Verify, ErrorsOnBadInput) {
+  TempDir tmp;
+  write_text(tmp / "empty.mcap", "");
+  EXPECT_FALSE(log::verify_golden(kChain.string(), (tmp / "empty.mcap").string()).ok());
+  EXPECT_FALSE(log::verify_golden((tmp / "missing.xml").string(), kChainGolden.string()).ok());
+  const Outcome o = rbsim({"check", "--verify-golden", kChain.string(), (tmp / "empty.mcap").string()});
+  EXPECT_EQ(o.exit_code, 2) << o;
+}
+
+// ---------------------------------------------------------------------------------------------
+// scripts/golden
+
+TEST(Script, RegeneratesAVerifiedGolden) {
+  TempDir tmp;
+  const Outcome o = run_process("/bin/bash", {(kSource / "scripts" / "golden").string(), kChain.string()},
+                                {std::string("RBSIM=") + RBSIM_EXE, "RBSIM_GOLDEN_DIR=" + tmp.path().string(),
+                                 "RBSIM_FOSSSIM_DIR=" + kFosssim.string()});
+  ASSERT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, "verified (symplectic-energy, independent-integration), --record-every 200")) << o;
+  const Outcome c = rbsim({"check", (tmp / "chain.mcap").string(), kChainGolden.string()});
+  EXPECT_EQ(c.exit_code, 0) << c;
+  for (const auto& entry : fs::directory_iterator(tmp.path())) {
+    EXPECT_EQ(entry.path().filename(), "chain.mcap") << "left behind: " << entry.path();
+  }
+}
+
+TEST(Script, RefusesAGoldenThatFailsVerification) {
+  // An rbsim whose `run` simulates 5% more gravity than the scene asks for: its recording of
+  // chain.xml fails verification, so scripts/golden must refuse it and keep the old golden.
+  TempDir tmp;
+  const fs::path wrong = edited(tmp / "wrong", kChain, "fy=\"-1.0\"", "fy=\"-1.05\"");
+  const fs::path fake = tmp / "fake-rbsim";
+  write_text(fake, "#!/bin/bash\nif [ \"$1\" = run ]; then shift 2; exec '" + std::string(RBSIM_EXE) + "' run '" +
+                       wrong.string() + "' \"$@\"; fi\nexec '" + std::string(RBSIM_EXE) + "' \"$@\"\n");
+  fs::permissions(fake, fs::perms::owner_all);
+  fs::create_directories(tmp / "out");
+  const fs::path old_golden = tmp / "out" / "chain.mcap";
+  write_text(old_golden, "the old golden");
+  const Outcome o = run_process("/bin/bash", {(kSource / "scripts" / "golden").string(), kChain.string()},
+                                {"RBSIM=" + fake.string(), "RBSIM_GOLDEN_DIR=" + (tmp / "out").string(),
+                                 "RBSIM_FOSSSIM_DIR=" + kFosssim.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.err, "refused")) << o;
+  EXPECT_TRUE(contains(o.err, "FAIL energy conservation")) << o;
+  EXPECT_EQ(read_text(old_golden), "the old golden");
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(tmp / "out")) ++files;
+  EXPECT_EQ(files, 1u);  // no temporary left behind
+}
+
+}  // namespace

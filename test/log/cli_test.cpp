@@ -1,0 +1,332 @@
+// rbsim log through the real binary (subprocess, time-bounded): export against rbsim run's own
+// CSV files byte for byte, info/doctor/recover on good files, and every tool on bad inputs.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+
+#include "log_test_util.hpp"
+#include "subprocess.hpp"
+
+namespace rbsim::logtest {
+namespace {
+
+namespace fs = std::filesystem;
+using std::chrono::seconds;
+
+std::string describe(const Outcome& o) {
+  return "exit " + std::to_string(o.exit_code) + (o.timed_out ? " (timed out)" : "") +
+         (o.signal ? " (signal " + std::to_string(o.signal) + ")" : "") + "\nstdout:\n" +
+         o.out.substr(0, 2000) + "\nstderr:\n" + o.err.substr(0, 2000);
+}
+
+// The per-step lines of `csv` (after its header) whose step is a multiple of k.
+std::string every_kth_step(const std::string& csv, std::int64_t k) {
+  std::string out;
+  bool header = true;
+  for (const std::string& line : lines_of(csv)) {
+    if (header || std::stoll(line.substr(0, line.find(','))) % k == 0) out += line + "\n";
+    header = false;
+  }
+  return out;
+}
+
+// A scene with several bodies and three gravity fields: World::energy() sums every body of every
+// field into one running total, which adding the per-field EnergyTerms entries does not
+// reproduce, so export recomputes U_gravity.
+std::string three_gravity_scene(const TempDir& dir) {
+  std::string xml = read_text(source_path("scenes/cantilever.xml"));  // five bodies, springs
+  const std::string g = "<rigidbodygravityforce fx=\"0.0\" fy=\"-1.0\"/>";
+  const auto at = xml.find(g);
+  EXPECT_NE(at, std::string::npos);
+  xml.insert(at + g.size(),
+             "\n  <rigidbodygravityforce fx=\"0.37\" fy=\"-1.3\"/>\n  <rigidbodygravityforce fx=\"-0.1\" "
+             "fy=\"0.77\"/>");
+  const fs::path path = dir / "three_gravity.xml";
+  write_text(path, xml);
+  return path.string();
+}
+
+struct ExportCase {
+  std::string name, scene;  // scene relative to the repository ("@3g": generated)
+  std::vector<std::string> run_args;
+};
+
+void PrintTo(const ExportCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class ExportMatchesRun : public ::testing::TestWithParam<ExportCase> {};
+
+TEST_P(ExportMatchesRun, ByteForByte) {
+  TempDir dir;
+  const ExportCase& c = GetParam();
+  const std::string scene = c.scene == "@3g" ? three_gravity_scene(dir) : source_path(c.scene);
+  std::vector<std::string> args = {"run",
+                                   scene,
+                                   "-q",
+                                   "--csv",
+                                   (dir / "run.csv").string(),
+                                   "--energy-csv",
+                                   (dir / "run_energy.csv").string(),
+                                   "--record",
+                                   (dir / "r.mcap").string()};
+  args.insert(args.end(), c.run_args.begin(), c.run_args.end());
+  Outcome run = rbsim(args, seconds(120));
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+  Outcome exp = rbsim({"log", "export", (dir / "r.mcap").string(), "--csv", (dir / "x.csv").string(),
+                       "--energy-csv", (dir / "x_energy.csv").string()},
+                      seconds(120));
+  ASSERT_EQ(exp.exit_code, 0) << describe(exp);
+  const std::string run_csv = read_text(dir / "run.csv"), run_energy = read_text(dir / "run_energy.csv");
+  ASSERT_GT(lines_of(run_energy).size(), 100u);
+  // Compared as whole files (EXPECT_EQ on megabytes would print them all on failure).
+  EXPECT_TRUE(read_text(dir / "x.csv") == run_csv) << "per-body CSV differs";
+  EXPECT_TRUE(read_text(dir / "x_energy.csv") == run_energy) << "energy CSV differs";
+  const auto a = lines_of(read_text(dir / "x_energy.csv")), b = lines_of(run_energy);
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    if (a[i] != b[i]) {
+      ADD_FAILURE() << "first energy difference at line " << i << ":\n  export: " << a[i]
+                    << "\n  run:    " << b[i];
+      break;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, ExportMatchesRun,
+    ::testing::Values(ExportCase{"cantilever_springs_gravity", "scenes/cantilever.xml", {"--steps", "300"}},
+                      ExportCase{
+                          "fosssim_wind_gravity", "test/data/fosssim/scenes/windtests/test06ee.xml", {}},
+                      ExportCase{"airplane_spring_gravity_wind", "scenes/airplane.xml", {"--steps", "3000"}},
+                      ExportCase{"three_gravity_fields", "@3g", {"--steps", "2000"}},
+                      ExportCase{"lz4_custom_namespace",
+                                 "scenes/chain.xml",
+                                 {"--steps", "500", "--compression", "lz4", "--namespace", "sim"}}),
+    [](const auto& param_info) { return param_info.param.name; });
+
+TEST(ExportCli, RecordEveryThreeExportsExactlyTheRecordedSteps) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/cantilever.xml");
+  Outcome run = rbsim({"run", scene, "-q", "--steps", "301", "--csv", (dir / "run.csv").string(),
+                       "--energy-csv", (dir / "run_energy.csv").string(), "--record",
+                       (dir / "r.mcap").string(), "--record-every", "3"});
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+  Outcome exp = rbsim({"log", "export", (dir / "r.mcap").string(), "--csv", (dir / "x.csv").string(),
+                       "--energy-csv", (dir / "x_energy.csv").string()});
+  ASSERT_EQ(exp.exit_code, 0) << describe(exp);
+  EXPECT_NE(exp.err.find("101 steps (0..300)"), std::string::npos) << exp.err;
+  EXPECT_TRUE(read_text(dir / "x.csv") == every_kth_step(read_text(dir / "run.csv"), 3));
+  const std::string energy = read_text(dir / "x_energy.csv");
+  EXPECT_TRUE(energy == every_kth_step(read_text(dir / "run_energy.csv"), 3));
+  EXPECT_EQ(lines_of(energy).size(), 1u + 101u);
+}
+
+TEST(ExportCli, ErrorsAreOneLine) {
+  TempDir dir;
+  Outcome run = rbsim({"run", source_path("scenes/chain.xml"), "-q", "--steps", "20", "--record",
+                       (dir / "r.mcap").string(), "--namespace", "a"});
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+  const std::string file = (dir / "r.mcap").string();
+  struct Case {
+    std::vector<std::string> args;
+    std::string needle;
+  };
+  const std::vector<Case> cases = {
+      {{"log", "export", file}, "nothing to export"},
+      {{"log", "export", file, "--csv", (dir / "x.csv").string(), "--namespace", "b"},
+       "no rbsim_msgs/msg/SceneDescription topic in namespace 'b'"},
+      {{"log", "export", file, "--csv", (dir / "no-dir" / "x.csv").string()}, "no-dir"},
+  };
+  for (const Case& c : cases) {
+    Outcome o = rbsim(c.args);
+    EXPECT_EQ(o.exit_code, 1) << describe(o);
+    ASSERT_EQ(o.err_lines().size(), 1u) << describe(o);
+    EXPECT_EQ(o.err.rfind("rbsim log export: error: ", 0), 0u) << o.err;
+    EXPECT_NE(o.err.find(c.needle), std::string::npos) << o.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x.csv"));
+  // A recording with a different schema text for one of the types is refused, not misread.
+  mcap::Writer w;
+  ASSERT_TRUE(w.open((dir / "other.mcap").string(), log::writer_options(mcap::Compression::Zstd)).ok());
+  for (const char* type :
+       {"rbsim_msgs/msg/SceneDescription", "rbsim_msgs/msg/BodyStates", "rbsim_msgs/msg/EnergyTerms"}) {
+    const auto s = w.add_schema(type, "ros2msg", mcap::Bytes{'f', 'l', 'o', 'a', 't', '6', '4', ' ', 'x'});
+    ASSERT_TRUE(s.ok());
+    ASSERT_TRUE(w.add_channel(s.value(), std::string("/rbsim/") + type, "cdr").ok());
+  }
+  ASSERT_TRUE(w.close().ok());
+  Outcome o = rbsim({"log", "export", (dir / "other.mcap").string(), "--csv", (dir / "x.csv").string()});
+  EXPECT_EQ(o.exit_code, 1) << describe(o);
+  EXPECT_NE(o.err.find("schema differs"), std::string::npos) << o.err;
+}
+
+TEST(LogCli, HelpForEveryCommand) {
+  for (std::vector<std::string> args : {std::vector<std::string>{"log", "--help"},
+                                        {"log", "info", "--help"},
+                                        {"log", "doctor", "--help"},
+                                        {"log", "recover", "--help"},
+                                        {"log", "export", "--help"}}) {
+    Outcome o = rbsim(args, seconds(20));
+    EXPECT_EQ(o.exit_code, 0) << describe(o);
+    EXPECT_NE(o.out.find("Usage"), std::string::npos) << describe(o);
+  }
+  Outcome o = rbsim({"log"}, seconds(20));
+  EXPECT_NE(o.exit_code, 0);
+}
+
+TEST(LogCli, InfoDoctorRecoverOnAGoodRecording) {
+  TempDir dir;
+  const std::string file = (dir / "r.mcap").string();
+  Outcome run =
+      rbsim({"run", source_path("scenes/cantilever.xml"), "-q", "--steps", "300", "--record", file});
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+
+  Outcome info = rbsim({"log", "info", file});
+  EXPECT_EQ(info.exit_code, 0) << describe(info);
+  for (const char* needle : {"profile:     ros2", "messages:    1807", "duration:    0.300000000 s",
+                             "compression:", "zstd: [", "/rbsim/body_states", "301 msgs",
+                             "rbsim_msgs/msg/BodyStates [ros2msg]", "/clock", "rosgraph_msgs/msg/Clock"}) {
+    EXPECT_NE(info.out.find(needle), std::string::npos) << needle << "\n" << info.out;
+  }
+  EXPECT_TRUE(info.err.empty()) << info.err;
+
+  Outcome doctor = rbsim({"log", "doctor", file});
+  EXPECT_EQ(doctor.exit_code, 0) << describe(doctor);
+  EXPECT_EQ(doctor.out, "Examining " + file + "\n0 errors, 0 warnings\n");
+  EXPECT_TRUE(doctor.err.empty()) << doctor.err;
+
+  Outcome recover = rbsim({"log", "recover", file, (dir / "copy.mcap").string()});
+  EXPECT_EQ(recover.exit_code, 0) << describe(recover);
+  EXPECT_NE(recover.out.find("kept 1807 messages"), std::string::npos) << recover.out;
+  EXPECT_NE(recover.out.find("input intact"), std::string::npos) << recover.out;
+  EXPECT_EQ(rbsim({"log", "doctor", (dir / "copy.mcap").string()}).exit_code, 0);
+  Outcome same = rbsim({"log", "recover", file, file});
+  EXPECT_EQ(same.exit_code, 1);
+  EXPECT_NE(same.err.find("must not be the input"), std::string::npos) << same.err;
+}
+
+TEST(LogCli, DoctorReportsPlantedStatisticsError) {
+  TempDir dir;
+  RecordSpec spec;
+  spec.chunk_size = 64 * 1024;
+  ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), dir / "r.mcap", 100, spec));
+  mcap::Bytes b = read_bytes(dir / "r.mcap");
+  const RawRecord& at = find_record(top_level_records(b), mcap::Opcode::Statistics);
+  auto stats = std::get<mcap::Statistics>(parse_at(b, at));
+  stats.message_count += 5;
+  overwrite_record(b, at, stats);
+  fix_crcs(b);
+  write_bytes(dir / "r.mcap", b);
+  Outcome o = rbsim({"log", "doctor", (dir / "r.mcap").string()});
+  EXPECT_EQ(o.exit_code, 1) << describe(o);
+  EXPECT_NE(o.out.find("error: Statistics has message count 612, but actual number of messages is 607"),
+            std::string::npos)
+      << o.out;
+  ASSERT_EQ(o.err_lines().size(), 1u) << o.err;
+  EXPECT_EQ(
+      o.err.rfind("rbsim log doctor: error: " + (dir / "r.mcap").string() + ": Statistics has message count",
+                  0),
+      0u)
+      << o.err;
+}
+
+TEST(LogCli, RecoverTruncatedRecording) {
+  TempDir dir;
+  RecordSpec spec;
+  spec.chunk_size = 32 * 1024;
+  ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), dir / "r.mcap", 150, spec));
+  const mcap::Bytes b = read_bytes(dir / "r.mcap");
+  const auto chunks = chunk_message_counts(dir / "r.mcap");
+  const std::uint64_t cut = (chunks[5].start + chunks[5].end) / 2;  // inside the sixth chunk
+  std::uint64_t kept = 0;
+  for (int k = 0; k < 5; ++k) kept += chunks[static_cast<std::size_t>(k)].messages;
+  write_bytes(dir / "cut.mcap", mcap::Bytes(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(cut)));
+  Outcome o = rbsim({"log", "recover", (dir / "cut.mcap").string(), (dir / "out.mcap").string()});
+  EXPECT_EQ(o.exit_code, 1) << describe(o);
+  ASSERT_EQ(o.err_lines().size(), 1u) << o.err;
+  EXPECT_NE(o.err.find("truncated: the file ends inside a Chunk record at offset " +
+                       std::to_string(chunks[5].start)),
+            std::string::npos)
+      << o.err;
+  EXPECT_NE(o.out.find("kept " + std::to_string(kept) + " messages"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("1 incomplete chunk"), std::string::npos) << o.out;
+  Outcome doctor = rbsim({"log", "doctor", (dir / "out.mcap").string()});
+  EXPECT_EQ(doctor.exit_code, 0) << describe(doctor);
+  Outcome info = rbsim({"log", "info", (dir / "out.mcap").string()});
+  EXPECT_EQ(info.exit_code, 0) << describe(info);
+  EXPECT_NE(info.out.find("messages:    " + std::to_string(kept)), std::string::npos) << info.out;
+}
+
+// Every tool on every kind of bad input: exit status 1, one clear line on stderr, no crash, no
+// hang (each run is bounded by a timeout).
+TEST(LogCli, EveryToolOnBadInputFailsCleanly) {
+  TempDir dir;
+  RecordSpec spec;
+  spec.chunk_size = 32 * 1024;
+  ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), dir / "good.mcap", 100, spec));
+  const mcap::Bytes good = read_bytes(dir / "good.mcap");
+  const auto records = top_level_records(good);
+  const RawRecord& chunk = find_record(records, mcap::Opcode::Chunk, 1);
+  const RawRecord& index = find_record(records, mcap::Opcode::MessageIndex, 3);
+  const RawRecord& stats = find_record(records, mcap::Opcode::Statistics);
+  const RawRecord& footer = find_record(records, mcap::Opcode::Footer);
+
+  std::vector<std::pair<std::string, mcap::Bytes>> inputs;
+  inputs.emplace_back("empty", mcap::Bytes{});
+  inputs.emplace_back("text", mcap::Bytes{'t', ',', 'x', '\n', '0', ',', '1', '\n'});
+  inputs.emplace_back("zeros", mcap::Bytes(1000, 0));
+  inputs.emplace_back("magic_only", mcap::Bytes(std::begin(mcap::kMagic), std::end(mcap::kMagic)));
+  for (std::uint64_t cut : {std::uint64_t{3}, std::uint64_t{20}, chunk.offset + 100, index.offset + 3,
+                            stats.offset + 10, footer.offset + 5, good.size() - 4}) {
+    inputs.emplace_back("cut_" + std::to_string(cut),
+                        mcap::Bytes(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut)));
+  }
+  for (std::uint64_t at :
+       {std::uint64_t{1}, std::uint64_t{12}, chunk.offset + 4, chunk.offset + chunk.length / 2,
+        index.offset + 12, stats.offset + 12, footer.offset + 12, good.size() - 3}) {
+    mcap::Bytes b = good;
+    b[at] ^= 0x41;
+    inputs.emplace_back("flip_" + std::to_string(at), b);
+  }
+  {
+    mcap::Bytes b(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(chunk.offset + chunk.length + 5));
+    b.resize(b.size() + 100'000, 0);
+    inputs.emplace_back("zero_tail", b);
+  }
+  // A huge length in a record header: must not allocate it or loop.
+  {
+    mcap::Bytes b = good;
+    for (int i = 0; i < 8; ++i) b[chunk.offset + 1 + static_cast<std::uint64_t>(i)] = 0xFF;
+    inputs.emplace_back("huge_length", b);
+  }
+
+  const std::regex one_line("rbsim log (info|doctor|recover|export): error: [^\n]+\n");
+  for (const auto& [name, bytes] : inputs) {
+    const std::string in = (dir / (name + ".mcap")).string();
+    write_bytes(in, bytes);
+    const std::string out = (dir / (name + "_out.mcap")).string();
+    for (std::vector<std::string> args : {std::vector<std::string>{"log", "info", in},
+                                          {"log", "doctor", in},
+                                          {"log", "recover", in, out},
+                                          {"log", "export", in, "--csv", (dir / "x.csv").string(),
+                                           "--energy-csv", (dir / "xe.csv").string()}}) {
+      Outcome o = rbsim(args, seconds(30));
+      SCOPED_TRACE(name + ": rbsim log " + args[1]);
+      EXPECT_FALSE(o.timed_out);
+      EXPECT_EQ(o.signal, 0);
+      EXPECT_EQ(o.exit_code, 1) << describe(o);
+      EXPECT_TRUE(std::regex_match(o.err, one_line)) << describe(o);
+    }
+    EXPECT_FALSE(fs::exists(dir / "x.csv"));
+    EXPECT_FALSE(fs::exists(dir / "xe.csv"));
+    // recover writes an output exactly when the input has a complete Header.
+    if (fs::exists(out)) {
+      Outcome doctor = rbsim({"log", "doctor", out}, seconds(30));
+      EXPECT_EQ(doctor.exit_code, 0) << name << ": recovered file\n" << describe(doctor);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rbsim::logtest

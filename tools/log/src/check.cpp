@@ -1,0 +1,1323 @@
+// Golden-log checks: two recordings compared message by message and field by field.
+//
+// Both files are streamed once, side by side (mcap::StreamReader, every CRC verified), so memory
+// stays bounded by the chunks in flight plus the messages one file is ahead of the other. Each
+// message pair is decoded into reused Scalar vectors; a "plan" mapping every scalar to its field
+// group (the path with indices collapsed) is computed once per message layout and reused while
+// sequence lengths stay the same, so the per-value loop allocates nothing and builds no strings.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "check_layout.hpp"
+#include "rbsim/log.hpp"
+
+namespace rbsim::log {
+
+// ---------------------------------------------------------------------------------------------
+// Layout: the schema parsed by msgs::MessageDecoder's rules, expanded into field groups.
+
+namespace {
+
+struct PrimitiveInfo {
+  std::string_view name;
+  msgs::Scalar::Kind kind;
+  std::uint8_t size;  // 0: string
+};
+constexpr PrimitiveInfo kPrimitiveKinds[] = {
+    {"bool", msgs::Scalar::Kind::Bool, 1},     {"byte", msgs::Scalar::Kind::UInt, 1},   {"char", msgs::Scalar::Kind::UInt, 1},
+    {"int8", msgs::Scalar::Kind::Int, 1},      {"uint8", msgs::Scalar::Kind::UInt, 1},  {"int16", msgs::Scalar::Kind::Int, 2},
+    {"uint16", msgs::Scalar::Kind::UInt, 2},   {"int32", msgs::Scalar::Kind::Int, 4},   {"uint32", msgs::Scalar::Kind::UInt, 4},
+    {"int64", msgs::Scalar::Kind::Int, 8},     {"uint64", msgs::Scalar::Kind::UInt, 8}, {"float32", msgs::Scalar::Kind::Float, 4},
+    {"float64", msgs::Scalar::Kind::Float, 8}, {"string", msgs::Scalar::Kind::String, 0},
+};
+
+bool primitive_kind(std::string_view t, msgs::Scalar::Kind& kind, std::uint8_t& size) {
+  if (t.starts_with("string<=")) t = "string";
+  for (const PrimitiveInfo& p : kPrimitiveKinds) {
+    if (p.name == t) {
+      kind = p.kind;
+      size = p.size;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string canonical_type(std::string_view type, std::string_view package) {
+  if (type == "Header") return "std_msgs/msg/Header";
+  const auto slash = type.find('/');
+  if (slash == std::string_view::npos) return std::string(package) + "/msg/" + std::string(type);
+  if (type.find('/', slash + 1) != std::string_view::npos) return std::string(type);
+  return std::string(type.substr(0, slash)) + "/msg/" + std::string(type.substr(slash + 1));
+}
+
+struct RawField {
+  std::string name, type;  // type: primitive name or canonical nested type
+  bool primitive = false;
+  msgs::Scalar::Kind kind = msgs::Scalar::Kind::Float;
+  std::uint8_t size = 0;
+  Layout::Field::Array array = Layout::Field::Array::None;
+  std::uint32_t fixed = 0;
+};
+
+// Bytes a run of fixed-size fields takes from offset `at` (relative to the data start).
+std::uint64_t flat_bytes(const std::vector<Layout::Field>& fields, std::uint64_t at) {
+  const std::uint64_t start = at;
+  for (const Layout::Field& f : fields) {
+    const std::uint64_t count = f.array == Layout::Field::Array::Fixed ? f.fixed : 1;
+    for (std::uint64_t k = 0; k < count; ++k) {
+      if (f.primitive) {
+        at += (f.size - at % f.size) % f.size + f.size;
+      } else {
+        at += f.flat_size[at % 8];
+      }
+    }
+  }
+  return at - start;
+}
+
+// The values one element of a flat type holds when it starts at offset `at`, in order.
+void flat_ops(const std::vector<Layout::Field>& fields, std::uint64_t& at, std::uint64_t start,
+              std::vector<Layout::Op>& out) {
+  for (const Layout::Field& f : fields) {
+    const std::uint64_t count = f.array == Layout::Field::Array::Fixed ? f.fixed : 1;
+    for (std::uint64_t k = 0; k < count; ++k) {
+      if (f.primitive) {
+        at += (f.size - at % f.size) % f.size;
+        out.push_back({static_cast<std::uint32_t>(at - start), f.size, f.kind, f.group});
+        at += f.size;
+      } else {
+        flat_ops(f.children, at, start, out);
+      }
+    }
+  }
+}
+
+void make_flat(Layout::Field& f) {
+  f.flat = true;
+  std::map<std::uint32_t, std::uint64_t> groups;
+  for (const Layout::Field& c : f.children) {
+    const std::uint64_t count = c.array == Layout::Field::Array::Fixed ? c.fixed : 1;
+    if (c.array == Layout::Field::Array::Sequence || (c.primitive && c.size == 0) || (!c.primitive && !c.flat) ||
+        count > 4096) {
+      f.flat = false;
+      return;
+    }
+    if (c.primitive) {
+      groups[c.group] += count;
+    } else {
+      for (const auto& [g, n] : c.flat_groups) groups[g] += n * count;
+    }
+  }
+  for (std::uint64_t r = 0; r < 8; ++r) {
+    const std::uint64_t bytes = flat_bytes(f.children, r);
+    if (bytes > UINT32_MAX) {
+      f.flat = false;
+      return;
+    }
+    f.flat_size[r] = static_cast<std::uint32_t>(bytes);
+    std::uint64_t at = r;
+    f.flat_ops[r].clear();
+    flat_ops(f.children, at, r, f.flat_ops[r]);
+  }
+  f.flat_groups.assign(groups.begin(), groups.end());
+}
+
+class LayoutBuilder {
+ public:
+  explicit LayoutBuilder(std::string_view schema, const std::string& root) {
+    std::string current = root, body;
+    std::istringstream lines{std::string(schema)};
+    std::string line;
+    while (std::getline(lines, line)) {
+      if (line.size() >= 3 && line.find_first_not_of('=') == std::string::npos) {
+        sections_[current] = std::move(body);
+        body.clear();
+        current.clear();
+        continue;
+      }
+      if (current.empty() && line.starts_with("MSG: ")) {
+        current = canonical_type(line.substr(5), "");
+        continue;
+      }
+      body += line + "\n";
+    }
+    if (!current.empty()) sections_[current] = std::move(body);
+  }
+
+  Result<std::vector<Layout::Field>> expand(const std::string& type, const std::string& prefix, int depth,
+                                            std::vector<FieldGroup>& groups) {
+    if (depth > 64) return Error{"types nest deeper than 64"};
+    Result<std::vector<RawField>> raw = parse(type);
+    if (!raw) return raw.error();
+    std::vector<Layout::Field> out;
+    for (const RawField& rf : raw.value()) {
+      if (groups.size() > 100000) return Error{"schema expands to more than 100000 fields"};
+      Layout::Field f;
+      f.name = rf.name;
+      f.array = rf.array;
+      f.fixed = rf.fixed;
+      const std::string path = prefix.empty() ? rf.name : prefix + "." + rf.name;
+      if (f.array == Layout::Field::Array::Sequence) {
+        f.length_group = static_cast<std::uint32_t>(groups.size());
+        groups.push_back({path + ".length", msgs::Scalar::Kind::Length});
+      }
+      const std::string element = f.array == Layout::Field::Array::None ? path : path + "[]";
+      if (rf.primitive) {
+        f.primitive = true;
+        f.kind = rf.kind;
+        f.size = rf.size;
+        f.group = static_cast<std::uint32_t>(groups.size());
+        groups.push_back({element, rf.kind});
+      } else {
+        auto children = expand(rf.type, element, depth + 1, groups);
+        if (!children) return children.error();
+        f.children = std::move(children.value());
+        make_flat(f);
+      }
+      out.push_back(std::move(f));
+    }
+    return out;
+  }
+
+ private:
+  Result<std::vector<RawField>> parse(const std::string& name) {
+    const auto it = sections_.find(name);
+    if (it == sections_.end()) return Error{"schema has no definition for " + name};
+    const std::string package = name.substr(0, name.find('/'));
+    std::vector<RawField> fields;
+    std::istringstream def(it->second);
+    std::string text;
+    while (std::getline(def, text)) {
+      if (const auto hash = text.find('#'); hash != std::string::npos) text.resize(hash);
+      std::istringstream words(text);
+      std::string type, field;
+      if (!(words >> type)) continue;
+      if (!(words >> field)) return Error{name + ": field without a name: " + type};
+      if (field.find('=') != std::string::npos) continue;  // constant
+      std::string rest;
+      if (words >> rest && rest.starts_with('=')) continue;
+      RawField f;
+      f.name = field;
+      if (const auto bracket = type.find('['); bracket != std::string::npos) {
+        if (type.back() != ']') return Error{name + ": bad array type in " + text};
+        const std::string inside = type.substr(bracket + 1, type.size() - bracket - 2);
+        type.resize(bracket);
+        if (inside.empty() || inside.starts_with("<=")) {
+          f.array = Layout::Field::Array::Sequence;
+        } else {
+          char* end = nullptr;
+          const unsigned long n = std::strtoul(inside.c_str(), &end, 10);
+          if (end == inside.c_str() || *end != '\0' || n > UINT32_MAX) return Error{name + ": bad array size in " + text};
+          f.array = Layout::Field::Array::Fixed;
+          f.fixed = static_cast<std::uint32_t>(n);
+        }
+      }
+      if (type == "wstring") return Error{name + ": wstring fields are not supported"};
+      f.primitive = primitive_kind(type, f.kind, f.size);
+      f.type = f.primitive ? type : canonical_type(type, package);
+      fields.push_back(std::move(f));
+    }
+    // rosidl gives a message without fields one uint8 member (as the decoder does).
+    if (fields.empty()) {
+      RawField f;
+      f.name = "structure_needs_at_least_one_member";
+      f.primitive = true;
+      f.kind = msgs::Scalar::Kind::UInt;
+      f.size = 1;
+      f.type = "uint8";
+      fields.push_back(std::move(f));
+    }
+    return fields;
+  }
+
+  std::map<std::string, std::string> sections_;
+};
+
+// Walks the scalars of one message along the fields; `plan` may be null (skipping an element).
+// `budget` bounds the elements visited, so no schema can make the walk run away.
+bool walk(const std::vector<Layout::Field>& fields, std::span<const msgs::Scalar> s, std::size_t& pos, Plan* plan,
+          bool root, std::uint64_t& budget) {
+  using Array = Layout::Field::Array;
+  for (const Layout::Field& f : fields) {
+    std::uint64_t count = 1;
+    if (f.array == Array::Sequence) {
+      if (pos >= s.size() || s[pos].kind != msgs::Scalar::Kind::Length) return false;
+      count = s[pos].u;
+      if (plan != nullptr) {
+        plan->group.push_back(f.length_group);
+        plan->lengths.emplace_back(static_cast<std::uint32_t>(pos), count);
+      }
+      ++pos;
+    } else if (f.array == Array::Fixed) {
+      count = f.fixed;
+    }
+    if (count > budget) return false;
+    budget -= count;
+    if (f.primitive) {
+      if (count > s.size() - pos) return false;
+      for (std::uint64_t k = 0; k < count; ++k, ++pos) {
+        if (s[pos].kind != f.kind) return false;
+        if (plan != nullptr) {
+          if (root && f.array == Array::None && f.name == "step") plan->step = static_cast<std::ptrdiff_t>(pos);
+          plan->group.push_back(f.group);
+        }
+      }
+    } else {
+      for (std::uint64_t k = 0; k < count; ++k) {
+        if (!walk(f.children, s, pos, plan, false, budget)) return false;
+      }
+    }
+  }
+  return true;
+}
+
+struct Pairer {
+  std::span<const msgs::Scalar> a, b;
+  std::size_t pa = 0, pb = 0;
+  std::vector<Pair>* out;
+  std::uint64_t budget;
+
+  bool fields(const std::vector<Layout::Field>& fs) {
+    using Array = Layout::Field::Array;
+    for (const Layout::Field& f : fs) {
+      std::uint64_t ca = 1, cb = 1;
+      if (f.array == Array::Sequence) {
+        if (pa >= a.size() || pb >= b.size() || a[pa].kind != msgs::Scalar::Kind::Length ||
+            b[pb].kind != msgs::Scalar::Kind::Length) {
+          return false;
+        }
+        ca = a[pa].u;
+        cb = b[pb].u;
+        out->push_back({pa++, pb++, f.length_group});
+      } else if (f.array == Array::Fixed) {
+        ca = cb = f.fixed;
+      }
+      if (ca > budget || cb > budget - ca) return false;
+      budget -= ca + cb;
+      const std::uint64_t common = std::min(ca, cb);
+      if (f.primitive) {
+        if (ca > a.size() - pa || cb > b.size() - pb) return false;
+        for (std::uint64_t k = 0; k < common; ++k) {
+          if (a[pa].kind != f.kind || b[pb].kind != f.kind) return false;
+          out->push_back({pa++, pb++, f.group});
+        }
+        pa += static_cast<std::size_t>(ca - common);
+        pb += static_cast<std::size_t>(cb - common);
+      } else {
+        for (std::uint64_t k = 0; k < common; ++k) {
+          if (!fields(f.children)) return false;
+        }
+        for (std::uint64_t k = common; k < ca; ++k) {
+          if (!walk(f.children, a, pa, nullptr, false, budget)) return false;
+        }
+        for (std::uint64_t k = common; k < cb; ++k) {
+          if (!walk(f.children, b, pb, nullptr, false, budget)) return false;
+        }
+      }
+    }
+    return true;
+  }
+};
+
+// Walks CDR bytes by the decoder's rules (XCDR1, little endian, alignment relative to the end of
+// the 4-byte encapsulation header), reading only lengths.
+struct ByteCounter {
+  std::span<const std::byte> d;
+  std::size_t pos = 4;
+  std::vector<std::uint64_t>& counts;
+  std::uint64_t budget;
+
+  bool skip(std::size_t size, std::uint64_t n) {
+    const std::size_t pad = (size - (pos - 4) % size) % size;
+    const std::size_t left = d.size() - pos;
+    if (pad > left || n > (left - pad) / size) return false;
+    pos += pad + static_cast<std::size_t>(n) * size;
+    return true;
+  }
+  bool u32(std::uint32_t& v) {
+    const std::size_t at = pos + (4 - (pos - 4) % 4) % 4;
+    if (!skip(4, 1)) return false;
+    std::memcpy(&v, d.data() + at, 4);
+    return true;
+  }
+  bool fields(const std::vector<Layout::Field>& fs) {
+    using Array = Layout::Field::Array;
+    for (const Layout::Field& f : fs) {
+      std::uint64_t count = 1;
+      if (f.array == Array::Sequence) {
+        std::uint32_t n = 0;
+        if (!u32(n) || n > d.size() - pos) return false;
+        ++counts[f.length_group];
+        count = n;
+      } else if (f.array == Array::Fixed) {
+        count = f.fixed;
+      }
+      if (count > budget) return false;
+      budget -= count;
+      if (f.primitive) {
+        counts[f.group] += count;
+        if (f.size > 0) {
+          if (count > 0 && !skip(f.size, count)) return false;
+        } else {
+          for (std::uint64_t k = 0; k < count; ++k) {
+            std::uint32_t n = 0;
+            if (!u32(n) || n == 0 || n > d.size() - pos) return false;
+            pos += n;
+          }
+        }
+      } else if (f.flat) {
+        for (std::uint64_t k = 0; k < count; ++k) {
+          const std::size_t bytes = f.flat_size[(pos - 4) % 8];
+          if (bytes > d.size() - pos) return false;
+          pos += bytes;
+        }
+        for (const auto& [g, n] : f.flat_groups) counts[g] += n * count;
+      } else {
+        for (std::uint64_t k = 0; k < count; ++k) {
+          if (!fields(f.children)) return false;
+        }
+      }
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
+bool Layout::count(std::span<const std::byte> cdr, std::vector<std::uint64_t>& counts) const {
+  if (cdr.size() < 4 || cdr[0] != std::byte{0} || cdr[1] != std::byte{1}) return false;
+  if (counts.size() < groups_.size()) counts.resize(groups_.size(), 0);
+  ByteCounter c{cdr, 4, counts, 4 * static_cast<std::uint64_t>(cdr.size()) + 1024};
+  return c.fields(root_);
+}
+
+Result<Layout> Layout::create(std::string_view type, std::string_view schema) {
+  const std::string root = canonical_type(type, "");
+  LayoutBuilder builder(schema, root);
+  Layout layout;
+  auto fields = builder.expand(root, "", 0, layout.groups_);
+  if (!fields) return fields.error();
+  layout.root_ = std::move(fields.value());
+  for (const Field& f : layout.root_) {
+    if (f.name == "step" && f.primitive && f.array == Field::Array::None &&
+        (f.kind == msgs::Scalar::Kind::UInt || f.kind == msgs::Scalar::Kind::Int)) {
+      layout.has_step_ = true;
+    }
+  }
+  return layout;
+}
+
+int Layout::find(std::string_view path) const {
+  for (std::size_t i = 0; i < groups_.size(); ++i) {
+    if (groups_[i].path == path) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+bool Layout::map(std::span<const msgs::Scalar> s, Plan& plan) const {
+  plan.group.clear();
+  plan.lengths.clear();
+  plan.step = -1;
+  std::size_t pos = 0;
+  std::uint64_t budget = 4 * static_cast<std::uint64_t>(s.size()) + 1024;
+  return walk(root_, s, pos, &plan, true, budget) && pos == s.size();
+}
+
+bool Layout::pair(std::span<const msgs::Scalar> a, std::span<const msgs::Scalar> b, std::vector<Pair>& out) const {
+  out.clear();
+  Pairer p{a, b, 0, 0, &out, 8 * static_cast<std::uint64_t>(a.size() + b.size()) + 1024};
+  return p.fields(root_) && p.pa == a.size() && p.pb == b.size();
+}
+
+namespace {
+
+using msgs::Scalar;
+using Kind = Scalar::Kind;
+
+constexpr int kRun = 0;
+constexpr int kGolden = 1;
+// Messages one file may be ahead of the other on a topic before we give up (memory bound).
+constexpr std::uint64_t kMaxQueuedBytes = std::uint64_t{1} << 30;
+
+std::span<const std::byte> cdr(const mcap::Bytes& b) { return std::as_bytes(std::span<const std::uint8_t>(b)); }
+std::string fmt_short(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// A value as the report shows it: floats in shortest round-trip form.
+std::string text(const Scalar& s) {
+  if (s.kind != Kind::Float) return s.to_string();
+  char buf[40];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, s.f, std::chars_format::general);  // shortest
+  return ec == std::errc() ? std::string(buf, end) : s.to_string();
+}
+
+std::uint64_t step_value(const Scalar& s) { return s.kind == Kind::Int ? static_cast<std::uint64_t>(s.i) : s.u; }
+
+const char* kind_label(Kind k) {
+  switch (k) {
+    case Kind::Bool: return "bool";
+    case Kind::Int: return "int";
+    case Kind::UInt: return "uint";
+    case Kind::Float: return "float";
+    case Kind::String: return "string";
+    case Kind::Length: return "length";
+  }
+  return "?";
+}
+
+// Ordering of divergences: the earliest in the golden (log time, then file position) is "first".
+struct Key {
+  std::uint64_t time = UINT64_MAX, ordinal = UINT64_MAX;
+  bool operator<(const Key& o) const { return time != o.time ? time < o.time : ordinal < o.ordinal; }
+};
+
+struct Pending {
+  mcap::Bytes data;
+  mcap::Timestamp log_time = 0;
+  std::uint64_t ordinal = 0;  // position among the file's messages
+  std::uint64_t index = 0;    // position among the topic's messages
+};
+
+struct Stat {
+  std::uint64_t values = 0, over = 0;
+  double max_abs = 0.0, max_rel = 0.0;
+  std::uint64_t step_at_max = 0;
+};
+
+struct SideInfo {
+  bool has = false;
+  std::string schema_name, schema_encoding, message_encoding;
+  mcap::Bytes schema_data;
+};
+
+struct Topic {
+  std::string name;
+  bool selected = true;
+  SideInfo side[2];
+  bool ready = false;
+  enum class Mode : std::uint8_t { Fields, Bytes, Skip } mode = Mode::Skip;
+  std::optional<msgs::MessageDecoder> decoder[2];
+  std::optional<Layout> layout;
+  std::vector<Stat> stats;  // one per layout group, then "(bytes)" / "(log_time)"
+  std::size_t bytes_stat = 0, time_stat = 0;
+  std::deque<Pending> queue[2];
+  std::uint64_t queued_bytes = 0;
+  std::uint64_t count[2] = {0, 0};
+  std::vector<std::uint64_t> identical_counts;  // values of byte-identical message pairs, per group
+  bool diverged_message = false;  // scratch: current message pair has a difference
+};
+
+// Reads one file on its own thread (decompression and CRCs are most of the work), handing its
+// Schema, Channel and Message records over in batches; at most kPumpBytes ahead of the consumer.
+class RecordPump {
+ public:
+  static constexpr std::uint64_t kPumpBytes = 64u << 20;
+  static constexpr std::size_t kBatchRecords = 256;
+  static constexpr std::uint64_t kBatchBytes = 4u << 20;
+
+  ~RecordPump() { stop(); }
+
+  mcap::Status open(const std::string& path) {
+    mcap::Status st = reader_.open(path);
+    if (st.ok()) thread_ = std::thread([this] { run(); });
+    return st;
+  }
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  // The next record, or null at the end (then status() says whether the file was read whole).
+  mcap::Record* next() {
+    if (pos_ < current_.size()) return &current_[pos_++];
+    current_.clear();
+    pos_ = 0;
+    std::unique_lock<std::mutex> lock(mu_);
+    cv_.wait(lock, [&] { return !batches_.empty() || finished_; });
+    if (batches_.empty()) return nullptr;
+    current_ = std::move(batches_.front().first);
+    queued_ -= batches_.front().second;
+    batches_.pop_front();
+    lock.unlock();
+    cv_.notify_all();
+    return current_.empty() ? next() : &current_[pos_++];
+  }
+  const mcap::Status& status() const { return status_; }  // valid once next() returned null
+
+ private:
+  void run() {
+    mcap::RecordEntry entry;
+    std::vector<mcap::Record> batch;
+    std::uint64_t bytes = 0;
+    for (;;) {
+      const bool more = reader_.next(entry);
+      if (more) {
+        if (const auto* m = std::get_if<mcap::Message>(&entry.record)) {
+          bytes += m->data.size() + 64;
+          batch.push_back(std::move(entry.record));
+        } else if (std::holds_alternative<mcap::Schema>(entry.record) ||
+                   std::holds_alternative<mcap::Channel>(entry.record)) {
+          bytes += 64;
+          batch.push_back(std::move(entry.record));
+        }
+      }
+      if (!more || batch.size() >= kBatchRecords || bytes >= kBatchBytes) {
+        std::unique_lock<std::mutex> lock(mu_);
+        cv_.wait(lock, [&] { return stop_ || queued_ < kPumpBytes; });
+        if (stop_) return;
+        queued_ += bytes;
+        batches_.emplace_back(std::move(batch), bytes);
+        batch = {};
+        bytes = 0;
+        if (!more) {
+          status_ = reader_.status();
+          finished_ = true;
+        }
+        lock.unlock();
+        cv_.notify_all();
+        if (!more) return;
+      }
+    }
+  }
+
+  mcap::StreamReader reader_;
+  std::thread thread_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<std::pair<std::vector<mcap::Record>, std::uint64_t>> batches_;
+  std::uint64_t queued_ = 0;
+  bool stop_ = false, finished_ = false;
+  mcap::Status status_;
+  std::vector<mcap::Record> current_;  // consumer side
+  std::size_t pos_ = 0;
+};
+
+struct Side {
+  std::string path, role;  // role: "run" or "golden"
+  RecordPump pump;
+  std::map<std::uint16_t, mcap::Schema> schemas;
+  std::map<std::uint16_t, std::size_t> channel_topic;
+  std::set<std::string> summary_topics;
+  bool summary_known = false;  // the summary lists every channel with messages
+  std::uint64_t ordinal = 0, bytes = 0, consumed = 0;
+  bool done = false;
+};
+
+std::string with_path(const Side& s, const std::string& what) { return s.role + " log " + s.path + ": " + what; }
+
+class Comparer {
+ public:
+  Comparer(const CheckOptions& options, const std::string& run, const std::string& golden) : o_(options) {
+    side_[kRun].path = run;
+    side_[kRun].role = "run";
+    side_[kGolden].path = golden;
+    side_[kGolden].role = "golden";
+  }
+
+  Result<CheckReport> compare() {
+    if (!(o_.atol >= 0.0) || !(o_.rtol >= 0.0) || !std::isfinite(o_.atol) || !std::isfinite(o_.rtol)) {
+      return Error{"--atol and --rtol must be finite and >= 0"};
+    }
+    for (int s : {kGolden, kRun}) {
+      if (Status st = open(side_[s]); !st) return st.error();
+    }
+    while (!side_[kRun].done || !side_[kGolden].done) {
+      int s = kGolden;
+      if (side_[kGolden].done) {
+        s = kRun;
+      } else if (!side_[kRun].done && side_[kRun].consumed < side_[kGolden].consumed) {
+        s = kRun;
+      }
+      if (Status st = step(s); !st) return st.error();
+    }
+    return finish();
+  }
+
+ private:
+  Status open(Side& s) {
+    // The summary first: a clear error for a truncated or non-MCAP file before any comparing, and
+    // the file's whole topic list (so messages of a topic the other file lacks are not queued).
+    std::error_code ec;
+    const auto status = std::filesystem::status(s.path, ec);
+    if (std::filesystem::is_directory(status)) return Error{with_path(s, "is a directory, not an MCAP file")};
+    if (std::filesystem::is_regular_file(status) && std::filesystem::file_size(s.path, ec) == 0 && !ec) {
+      return Error{with_path(s, "empty file, not an MCAP file")};
+    }
+    mcap::IndexedReader index;
+    if (auto st = index.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
+    for (const auto& [id, channel] : index.channels()) s.summary_topics.insert(channel.topic);
+    // The summary's channels are known to be complete when every chunk's message index names
+    // only channels it lists (rbsim writes indexes and repeats channels; other writers may not).
+    s.summary_known = index.indexed();
+    for (const mcap::ChunkIndex& ci : index.chunk_indexes()) {
+      if (ci.message_index_offsets.empty()) s.summary_known = false;
+      for (const auto& [channel_id, offset] : ci.message_index_offsets) {
+        if (index.channels().count(channel_id) == 0) s.summary_known = false;
+      }
+    }
+    if (auto st = s.pump.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
+    return Ok{};
+  }
+
+  static std::string describe(const mcap::Status& st) {
+    switch (st.code) {
+      case mcap::StatusCode::BadMagic:
+        return st.message.starts_with("not an MCAP file") ? st.message : "not an MCAP file (" + st.message + ")";
+      case mcap::StatusCode::Truncated: return "truncated or incomplete MCAP file (" + st.message + ")";
+      case mcap::StatusCode::CrcMismatch: return "corrupted MCAP file (" + st.message + ")";
+      case mcap::StatusCode::Malformed:
+      case mcap::StatusCode::DecompressionFailed: return "corrupted MCAP file (" + st.message + ")";
+      default: return st.message;
+    }
+  }
+
+  bool selected(const std::string& topic) const {
+    if (std::find(o_.exclude_topics.begin(), o_.exclude_topics.end(), topic) != o_.exclude_topics.end()) return false;
+    return o_.topics.empty() || std::find(o_.topics.begin(), o_.topics.end(), topic) != o_.topics.end();
+  }
+
+  Status step(int si) {
+    Side& s = side_[si];
+    mcap::Record* next = s.pump.next();
+    if (next == nullptr) {
+      if (!s.pump.status().ok()) return Error{with_path(s, describe(s.pump.status()))};
+      s.done = true;
+      return Ok{};
+    }
+    mcap::Record& record = *next;
+    if (auto* schema = std::get_if<mcap::Schema>(&record)) {
+      s.schemas.try_emplace(schema->id, std::move(*schema));
+    } else if (auto* channel = std::get_if<mcap::Channel>(&record)) {
+      return add_channel(si, *channel);
+    } else if (auto* message = std::get_if<mcap::Message>(&record)) {
+      return add_message(si, *message);
+    }
+    return Ok{};
+  }
+
+  Status add_channel(int si, const mcap::Channel& channel) {
+    Side& s = side_[si];
+    if (s.channel_topic.count(channel.id) != 0) return Ok{};  // the summary repeats channels
+    auto [it, fresh] = topic_index_.try_emplace(channel.topic, topics_.size());
+    if (fresh) {
+      topics_.emplace_back();
+      topics_.back().name = channel.topic;
+      topics_.back().selected = selected(channel.topic);
+    }
+    s.channel_topic[channel.id] = it->second;
+    Topic& t = topics_[it->second];
+    SideInfo& info = t.side[si];
+    if (info.has) return Ok{};  // a second channel on the topic: its messages join the first's
+    info.has = true;
+    info.message_encoding = channel.message_encoding;
+    if (channel.schema_id != 0) {
+      const auto sc = s.schemas.find(channel.schema_id);
+      if (sc == s.schemas.end()) {
+        return Error{with_path(s, "channel " + std::to_string(channel.id) + " (" + channel.topic +
+                                      ") refers to schema " + std::to_string(channel.schema_id) +
+                                      ", which the file does not define")};
+      }
+      info.schema_name = sc->second.name;
+      info.schema_encoding = sc->second.encoding;
+      info.schema_data = sc->second.data;
+    }
+    if (t.side[1 - si].has && t.selected) return setup(t);
+    return Ok{};
+  }
+
+  // Both files define the topic: decide how its messages compare.
+  Status setup(Topic& t) {
+    t.ready = true;
+    const SideInfo& r = t.side[kRun];
+    const SideInfo& g = t.side[kGolden];
+    auto problem = [&](const std::string& what) {
+      t.mode = Topic::Mode::Skip;
+      topic_problem(t, what);
+      return Ok{};
+    };
+    if (r.schema_name != g.schema_name) {
+      return problem("schema differs: golden " + quoted(g.schema_name) + ", run " + quoted(r.schema_name));
+    }
+    if (r.message_encoding != g.message_encoding || r.schema_encoding != g.schema_encoding) {
+      return problem("encoding differs: golden " + g.message_encoding + "/" + g.schema_encoding + ", run " +
+                     r.message_encoding + "/" + r.schema_encoding);
+    }
+    if (g.message_encoding == "cdr" && g.schema_encoding == "ros2msg") {
+      for (int si : {kRun, kGolden}) {
+        const SideInfo& info = t.side[si];
+        const std::string_view text(reinterpret_cast<const char*>(info.schema_data.data()), info.schema_data.size());
+        auto decoder = msgs::MessageDecoder::create(info.schema_name, text);
+        if (!decoder) {
+          return Error{with_path(side_[si], "schema " + info.schema_name + " of " + t.name + ": " +
+                                                decoder.error().message)};
+        }
+        t.decoder[si] = std::move(decoder.value());
+        auto layout = Layout::create(info.schema_name, text);
+        if (!layout) {
+          return Error{with_path(side_[si], "schema " + info.schema_name + " of " + t.name + ": " +
+                                                layout.error().message)};
+        }
+        if (si == kRun) {
+          t.layout = std::move(layout.value());
+        } else if (!t.layout->same_fields(layout.value())) {
+          return problem("schema " + g.schema_name + " defines different fields in the two files");
+        }
+      }
+      t.mode = Topic::Mode::Fields;
+      t.stats.resize(t.layout->groups().size() + 1);
+      t.time_stat = t.layout->groups().size();
+    } else {
+      t.mode = Topic::Mode::Bytes;  // not ros2msg/CDR: the bytes must be equal
+      t.stats.resize(2);
+      t.bytes_stat = 0;
+      t.time_stat = 1;
+    }
+    return Ok{};
+  }
+
+  static std::string quoted(const std::string& s) { return s.empty() ? "(none)" : "'" + s + "'"; }
+
+  void topic_problem(const Topic& t, const std::string& what) {
+    report_.topic_problems.push_back(t.name + ": " + what);
+    Divergence d;
+    d.topic = t.name;
+    d.topic_level = true;
+    d.field = "(" + what + ")";
+    consider(Key{0, problem_ordinal_++}, std::move(d));
+  }
+
+  void consider(Key key, Divergence d) {
+    if (!report_.first || key < first_key_) {
+      first_key_ = key;
+      report_.first = std::move(d);
+    }
+  }
+
+  // A file ends its topic while the other still has messages; or the other never had the topic.
+  bool other_lacks(const Topic& t, int si) const {
+    const Side& o = side_[1 - si];
+    return !t.side[1 - si].has && (o.done || (o.summary_known && o.summary_topics.count(t.name) == 0));
+  }
+
+  Status add_message(int si, mcap::Message& m) {
+    Side& s = side_[si];
+    const auto ch = s.channel_topic.find(m.channel_id);
+    if (ch == s.channel_topic.end()) {
+      return Error{with_path(s, "message on channel " + std::to_string(m.channel_id) +
+                                    ", which the file does not define before it")};
+    }
+    s.bytes += m.data.size();
+    const std::uint64_t ordinal = s.ordinal++;
+    Topic& t = topics_[ch->second];
+    if (!t.selected) return Ok{};
+    const std::uint64_t index = t.count[si]++;
+    ++s.consumed;
+    if (other_lacks(t, si) || (t.ready && t.mode == Topic::Mode::Skip)) return Ok{};
+    Pending p{std::move(m.data), m.log_time, ordinal, index};
+    std::deque<Pending>& other = t.queue[1 - si];
+    if (!other.empty()) {
+      Pending& q = other.front();
+      Status st = si == kRun ? compare(t, p, q) : compare(t, q, p);
+      t.queued_bytes -= q.data.size();
+      other.pop_front();
+      return st;
+    }
+    t.queued_bytes += p.data.size();
+    if (t.queued_bytes > kMaxQueuedBytes) {
+      return Error{"the two logs are too far out of step on " + t.name + " to compare (over " +
+                   std::to_string(kMaxQueuedBytes >> 20) + " MiB of messages in one file without a partner)"};
+    }
+    t.queue[si].push_back(std::move(p));
+    return Ok{};
+  }
+
+  // One message pair: `r` from the run, `g` from the golden.
+  Status compare(Topic& t, const Pending& r, const Pending& g) {
+    ++report_.messages;
+    last_has_step_ = false;
+    last_step_ = g.index;
+    t.diverged_message = false;
+    const Key key{g.log_time, g.ordinal};
+    if (t.mode == Topic::Mode::Bytes) {
+      const bool equal = r.data == g.data;
+      Stat& st = t.stats[t.bytes_stat];
+      ++st.values;
+      if (!equal) {
+        ++st.over;
+        ++report_.diverging_values;
+        t.diverged_message = true;
+        if (st.max_abs < 1.0) {
+          st.max_abs = 1.0;
+          st.max_rel = 1.0;
+          st.step_at_max = g.index;
+        }
+        if (!report_.first || key < first_key_) {
+          Divergence d{t.name, false, g.index, "(message bytes)", std::to_string(g.data.size()) + " bytes",
+                       std::to_string(r.data.size()) + " bytes", "bytes differ"};
+          consider(key, std::move(d));
+        }
+      }
+    } else if (r.data == g.data && t.layout->count(cdr(g.data), t.identical_counts)) {
+      // Byte-identical messages: every value matches exactly; only count them per field.
+    } else {
+      if (Status st = compare_fields(t, r, g, key); !st) return st;
+    }
+    if (o_.compare_log_time) compare_time(t, r, g, key);
+    if (t.diverged_message) ++report_.diverging_messages;
+    return Ok{};
+  }
+
+  void compare_time(Topic& t, const Pending& r, const Pending& g, Key key) {
+    Stat& st = t.stats[t.time_stat];
+    ++st.values;
+    if (r.log_time == g.log_time) return;
+    const double diff = static_cast<double>(r.log_time) - static_cast<double>(g.log_time);
+    ++st.over;
+    ++report_.diverging_values;
+    if (std::fabs(diff) > st.max_abs) {
+      st.max_abs = std::fabs(diff);
+      st.max_rel = g.log_time == 0 ? std::numeric_limits<double>::infinity() : st.max_abs / static_cast<double>(g.log_time);
+      st.step_at_max = last_step_;
+    }
+    if (!t.diverged_message) {
+      t.diverged_message = true;
+      if (!report_.first || key < first_key_) {
+        Divergence d{t.name, last_has_step_, last_step_, "(log_time)", std::to_string(g.log_time) + " ns",
+                     std::to_string(r.log_time) + " ns", fmt_short(diff) + " ns"};
+        consider(key, std::move(d));
+      }
+    }
+  }
+
+  Status decode(Topic& t, int si, const Pending& p, std::vector<Scalar>& out) {
+    if (Status st = t.decoder[si]->decode(cdr(p.data), out); !st) {
+      return Error{with_path(side_[si], t.name + " message " + std::to_string(p.index) + ": " + st.error().message)};
+    }
+    return Ok{};
+  }
+
+  // Walks a run message (a) and a golden message (b) in lockstep straight from their CDR bytes
+  // (the decoder's rules: XCDR1, little endian, alignment relative to the end of the 4-byte
+  // header), comparing every value as it goes. Stops at the first differing sequence length
+  // (the layouts part) or at data that does not fit the schema; `index` then counts the values
+  // compared, in the decoder's scalar order.
+  enum class Walk : std::uint8_t { Ok, Mismatch, Malformed };
+  struct Lockstep {
+    Comparer& c;
+    Topic& t;
+    std::span<const std::byte> a, b;
+    std::size_t pa = 4, pb = 4;
+    std::uint64_t index = 0;
+    std::uint64_t first_bad = UINT64_MAX;
+    bool has_step = false;
+    std::uint64_t step = 0;
+    std::uint64_t budget = 0;
+
+    static bool align(std::span<const std::byte> d, std::size_t& pos, std::size_t size, std::uint64_t n) {
+      const std::size_t pad = (size - (pos - 4) % size) % size;
+      const std::size_t left = d.size() - pos;
+      if (pad > left || n > (left - pad) / size) return false;
+      pos += pad;
+      return true;
+    }
+    static std::uint32_t u32(const std::byte* p) {
+      std::uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    static Scalar load(const std::byte* p, std::uint8_t size, Kind kind) {
+      Scalar s;
+      s.kind = kind;
+      switch (kind) {
+        case Kind::Float:
+          if (size == 4) {
+            float f;
+            std::memcpy(&f, p, 4);
+            s.f = f;
+          } else {
+            std::memcpy(&s.f, p, 8);
+          }
+          break;
+        case Kind::Int: {
+          std::uint64_t u = 0;
+          std::memcpy(&u, p, size);
+          const unsigned shift = 64u - 8u * size;
+          s.i = static_cast<std::int64_t>(u << shift) >> shift;
+          break;
+        }
+        case Kind::Bool: s.i = *p != std::byte{0}; break;
+        default: std::memcpy(&s.u, p, size); break;
+      }
+      return s;
+    }
+    // One value pair at x (run) and y (golden).
+    void value(const std::byte* x, const std::byte* y, std::uint8_t size, Kind kind, std::uint32_t group) {
+      Stat& st = t.stats[group];
+      ++st.values;
+      if (kind == Kind::Float) {
+        double va, vb;
+        if (size == 8) {
+          std::memcpy(&va, x, 8);
+          std::memcpy(&vb, y, 8);
+        } else {
+          float fa, fb;
+          std::memcpy(&fa, x, 4);
+          std::memcpy(&fb, y, 4);
+          va = fa;
+          vb = fb;
+        }
+        if (va == vb || (va != va && vb != vb)) {
+          ++index;
+          return;
+        }
+      } else if (std::memcmp(x, y, size) == 0) {
+        ++index;
+        return;
+      }
+      if (!c.differs(st, load(x, size, kind), load(y, size, kind)) && first_bad == UINT64_MAX) first_bad = index;
+      ++index;
+    }
+    Walk fields(const std::vector<Layout::Field>& fs, bool root) {
+      using Array = Layout::Field::Array;
+      for (const Layout::Field& f : fs) {
+        std::uint64_t count = 1;
+        if (f.array == Array::Sequence) {
+          if (!align(a, pa, 4, 1) || !align(b, pb, 4, 1)) return Walk::Malformed;
+          const std::uint32_t na = u32(a.data() + pa), nb = u32(b.data() + pb);
+          pa += 4;
+          pb += 4;
+          if (na > a.size() - pa || nb > b.size() - pb) return Walk::Malformed;
+          if (na != nb) {
+            pa -= 4;
+            pb -= 4;
+            return Walk::Mismatch;
+          }
+          ++t.stats[f.length_group].values;
+          ++index;
+          count = na;
+        } else if (f.array == Array::Fixed) {
+          count = f.fixed;
+        }
+        if (count > budget) return Walk::Malformed;
+        budget -= count;
+        if (f.primitive && f.size > 0) {
+          if (count == 0) continue;
+          if (!align(a, pa, f.size, count) || !align(b, pb, f.size, count)) return Walk::Malformed;
+          if (root && f.array == Array::None && f.name == "step") {
+            has_step = true;
+            step = step_value(load(b.data() + pb, f.size, f.kind));
+          }
+          for (std::uint64_t k = 0; k < count; ++k, pa += f.size, pb += f.size) {
+            value(a.data() + pa, b.data() + pb, f.size, f.kind, f.group);
+          }
+        } else if (f.primitive) {  // strings
+          for (std::uint64_t k = 0; k < count; ++k) {
+            if (!align(a, pa, 4, 1) || !align(b, pb, 4, 1)) return Walk::Malformed;
+            const std::uint32_t na = u32(a.data() + pa), nb = u32(b.data() + pb);
+            pa += 4;
+            pb += 4;
+            if (na == 0 || nb == 0 || na > a.size() - pa || nb > b.size() - pb) return Walk::Malformed;
+            Stat& st = t.stats[f.group];
+            ++st.values;
+            const std::string_view sa(reinterpret_cast<const char*>(a.data() + pa), na - 1);
+            const std::string_view sb(reinterpret_cast<const char*>(b.data() + pb), nb - 1);
+            if (sa != sb) {
+              Scalar x, y;
+              x.kind = y.kind = Kind::String;
+              x.s = sa;
+              y.s = sb;
+              if (!c.differs(st, x, y) && first_bad == UINT64_MAX) first_bad = index;
+            }
+            ++index;
+            pa += na;
+            pb += nb;
+          }
+        } else if (f.flat) {
+          for (std::uint64_t k = 0; k < count; ++k) {
+            const std::size_t ra = (pa - 4) % 8, rb = (pb - 4) % 8;
+            if (f.flat_size[ra] > a.size() - pa || f.flat_size[rb] > b.size() - pb) return Walk::Malformed;
+            const auto& ops_a = f.flat_ops[ra];
+            const auto& ops_b = f.flat_ops[rb];
+            for (std::size_t o = 0; o < ops_b.size(); ++o) {
+              const Layout::Op& op = ops_b[o];
+              value(a.data() + pa + ops_a[o].offset, b.data() + pb + op.offset, op.size, op.kind, op.group);
+            }
+            pa += f.flat_size[ra];
+            pb += f.flat_size[rb];
+          }
+        } else {
+          for (std::uint64_t k = 0; k < count; ++k) {
+            if (const Walk w = fields(f.children, false); w != Walk::Ok) return w;
+          }
+        }
+      }
+      return Walk::Ok;
+    }
+  };
+
+  Status compare_fields(Topic& t, const Pending& r, const Pending& g, Key key) {
+    touched_.clear();
+    step_known_ = false;
+    Lockstep ls{*this, t, cdr(r.data), cdr(g.data)};
+    ls.budget = 4 * static_cast<std::uint64_t>(r.data.size() + g.data.size()) + 1024;
+    Walk walk = Walk::Malformed;
+    if (r.data.size() >= 4 && g.data.size() >= 4 && r.data[0] == 0 && r.data[1] == 1 && g.data[0] == 0 &&
+        g.data[1] == 1) {
+      walk = ls.fields(t.layout->root(), true);
+    }
+    const std::uint64_t step = ls.has_step ? ls.step : g.index;
+    for (Stat* st : touched_) st->step_at_max = step;
+    step_known_ = true;
+    cur_step_ = step;
+    last_has_step_ = ls.has_step;
+    last_step_ = step;
+    std::uint64_t first_bad = ls.first_bad, first_bad_run = ls.first_bad;
+    bool decoded = false;
+    if (walk != Walk::Ok) {
+      // Sequence lengths differ (or the data is bad): decode both, which reports bad data, and
+      // pair the values the two have in common past those already compared.
+      if (Status st = decode(t, kRun, r, run_); !st) return st;
+      if (Status st = decode(t, kGolden, g, golden_); !st) return st;
+      decoded = true;
+      if (!t.layout->pair(run_, golden_, pairs_)) {
+        return Error{with_path(side_[kRun], t.name + " message " + std::to_string(r.index) + " does not fit its schema")};
+      }
+      for (const Pair& p : pairs_) {
+        if (p.b < ls.index) continue;
+        Stat& st = t.stats[p.group];
+        ++st.values;
+        if (!same_scalar(st, run_[p.a], golden_[p.b]) && first_bad == UINT64_MAX) {
+          first_bad = p.b;
+          first_bad_run = p.a;
+        }
+      }
+    }
+    if (first_bad != UINT64_MAX) {
+      t.diverged_message = true;
+      if (!report_.first || key < first_key_) {
+        if (!decoded) {
+          if (Status st = decode(t, kRun, r, run_); !st) return st;
+          if (Status st = decode(t, kGolden, g, golden_); !st) return st;
+        }
+        if (first_bad >= golden_.size() || first_bad_run >= run_.size()) {
+          return Error{"internal: value " + std::to_string(first_bad) + " of " + t.name + " out of range"};
+        }
+        const Scalar& a = run_[first_bad_run];
+        const Scalar& b = golden_[first_bad];
+        Divergence d{t.name, ls.has_step, step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b), text(a),
+                     difference(a, b)};
+        consider(key, std::move(d));
+      }
+    }
+    return Ok{};
+  }
+
+  static std::string difference(const Scalar& a, const Scalar& b) {
+    switch (b.kind) {
+      case Kind::Float: return fmt_short(a.f - b.f);
+      case Kind::Int: return std::to_string(static_cast<long long>(a.i) - static_cast<long long>(b.i));
+      case Kind::UInt:
+      case Kind::Length:
+        return a.u >= b.u ? std::to_string(a.u - b.u) : "-" + std::to_string(b.u - a.u);
+      case Kind::Bool:
+      case Kind::String: return "differs";
+    }
+    return "differs";
+  }
+
+  bool same_scalar(Stat& st, const Scalar& a, const Scalar& b) {
+    switch (b.kind) {
+      case Kind::Float:
+        if (a.f == b.f || (std::isnan(a.f) && std::isnan(b.f))) return true;
+        break;
+      case Kind::Int:
+      case Kind::Bool:
+        if (a.i == b.i) return true;
+        break;
+      case Kind::UInt:
+      case Kind::Length:
+        if (a.u == b.u && a.kind == b.kind) return true;
+        break;
+      case Kind::String:
+        if (a.s == b.s) return true;
+        break;
+    }
+    return differs(st, a, b);
+  }
+
+  // A value pair that is not bit-equal (a: run, b: golden): records the difference; false when it
+  // is outside the tolerance (any difference, for everything but floats).
+  bool differs(Stat& st, const Scalar& a, const Scalar& b) {
+    double abs_diff = 1.0, rel = 1.0;
+    bool ok = false;
+    switch (b.kind) {
+      case Kind::Float:
+        if (a.f == b.f || (std::isnan(a.f) && std::isnan(b.f))) return true;
+        abs_diff = std::fabs(a.f - b.f);
+        if (std::isnan(abs_diff)) abs_diff = std::numeric_limits<double>::infinity();  // NaN vs number, inf vs -inf
+        rel = b.f != 0.0 ? abs_diff / std::fabs(b.f) : std::numeric_limits<double>::infinity();
+        ok = abs_diff <= o_.atol + o_.rtol * std::fabs(b.f);
+        break;
+      case Kind::Int:
+        if (a.i == b.i) return true;
+        abs_diff = std::fabs(static_cast<double>(a.i) - static_cast<double>(b.i));
+        rel = b.i != 0 ? abs_diff / std::fabs(static_cast<double>(b.i)) : std::numeric_limits<double>::infinity();
+        break;
+      case Kind::UInt:
+      case Kind::Length:
+        if (a.u == b.u) return true;
+        abs_diff = std::fabs(static_cast<double>(a.u) - static_cast<double>(b.u));
+        rel = b.u != 0 ? abs_diff / static_cast<double>(b.u) : std::numeric_limits<double>::infinity();
+        break;
+      case Kind::Bool:
+        if (a.i == b.i) return true;
+        break;
+      case Kind::String:
+        if (a.s == b.s) return true;
+        break;
+    }
+    if (abs_diff > st.max_abs) {
+      st.max_abs = abs_diff;
+      if (step_known_) {
+        st.step_at_max = cur_step_;
+      } else {
+        touched_.push_back(&st);
+      }
+    }
+    st.max_rel = std::max(st.max_rel, rel);
+    if (!ok) {
+      ++st.over;
+      ++report_.diverging_values;
+    }
+    return ok;
+  }
+
+  // The step of a leftover message, for the missing/extra report.
+  std::pair<bool, std::uint64_t> step_of(Topic& t, int si, const Pending& p) {
+    if (t.mode != Topic::Mode::Fields) return {false, p.index};
+    std::vector<Scalar>& scratch = si == kRun ? run_ : golden_;
+    if (!t.decoder[si]->decode(cdr(p.data), scratch)) return {false, p.index};
+    Plan plan;
+    if (!t.layout->map(scratch, plan) || plan.step < 0) return {false, p.index};
+    return {true, step_value(scratch[static_cast<std::size_t>(plan.step)])};
+  }
+
+  Result<CheckReport> finish() {
+    for (const std::string& name : o_.topics) {
+      if (topic_index_.count(name) == 0) {
+        std::string known;
+        for (const Topic& t : topics_) known += (known.empty() ? "" : ", ") + t.name;
+        return Error{"--topics: " + name + " is in neither log (topics: " + (known.empty() ? "none" : known) + ")"};
+      }
+    }
+    std::vector<std::size_t> order(topics_.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return topics_[a].name < topics_[b].name; });
+    for (std::size_t i : order) {
+      Topic& t = topics_[i];
+      if (!t.selected) continue;
+      for (int si : {kRun, kGolden}) {
+        if (t.side[si].has && !t.side[1 - si].has) {
+          topic_problem(t, "topic only in the " + side_[si].role + " (" + std::to_string(t.count[si]) + " messages)");
+          report_.diverging_messages += t.count[si];
+        }
+      }
+      if (!t.side[kRun].has || !t.side[kGolden].has) continue;
+      report_.topics.push_back(t.name);
+      for (int si : {kRun, kGolden}) {
+        if (t.queue[si].empty()) continue;
+        const Pending& p = t.queue[si].front();
+        const auto [has_step, step] = step_of(t, si, p);
+        const std::string what =
+            si == kGolden ? "message missing from the run: the golden has " + std::to_string(t.count[kGolden]) +
+                                " messages on this topic, the run " + std::to_string(t.count[kRun])
+                          : "extra message in the run: the run has " + std::to_string(t.count[kRun]) +
+                                " messages on this topic, the golden " + std::to_string(t.count[kGolden]);
+        Divergence d{t.name, has_step, step, "(" + what + ")", "", "", ""};
+        consider(Key{p.log_time, p.ordinal}, std::move(d));
+        report_.diverging_messages += t.queue[si].size();
+      }
+      if (t.mode == Topic::Mode::Skip) continue;
+      auto row = [&](const std::string& field, const std::string& kind, const Stat& st, bool has_step) {
+        FieldStats f;
+        f.topic = t.name;
+        f.field = field;
+        f.kind = kind;
+        f.values = st.values;
+        f.over = st.over;
+        f.max_abs = st.max_abs;
+        f.max_rel = st.max_rel;
+        f.has_step = has_step;
+        f.step_at_max = st.step_at_max;
+        report_.fields.push_back(std::move(f));
+      };
+      const bool has_step = t.mode == Topic::Mode::Fields && t.layout->has_step();
+      for (std::size_t gi = 0; gi < t.identical_counts.size(); ++gi) t.stats[gi].values += t.identical_counts[gi];
+      if (t.mode == Topic::Mode::Fields) {
+        const auto& groups = t.layout->groups();
+        for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+          if (t.stats[gi].values > 0) row(groups[gi].path, kind_label(groups[gi].kind), t.stats[gi], has_step);
+        }
+      } else {
+        row("(bytes)", "bytes", t.stats[t.bytes_stat], false);
+      }
+      row("(log_time)", "time", t.stats[t.time_stat], has_step);
+    }
+    report_.run_bytes = side_[kRun].bytes;
+    report_.golden_bytes = side_[kGolden].bytes;
+    return std::move(report_);
+  }
+
+  const CheckOptions& o_;
+  Side side_[2];
+  std::vector<Topic> topics_;  // std::vector<Topic>: indices stay valid; elements are moved only on growth
+  std::map<std::string, std::size_t> topic_index_;
+  std::vector<Scalar> run_, golden_;
+  std::vector<Pair> pairs_;
+  CheckReport report_;
+  Key first_key_;
+  std::uint64_t problem_ordinal_ = 0;
+  bool last_has_step_ = false;
+  std::uint64_t last_step_ = 0;
+  // Stats whose maximum changed before the message's step was known (fixed up after the walk).
+  std::vector<Stat*> touched_;
+  bool step_known_ = false;
+  std::uint64_t cur_step_ = 0;
+};
+
+}  // namespace
+
+std::string Divergence::line() const {
+  if (topic_level) return "topic " + topic + ": " + field.substr(1, field.size() - 2);
+  std::string out = "topic " + topic + ", " + (has_step ? "step " : "message ") + std::to_string(step);
+  if (!field.empty() && field.front() == '(' && expected.empty()) return out + ": " + field.substr(1, field.size() - 2);
+  out += ", field " + field + ": expected " + expected + ", actual " + actual + ", difference " + difference;
+  return out;
+}
+
+Result<CheckReport> check_logs(const std::string& run_path, const std::string& golden_path, const CheckOptions& options) {
+  Comparer c(options, run_path, golden_path);
+  return c.compare();
+}
+
+}  // namespace rbsim::log

@@ -1,0 +1,847 @@
+// Golden logs: the record-every rule, finding a scene's FOSSSim reference output, and the
+// verification a golden passes before it is written (independent of the simulator: everything
+// here is recomputed from the scene file and the recorded body states with its own code).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "check_layout.hpp"
+#include "rbsim/log.hpp"
+
+namespace rbsim::log {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using msgs::Scalar;
+using Kind = Scalar::Kind;
+
+constexpr std::string_view kSceneType = "rbsim_msgs/msg/SceneDescription";
+constexpr std::string_view kBodyStatesType = "rbsim_msgs/msg/BodyStates";
+constexpr std::string_view kSpringStatesType = "rbsim_msgs/msg/SpringStates";
+constexpr std::string_view kEnergyType = "rbsim_msgs/msg/EnergyTerms";
+constexpr std::string_view kPosesType = "geometry_msgs/msg/PoseArray";
+
+std::string g17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+std::string g3(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+double number(const Scalar& s) {
+  switch (s.kind) {
+    case Kind::Float: return s.f;
+    case Kind::Int:
+    case Kind::Bool: return static_cast<double>(s.i);
+    case Kind::UInt:
+    case Kind::Length: return static_cast<double>(s.u);
+    case Kind::String: return std::nan("");
+  }
+  return std::nan("");
+}
+
+// Every message of one topic of a log, decoded.
+struct TopicLog {
+  std::string topic, type;
+  std::optional<msgs::MessageDecoder> decoder;
+  std::optional<Layout> layout;
+  struct Msg {
+    mcap::Timestamp log_time = 0;
+    mcap::Bytes data;  // the scalars' strings point into it
+    std::vector<Scalar> scalars;
+    Plan plan;
+  };
+  std::vector<Msg> messages;
+
+  // The values of field group `path` ("bodies[].x") in message m, in order.
+  std::vector<const Scalar*> values(std::size_t m, std::string_view path) const {
+    std::vector<const Scalar*> out;
+    const int g = layout->find(path);
+    if (g < 0) return out;
+    const Msg& msg = messages[m];
+    for (std::size_t i = 0; i < msg.scalars.size(); ++i) {
+      if (msg.plan.group[i] == static_cast<std::uint32_t>(g)) out.push_back(&msg.scalars[i]);
+    }
+    return out;
+  }
+  std::vector<double> numbers(std::size_t m, std::string_view path) const {
+    std::vector<double> out;
+    for (const Scalar* s : values(m, path)) out.push_back(number(*s));
+    return out;
+  }
+  double one(std::size_t m, std::string_view path) const {
+    const auto v = values(m, path);
+    return v.empty() ? std::nan("") : number(*v.front());
+  }
+  std::string text(std::size_t m, std::string_view path) const {
+    const auto v = values(m, path);
+    return v.empty() || v.front()->kind != Kind::String ? std::string() : std::string(v.front()->s);
+  }
+  std::uint64_t step(std::size_t m) const {
+    const Msg& msg = messages[m];
+    if (msg.plan.step < 0) return UINT64_MAX;
+    const Scalar& s = msg.scalars[static_cast<std::size_t>(msg.plan.step)];
+    return s.kind == Kind::Int ? static_cast<std::uint64_t>(s.i) : s.u;
+  }
+};
+
+// A golden log read whole (goldens are small), topics keyed by message type.
+Result<std::map<std::string, TopicLog>> read_log(const std::string& path) {
+  mcap::IndexedReader reader;
+  if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
+  if (auto st = reader.verify_data_section_crc(); !st.ok()) return Error{path + ": " + st.message};
+  std::map<std::string, TopicLog> topics;
+  std::optional<Error> failure;
+  auto st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+    if (e.channel == nullptr || e.schema == nullptr || e.schema->encoding != "ros2msg" ||
+        e.channel->message_encoding != "cdr") {
+      return true;  // not one of ours: ignored
+    }
+    TopicLog& t = topics[e.schema->name];
+    if (t.topic.empty()) {
+      t.topic = e.channel->topic;
+      t.type = e.schema->name;
+      const std::string_view text(reinterpret_cast<const char*>(e.schema->data.data()), e.schema->data.size());
+      auto decoder = msgs::MessageDecoder::create(t.type, text);
+      auto layout = Layout::create(t.type, text);
+      if (!decoder || !layout) {
+        failure = Error{path + ": schema " + t.type + ": " + (!decoder ? decoder.error().message : layout.error().message)};
+        return false;
+      }
+      t.decoder = std::move(decoder.value());
+      t.layout = std::move(layout.value());
+    } else if (t.topic != e.channel->topic) {
+      failure = Error{path + ": two topics carry " + t.type + ": " + t.topic + " and " + e.channel->topic};
+      return false;
+    }
+    TopicLog::Msg m;
+    m.log_time = e.message.log_time;
+    m.data = e.message.data;
+    if (Status d = t.decoder->decode(std::as_bytes(std::span<const std::uint8_t>(m.data)), m.scalars); !d) {
+      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) + ": " + d.error().message};
+      return false;
+    }
+    if (!t.layout->map(m.scalars, m.plan)) {
+      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) + " does not fit its schema"};
+      return false;
+    }
+    t.messages.push_back(std::move(m));
+    return true;
+  });
+  if (!st.ok()) return Error{path + ": " + st.message};
+  if (failure) return *failure;
+  return topics;
+}
+
+// The largest deviation of a set of comparisons, and the first one outside its tolerance.
+class Tally {
+ public:
+  void add(double got, double want, double tol, const std::function<std::string()>& where) {
+    ++count_;
+    double d = std::fabs(got - want);
+    if (std::isnan(d)) d = got == want ? 0.0 : HUGE_VAL;
+    if (d > max_) max_ = d;
+    if (!(d <= tol) && fails_++ == 0) {
+      first_ = where() + ": recorded " + g17(got) + ", expected " + g17(want) + " (tolerance " + g3(tol) + ")";
+    }
+  }
+  void fail(const std::string& what) {
+    if (fails_++ == 0) first_ = what;
+  }
+  bool ok() const { return fails_ == 0; }
+  double max() const { return max_; }
+  std::uint64_t count() const { return count_; }
+  std::string summary() const {
+    return ok() ? "max diff " + g3(max_)
+                : std::to_string(fails_) + " of " + std::to_string(count_) + " outside tolerance, first " + first_;
+  }
+
+ private:
+  std::uint64_t count_ = 0, fails_ = 0;
+  double max_ = 0.0;
+  std::string first_;
+};
+
+struct Report {
+  GoldenVerification& v;
+  void line(bool ok, const std::string& what) {
+    v.lines.push_back((ok ? "PASS " : "FAIL ") + what);
+    if (!ok) failed = true;
+  }
+  void info(const std::string& what) { v.lines.push_back("info " + what); }
+  bool failed = false;
+};
+
+// The scene's constant properties, recomputed from its file with this file's own code.
+struct Model {
+  std::vector<double> mass, inertia;
+  std::vector<Vec2> center;                  // X at t = 0
+  std::vector<std::vector<Vec2>> body_hull;  // body space
+  std::vector<SpringDef> springs;
+  std::vector<GravityDef> gravity;
+};
+
+Model model_of(const Scene& scene) {
+  Model m;
+  for (const BodyDef& b : scene.world.bodies) {
+    double M = 0.0;
+    Vec2 X(0.0, 0.0);
+    for (std::size_t i = 0; i < b.hull.size(); ++i) {
+      M += b.masses[i];
+      X += b.masses[i] * b.hull[i];
+    }
+    X /= M;
+    double I = 0.0;
+    std::vector<Vec2> hull;
+    for (std::size_t i = 0; i < b.hull.size(); ++i) {
+      const Vec2 r = b.hull[i] - X;
+      I += b.masses[i] * r.squaredNorm();
+      hull.push_back(r);
+    }
+    m.mass.push_back(M);
+    m.inertia.push_back(I);
+    m.center.push_back(X);
+    m.body_hull.push_back(std::move(hull));
+  }
+  m.springs = scene.world.springs;
+  m.gravity = scene.world.gravity;
+  return m;
+}
+
+struct State {
+  std::vector<double> x, y, theta, vx, vy, omega;
+};
+
+struct SpringEnds {
+  Vec2 end_i, end_j;
+  double length = 0.0, potential = 0.0;
+};
+
+// Everything a step's energy, spring and pose messages should hold, from the state alone.
+struct Terms {
+  std::vector<double> px, py, l_point, l_spin, t_point, t_spin;
+  std::vector<double> force_potential;  // each gravity field, then each spring
+  std::vector<SpringEnds> springs;
+  double momentum_x = 0.0, momentum_y = 0.0, angular = 0.0, potential = 0.0, kinetic_point = 0.0,
+         kinetic_spin = 0.0, total = 0.0;
+  double power = 0.0;  // sum F.V + tau omega of gravity and springs
+  double scale = 0.0;  // sum of |term|: the size of the rounding error of the total
+};
+
+Terms terms_of(const Model& m, const State& s) {
+  const std::size_t n = m.mass.size();
+  Terms t;
+  std::vector<Vec2> force(n, Vec2(0.0, 0.0));
+  std::vector<double> torque(n, 0.0);
+  for (std::size_t b = 0; b < n; ++b) {
+    const double M = m.mass[b], I = m.inertia[b];
+    const Vec2 X(s.x[b], s.y[b]), V(s.vx[b], s.vy[b]);
+    t.px.push_back(M * V.x());
+    t.py.push_back(M * V.y());
+    t.l_point.push_back(M * (X.x() * V.y() - X.y() * V.x()));
+    t.l_spin.push_back(I * s.omega[b]);
+    t.t_point.push_back(0.5 * M * V.squaredNorm());
+    t.t_spin.push_back(0.5 * I * s.omega[b] * s.omega[b]);
+    t.momentum_x += t.px.back();
+    t.momentum_y += t.py.back();
+    t.angular += t.l_point.back() + t.l_spin.back();
+    t.kinetic_point += t.t_point.back();
+    t.kinetic_spin += t.t_spin.back();
+  }
+  for (const GravityDef& g : m.gravity) {
+    double u = 0.0;
+    for (std::size_t b = 0; b < n; ++b) {
+      u -= m.mass[b] * (g.acceleration.x() * s.x[b] + g.acceleration.y() * s.y[b]);
+      force[b] += m.mass[b] * g.acceleration;
+      t.scale += std::fabs(m.mass[b] * g.acceleration.x() * s.x[b]) + std::fabs(m.mass[b] * g.acceleration.y() * s.y[b]);
+    }
+    t.force_potential.push_back(u);
+  }
+  auto end = [&](std::int32_t body, const Vec2& anchor, Vec2& arm) {
+    if (body < 0) {
+      arm = Vec2(0.0, 0.0);
+      return anchor;
+    }
+    const double c = std::cos(s.theta[body]), sn = std::sin(s.theta[body]);
+    arm = Vec2(c * anchor.x() - sn * anchor.y(), sn * anchor.x() + c * anchor.y());
+    return Vec2(s.x[body] + arm.x(), s.y[body] + arm.y());
+  };
+  for (const SpringDef& sp : m.springs) {
+    Vec2 arm_i, arm_j;
+    SpringEnds e;
+    e.end_i = end(sp.body_i, sp.anchor_i, arm_i);
+    e.end_j = end(sp.body_j, sp.anchor_j, arm_j);
+    const Vec2 d = e.end_j - e.end_i;
+    e.length = d.norm();
+    const double stretch = e.length - sp.rest_length;
+    e.potential = 0.5 * sp.stiffness * stretch * stretch;
+    t.springs.push_back(e);
+    t.force_potential.push_back(e.potential);
+    t.scale += e.potential;
+    // Force on end i pulls it towards end j when stretched; with l0 = 0 it is k d (no 0/0).
+    Vec2 f(0.0, 0.0);
+    if (sp.rest_length == 0.0) {
+      f = sp.stiffness * d;
+    } else if (e.length > 0.0) {
+      f = sp.stiffness * stretch / e.length * d;
+    }
+    if (sp.body_i >= 0) {
+      force[sp.body_i] += f;
+      torque[sp.body_i] += arm_i.x() * f.y() - arm_i.y() * f.x();
+    }
+    if (sp.body_j >= 0) {
+      force[sp.body_j] -= f;
+      torque[sp.body_j] -= arm_j.x() * f.y() - arm_j.y() * f.x();
+    }
+  }
+  for (double u : t.force_potential) t.potential += u;
+  t.total = t.potential + t.kinetic_point + t.kinetic_spin;
+  t.scale += t.kinetic_point + t.kinetic_spin;
+  for (std::size_t b = 0; b < n; ++b) {
+    t.power += force[b].x() * s.vx[b] + force[b].y() * s.vy[b] + torque[b] * s.omega[b];
+  }
+  return t;
+}
+
+// The verifier's own integrator, written from the spec (sections 4.6-4.8) and the README's
+// conventions, independently of sim_core: every force summed directly, the wind over its sample
+// points (sim_core uses a closed form), rotations by cos/sin per point.
+void step_state(const Model& m, const Scene& scene, State& s) {
+  const std::size_t n = m.mass.size();
+  std::vector<Vec2> force(n, Vec2(0.0, 0.0));
+  std::vector<double> torque(n, 0.0);
+  auto rotate = [&](std::size_t b, const Vec2& p) {
+    const double c = std::cos(s.theta[b]), sn = std::sin(s.theta[b]);
+    return Vec2(c * p.x() - sn * p.y(), sn * p.x() + c * p.y());
+  };
+  for (const GravityDef& g : m.gravity) {
+    for (std::size_t b = 0; b < n; ++b) force[b] += m.mass[b] * g.acceleration;
+  }
+  for (const SpringDef& sp : m.springs) {
+    const Vec2 arm_i = sp.body_i < 0 ? Vec2(0.0, 0.0) : rotate(static_cast<std::size_t>(sp.body_i), sp.anchor_i);
+    const Vec2 arm_j = sp.body_j < 0 ? Vec2(0.0, 0.0) : rotate(static_cast<std::size_t>(sp.body_j), sp.anchor_j);
+    const Vec2 pi = sp.body_i < 0 ? sp.anchor_i : Vec2(s.x[sp.body_i], s.y[sp.body_i]) + arm_i;
+    const Vec2 pj = sp.body_j < 0 ? sp.anchor_j : Vec2(s.x[sp.body_j], s.y[sp.body_j]) + arm_j;
+    const Vec2 d = pj - pi;
+    const double l = d.norm();
+    Vec2 f(0.0, 0.0);  // on end i, towards j when stretched
+    if (sp.rest_length == 0.0) {
+      f = sp.stiffness * d;
+    } else if (l > 0.0) {
+      f = sp.stiffness * (l - sp.rest_length) / l * d;
+    }
+    if (sp.body_i >= 0) {
+      force[sp.body_i] += f;
+      torque[sp.body_i] += arm_i.x() * f.y() - arm_i.y() * f.x();
+    }
+    if (sp.body_j >= 0) {
+      force[sp.body_j] -= f;
+      torque[sp.body_j] -= arm_j.x() * f.y() - arm_j.y() * f.x();
+    }
+  }
+  // F = sum over edges i and sample points j of beta l_i / P ((v_wind - v_j) . n_i) n_i, the
+  // hull clockwise, so n = (-e.y, e.x) / |e| points out; sample j at (j + 1/2) / P along the edge.
+  for (const WindDef& w : scene.world.winds) {
+    const int P = w.points_per_edge;
+    for (std::size_t b = 0; b < n; ++b) {
+      const std::vector<Vec2>& hull = m.body_hull[b];
+      const Vec2 V(s.vx[b], s.vy[b]);
+      for (std::size_t i = 0; i < hull.size(); ++i) {
+        const Vec2 a = rotate(b, hull[i]), c = rotate(b, hull[(i + 1) % hull.size()]);
+        const Vec2 e = c - a;
+        const double l = e.norm();
+        if (l == 0.0) continue;
+        const Vec2 normal(-e.y() / l, e.x() / l);
+        for (int j = 0; j < P; ++j) {
+          const Vec2 r = a + ((j + 0.5) / P) * e;  // from the centre of mass
+          const Vec2 v = V + Vec2(-s.omega[b] * r.y(), s.omega[b] * r.x());
+          const Vec2 f = w.beta * (l / P) * (w.velocity - v).dot(normal) * normal;
+          force[b] += f;
+          torque[b] += r.x() * f.y() - r.y() * f.x();
+        }
+      }
+    }
+  }
+  const double dt = scene.world.dt;
+  const bool symplectic = scene.world.integrator == Integrator::SymplecticEuler;
+  for (std::size_t b = 0; b < n; ++b) {
+    const double vx = s.vx[b], vy = s.vy[b], w = s.omega[b];
+    s.vx[b] += dt * force[b].x() / m.mass[b];
+    s.vy[b] += dt * force[b].y() / m.mass[b];
+    s.omega[b] += dt * torque[b] / m.inertia[b];
+    s.x[b] += dt * (symplectic ? s.vx[b] : vx);
+    s.y[b] += dt * (symplectic ? s.vy[b] : vy);
+    s.theta[b] += dt * (symplectic ? s.omega[b] : w);
+  }
+}
+
+std::uint64_t stamp_ns(std::uint64_t step, double dt) {
+  const double ns = std::round(static_cast<double>(step) * dt * 1e9);
+  return ns <= 0.0 ? 0 : static_cast<std::uint64_t>(ns);
+}
+
+bool same_file_contents(const fs::path& a, const std::string& bytes) {
+  std::error_code ec;
+  if (fs::file_size(a, ec) != bytes.size() || ec) return false;
+  std::ifstream in(a, std::ios::binary);
+  std::string other((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return other == bytes;
+}
+
+}  // namespace
+
+std::int64_t golden_record_every(std::int64_t steps) {
+  constexpr std::int64_t kTarget = 500;
+  if (steps <= kTarget) return 1;
+  const std::int64_t k0 = (steps + kTarget - 1) / kTarget;
+  for (std::int64_t k = k0; k <= 2 * k0; ++k) {
+    if (steps % k == 0) return k;
+  }
+  return k0;
+}
+
+FosssimMatch find_fosssim_reference(const std::string& scene_path, const std::string& fosssim_dir) {
+  FosssimMatch match;
+  std::ifstream in(scene_path, std::ios::binary);
+  if (!in) return match;
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const fs::path scenes = fs::path(fosssim_dir) / "scenes";
+  std::error_code ec;
+  std::vector<fs::path> candidates;
+  for (fs::recursive_directory_iterator it(scenes, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_regular_file(ec) && it->path().extension() == ".xml") candidates.push_back(it->path());
+  }
+  std::sort(candidates.begin(), candidates.end());
+  for (const fs::path& p : candidates) {
+    if (!same_file_contents(p, bytes)) continue;
+    match.scene = p.string();
+    const fs::path rel = p.lexically_relative(scenes);
+    for (const char* ext : {".bin.zst", ".bin"}) {
+      fs::path ref = fs::path(fosssim_dir) / "reference" / rel.parent_path() / (rel.stem().string() + ext);
+      if (fs::is_regular_file(ref, ec)) {
+        match.reference = ref.string();
+        return match;
+      }
+    }
+    return match;
+  }
+  return match;
+}
+
+Result<std::int64_t> read_record_every(const std::string& golden_path) {
+  auto log = read_log(golden_path);
+  if (!log) return log.error();
+  const auto it = log->find(std::string(kBodyStatesType));
+  if (it == log->end() || it->second.messages.empty()) return Error{golden_path + ": no body states recorded"};
+  const TopicLog& t = it->second;
+  if (t.messages.size() < 2) return std::int64_t{1};
+  return static_cast<std::int64_t>(t.step(1) - t.step(0));
+}
+
+Result<GoldenVerification> verify_golden(const std::string& scene_path, const std::string& golden_path,
+                                         const GoldenVerifyOptions& options) {
+  Result<Scene> loaded = load_scene(scene_path);
+  if (!loaded) return loaded.error();
+  const Scene& scene = loaded.value();
+  auto log_result = read_log(golden_path);
+  if (!log_result) return log_result.error();
+  const std::map<std::string, TopicLog>& topics = log_result.value();
+
+  GoldenVerification v;
+  Report r{v};
+  const Model model = model_of(scene);
+  const std::size_t bodies = model.mass.size();
+  const double dt = scene.world.dt;
+  v.steps = scene.step_count();
+
+  auto topic = [&](std::string_view type) -> const TopicLog* {
+    const auto it = topics.find(std::string(type));
+    return it == topics.end() || it->second.messages.empty() ? nullptr : &it->second;
+  };
+  const TopicLog* desc = topic(kSceneType);
+  const TopicLog* states = topic(kBodyStatesType);
+  const TopicLog* springs = topic(kSpringStatesType);
+  const TopicLog* energy = topic(kEnergyType);
+  const TopicLog* poses = topic(kPosesType);
+  for (auto [t, type] : {std::pair{desc, kSceneType}, {states, kBodyStatesType}, {springs, kSpringStatesType},
+                         {energy, kEnergyType}}) {
+    if (t == nullptr) r.line(false, "recording: no " + std::string(type) + " messages");
+  }
+  if (r.failed) return v;
+
+  // 1. The recorded scene description against the scene file.
+  {
+    Tally tally;
+    auto exact = [&](double got, double want, const std::string& what) { tally.add(got, want, 0.0, [&] { return what; }); };
+    auto rel = [&](double got, double want, const std::string& what) {
+      tally.add(got, want, 1e-12 * std::max(1.0, std::fabs(want)), [&] { return what; });
+    };
+    if (desc->messages.size() != 1 || desc->messages[0].log_time != 0) {
+      tally.fail("expected one scene description at log time 0, found " + std::to_string(desc->messages.size()));
+    }
+    if (desc->text(0, "integrator") != to_string(scene.world.integrator)) {
+      tally.fail("integrator '" + desc->text(0, "integrator") + "', scene " + to_string(scene.world.integrator));
+    }
+    exact(desc->one(0, "dt"), dt, "dt");
+    exact(desc->one(0, "duration"), scene.duration, "duration");
+    exact(desc->one(0, "step_count"), static_cast<double>(v.steps), "step_count");
+    const auto mass = desc->numbers(0, "bodies[].mass"), inertia = desc->numbers(0, "bodies[].inertia");
+    const auto hull_n = desc->numbers(0, "bodies[].hull.length");
+    const auto hx = desc->numbers(0, "bodies[].hull[].x"), hy = desc->numbers(0, "bodies[].hull[].y");
+    exact(static_cast<double>(mass.size()), static_cast<double>(bodies), "body count");
+    std::size_t h = 0;
+    for (std::size_t b = 0; b < std::min(bodies, mass.size()); ++b) {
+      const std::string id = "body " + std::to_string(b);
+      rel(mass[b], model.mass[b], id + " mass");
+      rel(inertia[b], model.inertia[b], id + " inertia");
+      exact(hull_n[b], static_cast<double>(model.body_hull[b].size()), id + " hull vertex count");
+      for (std::size_t k = 0; k < model.body_hull[b].size() && h < hx.size(); ++k, ++h) {
+        const Vec2& want = model.body_hull[b][k];
+        rel(hx[h], want.x(), id + " hull vertex " + std::to_string(k) + " x");
+        rel(hy[h], want.y(), id + " hull vertex " + std::to_string(k) + " y");
+      }
+    }
+    const auto bi = desc->numbers(0, "springs[].body_i"), bj = desc->numbers(0, "springs[].body_j");
+    const auto aix = desc->numbers(0, "springs[].anchor_i.x"), aiy = desc->numbers(0, "springs[].anchor_i.y");
+    const auto ajx = desc->numbers(0, "springs[].anchor_j.x"), ajy = desc->numbers(0, "springs[].anchor_j.y");
+    const auto k = desc->numbers(0, "springs[].stiffness"), l0 = desc->numbers(0, "springs[].rest_length");
+    exact(static_cast<double>(k.size()), static_cast<double>(model.springs.size()), "spring count");
+    for (std::size_t s = 0; s < std::min(k.size(), model.springs.size()); ++s) {
+      const SpringDef& sp = model.springs[s];
+      const std::string id = "spring " + std::to_string(s);
+      exact(bi[s], sp.body_i, id + " body_i");
+      exact(bj[s], sp.body_j, id + " body_j");
+      exact(aix[s], sp.anchor_i.x(), id + " anchor_i.x");
+      exact(aiy[s], sp.anchor_i.y(), id + " anchor_i.y");
+      exact(ajx[s], sp.anchor_j.x(), id + " anchor_j.x");
+      exact(ajy[s], sp.anchor_j.y(), id + " anchor_j.y");
+      exact(k[s], sp.stiffness, id + " stiffness");
+      exact(l0[s], sp.rest_length, id + " rest_length");
+    }
+    const auto gx = desc->numbers(0, "gravity[].acceleration.x"), gy = desc->numbers(0, "gravity[].acceleration.y");
+    exact(static_cast<double>(gx.size()), static_cast<double>(model.gravity.size()), "gravity count");
+    for (std::size_t g = 0; g < std::min(gx.size(), model.gravity.size()); ++g) {
+      exact(gx[g], model.gravity[g].acceleration.x(), "gravity " + std::to_string(g) + " x");
+      exact(gy[g], model.gravity[g].acceleration.y(), "gravity " + std::to_string(g) + " y");
+    }
+    const auto beta = desc->numbers(0, "winds[].beta"), wx = desc->numbers(0, "winds[].velocity.x");
+    const auto wy = desc->numbers(0, "winds[].velocity.y"), ppe = desc->numbers(0, "winds[].points_per_edge");
+    exact(static_cast<double>(beta.size()), static_cast<double>(scene.world.winds.size()), "wind count");
+    for (std::size_t w = 0; w < std::min(beta.size(), scene.world.winds.size()); ++w) {
+      const WindDef& wd = scene.world.winds[w];
+      exact(beta[w], wd.beta, "wind " + std::to_string(w) + " beta");
+      exact(wx[w], wd.velocity.x(), "wind " + std::to_string(w) + " velocity.x");
+      exact(wy[w], wd.velocity.y(), "wind " + std::to_string(w) + " velocity.y");
+      exact(ppe[w], wd.points_per_edge, "wind " + std::to_string(w) + " points_per_edge");
+    }
+    r.line(tally.ok(), "scene description: " + std::to_string(bodies) + " bodies (M, I and body-space hulls recomputed "
+                       "from the vertices), " + std::to_string(model.springs.size()) + " springs, " +
+                       std::to_string(model.gravity.size()) + " gravity, " + std::to_string(scene.world.winds.size()) +
+                       " wind, dt " + g17(dt) + ", " + to_string(scene.world.integrator) + ", " +
+                       std::to_string(v.steps) + " steps: " + tally.summary());
+    // With other counts the recording cannot be read against this scene; with other values it
+    // can, and the checks below show what they break.
+    if (mass.size() != bodies || k.size() != model.springs.size() || gx.size() != model.gravity.size() ||
+        hull_n.size() != bodies) {
+      return v;
+    }
+  }
+
+  // 2. The recording: steps 0, K, 2K, ... up to the end of the run, stamped t = step * dt, the
+  //    same steps on every per-step topic, the initial state from the scene.
+  std::vector<State> state(states->messages.size());
+  std::vector<std::uint64_t> steps(states->messages.size());
+  {
+    Tally tally;
+    for (std::size_t m = 0; m < states->messages.size(); ++m) {
+      steps[m] = states->step(m);
+      State& s = state[m];
+      s.x = states->numbers(m, "bodies[].x");
+      s.y = states->numbers(m, "bodies[].y");
+      s.theta = states->numbers(m, "bodies[].theta");
+      s.vx = states->numbers(m, "bodies[].vx");
+      s.vy = states->numbers(m, "bodies[].vy");
+      s.omega = states->numbers(m, "bodies[].omega");
+      const auto ids = states->numbers(m, "bodies[].id");
+      if (s.x.size() != bodies || s.omega.size() != bodies || ids.size() != bodies) {
+        tally.fail("step message " + std::to_string(m) + " holds " + std::to_string(s.x.size()) + " bodies");
+        state.resize(m);
+        steps.resize(m);
+        break;
+      }
+      for (std::size_t b = 0; b < bodies; ++b) {
+        if (ids[b] != static_cast<double>(b)) tally.fail("message " + std::to_string(m) + " body ids out of order");
+      }
+    }
+    const std::uint64_t K = steps.size() >= 2 ? steps[1] - steps[0] : 1;
+    v.record_every = static_cast<std::int64_t>(K);
+    v.last_step = steps.empty() ? 0 : static_cast<std::int64_t>(steps.back());
+    if (steps.empty() || steps[0] != 0) tally.fail("the first recorded step is not step 0");
+    for (std::size_t m = 0; m < steps.size(); ++m) {
+      if (steps[m] != m * K) {
+        tally.fail("recorded step " + std::to_string(steps[m]) + " where step " + std::to_string(m * K) + " was expected");
+        break;
+      }
+      const std::uint64_t ns = stamp_ns(steps[m], dt);
+      tally.add(static_cast<double>(states->messages[m].log_time), static_cast<double>(ns), 0.0,
+                [&] { return "step " + std::to_string(steps[m]) + " log time"; });
+      const double sec = states->one(m, "header.stamp.sec"), nsec = states->one(m, "header.stamp.nanosec");
+      tally.add(sec * 1e9 + nsec, static_cast<double>(ns), 0.0,
+                [&] { return "step " + std::to_string(steps[m]) + " header stamp"; });
+    }
+    if (!steps.empty() && (steps.back() > static_cast<std::uint64_t>(v.steps) ||
+                           static_cast<std::uint64_t>(v.steps) - steps.back() >= std::max<std::uint64_t>(K, 1))) {
+      tally.fail("the recording ends at step " + std::to_string(steps.back()) + ", the scene runs " +
+                 std::to_string(v.steps) + " steps");
+    }
+    for (const TopicLog* t : {springs, energy, poses}) {
+      if (t == nullptr) continue;
+      if (t->messages.size() != states->messages.size()) {
+        tally.fail(t->topic + " has " + std::to_string(t->messages.size()) + " messages, " + states->topic + " " +
+                   std::to_string(states->messages.size()));
+        continue;
+      }
+      for (std::size_t m = 0; m < steps.size(); ++m) {
+        tally.add(static_cast<double>(t->messages[m].log_time), static_cast<double>(states->messages[m].log_time), 0.0,
+                  [&] { return t->topic + " message " + std::to_string(m) + " log time"; });
+        if (t->layout->has_step()) {
+          tally.add(static_cast<double>(t->step(m)), static_cast<double>(steps[m]), 0.0,
+                    [&] { return t->topic + " message " + std::to_string(m) + " step"; });
+        }
+      }
+    }
+    if (!state.empty()) {
+      const State& s0 = state[0];
+      for (std::size_t b = 0; b < bodies; ++b) {
+        const BodyDef& def = scene.world.bodies[b];
+        const std::string id = "step 0 body " + std::to_string(b);
+        const double tol = 1e-12 * std::max(1.0, model.center[b].norm());
+        tally.add(s0.x[b], model.center[b].x(), tol, [&] { return id + " x"; });
+        tally.add(s0.y[b], model.center[b].y(), tol, [&] { return id + " y"; });
+        tally.add(s0.theta[b], 0.0, 0.0, [&] { return id + " theta"; });
+        tally.add(s0.vx[b], def.velocity.x(), 0.0, [&] { return id + " vx"; });
+        tally.add(s0.vy[b], def.velocity.y(), 0.0, [&] { return id + " vy"; });
+        tally.add(s0.omega[b], def.omega, 0.0, [&] { return id + " omega"; });
+      }
+    }
+    r.line(tally.ok(), "recording: steps 0.." + std::to_string(v.last_step) + " every " + std::to_string(K) + " (" +
+                           std::to_string(steps.size()) + " per topic), stamps = step * dt, initial state = scene: " +
+                           tally.summary());
+    if (!tally.ok()) return v;
+  }
+
+  // 3. Every recorded energy, spring and pose term against its recomputation from the state.
+  std::vector<Terms> terms;
+  for (const State& s : state) terms.push_back(terms_of(model, s));
+  {
+    const double rtol = options.recompute_rtol;
+    Tally e, sp, po;
+    for (std::size_t m = 0; m < state.size(); ++m) {
+      const Terms& t = terms[m];
+      const std::string at = "step " + std::to_string(steps[m]);
+      auto near = [&](Tally& tally, double got, double want, const char* what, std::size_t i = SIZE_MAX) {
+        tally.add(got, want, rtol * std::max(1.0, std::fabs(want)), [&] {
+          return at + " " + what + (i == SIZE_MAX ? std::string() : " [" + std::to_string(i) + "]");
+        });
+      };
+      auto each = [&](Tally& tally, const TopicLog* t_log, const char* path, const std::vector<double>& want) {
+        const auto got = t_log->numbers(m, path);
+        if (got.size() != want.size()) {
+          tally.fail(at + " " + path + ": " + std::to_string(got.size()) + " values, expected " + std::to_string(want.size()));
+          return;
+        }
+        for (std::size_t i = 0; i < got.size(); ++i) near(tally, got[i], want[i], path, i);
+      };
+      each(e, energy, "bodies[].momentum.x", t.px);
+      each(e, energy, "bodies[].momentum.y", t.py);
+      each(e, energy, "bodies[].l_point", t.l_point);
+      each(e, energy, "bodies[].l_spin", t.l_spin);
+      each(e, energy, "bodies[].t_point", t.t_point);
+      each(e, energy, "bodies[].t_spin", t.t_spin);
+      each(e, energy, "forces[].potential", t.force_potential);
+      near(e, energy->one(m, "momentum.x"), t.momentum_x, "momentum.x");
+      near(e, energy->one(m, "momentum.y"), t.momentum_y, "momentum.y");
+      near(e, energy->one(m, "angular_momentum"), t.angular, "angular_momentum");
+      near(e, energy->one(m, "potential"), t.potential, "potential");
+      near(e, energy->one(m, "kinetic_point"), t.kinetic_point, "kinetic_point");
+      near(e, energy->one(m, "kinetic_spin"), t.kinetic_spin, "kinetic_spin");
+      near(e, energy->one(m, "total"), t.total, "total");
+      std::vector<double> ex, ey, fx, fy, len, rest, pot;
+      for (std::size_t k = 0; k < t.springs.size(); ++k) {
+        ex.push_back(t.springs[k].end_i.x());
+        ey.push_back(t.springs[k].end_i.y());
+        fx.push_back(t.springs[k].end_j.x());
+        fy.push_back(t.springs[k].end_j.y());
+        len.push_back(t.springs[k].length);
+        rest.push_back(model.springs[k].rest_length);
+        pot.push_back(t.springs[k].potential);
+      }
+      each(sp, springs, "springs[].end_i.x", ex);
+      each(sp, springs, "springs[].end_i.y", ey);
+      each(sp, springs, "springs[].end_j.x", fx);
+      each(sp, springs, "springs[].end_j.y", fy);
+      each(sp, springs, "springs[].length", len);
+      each(sp, springs, "springs[].rest_length", rest);
+      each(sp, springs, "springs[].potential", pot);
+      if (poses != nullptr) {
+        std::vector<double> qz, qw;
+        for (std::size_t b = 0; b < bodies; ++b) {
+          qz.push_back(std::sin(0.5 * state[m].theta[b]));
+          qw.push_back(std::cos(0.5 * state[m].theta[b]));
+        }
+        each(po, poses, "poses[].position.x", state[m].x);
+        each(po, poses, "poses[].position.y", state[m].y);
+        each(po, poses, "poses[].orientation.z", qz);
+        each(po, poses, "poses[].orientation.w", qw);
+      }
+    }
+    const std::string tol = " (tolerance " + g3(rtol) + " x max(1, |value|))";
+    r.line(e.ok(), "energy terms: P, L_point, L_spin, T_point, T_spin per body, U per force and the totals of " +
+                       std::to_string(state.size()) + " steps recomputed from the recorded states" + tol + ": " +
+                       e.summary());
+    r.line(sp.ok(), "spring states: endpoints, lengths and potentials recomputed from the recorded poses" + tol + ": " +
+                        sp.summary());
+    if (poses != nullptr) r.line(po.ok(), "poses: positions and orientation quaternions" + tol + ": " + po.summary());
+  }
+
+  // 4. The dynamics, re-integrated independently: from each recorded state, K steps of the
+  //    verifier's own integrator must land on the next recorded state.
+  {
+    Tally tally;
+    const double tol = options.integration_tol;
+    for (std::size_t m = 0; m + 1 < state.size(); ++m) {
+      State s = state[m];
+      for (std::uint64_t k = steps[m]; k < steps[m + 1]; ++k) step_state(model, scene, s);
+      const State& want = state[m + 1];
+      for (std::size_t b = 0; b < bodies; ++b) {
+        const std::string at = "step " + std::to_string(steps[m + 1]) + " body " + std::to_string(b);
+        auto add = [&](double got, double expected, const char* what) {
+          tally.add(expected, got, tol * std::max(1.0, std::fabs(got)), [&] { return at + " " + what; });
+        };
+        add(s.x[b], want.x[b], "x");
+        add(s.y[b], want.y[b], "y");
+        add(s.theta[b], want.theta[b], "theta");
+        add(s.vx[b], want.vx[b], "vx");
+        add(s.vy[b], want.vy[b], "vy");
+        add(s.omega[b], want.omega[b], "omega");
+      }
+    }
+    r.line(tally.ok(), "independent integration: from each recorded state, " + std::to_string(v.record_every) +
+                           " steps of the verifier's own " + to_string(scene.world.integrator) +
+                           " (gravity, springs, wind summed over its sample points) reach the next recorded state "
+                           "(tolerance " + g3(tol) + " x max(1, |value|)): " + tally.summary());
+    if (tally.ok()) v.rule = "independent-integration";
+  }
+
+  // 5. Against an independent result: the reference solver's output, or energy conservation.
+  const FosssimMatch match =
+      options.fosssim_dir.empty() ? FosssimMatch{} : find_fosssim_reference(scene_path, options.fosssim_dir);
+  if (!match.reference.empty()) {
+    v.rule = "fosssim-reference, " + v.rule;
+    r.info("the scene is FOSSSim's " + match.scene + ", reference output " + match.reference);
+    Result<std::vector<std::byte>> bytes = read_file(match.reference);
+    if (!bytes) return bytes.error();
+    Result<FosssimLog> ref = parse_fosssim(bytes.value(), static_cast<std::int32_t>(bodies));
+    if (!ref) return Error{match.reference + ": " + ref.error().message};
+    Result<GradeReport> graded = grade(scene, ref.value());
+    if (!graded) return graded.error();
+    const GradeReport& gr = graded.value();
+    r.line(gr.passed, "grade (the reference's rule, as rbsim grade): " + std::to_string(gr.steps) +
+                          " steps, max step diff " + g3(gr.max_step_diff) + ", summed " + g3(gr.sum_step_diff) +
+                          ", max quantity diff " + g3(gr.max_quantity_diff) + (gr.passed ? "" : ": " + gr.message));
+    Tally st, q;
+    const FosssimLog& rl = ref.value();
+    for (std::size_t b = 0; b < bodies; ++b) {
+      const std::string id = "body " + std::to_string(b);
+      q.add(desc->numbers(0, "bodies[].mass")[b], rl.mass[b], options.quantity_tol, [&] { return id + " M"; });
+      q.add(desc->numbers(0, "bodies[].inertia")[b], rl.inertia[b], options.quantity_tol, [&] { return id + " I"; });
+    }
+    for (std::size_t m = 0; m < state.size(); ++m) {
+      if (steps[m] >= rl.frames.size()) {
+        st.fail("step " + std::to_string(steps[m]) + " is past the reference's " + std::to_string(rl.frames.size() - 1));
+        break;
+      }
+      const FosssimFrame& f = rl.frames[steps[m]];
+      const State& s = state[m];
+      const std::string at = "step " + std::to_string(steps[m]) + " body ";
+      for (std::size_t b = 0; b < bodies; ++b) {
+        const BodyState& want = f.states[b];
+        const double tol = options.state_tol;
+        auto where = [&](const char* what) { return [&, what] { return at + std::to_string(b) + " " + what; }; };
+        st.add(s.x[b], want.position.x(), tol, where("x"));
+        st.add(s.y[b], want.position.y(), tol, where("y"));
+        st.add(s.theta[b], want.theta, tol, where("theta"));
+        st.add(s.vx[b], want.velocity.x(), tol, where("vx"));
+        st.add(s.vy[b], want.velocity.y(), tol, where("vy"));
+        st.add(s.omega[b], want.omega, tol, where("omega"));
+        const BodyQuantities& wq = f.quantities[b];
+        const double qt = options.quantity_tol;
+        q.add(energy->numbers(m, "bodies[].momentum.x")[b], wq.momentum.x(), qt, where("P.x"));
+        q.add(energy->numbers(m, "bodies[].momentum.y")[b], wq.momentum.y(), qt, where("P.y"));
+        q.add(energy->numbers(m, "bodies[].l_point")[b], wq.l_point, qt, where("L_point"));
+        q.add(energy->numbers(m, "bodies[].l_spin")[b], wq.l_spin, qt, where("L_spin"));
+        q.add(energy->numbers(m, "bodies[].t_point")[b], wq.t_point, qt, where("T_point"));
+        q.add(energy->numbers(m, "bodies[].t_spin")[b], wq.t_spin, qt, where("T_spin"));
+      }
+      q.add(energy->one(m, "potential"), f.potential, options.quantity_tol,
+            [&] { return "step " + std::to_string(steps[m]) + " U"; });
+    }
+    r.line(st.ok(), "body states of the " + std::to_string(state.size()) +
+                        " recorded steps against the reference's free run (absolute tolerance " +
+                        g3(options.state_tol) + "): " + st.summary());
+    r.line(q.ok(), "M, I, P, L_point, L_spin, T_point, T_spin, U of the recorded steps against the reference's "
+                   "(absolute tolerance " + g3(options.quantity_tol) + "): " + q.summary());
+  } else if (scene.world.integrator == Integrator::SymplecticEuler && scene.world.winds.empty()) {
+    v.rule = "symplectic-energy, " + v.rule;
+    if (!match.scene.empty()) r.info("the scene is FOSSSim's " + match.scene + ", which has no reference output");
+    // Symplectic Euler on H = T(P, L) + U(X, theta) (separable: I is constant in 2D) conserves the
+    // modified energy E + (dt / 2) Pi up to O(dt^2), Pi being the power of the conservative
+    // forces.
+    double max_power = 0.0, max_scale = 0.0, err = 0.0, modified = 0.0;
+    std::uint64_t worst = 0;
+    for (const Terms& t : terms) {
+      max_power = std::max(max_power, std::fabs(t.power));
+      max_scale = std::max(max_scale, t.scale);
+    }
+    const double e0 = terms.front().total, m0 = e0 + 0.5 * dt * terms.front().power;
+    for (std::size_t m = 0; m < terms.size(); ++m) {
+      const double d = std::fabs(terms[m].total - e0);
+      if (d > err || std::isnan(d)) {
+        err = std::isnan(d) ? HUGE_VAL : d;
+        worst = steps[m];
+      }
+      modified = std::max(modified, std::fabs(terms[m].total + 0.5 * dt * terms[m].power - m0));
+    }
+    // First order: |E_n - E_0| ~ (dt/2) |Pi_n - Pi_0| <= (dt/2) (max|Pi| + |Pi_0|); the bound is twice
+    // that (room for the O(dt^2) remainder), plus rounding.
+    const double bound = dt * (max_power + std::fabs(terms.front().power)) + 1e-12 * max_scale;
+    v.energy_error = err;
+    v.energy_bound = bound;
+    r.line(err <= bound, "energy conservation (symplectic Euler, gravity and springs): E = T + U recomputed from the "
+                         "recorded states; max |E - E0| = " + g3(err) + " at step " + std::to_string(worst) +
+                         " <= dt * (max|Pi| + |Pi_0|) + 1e-12 * max(sum |terms|) = " + g3(bound) + " (ratio " +
+                         g3(bound > 0 ? err / bound : 0.0) + ", E0 = " + g17(e0) + ", max|Pi| = " + g3(max_power) + ")");
+    r.info("modified energy E + dt/2 Pi drifts by at most " + g3(modified) + " (first-order backward error analysis)");
+  } else if (!match.scene.empty()) {
+    r.info("the scene is FOSSSim's " + match.scene + ", which has no reference output; with " +
+           (scene.world.winds.empty() ? "explicit Euler" : "wind") + " energy is not conserved");
+  } else {
+    r.info(std::string("no FOSSSim reference output") + (options.fosssim_dir.empty() ? " (no FOSSSim directory given)" : "") +
+           "; with " + (scene.world.winds.empty() ? "explicit Euler" : "wind") + " energy is not conserved");
+  }
+  v.passed = !r.failed && !v.rule.empty();
+  return v;
+}
+
+}  // namespace rbsim::log

@@ -1,0 +1,303 @@
+// rbsim log recover: every complete record of a damaged file copied into a fresh, indexed one.
+//
+// The input is streamed record by record (mcap::StreamReader, which stops at the first record it
+// cannot frame: the end of a truncated file). Chunks are the unit of recovery: each complete
+// chunk is decompressed and CRC-checked here, so one corrupt chunk is skipped and the chunks after
+// it are still kept; a chunk cut off by the end of the file is lost with its messages.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "rbsim/log.hpp"
+#include "tools_util.hpp"
+
+namespace rbsim::log {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kPrefix = 9;
+
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
+  const fs::path ca = fs::weakly_canonical(a, ec);
+  if (ec) return false;
+  const fs::path cb = fs::weakly_canonical(b, ec);
+  return !ec && ca == cb;
+}
+
+// Whether the file ends in a Footer that points at a summary (checked before opening an
+// IndexedReader, which would scan a whole file without one).
+bool has_summary(detail::FileBytes& file) {
+  constexpr std::uint64_t kTail = kPrefix + 20 + 8;  // Footer record + trailing magic
+  mcap::Bytes tail;
+  if (file.size() < 8 + kTail || !file.read(file.size() - kTail, kTail, tail)) return false;
+  return tail[0] == static_cast<std::uint8_t>(mcap::Opcode::Footer) && detail::le64(&tail[kPrefix]) != 0 &&
+         std::equal(tail.end() - 8, tail.end(), std::begin(mcap::kMagic));
+}
+
+class Recoverer {
+ public:
+  explicit Recoverer(RecoverReport& report) : report_(report) {}
+
+  // Copies one data-section record; errors only for output failures.
+  mcap::Status copy(mcap::Record& record) {
+    if (auto* m = std::get_if<mcap::Message>(&record)) return message(*m);
+    if (auto* s = std::get_if<mcap::Schema>(&record)) {
+      mcap::Status st = writer_.add_schema(*s);
+      if (st.code == mcap::StatusCode::InvalidArgument) {
+        note("schema " + std::to_string(s->id) + " skipped: " + st.message);
+        return mcap::Status::Ok();
+      }
+      if (st.ok() && schema_ids_.insert(s->id)) ++report_.schemas;
+      return st;
+    }
+    if (auto* c = std::get_if<mcap::Channel>(&record)) {
+      mcap::Status st = writer_.add_channel(*c);
+      if (st.code == mcap::StatusCode::InvalidArgument) {
+        note("channel " + std::to_string(c->id) + " (" + c->topic + ") skipped: " + st.message);
+        return mcap::Status::Ok();
+      }
+      if (st.ok() && channel_ids_.insert(c->id)) ++report_.channels;
+      return st;
+    }
+    if (auto* a = std::get_if<mcap::Attachment>(&record)) {
+      mcap::Status st = writer_.add_attachment(a->log_time, a->create_time, a->name, a->media_type, a->data);
+      if (st.ok()) ++report_.attachments;
+      return st;
+    }
+    if (auto* md = std::get_if<mcap::Metadata>(&record)) {
+      mcap::Status st = writer_.add_metadata(md->name, md->metadata);
+      if (st.ok()) ++report_.metadata;
+      return st;
+    }
+    return mcap::Status::Ok();
+  }
+
+  mcap::Status chunk(const mcap::Chunk& chunk, std::uint64_t offset) {
+    mcap::Bytes data;
+    if (mcap::Status s = mcap::decompress_chunk(chunk, data, true); !s.ok()) {
+      ++report_.corrupt_chunks;
+      note("chunk at offset " + std::to_string(offset) + " skipped: " + s.message);
+      return mcap::Status::Ok();
+    }
+    for (std::size_t at = 0; at < data.size();) {
+      const std::size_t left = data.size() - at;
+      const std::uint64_t length = left < kPrefix ? 0 : detail::le64(data.data() + at + 1);
+      if (left < kPrefix || length > left - kPrefix) {
+        note("chunk at offset " + std::to_string(offset) + ": records cut off at byte " + std::to_string(at));
+        break;
+      }
+      auto record = mcap::parse_record(data[at], mcap::ByteView(data).subspan(at + kPrefix, length));
+      at += kPrefix + static_cast<std::size_t>(length);
+      if (!record.ok()) {
+        note("chunk at offset " + std::to_string(offset) +
+             ": unreadable record skipped: " + record.status().message);
+        continue;
+      }
+      if (mcap::Status s = copy(record.value()); !s.ok()) return s;
+    }
+    ++report_.chunks;
+    return mcap::Status::Ok();
+  }
+
+  struct IdSet {
+    std::vector<bool> seen = std::vector<bool>(65536, false);
+    bool insert(std::uint16_t id) {
+      if (seen[id]) return false;
+      seen[id] = true;
+      return true;
+    }
+  };
+
+  mcap::Writer& writer() { return writer_; }
+
+  // Schemas and channels of the input's summary, for channels whose own record was lost with a
+  // corrupt chunk (rbsim logs define them in the first chunk and repeat them in the summary).
+  void set_fallback(std::map<std::uint16_t, mcap::Schema> schemas,
+                    std::map<std::uint16_t, mcap::Channel> channels) {
+    fallback_schemas_ = std::move(schemas);
+    fallback_channels_ = std::move(channels);
+  }
+
+ private:
+  mcap::Status restore_channel(std::uint16_t id) {
+    const auto c = fallback_channels_.find(id);
+    if (c == fallback_channels_.end()) return mcap::Status::Ok();
+    const std::uint16_t schema_id = c->second.schema_id;
+    if (schema_id != 0 && !schema_ids_.seen[schema_id]) {
+      const auto s = fallback_schemas_.find(schema_id);
+      if (s == fallback_schemas_.end()) return mcap::Status::Ok();
+      mcap::Record r = s->second;
+      if (mcap::Status st = copy(r); !st.ok()) return st;
+    }
+    mcap::Record r = c->second;
+    if (mcap::Status st = copy(r); !st.ok()) return st;
+    if (channel_ids_.seen[id])
+      note("channel " + std::to_string(id) + " (" + c->second.topic + ") restored from the summary section");
+    return mcap::Status::Ok();
+  }
+
+  mcap::Status message(const mcap::Message& m) {
+    if (!channel_ids_.seen[m.channel_id]) {
+      if (mcap::Status st = restore_channel(m.channel_id); !st.ok()) return st;
+    }
+    mcap::Status st = writer_.write_message(m);
+    if (st.code == mcap::StatusCode::InvalidArgument) {
+      if (report_.dropped_messages++ == 0) {
+        note("messages of channels whose Channel record was lost are dropped (first: channel " +
+             std::to_string(m.channel_id) + ")");
+      }
+      return mcap::Status::Ok();
+    }
+    if (st.ok()) ++report_.messages;
+    return st;
+  }
+
+  void note(std::string text) {
+    if (report_.notes.size() < 100) report_.notes.push_back(std::move(text));
+  }
+
+  RecoverReport& report_;
+  mcap::Writer writer_;
+  IdSet schema_ids_, channel_ids_;
+  std::map<std::uint16_t, mcap::Schema> fallback_schemas_;
+  std::map<std::uint16_t, mcap::Channel> fallback_channels_;
+};
+
+}  // namespace
+
+std::string RecoverReport::summary() const {
+  std::string out;
+  out += "kept " + std::to_string(messages) + " messages, " + std::to_string(schemas) + " schemas, " +
+         std::to_string(channels) + " channels, " + std::to_string(attachments) + " attachments, " +
+         std::to_string(metadata) + " metadata records from " + std::to_string(chunks) + " complete chunks\n";
+  if (input_intact) {
+    out += "input intact: read to its end (" + std::to_string(input_size) + " bytes)\n";
+  } else {
+    out += "input damaged: reading stopped at offset " + std::to_string(stopped_at) + " of " +
+           std::to_string(input_size) + ": " + problem + "\n";
+  }
+  if (incomplete_chunks > 0) {
+    out += std::to_string(incomplete_chunks) +
+           " incomplete chunk (cut off by the end of the file): its messages are lost\n";
+  }
+  if (corrupt_chunks > 0) {
+    out += std::to_string(corrupt_chunks) +
+           " corrupt chunks skipped (CRC or decompression failed): their messages are lost\n";
+  }
+  if (dropped_messages > 0)
+    out += std::to_string(dropped_messages) + " complete messages dropped (channel unknown)\n";
+  for (const std::string& n : notes) out += "  " + n + "\n";
+  return out;
+}
+
+Result<RecoverReport> recover(const std::string& in, const std::string& out, const RecoverOptions& options) {
+  RecoverReport report;
+  detail::FileBytes file;
+  if (std::string e = file.open(in); !e.empty()) return Error{in + ": " + e};
+  report.input_size = file.size();
+  if (report.input_size == 0) return Error{in + ": empty file (0 bytes): not an MCAP file; nothing written"};
+  if (same_file(in, out)) return Error{out + ": the output must not be the input file"};
+
+  mcap::StreamReader reader;
+  mcap::StreamOptions so;
+  so.descend_into_chunks = false;  // chunks are decompressed and checked here, one by one
+  so.verify_crcs = true;           // data section, attachment and summary CRCs
+  if (mcap::Status s = reader.open(in, so); !s.ok()) return Error{in + ": " + detail::read_error(s)};
+
+  mcap::RecordEntry entry;
+  if (!reader.next(entry) || !std::holds_alternative<mcap::Header>(entry.record)) {
+    const mcap::Status& s = reader.status();
+    return Error{in + ": " + (s.ok() ? std::string("no Header record") : detail::read_error(s)) +
+                 "; nothing to recover, nothing written"};
+  }
+  const mcap::Header header = std::get<mcap::Header>(entry.record);
+
+  const std::string temp = out + ".tmp." + std::to_string(::getpid());
+  Recoverer rec(report);
+  if (has_summary(file)) {
+    mcap::IndexedReader summary;
+    if (summary.open(in).ok() && summary.indexed()) rec.set_fallback(summary.schemas(), summary.channels());
+  }
+  mcap::WriterOptions wo = writer_options(options.compression, options.chunk_size);
+  wo.profile = header.profile;
+  wo.library = header.library;
+  if (mcap::Status s = rec.writer().open(temp, wo); !s.ok()) return Error{out + ": " + s.message};
+  auto abandon = [&](const std::string& why) -> Result<RecoverReport> {
+    (void)rec.writer().close();
+    std::remove(temp.c_str());
+    return Error{out + ": " + why};
+  };
+
+  bool in_summary = false;
+  std::optional<std::uint64_t> garbage_at;  // an opcode 0 record: a zero-filled tail, not data
+  while (reader.next(entry)) {
+    if (const auto* u = std::get_if<mcap::UnknownRecord>(&entry.record); u != nullptr && u->opcode == 0) {
+      garbage_at = entry.offset;
+      break;
+    }
+    if (std::holds_alternative<mcap::DataEnd>(entry.record)) in_summary = true;
+    if (in_summary) continue;  // the summary is rebuilt; reading on only checks the rest of the file
+    mcap::Status s = std::holds_alternative<mcap::Chunk>(entry.record)
+                         ? rec.chunk(std::get<mcap::Chunk>(entry.record), entry.offset)
+                         : rec.copy(entry.record);
+    if (!s.ok()) return abandon(s.message);
+  }
+  const mcap::Status& status = reader.status();
+  report.input_intact = status.ok() && !garbage_at && report.corrupt_chunks == 0;
+  report.stopped_at = garbage_at ? *garbage_at : status.ok() ? report.input_size : reader.position();
+  if (garbage_at) {
+    report.problem = "invalid record (opcode 0x00) at offset " + std::to_string(*garbage_at) +
+                     ": the rest of the file is not MCAP records (zero-filled?)";
+  } else if (!status.ok()) {
+    report.problem = status.message;
+    if (status.code == mcap::StatusCode::Truncated) {
+      report.problem = "truncated: " + status.message;
+      // Which record does the file end in? A chunk loses its messages.
+      mcap::Bytes prefix;
+      const std::uint64_t left = report.input_size - std::min(report.stopped_at, report.input_size);
+      if (left > 0 && file.read(report.stopped_at, std::min<std::uint64_t>(left, kPrefix), prefix) &&
+          prefix[0] != mcap::kMagic[0]) {  // (not the trailing magic: the status says what is wrong with it)
+        const std::string name = detail::opcode_name(prefix[0]);
+        report.problem = "truncated: the file ends inside a " + name + " record at offset " +
+                         std::to_string(report.stopped_at);
+        if (prefix.size() == kPrefix) {
+          report.problem += " (it claims " + std::to_string(detail::le64(&prefix[1])) + " bytes, " +
+                            std::to_string(left - kPrefix) + " remain)";
+        }
+        if (prefix[0] == static_cast<std::uint8_t>(mcap::Opcode::Chunk)) report.incomplete_chunks = 1;
+      }
+    }
+    if (in_summary) report.problem += " (in the summary section, after every data record was read)";
+    if (report.corrupt_chunks > 0)
+      report.problem += "; " + std::to_string(report.corrupt_chunks) + " corrupt chunks";
+  } else if (report.corrupt_chunks > 0) {
+    report.problem = std::to_string(report.corrupt_chunks) + " corrupt chunks";
+  }
+
+  if (mcap::Status s = rec.writer().close(); !s.ok()) {
+    std::remove(temp.c_str());
+    return Error{out + ": " + s.message};
+  }
+  // Durable before it replaces anything (as AtomicFile does).
+  if (const int fd = ::open(temp.c_str(), O_RDONLY); fd >= 0) {
+    (void)::fsync(fd);
+    ::close(fd);
+  }
+  std::error_code ec;
+  fs::rename(temp, out, ec);
+  if (ec) {
+    std::remove(temp.c_str());
+    return Error{out + ": cannot move the output into place: " + ec.message()};
+  }
+  return report;
+}
+
+}  // namespace rbsim::log

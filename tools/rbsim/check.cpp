@@ -1,0 +1,163 @@
+// rbsim check: compare a recording with a golden one field by field; verify a golden log.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "commands.hpp"
+#include "rbsim/log.hpp"
+
+namespace rbsim::cli {
+
+namespace {
+
+struct CheckArgs {
+  std::vector<std::string> files;  // RUN GOLDEN, or SCENE GOLDEN with --verify-golden
+  log::CheckOptions options;
+  bool all_fields = false;
+  bool verify_golden = false;
+  std::string fosssim_dir;
+  std::string golden_every;  // SCENE
+};
+
+constexpr int kMatch = 0, kDiverged = 1, kError = 2;
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "rbsim check: error: %s\n", message.c_str());
+  return kError;
+}
+
+std::string g(double v, const char* format = "%.3g") {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+void print_table(const log::CheckReport& r, bool all_fields) {
+  std::size_t topic_w = 5, field_w = 5;
+  std::size_t identical = 0;
+  std::vector<const log::FieldStats*> rows;
+  for (const log::FieldStats& f : r.fields) {
+    if (!all_fields && f.max_abs == 0.0 && f.over == 0) {
+      ++identical;
+      continue;
+    }
+    rows.push_back(&f);
+    topic_w = std::max(topic_w, f.topic.size());
+    field_w = std::max(field_w, f.field.size());
+  }
+  std::printf("per-field max error (run - golden, array indices collapsed):\n");
+  if (!rows.empty()) {
+    std::printf("  %-*s  %-*s  %-6s  %10s  %10s  %10s  %12s  %10s\n", static_cast<int>(topic_w), "topic",
+                static_cast<int>(field_w), "field", "kind", "values", "max |diff|", "max rel", "at", "over tol");
+    for (const log::FieldStats* f : rows) {
+      const std::string at = f->max_abs == 0.0 ? "-" : (f->has_step ? "step " : "msg ") + std::to_string(f->step_at_max);
+      std::printf("  %-*s  %-*s  %-6s  %10llu  %10s  %10s  %12s  %10llu\n", static_cast<int>(topic_w), f->topic.c_str(),
+                  static_cast<int>(field_w), f->field.c_str(), f->kind.c_str(),
+                  static_cast<unsigned long long>(f->values), g(f->max_abs).c_str(), g(f->max_rel).c_str(), at.c_str(),
+                  static_cast<unsigned long long>(f->over));
+    }
+  }
+  if (identical > 0) {
+    std::printf("  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical, identical == 1 ? "" : "s",
+                all_fields || rows.empty() ? "" : " (--all-fields lists them)");
+  }
+}
+
+int compare(const CheckArgs& a) {
+  const std::string& run = a.files[0];
+  const std::string& golden = a.files[1];
+  const auto start = std::chrono::steady_clock::now();
+  Result<log::CheckReport> result = log::check_logs(run, golden, a.options);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!result) return fail(result.error().message);
+  const log::CheckReport& r = result.value();
+  std::printf("rbsim check: %s vs golden %s (atol %s, rtol %s): %s\n", run.c_str(), golden.c_str(),
+              g(a.options.atol, "%g").c_str(), g(a.options.rtol, "%g").c_str(), r.passed() ? "MATCH" : "DIVERGED");
+  if (r.first) std::printf("first divergence: %s\n", r.first->line().c_str());
+  for (const std::string& p : r.topic_problems) std::printf("topic difference: %s\n", p.c_str());
+  print_table(r, a.all_fields);
+  const double mb = static_cast<double>(r.run_bytes + r.golden_bytes) / 1e6;
+  std::printf("%zu topics, %llu message pairs, %s MB of message data in %s s (%s MB/s)", r.topics.size(),
+              static_cast<unsigned long long>(r.messages), g(mb).c_str(), g(wall).c_str(),
+              g(wall > 0 ? mb / wall : 0.0).c_str());
+  if (!r.passed()) {
+    std::printf("; %llu values in %llu messages differ", static_cast<unsigned long long>(r.diverging_values),
+                static_cast<unsigned long long>(r.diverging_messages));
+  }
+  std::printf("\n");
+  return r.passed() ? kMatch : kDiverged;
+}
+
+int verify(const CheckArgs& a) {
+  const std::string& scene = a.files[0];
+  const std::string& golden = a.files[1];
+  log::GoldenVerifyOptions o;
+  o.fosssim_dir = a.fosssim_dir;
+  Result<log::GoldenVerification> result = log::verify_golden(scene, golden, o);
+  if (!result) return fail(result.error().message);
+  const log::GoldenVerification& v = result.value();
+  std::printf("rbsim check --verify-golden %s %s: rule %s\n", scene.c_str(), golden.c_str(),
+              v.rule.empty() ? "(none applies)" : v.rule.c_str());
+  for (const std::string& line : v.lines) std::printf("  %s\n", line.c_str());
+  std::printf("%s\n", v.passed ? "VERIFIED" : "NOT VERIFIED");
+  return v.passed ? kMatch : kDiverged;
+}
+
+int golden_every(const CheckArgs& a) {
+  Result<Scene> scene = load_scene(a.golden_every);
+  if (!scene) return fail(scene.error().message);
+  std::printf("%lld\n", static_cast<long long>(log::golden_record_every(scene->step_count())));
+  return kMatch;
+}
+
+int check_command(const CheckArgs& a) {
+  if (!a.golden_every.empty()) {
+    if (!a.files.empty() || a.verify_golden) return fail("--golden-every takes no other arguments");
+    return golden_every(a);
+  }
+  if (a.files.size() != 2) {
+    return fail(a.verify_golden ? "--verify-golden needs SCENE and GOLDEN" : "expected two files: RUN.mcap GOLDEN.mcap");
+  }
+  return a.verify_golden ? verify(a) : compare(a);
+}
+
+}  // namespace
+
+Subcommand add_check_command(CLI::App& parent) {
+  auto a = std::make_shared<CheckArgs>();
+  CLI::App* app = parent.add_subcommand(
+      "check", "Compare a recording with a golden log message by message and field by field (or verify a golden)");
+  app->add_option("files", a->files, "RUN.mcap GOLDEN.mcap (with --verify-golden: SCENE.xml GOLDEN.mcap)")
+      ->expected(0, 2);
+  app->add_option("--atol", a->options.atol, "Absolute tolerance for floating-point fields (default 0: exact)");
+  app->add_option("--rtol", a->options.rtol,
+                  "Relative tolerance: a float matches when |actual - expected| <= atol + rtol * |expected| "
+                  "(default 0: exact)");
+  app->add_option("--topics", a->options.topics, "Compare only these topics (comma-separated or repeated)")
+      ->delimiter(',');
+  app->add_option("--exclude-topics", a->options.exclude_topics, "Leave these topics out (comma-separated or repeated)")
+      ->delimiter(',');
+  app->add_flag("--ignore-log-time", [a](std::int64_t) { a->options.compare_log_time = false; },
+                "Compare payloads only, not log times (a live recording against rbsim run --record)");
+  app->add_flag("--all-fields", a->all_fields, "List every field in the table, also the identical ones");
+  app->add_flag("--verify-golden", a->verify_golden,
+                "Verify GOLDEN.mcap as a golden log of SCENE.xml, independently of the simulator: the scene "
+                "description, steps and every energy/spring/pose term recomputed, the dynamics re-integrated "
+                "between recorded steps, and the FOSSSim reference output (found by scene contents under "
+                "--fosssim-dir) or energy conservation (test/golden/README.md)");
+  app->add_option("--fosssim-dir", a->fosssim_dir,
+                  "With --verify-golden: FOSSSim scenes and reference outputs (test/data/fosssim)");
+  app->add_option("--golden-every", a->golden_every,
+                  "Print the --record-every K a golden of this scene is recorded with (about 500 steps) and exit");
+  app->footer(
+      "Messages pair up per topic in order; a missing or extra message, a topic in only one file, a different "
+      "schema or log time, or a value outside the tolerance is a divergence. Integers, strings, booleans and "
+      "array lengths compare exactly. Prints the first divergence (topic, step, field path, expected, actual, "
+      "difference) and the largest difference per field.\n"
+      "Exit status: 0 match (or golden verified), 1 divergence (or verification failed), 2 error (unreadable, "
+      "truncated, corrupted or non-MCAP input, bad arguments).");
+  return {app, [a] { return check_command(*a); }};
+}
+
+}  // namespace rbsim::cli

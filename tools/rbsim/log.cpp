@@ -1,0 +1,160 @@
+// rbsim log: info, doctor, recover and export on MCAP recordings.
+#include <cstdio>
+#include <memory>
+
+#include "commands.hpp"
+#include "rbsim/log.hpp"
+
+namespace rbsim::cli {
+
+namespace {
+
+struct LogOptions {
+  std::string file, out;
+  bool strict_message_order = false;
+  std::string compression = "zstd";
+  std::string csv, energy_csv, ns;
+  bool quiet = false;
+};
+
+int fail(const char* command, const std::string& message) {
+  std::fprintf(stderr, "rbsim log %s: error: %s\n", command, message.c_str());
+  return 1;
+}
+
+int info_command(const LogOptions& o) {
+  auto info = log::info(o.file);
+  if (!info) return fail("info", o.file + ": " + info.error().message);
+  std::fputs(log::format_info(info.value()).c_str(), stdout);
+  return 0;
+}
+
+int doctor_command(const LogOptions& o) {
+  log::DoctorOptions options;
+  options.strict_message_order = o.strict_message_order;
+  std::printf("Examining %s\n", o.file.c_str());
+  const log::DoctorReport report = log::doctor(o.file, options);
+  for (const log::DoctorFinding& f : report.findings) {
+    std::printf("%s: %s\n", f.error ? "error" : "warning", f.text.c_str());
+  }
+  std::printf("%llu errors, %llu warnings\n", static_cast<unsigned long long>(report.errors),
+              static_cast<unsigned long long>(report.warnings));
+  std::fflush(stdout);
+  if (!report.ok()) {
+    const std::string more =
+        report.errors > 1 ? " (and " + std::to_string(report.errors - 1) + " more errors, listed on stdout)"
+                          : "";
+    return fail("doctor", o.file + ": " + report.first_error() + more);
+  }
+  return 0;
+}
+
+int recover_command(const LogOptions& o) {
+  log::RecoverOptions options;
+  if (!log::parse_compression(o.compression, options.compression)) {
+    return fail("recover", "unknown compression " + o.compression);
+  }
+  auto report = log::recover(o.file, o.out, options);
+  if (!report) return fail("recover", report.error().message);
+  const log::RecoverReport& r = report.value();
+  if (!o.quiet) std::fputs(r.summary().c_str(), stdout);
+  std::fflush(stdout);
+  if (!r.input_intact) {
+    return fail("recover", o.file + ": " + r.problem + "; wrote " + o.out + " with the " +
+                               std::to_string(r.messages) + " complete messages (chunks lost: " +
+                               std::to_string(r.incomplete_chunks + r.corrupt_chunks) + ")");
+  }
+  return 0;
+}
+
+int export_command(const LogOptions& o) {
+  log::ExportOptions options;
+  options.csv = o.csv;
+  options.energy_csv = o.energy_csv;
+  options.ns = o.ns;
+  auto report = log::export_csv(o.file, options);
+  if (!report) return fail("export", report.error().message);
+  for (const std::string& w : report.value().warnings) {
+    std::fprintf(stderr, "rbsim log export: warning: %s: %s\n", o.file.c_str(), w.c_str());
+  }
+  if (!o.quiet) {
+    const log::ExportReport& r = report.value();
+    std::fprintf(stderr, "rbsim log export: %s: %llu steps (%llu..%llu)\n", o.file.c_str(),
+                 static_cast<unsigned long long>(r.steps), static_cast<unsigned long long>(r.first_step),
+                 static_cast<unsigned long long>(r.last_step));
+  }
+  return 0;
+}
+
+}  // namespace
+
+Subcommand add_log_command(CLI::App& parent) {
+  auto o = std::make_shared<LogOptions>();
+  CLI::App* app =
+      parent.add_subcommand("log", "Inspect, check, repair and export MCAP recordings (rbsim run --record)");
+  app->require_subcommand(1);
+  app->footer("Run 'rbsim log <command> --help' for a command's options.");
+
+  CLI::App* info =
+      app->add_subcommand("info",
+                          "Summarise a recording: duration, topics with types and counts, chunks, "
+                          "compression");
+  info->add_option("file", o->file, "MCAP file")->required();
+  info->footer(
+      "Reads the summary section (or scans a file that has none, and says so) and checks the data section "
+      "CRC.\nExit status: 0 success, 1 error (unreadable, truncated or corrupted file).");
+
+  CLI::App* doctor = app->add_subcommand(
+      "doctor",
+      "Check a recording's structure the way 'mcap doctor' does: magic, header/footer, records, chunk CRCs "
+      "and decompression, message and chunk indexes, statistics, summary offsets, data and summary CRCs");
+  doctor->add_option("file", o->file, "MCAP file")->required();
+  doctor->add_flag("--strict-message-order", o->strict_message_order,
+                   "Messages out of log-time order are errors (by default warnings)");
+  doctor->footer(
+      "Prints 'Examining FILE', then one line per problem ('error: ...' or 'warning: ...').\n"
+      "Exit status: 0 no errors (warnings allowed), 1 any error.");
+
+  CLI::App* recover = app->add_subcommand(
+      "recover",
+      "Rebuild a valid, indexed recording from a truncated or damaged one, keeping every complete message");
+  recover->add_option("in", o->file, "Damaged MCAP file")->required();
+  recover->add_option("out", o->out, "Output MCAP file (written under a temporary name, then renamed)")
+      ->required();
+  recover->add_option("--compression", o->compression, "Chunk compression of the output")
+      ->check(CLI::IsMember({"zstd", "lz4", "none"}))
+      ->default_str("zstd");
+  recover->add_flag("-q,--quiet", o->quiet, "No report on stdout");
+  recover->footer(
+      "Chunks are the unit of recovery: a chunk cut off by the end of the file (or failing its CRC) is lost "
+      "with "
+      "its messages; every complete chunk is kept, with the same schema and channel ids, profile and "
+      "library.\n"
+      "Exit status: 0 the input was intact (OUT is a copy); 1 the input was damaged (OUT holds every "
+      "complete "
+      "message, the reason is on stderr) or nothing could be recovered (no OUT written).");
+
+  CLI::App* exp = app->add_subcommand(
+      "export", "Write the CSV files 'rbsim run --csv / --energy-csv' write, from a recording of the run");
+  exp->add_option("file", o->file, "MCAP file recorded by rbsim run --record")->required();
+  exp->add_option("--csv", o->csv,
+                  "Per-body CSV: step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin");
+  exp->add_option("--energy-csv", o->energy_csv,
+                  "Scene-wide CSV: step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L");
+  exp->add_option("--namespace", o->ns,
+                  "ROS namespace of the recording's topics (default: the only one in the file)");
+  exp->add_flag("-q,--quiet", o->quiet, "No closing summary line");
+  exp->footer(
+      "Byte for byte what rbsim run wrote for the recorded steps (all of them, or every k-th with "
+      "--record-every k).\nExit status: 0 success, 1 error.");
+
+  return {app, [o, info, doctor, recover, exp]() -> int {
+            if (info->parsed()) return info_command(*o);
+            if (doctor->parsed()) return doctor_command(*o);
+            if (recover->parsed()) return recover_command(*o);
+            if (exp->parsed()) return export_command(*o);
+            return 1;
+          }};
+}
+
+}  // namespace rbsim::cli
