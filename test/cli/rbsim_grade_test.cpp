@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <string>
 
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
 namespace rbsim {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "bad_scenes.hpp"
 #include "rbsim/scene.hpp"
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
 namespace rbsim {
 namespace {

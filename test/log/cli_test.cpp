@@ -6,9 +6,9 @@
 #include <regex>
 
 #include "log_test_util.hpp"
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -329,4 +329,4 @@ TEST(LogCli, EveryToolOnBadInputFailsCleanly) {
 }
 
 }  // namespace
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

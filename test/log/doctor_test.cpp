@@ -7,9 +7,9 @@
 #include <regex>
 
 #include "log_test_util.hpp"
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -357,4 +357,4 @@ TEST(DoctorConformance, NoFalseErrorsOnTheOfficialFiles) {
 }
 
 }  // namespace
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

@@ -2,9 +2,9 @@
 #include <gtest/gtest.h>
 
 #include "log_test_util.hpp"
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -111,4 +111,4 @@ TEST(Info, DamagedFilesAreErrors) {
 }
 
 }  // namespace
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

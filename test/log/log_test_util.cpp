@@ -9,7 +9,7 @@
 #include "rbsim/core.hpp"
 #include "rbsim/scene.hpp"
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 
 namespace fs = std::filesystem;
 
@@ -135,4 +135,4 @@ std::vector<ChunkCount> chunk_message_counts(const fs::path& path) {
   return out;
 }
 
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

@@ -10,7 +10,7 @@
 #include "rbsim/log.hpp"
 #include "rbsim/mcap.hpp"
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 
 mcap::Bytes read_bytes(const std::filesystem::path& path);
 void write_bytes(const std::filesystem::path& path, const mcap::Bytes& bytes);
@@ -53,4 +53,4 @@ struct ChunkCount {
 };
 std::vector<ChunkCount> chunk_message_counts(const std::filesystem::path& path);
 
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 
 #include "log_test_util.hpp"
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -211,4 +211,4 @@ TEST_F(RecoverTest, RecoveredRecordingExportsItsCompleteSteps) {
 }
 
 }  // namespace
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

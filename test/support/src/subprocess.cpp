@@ -1,4 +1,4 @@
-#include "subprocess.hpp"
+#include "rbsim/subprocess.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -16,13 +16,11 @@
 
 extern char** environ;
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> Outcome::err_lines() const {
-  return lines_of(err);
-}
+std::vector<std::string> Outcome::err_lines() const { return lines_of(err); }
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -67,7 +65,7 @@ std::vector<std::string> split(const std::string& line, char sep) {
 TempDir::TempDir() {
   static std::atomic<int> counter{0};
   path_ = fs::temp_directory_path() /
-          ("rbsim_log_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+          ("rbsim_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
   fs::remove_all(path_);
   fs::create_directories(path_);
 }
@@ -77,17 +75,14 @@ TempDir::~TempDir() {
   fs::remove_all(path_, ec);
 }
 
-Outcome run_process(const std::string& exe, const std::vector<std::string>& args,
-                    std::chrono::milliseconds timeout) {
+Outcome run_process(const std::string& exe, const std::vector<std::string>& args, std::chrono::milliseconds timeout) {
   TempDir capture;
   const std::string out_path = (capture / "stdout").string(), err_path = (capture / "stderr").string();
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0600);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0600);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   std::vector<std::string> argv_storage;
   argv_storage.push_back(exe);
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());
@@ -126,4 +121,4 @@ Outcome rbsim(const std::vector<std::string>& args, std::chrono::milliseconds ti
   return run_process(RBSIM_EXE, args, timeout);
 }
 
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test

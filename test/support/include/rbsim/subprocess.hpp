@@ -1,4 +1,4 @@
-// Running rbsim as a child process with a time limit, and small file helpers (as in test/cli).
+// Running rbsim as a child process with a time limit, and small file helpers, for the tests.
 #pragma once
 
 #include <chrono>
@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-namespace rbsim::logtest {
+namespace rbsim::test {
 
 struct Outcome {
-  int exit_code = -1;  // exit status, or -1 if killed by a signal / the timeout
-  int signal = 0;      // the signal that ended it, if any
+  int exit_code = -1;      // exit status, or -1 if killed by a signal / the timeout
+  int signal = 0;          // the signal that ended it, if any
   bool timed_out = false;
-  std::string out, err;  // everything written to stdout and stderr
+  std::string out, err;    // everything written to stdout and stderr
   std::vector<std::string> err_lines() const;
 };
 
@@ -21,8 +21,7 @@ Outcome run_process(const std::string& exe, const std::vector<std::string>& args
                     std::chrono::milliseconds timeout = std::chrono::seconds(60));
 
 // Runs the rbsim binary under test.
-Outcome rbsim(const std::vector<std::string>& args,
-              std::chrono::milliseconds timeout = std::chrono::seconds(60));
+Outcome rbsim(const std::vector<std::string>& args, std::chrono::milliseconds timeout = std::chrono::seconds(60));
 
 std::string read_text(const std::filesystem::path& path);
 void write_text(const std::filesystem::path& path, const std::string& text);
@@ -43,4 +42,4 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-}  // namespace rbsim::logtest
+}  // namespace rbsim::test
