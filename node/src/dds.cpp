@@ -17,10 +17,15 @@ Error dds_error(const std::string& what, dds_return_t rc) { return Error{what + 
 
 dds_qos_t* make_qos(const QosSpec& q, bool reader) {
   dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  // A reliable writer blocks (up to 30 s) when its readers fall behind: a slow recorder throttles
+  // the node instead of losing samples.
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(30));
   dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
-  if (reader && !q.transient_local) {
-    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);  // the recorder keeps everything it is sent
+  // Per-step topics keep all: with keep-last, a writer drops samples a slow reader has not yet
+  // acknowledged once `depth` newer ones exist (measured: 700 of 12,000 lost to a recorder of a
+  // 1,000-body scene); keep-all makes the node wait instead. A reader keeps all it is sent.
+  if (!q.transient_local && (reader || q.keep_all)) {
+    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
   } else {
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.depth);
   }
@@ -66,6 +71,7 @@ Participant::~Participant() {
 QosSpec qos_for(const msgs::TopicSpec& spec) {
   QosSpec q;
   q.transient_local = spec.transient_local;
+  q.keep_all = !spec.transient_local;
   q.depth = spec.transient_local ? 1 : 1000;
   return q;
 }
@@ -98,6 +104,12 @@ Status Publisher::publish(std::span<const std::byte> cdr) {
   ddsi_serdata* d = make_raw_serdata(cdr);
   const dds_return_t rc = dds_writecdr(writer_, d);  // takes the reference
   if (rc < 0) return dds_error("publishing on " + ros_topic_ + " failed", rc);
+  return Ok{};
+}
+
+Status Publisher::flush(double timeout_s) {
+  const dds_return_t rc = dds_wait_for_acks(writer_, static_cast<dds_duration_t>(timeout_s * 1e9));
+  if (rc < 0) return dds_error("subscribers of " + ros_topic_ + " did not acknowledge everything in time", rc);
   return Ok{};
 }
 

@@ -64,6 +64,13 @@ Status DdsSink::write(const World& world) {
   return Ok{};
 }
 
+Status DdsSink::finish() {
+  for (auto& p : publishers_) {
+    if (Status st = p->flush(30.0); !st) return st;
+  }
+  return Ok{};
+}
+
 bool DdsSink::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
   const auto& states = publishers_[static_cast<std::size_t>(msgs::TopicId::BodyStates)];
   while (states->matched() < count) {

@@ -1,6 +1,7 @@
 // The recorder: DDS topics to an MCAP file, byte for byte.
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "rbsim/log.hpp"
@@ -33,6 +34,10 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
       wanted.push_back(spec);
     }
   }
+  // The node's --wait-for-subscribers watches the body-state topic: subscribe to it last, so
+  // every other reader exists by the time the node starts publishing.
+  std::stable_partition(wanted.begin(), wanted.end(),
+                        [](const msgs::TopicSpec* s) { return s->id != msgs::TopicId::BodyStates; });
   if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size)); !st.ok()) {
     return Error{options.path + ": " + st.message};
   }

@@ -13,18 +13,10 @@ int main(int argc, char** argv) {
       rbsim::cli::add_render_command(app),
       rbsim::cli::add_plot_command(app),
       rbsim::cli::add_node_command(app),
-#ifdef RBSIM_HAVE_RECORD_COMMAND
       rbsim::cli::add_record_command(app),
-#endif
-#ifdef RBSIM_HAVE_REPLAY_COMMAND
       rbsim::cli::add_replay_command(app),
-#endif
-#ifdef RBSIM_HAVE_LOG_COMMAND
       rbsim::cli::add_log_command(app),
-#endif
-#ifdef RBSIM_HAVE_CHECK_COMMAND
       rbsim::cli::add_check_command(app),
-#endif
   };
   try {
     app.parse(argc, argv);

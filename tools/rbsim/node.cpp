@@ -1,4 +1,5 @@
 // rbsim node: run a scene and stream it over DDS with ROS 2 conventions.
+#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -46,6 +47,7 @@ int node_command(const NodeArgs& a) {
     if (!sink.value()->wait_for_subscribers(a.wait_for, stop_requested)) return 128 + stop_signal();
   }
   std::int64_t total_steps = 0;
+  const auto start = std::chrono::steady_clock::now();
   do {
     Result<World> created = World::create(scene.world);
     if (!created) return fail(created.error().message);
@@ -61,9 +63,12 @@ int node_command(const NodeArgs& a) {
       if (Status st = sink.value()->write(world); !st) return fail(st.error().message);
     }
   } while (a.loop && !stop_requested());
+  if (Status st = sink.value()->finish(); !st) return fail(st.error().message);
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim node: %s after %lld steps, %llu messages published\n",
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published\n",
                  stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
+                 format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
                  static_cast<unsigned long long>(sink.value()->published()));
   }
   return 0;
@@ -92,7 +97,8 @@ Subcommand add_node_command(CLI::App& parent) {
       "Topics (DDS name rt/<namespace>/<name>, type pkg::msg::dds_::Name_, CDR): scene "
       "(rbsim_msgs/SceneDescription, reliable, transient local, keep last 1: late joiners get it), body_states, "
       "spring_states, energy, poses (geometry_msgs/PoseArray), markers (visualization_msgs/MarkerArray) and /clock "
-      "(rosgraph_msgs/Clock), all reliable, volatile, keep last 1000.\n"
+      "(rosgraph_msgs/Clock), all reliable, volatile, keep all: a slow subscriber slows the node down rather than "
+      "losing samples.\n"
       "DDS: without CYCLONEDDS_URI the node uses rbsim's loopback configuration (127.0.0.1 only, no multicast); set "
       "CYCLONEDDS_URI to a Cyclone DDS configuration to go onto a real network.\n"
       "Ctrl-C stops cleanly (exit 0).");

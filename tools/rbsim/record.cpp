@@ -1,5 +1,6 @@
 // rbsim record: DDS topics to MCAP until Ctrl-C, --duration or --max-messages.
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <memory>
 
@@ -26,6 +27,9 @@ int fail(const std::string& m) {
 
 int record_command(RecordArgs a) {
   if (!log::parse_compression(a.compression, a.rec.compression)) return fail("unknown compression " + a.compression);
+  // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
+  // error, leaving a recoverable file, instead of SIGXFSZ killing it.
+  std::signal(SIGXFSZ, SIG_IGN);
   auto participant = node::Participant::create(a.domain);
   if (!participant) return fail(participant.error().message);
   auto recorder = node::Recorder::create(participant.value(), a.rec);

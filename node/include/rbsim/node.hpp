@@ -44,6 +44,7 @@ std::string_view loopback_config();
 
 struct QosSpec {
   bool transient_local = false;  // late joiners get the last sample (the scene description)
+  bool keep_all = false;         // writers: keep all (wait for slow readers) instead of keep last
   std::int32_t depth = 1000;     // keep-last depth
 };
 QosSpec qos_for(const msgs::TopicSpec& spec);
@@ -58,6 +59,9 @@ class Publisher {
   ~Publisher();
   [[nodiscard]] Status publish(std::span<const std::byte> cdr);
   std::int32_t matched() const;  // subscriptions currently matched
+  // Waits until every matched reliable reader acknowledged everything written (bounded).
+  [[nodiscard]] Status flush(double timeout_s);
+  std::int32_t writer() const { return writer_; }
   const std::string& ros_topic() const { return ros_topic_; }
 
  private:
@@ -108,7 +112,9 @@ class DdsSink final : public Sink {
   static Result<std::unique_ptr<DdsSink>> create(const Participant& participant, const NodeOptions& options);
   Status begin(const Scene& scene, const World& world) override;
   Status write(const World& world) override;
-  Status finish() override { return Ok{}; }
+  // Waits (bounded) until subscribers acknowledged everything, so nothing in flight is lost
+  // when the node exits.
+  Status finish() override;
   // Waits until `count` subscriptions match the body-state topic; false when `stop` turned true.
   bool wait_for_subscribers(std::int32_t count, bool (*stop)());
   // Restarts the pacing clock (e.g. when --loop starts the scene again).
@@ -172,5 +178,63 @@ class Recorder {
 
 // Looks up a TopicSpec by ROS topic suffix ("body_states") or full name ("/rbsim/body_states").
 const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns);
+
+}  // namespace rbsim::node
+
+// ---------------------------------------------------------------------------------------------
+// The replay: an MCAP recording (rbsim run --record or rbsim record) republished over DDS with
+// its recorded timing. Every channel whose schema names one of our types (msgs::topics()) and
+// whose messages are CDR gets a publisher with that topic's QoS; messages go out in log-time
+// order, paced by their log-time differences divided by `rate`.
+
+namespace rbsim::node {
+
+struct ReplayOptions {
+  std::string path;
+  double rate = 1.0;                // real-time factor on log time; 0: as fast as possible
+  std::vector<std::string> topics;  // recorded names ("/rbsim/body_states") or suffixes ("body_states"); empty: all
+  double start_offset = 0.0;        // seconds of log time skipped at the start (the scene description is still sent)
+  bool clock = false;               // publish rosgraph_msgs/Clock on /clock with each message's log time
+                                    // (recorded /clock messages are then not replayed)
+  std::optional<std::string> ns;    // republish under /<ns>/<name> instead of the recorded names
+};
+
+class Replay {
+ public:
+  // Opens the recording and creates the publishers. Errors: unreadable or non-MCAP input, no rbsim
+  // topics in the log, --topics names the log does not have.
+  static Result<std::unique_ptr<Replay>> open(const Participant& participant, const ReplayOptions& options);
+  ~Replay();
+
+  struct Output {
+    std::string recorded;  // channel topic in the log ("/rbsim/body_states"), empty for the synthesized /clock
+    std::string topic;     // topic published
+    std::uint64_t messages = 0;  // messages of the channel in the log (0 when unknown)
+  };
+  const std::vector<Output>& outputs() const { return outputs_; }
+  std::uint64_t first_log_time() const { return first_log_time_; }
+  std::uint64_t last_log_time() const { return last_log_time_; }
+
+  // Waits until `count` subscriptions match the body-state publisher (or, without body states,
+  // the first one); false when `stop` turned true.
+  bool wait_for_subscribers(std::int32_t count, bool (*stop)());
+  // Plays the log once from the start offset; Ok(false) when `stop` turned true on the way.
+  Result<bool> play(bool (*stop)());
+  // Waits (bounded) until the subscribers acknowledged everything published, so nothing in
+  // flight is lost when the replay exits.
+  [[nodiscard]] Status finish(double timeout_s = 30.0);
+  std::uint64_t published() const { return published_; }
+  // Channels left out (not CDR, or a definition that differs from this build's).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  Replay() = default;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::vector<Output> outputs_;
+  std::vector<std::string> warnings_;
+  std::uint64_t first_log_time_ = 0, last_log_time_ = 0;
+  std::uint64_t published_ = 0;
+};
 
 }  // namespace rbsim::node

@@ -1,0 +1,317 @@
+// The replay: an MCAP recording republished over DDS with its recorded timing.
+#include <time.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include "rbsim/node.hpp"
+
+namespace rbsim::node {
+
+namespace {
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// Sleeps until `deadline_ns` (monotonic) in slices of at most 50 ms, so a stop request is seen
+// promptly whichever thread the signal went to; false when `stop` turned true.
+bool sleep_until(std::int64_t deadline_ns, bool (*stop)()) {
+  constexpr std::int64_t kSlice = 50'000'000;
+  while (true) {
+    if (stop()) return false;
+    const std::int64_t now = monotonic_ns();
+    if (now >= deadline_ns) return true;
+    const std::int64_t until = std::min(deadline_ns, now + kSlice);
+    timespec ts{static_cast<time_t>(until / 1'000'000'000), static_cast<long>(until % 1'000'000'000)};
+    (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+  }
+}
+
+// "pkg/Name" -> "pkg/msg/Name" (rosbag2 writes the long form; older tools the short one).
+std::string canonical_type(std::string_view type) {
+  const auto a = type.find('/');
+  if (a == std::string_view::npos || type.find('/', a + 1) != std::string_view::npos) return std::string(type);
+  return std::string(type.substr(0, a)) + "/msg/" + std::string(type.substr(a + 1));
+}
+
+const msgs::TopicSpec* spec_for_type(std::string_view type) {
+  const std::string t = canonical_type(type);
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (spec.type == t) return &spec;
+  }
+  return nullptr;
+}
+
+std::string last_component(std::string_view topic) {
+  const auto slash = topic.rfind('/');
+  return std::string(slash == std::string_view::npos ? topic : topic.substr(slash + 1));
+}
+
+std::span<const std::byte> bytes(const mcap::Bytes& b) { return std::as_bytes(std::span(b.data(), b.size())); }
+
+// rosgraph_msgs/msg/Clock in CDR: encapsulation header (CDR_LE), int32 sec, uint32 nanosec.
+std::array<std::byte, 12> clock_cdr(std::uint64_t t_ns) {
+  std::array<std::byte, 12> out{};
+  out[1] = std::byte{1};
+  const auto sec = static_cast<std::int32_t>(t_ns / 1'000'000'000);
+  const auto nsec = static_cast<std::uint32_t>(t_ns % 1'000'000'000);
+  std::memcpy(out.data() + 4, &sec, 4);
+  std::memcpy(out.data() + 8, &nsec, 4);
+  return out;
+}
+}  // namespace
+
+struct Replay::Impl {
+  ReplayOptions options;
+  mcap::IndexedReader reader;
+  std::vector<Publisher> publishers;
+  std::map<std::uint16_t, std::size_t> route;  // replayed channel id -> publisher index
+  std::set<std::uint16_t> scene_channels;      // replayed channels carrying the scene description
+  std::vector<std::string> topics;             // replayed channel topics (the read filter)
+  std::optional<std::size_t> clock_publisher;
+  std::size_t wait_publisher = 0;
+};
+
+Replay::~Replay() = default;
+
+Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, const ReplayOptions& options) {
+  std::unique_ptr<Replay> r(new Replay());
+  r->impl_ = std::make_unique<Impl>();
+  Impl& im = *r->impl_;
+  im.options = options;
+  const std::string& path = options.path;
+  if (auto st = im.reader.open(path); !st.ok()) {
+    std::string hint;
+    if (st.code == mcap::StatusCode::Truncated) hint = " (an unfinished recording: 'rbsim log recover' repairs it)";
+    return Error{"cannot read " + path + ": " + st.message + hint};
+  }
+
+  // Channels that carry one of our types as CDR, by id (file order).
+  struct Candidate {
+    const mcap::Channel* channel;
+    const msgs::TopicSpec* spec;
+  };
+  std::vector<Candidate> candidates;
+  for (const auto& [id, channel] : im.reader.channels()) {
+    const auto schema_it = im.reader.schemas().find(channel.schema_id);
+    if (schema_it == im.reader.schemas().end()) continue;
+    const msgs::TopicSpec* spec = spec_for_type(schema_it->second.name);
+    if (spec == nullptr) continue;
+    if (channel.message_encoding != "cdr") {
+      r->warnings_.push_back("skipping " + channel.topic + ": message encoding \"" + channel.message_encoding +
+                             "\", not cdr");
+      continue;
+    }
+    Result<std::string> ours = msgs::ros2msg_schema(spec->type);
+    const mcap::Bytes& theirs = schema_it->second.data;
+    if (!ours || std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) != ours.value()) {
+      r->warnings_.push_back("skipping " + channel.topic + ": its " + std::string(spec->type) +
+                             " definition differs from this build's");
+      continue;
+    }
+    candidates.push_back({&channel, spec});
+  }
+  if (candidates.empty()) {
+    std::string why = "none of its channels carries an rbsim message type as CDR";
+    for (const std::string& w : r->warnings_) why += "; " + w;
+    return Error{path + ": no rbsim topics in this log (" + why + ")"};
+  }
+
+  // --topics: every name must pick at least one recorded rbsim channel.
+  if (!options.topics.empty()) {
+    std::vector<Candidate> chosen;
+    for (const std::string& name : options.topics) {
+      bool found = false;
+      for (const Candidate& c : candidates) {
+        if (name == c.channel->topic || name == last_component(c.channel->topic) || name == c.spec->suffix) {
+          found = true;
+          if (std::none_of(chosen.begin(), chosen.end(), [&](const Candidate& x) { return x.channel == c.channel; })) {
+            chosen.push_back(c);
+          }
+        }
+      }
+      if (!found) {
+        std::string known;
+        for (const Candidate& c : candidates) known += (known.empty() ? "" : ", ") + c.channel->topic;
+        return Error{"unknown topic \"" + name + "\": " + path + " has " + known};
+      }
+    }
+    std::sort(chosen.begin(), chosen.end(), [](const Candidate& a, const Candidate& b) { return a.channel->id < b.channel->id; });
+    candidates = std::move(chosen);
+  }
+  if (options.clock) {
+    std::erase_if(candidates, [](const Candidate& c) { return c.spec->id == msgs::TopicId::Clock; });
+    if (candidates.empty()) return Error{"nothing to replay: --topics selects only /clock, which --clock replaces"};
+  }
+
+  // One publisher per published topic name (channels that map onto the same name share it).
+  std::map<std::string, std::pair<std::size_t, const msgs::TopicSpec*>> by_topic;
+  auto publisher_for = [&](const msgs::TopicSpec& spec, const std::string& topic) -> Result<std::size_t> {
+    if (auto it = by_topic.find(topic); it != by_topic.end()) {
+      if (it->second.second != &spec) {
+        return Error{"cannot publish " + std::string(spec.type) + " and " + std::string(it->second.second->type) +
+                     " on the same topic " + topic};
+      }
+      return it->second.first;
+    }
+    auto pub = Publisher::create(participant, spec, topic, qos_for(spec));
+    if (!pub) return pub.error();
+    im.publishers.push_back(std::move(pub.value()));
+    by_topic.emplace(topic, std::make_pair(im.publishers.size() - 1, &spec));
+    return im.publishers.size() - 1;
+  };
+  const auto& stats = im.reader.statistics();
+  std::optional<std::size_t> states_publisher;
+  for (const Candidate& c : candidates) {
+    const std::string topic = options.ns ? msgs::topic_name(*c.spec, *options.ns) : c.channel->topic;
+    auto index = publisher_for(*c.spec, topic);
+    if (!index) return index.error();
+    im.route.emplace(c.channel->id, index.value());
+    if (c.spec->id == msgs::TopicId::Scene) im.scene_channels.insert(c.channel->id);
+    if (c.spec->id == msgs::TopicId::BodyStates && !states_publisher) states_publisher = index.value();
+    im.topics.push_back(c.channel->topic);
+    std::uint64_t count = 0;
+    if (stats) {
+      if (auto it = stats->channel_message_counts.find(c.channel->id); it != stats->channel_message_counts.end()) {
+        count = it->second;
+      }
+    }
+    r->outputs_.push_back({c.channel->topic, topic, count});
+  }
+  if (options.clock) {
+    const msgs::TopicSpec& spec = msgs::topic(msgs::TopicId::Clock);
+    auto index = publisher_for(spec, msgs::topic_name(spec, ""));
+    if (!index) return index.error();
+    im.clock_publisher = index.value();
+    r->outputs_.push_back({"", msgs::topic_name(spec, ""), 0});
+  }
+  im.wait_publisher = states_publisher.value_or(0);
+
+  // The log-time range of the replayed channels: the first message is where pacing and
+  // --start-offset count from.
+  bool any = false;
+  mcap::ReadMessagesOptions first;
+  first.topics = im.topics;
+  auto st = im.reader.read_messages(first, [&](const mcap::MessageEntry& e) {
+    r->first_log_time_ = e.message.log_time;
+    any = true;
+    return false;
+  });
+  if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
+  if (!any) return Error{path + ": the log has rbsim topics but no messages on them"};
+  r->last_log_time_ = r->first_log_time_;
+  for (const mcap::ChunkIndex& ci : im.reader.chunk_indexes()) r->last_log_time_ = std::max(r->last_log_time_, ci.message_end_time);
+  if (stats) r->last_log_time_ = std::max(r->last_log_time_, stats->message_end_time);
+  return r;
+}
+
+bool Replay::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
+  const Publisher& pub = impl_->publishers[impl_->wait_publisher];
+  while (pub.matched() < count) {
+    if (!sleep_until(monotonic_ns() + 20'000'000, stop)) return false;
+  }
+  return true;
+}
+
+Status Replay::finish(double timeout_s) {
+  for (Publisher& p : impl_->publishers) {
+    if (Status st = p.flush(timeout_s); !st) return st;
+  }
+  return Ok{};
+}
+
+Result<bool> Replay::play(bool (*stop)()) {
+  Impl& im = *impl_;
+  const std::string& path = im.options.path;
+  const double offset_ns = std::max(0.0, im.options.start_offset) * 1e9;
+  const std::uint64_t start = offset_ns >= static_cast<double>(mcap::kMaxTime - first_log_time_)
+                                  ? mcap::kMaxTime
+                                  : first_log_time_ + static_cast<std::uint64_t>(std::llround(offset_ns));
+
+  // The scene description goes first: per scene channel, the last one before the start, or else
+  // the first one of the played part (which is then not sent a second time).
+  std::map<std::uint16_t, mcap::Message> scenes;
+  std::set<std::uint16_t> sent_early;
+  if (!im.scene_channels.empty()) {
+    mcap::ReadMessagesOptions o;
+    for (const auto& [id, channel] : im.reader.channels()) {
+      if (im.scene_channels.count(id) > 0) o.topics.push_back(channel.topic);
+    }
+    auto st = im.reader.read_messages(o, [&](const mcap::MessageEntry& e) {
+      const std::uint16_t ch = e.message.channel_id;
+      if (im.scene_channels.count(ch) == 0) return true;
+      if (e.message.log_time < start || scenes.count(ch) == 0) scenes[ch] = e.message;
+      // Past the start with one per channel: the rest of the log cannot change the choice.
+      return e.message.log_time < start || scenes.size() < im.scene_channels.size();
+    });
+    if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
+    for (const auto& [ch, m] : scenes) {
+      if (stop()) return false;
+      if (Status s = im.publishers[im.route.at(ch)].publish(bytes(m.data)); !s) return s.error();
+      ++published_;
+      if (m.log_time >= start) sent_early.insert(ch);
+    }
+  }
+
+  std::optional<Error> failure;
+  bool stopped = false;
+  bool started = false;
+  std::int64_t wall0 = 0;
+  std::uint64_t t0 = 0;
+  std::optional<std::uint64_t> last_clock;
+  const double rate = im.options.rate;
+  mcap::ReadMessagesOptions o;
+  o.topics = im.topics;
+  o.start_time = start;
+  auto st = im.reader.read_messages(o, [&](const mcap::MessageEntry& e) {
+    const mcap::Message& m = e.message;
+    const auto route = im.route.find(m.channel_id);
+    if (route == im.route.end()) return true;  // a channel of the same name we do not replay
+    if (sent_early.count(m.channel_id) > 0 && scenes.at(m.channel_id).log_time == m.log_time &&
+        scenes.at(m.channel_id).sequence == m.sequence) {
+      sent_early.erase(m.channel_id);
+      return true;
+    }
+    if (!started) {
+      started = true;
+      wall0 = monotonic_ns();
+      t0 = m.log_time;
+    }
+    if (rate > 0.0) {
+      const double due = static_cast<double>(m.log_time - t0) / rate;
+      if (!sleep_until(wall0 + static_cast<std::int64_t>(std::llround(due)), stop)) {
+        stopped = true;
+        return false;
+      }
+    } else if (stop()) {
+      stopped = true;
+      return false;
+    }
+    if (im.clock_publisher && last_clock != m.log_time) {
+      const auto cdr = clock_cdr(m.log_time);
+      if (Status s = im.publishers[*im.clock_publisher].publish(cdr); !s) {
+        failure = s.error();
+        return false;
+      }
+      last_clock = m.log_time;
+      ++published_;
+    }
+    if (Status s = im.publishers[route->second].publish(bytes(m.data)); !s) {
+      failure = s.error();
+      return false;
+    }
+    ++published_;
+    return true;
+  });
+  if (!st.ok()) return Error{"reading " + path + " failed: " + st.message};
+  if (failure) return *failure;
+  return !stopped;
+}
+
+}  // namespace rbsim::node

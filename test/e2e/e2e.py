@@ -1,0 +1,1118 @@
+#!/usr/bin/env python3
+"""End-to-end tests of the DDS side: the real `rbsim node`, `rbsim record` and `rbsim replay` as
+separate processes talking real DDS on loopback (or, in the netns case, across a veth pair
+between two network namespaces the test creates).
+
+    e2e.py --case NAME --index N --rbsim BUILD/rbsim --source-dir SRC --workdir DIR --venv BUILD/venv ...
+
+Every case uses its own DDS domain id (one of 200..232 no other running case holds: a flock
+registry in the temp directory) and its own ROS namespace (e2e_<case>_<pid>), so parallel runs,
+also from other build trees, do not cross. rbsim
+processes run with CYCLONEDDS_URI removed (the compiled-in loopback configuration) unless a case
+sets it to node/config/cyclonedds-loopback.xml or, in the netns case, to a configuration bound to
+the veth addresses inside the namespaces. Every wait is bounded in time; every process started
+is killed at the end (and, through PR_SET_PDEATHSIG, if this driver dies); namespaces are
+deleted in a finally block and stale ones of dead runs are swept at the start.
+
+Exit status: 0 pass, 1 fail (every failed check listed), 77 skip (netns not permitted).
+Started with any Python 3: it re-executes itself with the venv's interpreter (scripts/setup makes
+it); a missing venv is a failure with instructions, never a skip.
+"""
+
+import argparse
+import ctypes
+import json
+import math
+import os
+import resource
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import time
+import traceback
+
+SKIP = 77
+
+
+# ---------------------------------------------------------------------------------------------
+# Bootstrapping into the venv (same policy as test/python/check_mcap.py)
+
+
+def ensure_venv(venv: str, requirements: str) -> None:
+    venv = os.path.abspath(venv)
+    python = os.path.join(venv, "bin", "python")
+    if os.path.realpath(sys.prefix) != os.path.realpath(venv):
+        if not os.path.exists(python):
+            print(f"FAIL: the Python venv is missing: {python} does not exist.\n"
+                  f"Run scripts/setup to create it (for a build folder other than build/: "
+                  f"BUILD_DIR={os.path.dirname(venv)} scripts/setup). This test never skips for it.", file=sys.stderr)
+            sys.exit(1)
+        os.execv(python, [python, os.path.abspath(__file__)] + sys.argv[1:])
+    from importlib import metadata
+
+    wrong = []
+    with open(requirements) as f:
+        for line in f:
+            line = line.split("#", 1)[0].strip()
+            if "==" not in line:
+                continue
+            name, version = (s.strip() for s in line.split("==", 1))
+            try:
+                have = metadata.version(name)
+            except metadata.PackageNotFoundError:
+                have = None
+            if have != version:
+                wrong.append(f"{name}=={version} (installed: {have})")
+    if wrong:
+        print(f"FAIL: the venv {venv} does not match {requirements}: {', '.join(wrong)}; run scripts/setup",
+              file=sys.stderr)
+        sys.exit(1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Processes
+
+
+class Failure(Exception):
+    pass
+
+
+_libc = ctypes.CDLL(None, use_errno=True)
+PR_SET_PDEATHSIG = 1
+
+
+def _child_setup(fsize_limit=None):
+    def setup():
+        # Die with the driver (ctest kills the driver on a timeout): no orphaned DDS processes.
+        _libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if fsize_limit is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (fsize_limit, fsize_limit))
+    return setup
+
+
+class Proc:
+    def __init__(self, ctx, name, argv, env, fsize_limit=None):
+        self.ctx, self.name, self.argv = ctx, name, argv
+        self.out_path = os.path.join(ctx.workdir, f"{name}.out")
+        self.err_path = os.path.join(ctx.workdir, f"{name}.err")
+        self._out = open(self.out_path, "w")
+        self._err = open(self.err_path, "w")
+        self.started = time.monotonic()
+        ctx.log(f"start {name}: {' '.join(argv)}")
+        # restore_signals (default): SIGPIPE/SIGXFSZ back to SIG_DFL in the child, as from a shell.
+        self.p = subprocess.Popen(argv, env=env, stdin=subprocess.DEVNULL, stdout=self._out, stderr=self._err,
+                                  preexec_fn=_child_setup(fsize_limit))
+        self.rc = None
+
+    def alive(self):
+        return self.p.poll() is None
+
+    def signal(self, sig):
+        if self.alive():
+            self.ctx.log(f"{signal.Signals(sig).name} -> {self.name}")
+            self.p.send_signal(sig)
+
+    def wait(self, timeout):
+        try:
+            self.rc = self.p.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.kill()
+            raise Failure(f"{self.name} did not exit within {timeout} s\n{self.output()}")
+        self._out.close()
+        self._err.close()
+        self.ctx.log(f"{self.name} exited with {self.rc} after {time.monotonic() - self.started:.2f} s")
+        return self.rc
+
+    def kill(self):
+        if self.alive():
+            self.p.kill()
+        try:
+            self.p.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            pass
+
+    def stdout(self):
+        with open(self.out_path, errors="replace") as f:
+            return f.read()
+
+    def stderr(self):
+        with open(self.err_path, errors="replace") as f:
+            return f.read()
+
+    def output(self):
+        return f"--- {self.name} stdout ---\n{self.stdout()}--- {self.name} stderr ---\n{self.stderr()}"
+
+    def wait_for_text(self, text, timeout, stream="stdout"):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if text in (self.stdout() if stream == "stdout" else self.stderr()):
+                return
+            if not self.alive():
+                break
+            time.sleep(0.05)
+        raise Failure(f"{self.name}: no '{text}' on {stream} within {timeout} s\n{self.output()}")
+
+
+DOMAINS = range(200, 233)  # clear of ROS's default 0, rbsim's benchmarks (100..199) and test/dds (142)
+
+
+def claim_domain(index, pid):
+    """A DDS domain id no other e2e case on this machine uses right now (any build tree): an
+    exclusive flock on <tmp>/rbsim-e2e-domains/<id>, held until this process exits (the kernel
+    drops it even on SIGKILL). Distinct domains keep /clock, which every node publishes outside
+    any namespace, from crossing between cases that run at the same time."""
+    import fcntl
+    import tempfile
+
+    lock_dir = os.path.join(tempfile.gettempdir(), "rbsim-e2e-domains")
+    os.makedirs(lock_dir, exist_ok=True)
+    first = (index * 5 + pid) % len(DOMAINS)
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        for k in range(len(DOMAINS)):
+            domain = DOMAINS[(first + k) % len(DOMAINS)]
+            fd = os.open(os.path.join(lock_dir, str(domain)), os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                return domain, fd
+            except OSError:
+                os.close(fd)
+        time.sleep(0.2)
+    raise SystemExit(f"FAIL: no free DDS domain in {DOMAINS.start}..{DOMAINS.stop - 1} within 30 s ({lock_dir})")
+
+
+class Ctx:
+    def __init__(self, args):
+        self.args = args
+        self.rbsim = os.path.abspath(args.rbsim)
+        self.src = os.path.abspath(args.source_dir)
+        self.workdir = os.path.abspath(args.workdir)
+        self.index = args.index
+        self.pid = os.getpid()
+        self.domain, self._domain_lock = claim_domain(args.index, self.pid)
+        self.ns = f"e2e_{args.case}_{self.pid}"
+        self.procs = []
+        self.failures = []
+        self.notes = []
+        self.t0 = time.monotonic()
+        self.loopback_xml = os.path.join(self.src, "node", "config", "cyclonedds-loopback.xml")
+        shutil.rmtree(self.workdir, ignore_errors=True)
+        os.makedirs(self.workdir)
+        self.log(f"case {args.case}: domain {self.domain}, namespace /{self.ns}, workdir {self.workdir}")
+
+    def log(self, msg):
+        print(f"[{time.monotonic() - self.t0:7.2f}] {msg}", flush=True)
+
+    def env(self, uri=None):
+        env = dict(os.environ)
+        env.pop("CYCLONEDDS_URI", None)  # the compiled-in loopback configuration
+        env.pop("ROS_DOMAIN_ID", None)
+        if uri:
+            env["CYCLONEDDS_URI"] = uri
+        return env
+
+    def path(self, name):
+        return os.path.join(self.workdir, name)
+
+    def scene(self, name):
+        return os.path.join(self.src, "scenes", name)
+
+    def start(self, name, argv, env=None, fsize_limit=None):
+        p = Proc(self, name, argv, env if env is not None else self.env(), fsize_limit)
+        self.procs.append(p)
+        return p
+
+    def rb(self, name, *args, env=None, fsize_limit=None):
+        return self.start(name, [self.rbsim, *map(str, args)], env=env, fsize_limit=fsize_limit)
+
+    def run(self, name, argv, timeout=120, env=None):
+        """Runs a command to completion (bounded); returns (rc, stdout, stderr)."""
+        p = self.start(name, argv, env=env)
+        rc = p.wait(timeout)
+        return rc, p.stdout(), p.stderr()
+
+    def rbrun(self, name, *args, timeout=120, env=None, ok=True):
+        rc, out, err = self.run(name, [self.rbsim, *map(str, args)], timeout=timeout, env=env)
+        if ok and rc != 0:
+            raise Failure(f"rbsim {' '.join(map(str, args))} exited with {rc}\n{out}{err}")
+        return rc, out, err
+
+    def check(self, cond, what):
+        if cond:
+            return True
+        self.failures.append(what)
+        self.log(f"FAIL: {what}")
+        return False
+
+    def require(self, cond, what):
+        if not cond:
+            raise Failure(what)
+
+    def note(self, msg):
+        self.notes.append(msg)
+        self.log(f"NOTE: {msg}")
+
+    def cleanup(self):
+        for p in self.procs:
+            if p.alive():
+                self.log(f"cleanup: killing {p.name}")
+                p.kill()
+
+
+def exited_ok(ctx, proc, timeout, what=None):
+    rc = proc.wait(timeout)
+    ctx.check(rc == 0, f"{what or proc.name} exited with {rc} (want 0)\n{proc.output()}")
+    return rc
+
+
+# ---------------------------------------------------------------------------------------------
+# MCAP and CDR
+
+
+class Log:
+    """A recording read with the official Python reader (CRCs validated), in log-time order."""
+
+    def __init__(self, path):
+        from mcap.reader import make_reader
+
+        self.path = path
+        self.messages = []  # (topic, schema name, log_time, publish_time, sequence, payload)
+        with open(path, "rb") as f:
+            reader = make_reader(f, validate_crcs=True)
+            self.summary = reader.get_summary()
+            for schema, channel, m in reader.iter_messages(log_time_order=True):
+                self.messages.append((channel.topic, schema.name if schema else "", m.log_time, m.publish_time,
+                                      m.sequence, bytes(m.data)))
+
+    def topics(self):
+        return sorted({m[0] for m in self.messages})
+
+    def by_topic(self):
+        out = {}
+        for m in self.messages:
+            out.setdefault(m[0], []).append(m)
+        return out
+
+    def payloads(self, topic):
+        return [m[5] for m in self.messages if m[0] == topic]
+
+    def by_suffix(self):
+        """payloads per topic name without its namespace ("body_states", "clock")."""
+        out = {}
+        for m in self.messages:
+            out.setdefault(m[0].rsplit("/", 1)[-1], []).append(m[5])
+        return out
+
+
+def read_stream_messages(path):
+    """Messages of the complete chunks of a possibly truncated file (the streaming reader)."""
+    from mcap.stream_reader import StreamReader
+    from mcap.records import Message
+
+    n = 0
+    with open(path, "rb") as f:
+        try:
+            for record in StreamReader(f, skip_magic=False).records:
+                if isinstance(record, Message):
+                    n += 1
+        except Exception:  # the truncated tail
+            pass
+    return n
+
+
+def first_published(log):
+    """Topic of the message published first (publish_time: the sample's source timestamp). The
+    order in which a subscriber receives messages of different writers is not defined by DDS."""
+    return min(log.messages, key=lambda m: m[3])[0] if log.messages else None
+
+
+def cdr_header_end(cdr):
+    """Offset (after the 4-byte encapsulation) just past std_msgs/Header: stamp, frame_id."""
+    (length,) = struct.unpack_from("<I", cdr, 4 + 8)
+    return 8 + 4 + length  # relative to the end of the encapsulation header
+
+
+def stamp_of(cdr):
+    return struct.unpack_from("<iI", cdr, 4)
+
+
+def step_of(cdr):
+    """The step field of rbsim BodyStates / SpringStates / EnergyTerms (after the header)."""
+    off = cdr_header_end(cdr)
+    off += (-off) % 8
+    return struct.unpack_from("<Q", cdr, 4 + off)[0]
+
+
+def expect_indexed(ctx, log, count=None):
+    s = log.summary
+    if not ctx.check(s is not None and s.statistics is not None and len(s.chunk_indexes) > 0,
+                     f"{log.path}: not a finished, indexed MCAP file (no summary / chunk indexes)"):
+        return
+    ctx.check(s.statistics.message_count == len(log.messages),
+              f"{log.path}: statistics say {s.statistics.message_count} messages, the file holds {len(log.messages)}")
+    if count is not None:
+        ctx.check(len(log.messages) == count, f"{log.path}: {len(log.messages)} messages, want {count}")
+
+
+def same_payloads(ctx, got, want, what, by_suffix=False):
+    """Every topic's payloads equal, message for message."""
+    g = got.by_suffix() if by_suffix else {t: got.payloads(t) for t in got.topics()}
+    w = want.by_suffix() if by_suffix else {t: want.payloads(t) for t in want.topics()}
+    ok = ctx.check(sorted(g) == sorted(w), f"{what}: topics {sorted(g)} != {sorted(w)}")
+    for t in sorted(set(g) & set(w)):
+        a, b = g[t], w[t]
+        if len(a) != len(b):
+            ok = ctx.check(False, f"{what}: {t}: {len(a)} messages, want {len(b)}") and ok
+            continue
+        diff = next((i for i in range(len(a)) if a[i] != b[i]), None)
+        ok = ctx.check(diff is None, f"{what}: {t}: message {diff} differs ({len(a[diff or 0])} vs "
+                                     f"{len(b[diff or 0])} bytes)") and ok
+    if ok:
+        n = sum(len(v) for v in g.values())
+        ctx.log(f"{what}: {n} payloads on {len(g)} topics identical, message for message")
+    return ok
+
+
+def contiguous_slice(part, whole):
+    """True when `part` equals whole[k:k+len(part)] for some k (found from part's first element)."""
+    if not part:
+        return False
+    for k in (i for i, x in enumerate(whole) if x == part[0]):
+        if whole[k:k + len(part)] == part:
+            return True
+    return False
+
+
+def check_option(ctx, name):
+    """An option of `rbsim check` that ignores log times, if it has one."""
+    rc, out, err = ctx.rbrun(f"check-help-{name}", "check", "--help", ok=False, timeout=30)
+    if rc != 0:
+        return None, False
+    text = out + err
+    for opt in ("--ignore-log-time", "--ignore-log-times", "--no-log-time", "--ignore-time", "--ignore-times"):
+        if opt in text:
+            return opt, True
+    return None, True
+
+
+def rbsim_check(ctx, run, golden, name, live):
+    """`rbsim check RUN GOLDEN`: must pass for two offline recordings; for a live one it must pass
+    when check can ignore log times (wall clock there), else the result is reported."""
+    opt, have = check_option(ctx, name)
+    if not have:
+        ctx.note("rbsim check is not built: check comparison skipped (payloads compared directly)")
+        return
+    args = ["check", run, golden] + ([opt] if live and opt else [])
+    rc, out, err = ctx.rbrun(name, *args, ok=False, timeout=120)
+    if not live or opt:
+        ctx.check(rc == 0, f"rbsim {' '.join(args)} exited with {rc}\n{out}{err}")
+    else:
+        first = next((l for l in out.splitlines() if l.startswith("first divergence")), out.strip()[:200])
+        ctx.note(f"rbsim check has no option to ignore log times (wall clock in a live recording): "
+                 f"'rbsim check {os.path.basename(run)} {os.path.basename(golden)}' exits {rc}: {first}")
+
+
+def record_args(ctx, out, *extra, ns=None, domain=None):
+    return ("record", out, "--domain", domain if domain is not None else ctx.domain, "--namespace", ns or ctx.ns,
+            *extra)
+
+
+def node_args(ctx, scene, *extra, ns=None, domain=None):
+    return ("node", scene, "--domain", domain if domain is not None else ctx.domain, "--namespace", ns or ctx.ns,
+            *extra)
+
+
+def golden_every(ctx, scene):
+    rc, out, _ = ctx.rbrun("golden-every", "check", "--golden-every", scene, ok=False, timeout=30)
+    if rc == 0 and out.strip().isdigit():
+        return int(out.strip())
+    return 100
+
+
+def counts_line(proc):
+    """(received, lost) from the recorder's closing line."""
+    for line in proc.stderr().splitlines():
+        if line.startswith("rbsim record:") and "messages received" in line:
+            words = line.split()
+            return int(words[2]), int(words[5])
+    return None
+
+
+# ---------------------------------------------------------------------------------------------
+# Cases
+
+
+def live_recording(ctx, scene, every, out, tag, env=None, steps_total=None):
+    """Recorder first, then the node (--rate 0, --wait-for-subscribers 1): the complete run."""
+    expected = 1 + 6 * (steps_total // every + 1)
+    rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, "--max-messages", expected, "--duration", 90), env=env)
+    node = ctx.rb(f"node-{tag}", *node_args(ctx, scene, "--rate", 0, "--publish-every", every,
+                                            "--wait-for-subscribers", 1), env=env)
+    exited_ok(ctx, node, 90)
+    exited_ok(ctx, rec, 90)
+    ctx.check(counts_line(rec) == (expected, 0),
+              f"recorder reports {counts_line(rec)} (received, lost), want ({expected}, 0)\n{rec.output()}")
+    return expected
+
+
+def case_node_record(ctx):
+    """Node and recorder: the live recording equals `rbsim run --record`, message for message,
+    and the golden log's payloads; the recording is a finished, indexed MCAP file."""
+    scene = ctx.scene("airplane.xml")
+    every = golden_every(ctx, scene)
+    run = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--record", run, "--record-every", every, "--namespace", ctx.ns)
+    want = Log(run)
+    steps = max(step_of(p) for p in want.by_suffix()["body_states"])
+    live = ctx.path("live.mcap")
+    expected = live_recording(ctx, scene, every, live, "live", steps_total=steps)
+    got = Log(live)
+    expect_indexed(ctx, got, expected)
+    ctx.check(first_published(got).endswith("/scene"), f"first published message is {first_published(got)}, "
+                                                       f"not the scene")
+    same_payloads(ctx, got, want, "live recording vs rbsim run --record")
+    golden = os.path.join(ctx.src, "test", "golden", "airplane.mcap")
+    if os.path.exists(golden):
+        same_payloads(ctx, got, Log(golden), "live recording vs golden test/golden/airplane.mcap", by_suffix=True)
+        gold_run = ctx.path("run-rbsim-ns.mcap")
+        ctx.rbrun("run-record-rbsim", "run", scene, "--record", gold_run, "--record-every", every)
+        rbsim_check(ctx, gold_run, golden, "check-run-golden", live=False)
+    else:
+        ctx.note(f"no golden log {golden}: golden comparison skipped")
+    rbsim_check(ctx, live, run, "check-live-run", live=True)
+
+
+def case_late_recorder(ctx):
+    """A recorder started after the node still gets the scene description (transient local) and
+    then every step, contiguous and byte-equal to the run; SIGTERM finishes a valid file."""
+    scene = ctx.scene("cantilever.xml")
+    every = 10
+    run = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--record", run, "--record-every", every, "--namespace", ctx.ns)
+    want = Log(run)
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--publish-every", every))
+    node.wait_for_text("rbsim node:", 20, stream="stderr")
+    time.sleep(1.5)
+    late = ctx.path("late.mcap")
+    rec = ctx.rb("record-late", *record_args(ctx, late))
+    rec.wait_for_text("recording", 20, stream="stderr")
+    time.sleep(2.0)
+    ctx.require(node.alive(), f"the node stopped\n{node.output()}")
+    rec.signal(signal.SIGTERM)
+    exited_ok(ctx, rec, 15, "recorder stopped with SIGTERM")
+    ctx.check(node.alive(), "the node stopped when the recorder left")
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 15, "node stopped with SIGINT")
+    counts = counts_line(rec)
+    ctx.check(counts is not None and counts[0] > 0 and counts[1] == 0, f"recorder counts {counts}\n{rec.output()}")
+    got = Log(late)
+    expect_indexed(ctx, got)
+    g = got.by_suffix()
+    w = want.by_suffix()
+    ctx.check(g.get("scene") == w["scene"], f"late recorder: scene description {len(g.get('scene', []))} messages, "
+                                            f"want the run's one (transient local)")
+    for t in ("body_states", "spring_states", "energy", "poses", "markers", "clock"):
+        part = g.get(t, [])
+        ctx.check(len(part) > 20, f"late recorder: only {len(part)} {t} messages in 2 s")
+        ctx.check(contiguous_slice(part, w[t]), f"late recorder: {t} is not a contiguous, byte-equal part of the run")
+    steps = [step_of(p) for p in g.get("body_states", [])]
+    if steps:
+        ctx.check(steps[0] > 0, "late recorder got step 0: it was not late")
+        ctx.log(f"late recorder: scene + steps {steps[0]}..{steps[-1]} (every {every})")
+
+
+def case_replay_roundtrip(ctx):
+    """run --record -> replay -> record, and node -> record -> replay -> record: same payloads."""
+    scene = ctx.scene("airplane.xml")
+    every = 100
+    x = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--record", x, "--record-every", every, "--namespace", ctx.ns)
+    want = Log(x)
+    n = len(want.messages)
+    r1 = ctx.path("replayed.mcap")
+    rec = ctx.rb("record-replayed", *record_args(ctx, r1, "--max-messages", n, "--duration", 90))
+    rep = ctx.rb("replay-run", "replay", x, "--domain", ctx.domain, "--rate", 0, "--wait-for-subscribers", 1)
+    exited_ok(ctx, rep, 90)
+    exited_ok(ctx, rec, 90)
+    got = Log(r1)
+    expect_indexed(ctx, got, n)
+    ctx.check(first_published(got).endswith("/scene"), f"first replayed message is {first_published(got)}, "
+                                                       f"not the scene")
+    same_payloads(ctx, got, want, "rbsim run --record -> replay -> record")
+    rbsim_check(ctx, r1, x, "check-replayed-run", live=True)
+
+    # Live round trip: node -> record L -> replay L -> record L2.
+    steps = max(step_of(p) for p in want.by_suffix()["body_states"])
+    live = ctx.path("live.mcap")
+    live_recording(ctx, scene, every, live, "live", steps_total=steps)
+    lv = Log(live)
+    same_payloads(ctx, lv, want, "live recording vs rbsim run --record")
+    l2 = ctx.path("live-replayed.mcap")
+    rec2 = ctx.rb("record-live-replayed", *record_args(ctx, l2, "--max-messages", len(lv.messages), "--duration", 90))
+    rep2 = ctx.rb("replay-live", "replay", live, "--domain", ctx.domain, "--rate", 0, "--wait-for-subscribers", 1)
+    exited_ok(ctx, rep2, 90)
+    exited_ok(ctx, rec2, 90)
+    l2log = Log(l2)
+    expect_indexed(ctx, l2log, len(lv.messages))
+    same_payloads(ctx, l2log, lv, "record -> replay -> record round trip")
+    rbsim_check(ctx, l2, live, "check-roundtrip", live=True)
+
+
+def case_replay_options(ctx):
+    """--rate, --topics, --namespace, --clock, --start-offset, --loop, Ctrl-C (exit 0)."""
+    scene = ctx.scene("cantilever.xml")
+    every = 20
+    x = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--duration", 2, "--record", x, "--record-every", every,
+              "--namespace", ctx.ns)
+    want = Log(x)
+    w = want.by_suffix()
+    n = len(want.messages)
+    per_step = len(w["body_states"])  # 101: steps 0, 20, ..., 2000
+    ctx.require(per_step == 101, f"run --duration 2 --record-every 20 gave {per_step} body states, want 101")
+
+    def replay_into(tag, replay_extra, max_messages=None, ns=None, settle=1.0, rec_extra=()):
+        out = ctx.path(f"{tag}.mcap")
+        extra = ("--max-messages", max_messages) if max_messages else ()
+        rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, *extra, *rec_extra, "--duration", 60, ns=ns))
+        rep = ctx.rb(f"replay-{tag}", "replay", x, "--domain", ctx.domain, "--wait-for-subscribers", 1,
+                     *replay_extra)
+        t = time.monotonic()
+        exited_ok(ctx, rep, 60)
+        wall = time.monotonic() - t
+        if max_messages:
+            exited_ok(ctx, rec, 60)
+        else:
+            time.sleep(settle)
+            rec.signal(signal.SIGINT)
+            exited_ok(ctx, rec, 15)
+        return Log(out), wall
+
+    # --rate 2: 2 s of log time in about 1 s, the recorded log-time gaps halved.
+    got, wall = replay_into("rate2", ("--rate", 2), max_messages=n)
+    same_payloads(ctx, got, want, "replay --rate 2")
+    lt = [m[2] for m in got.messages if m[0].endswith("/body_states")]
+    span = (lt[-1] - lt[0]) * 1e-9 if lt else 0.0
+    ctx.check(0.85 <= span <= 1.6, f"replay --rate 2 of 2 s of log: body states spread over {span:.3f} s, want ~1 s")
+    ctx.log(f"--rate 2: body states spread over {span:.3f} s of wall time (replay process {wall:.2f} s)")
+
+    # --topics: only the scene description and the body states.
+    got, _ = replay_into("topics", ("--rate", 0, "--topics", f"body_states,/{ctx.ns}/scene"))
+    g = got.by_suffix()
+    ctx.check(sorted(g) == ["body_states", "scene"], f"replay --topics: recorded {sorted(g)}")
+    ctx.check(g.get("body_states") == w["body_states"] and g.get("scene") == w["scene"],
+              "replay --topics: payloads differ from the log's")
+
+    # --namespace: the same payloads under another namespace.
+    other = ctx.ns + "_remap"
+    got, _ = replay_into("namespace", ("--rate", 0, "--namespace", other), max_messages=n, ns=other)
+    ctx.check(all(t == "/clock" or t.startswith(f"/{other}/") for t in got.topics()),
+              f"replay --namespace: topics {got.topics()}")
+    same_payloads(ctx, got, want, "replay --namespace", by_suffix=True)
+
+    # --clock: /clock carries the log time of each message; a run's log time is simulated time,
+    # so the published clock equals the recorded one (which is not replayed on top of it).
+    got, _ = replay_into("clock", ("--rate", 0, "--clock"), max_messages=n)
+    same_payloads(ctx, got, want, "replay --clock")
+    clocks = [stamp_of(p) for p in got.by_suffix().get("clock", [])]
+    ctx.check(clocks == [(s // 10**9, s % 10**9) for s in sorted({m[2] for m in want.messages})],
+              "replay --clock: /clock values are not the log times")
+
+    # --start-offset 1: the scene description first, then steps from 1000 (t = 1 s) on.
+    got, _ = replay_into("offset", ("--rate", 0, "--start-offset", 1.0))
+    g = got.by_suffix()
+    ctx.check(bool(got.messages) and first_published(got).endswith("/scene"),
+              f"replay --start-offset: first published {first_published(got)}, not the scene")
+    ctx.check(g.get("scene") == w["scene"], "replay --start-offset: scene description missing or different")
+    steps = [step_of(p) for p in g.get("body_states", [])]
+    ctx.check(steps == list(range(1000, 2001, every)), f"replay --start-offset 1: steps {steps[:3]}..{steps[-3:]}")
+    ctx.check(g.get("body_states") == w["body_states"][50:], "replay --start-offset: payloads differ")
+
+    # --loop: passes repeat (scene + steps 0..2000 each) until Ctrl-C, which exits 0. At --rate 10
+    # a pass takes 0.2 s: the recorder (there before the replay starts) sees several.
+    out = ctx.path("loop.mcap")
+    rec = ctx.rb("record-loop", *record_args(ctx, out))
+    rep = ctx.rb("replay-loop", "replay", x, "--domain", ctx.domain, "--rate", 10, "--loop",
+                 "--wait-for-subscribers", 1)
+    rep.wait_for_text("waiting", 20, stream="stderr")
+    time.sleep(1.5)
+    ctx.check(rep.alive(), "replay --loop ended by itself")
+    rep.signal(signal.SIGINT)
+    exited_ok(ctx, rep, 15, "replay --loop stopped with SIGINT")
+    time.sleep(0.5)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 15, "recorder of the looping replay")
+    g = Log(out).by_suffix()
+    steps = [step_of(p) for p in g.get("body_states", [])]
+    one = list(range(0, 2001, every))
+    ctx.check(steps[:2 * per_step] == one + one, f"replay --loop: body-state steps {steps[:3]}... "
+                                                 f"({len(steps)}) are not two passes")
+    ctx.check(len(g.get("scene", [])) >= 2, f"replay --loop: {len(g.get('scene', []))} scene descriptions, want one "
+                                            f"per pass")
+    ctx.log(f"--loop: {len(steps) / per_step:.1f} passes recorded in 1.5 s at --rate 10")
+
+    # Ctrl-C while waiting for subscribers, and in the middle of a paced replay: exit 0.
+    rep = ctx.rb("replay-wait-int", "replay", x, "--domain", ctx.domain, "--namespace", ctx.ns + "_nobody",
+                 "--wait-for-subscribers", 1)
+    rep.wait_for_text("waiting", 20, stream="stderr")
+    time.sleep(0.5)
+    rep.signal(signal.SIGINT)
+    exited_ok(ctx, rep, 10, "replay stopped with SIGINT while waiting")
+    rep = ctx.rb("replay-mid-int", "replay", x, "--domain", ctx.domain, "--namespace", ctx.ns + "_nobody",
+                 "--rate", 0.25)
+    time.sleep(1.0)
+    ctx.check(rep.alive(), "replay --rate 0.25 of 2 s ended within 1 s")
+    rep.signal(signal.SIGINT)
+    exited_ok(ctx, rep, 10, "replay stopped with SIGINT while replaying")
+
+
+def case_subscribers_come_and_go(ctx):
+    """The node keeps running while recorders and a Python subscriber come and go (clean exits,
+    SIGKILL); a SIGKILLed recorder's file is repaired by `rbsim log recover`. After a clean
+    leave the stream goes on without a gap; after a SIGKILL it may stall until DDS declares the
+    dead reader gone (the participant lease duration, 10 s by default): bounded here, measured
+    and reported."""
+    scene = ctx.scene("cantilever.xml")
+    states = f"/{ctx.ns}/body_states"
+    # Rate 1, every 5th step of dt = 1 ms: 200 body states per second.
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--publish-every", 5, "--loop"))
+    node.wait_for_text("rbsim node:", 20, stream="stderr")
+
+    def alive(after):
+        ctx.require(node.alive(), f"the node stopped after {after}\n{node.output()}")
+
+    def max_gap(log):
+        t = [m[2] for m in log.messages if m[0] == states]
+        return max((b - a for a, b in zip(t, t[1:])), default=0) * 1e-9
+
+    # 1: a recorder that stops by itself (--duration).
+    rec = ctx.rb("record-1", *record_args(ctx, ctx.path("r1.mcap"), "--duration", 1.5))
+    exited_ok(ctx, rec, 30)
+    ctx.check(len(Log(ctx.path("r1.mcap")).payloads(states)) > 100, "recorder 1 got few body states in 1.5 s")
+    alive("a recorder finished")
+
+    # 2: right after a clean leave, a recorder stopped with SIGINT: no gap, a valid indexed file.
+    r2 = ctx.path("r2.mcap")
+    rec = ctx.rb("record-2", *record_args(ctx, r2))
+    rec.wait_for_text("recording", 20, stream="stderr")
+    time.sleep(1.5)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 15, "recorder stopped with SIGINT")
+    log2 = Log(r2)
+    expect_indexed(ctx, log2)
+    n2, gap2 = len(log2.payloads(states)), max_gap(log2)
+    ctx.check(n2 > 150, f"recorder 2 (after a clean leave) got {n2} body states in 1.5 s, want ~300")
+    ctx.check(gap2 < 0.5, f"recorder 2 (after a clean leave): the body states stalled {gap2:.2f} s")
+    ctx.log(f"after a clean leave: {n2} body states in 1.5 s, largest gap {gap2 * 1e3:.0f} ms")
+    alive("a recorder was stopped with SIGINT")
+
+    # 3: a Python subscriber, SIGKILLed.
+    sub = ctx.start("python-sub", [sys.executable, os.path.join(os.path.dirname(__file__), "dds_subscriber.py"),
+                                   "--domain", str(ctx.domain), "--namespace", ctx.ns, "--count", "1000000",
+                                   "--timeout", "30", "--out", ctx.path("sub.jsonl")],
+                    env=ctx.env(uri="file://" + ctx.loopback_xml))
+    sub.wait_for_text("READY", 30)
+    time.sleep(1.0)
+    sub.signal(signal.SIGKILL)
+    sub.wait(10)
+    alive("a Python subscriber was killed")
+    with open(ctx.path("sub.jsonl")) as f:
+        ctx.check(sum(1 for _ in f) > 0, "the Python subscriber received nothing in 1 s")
+
+    # 4: a recorder SIGKILLed after a few chunks: rbsim log recover saves its complete chunks.
+    killed = ctx.path("killed.mcap")
+    rec = ctx.rb("record-killed", *record_args(ctx, killed, "--compression", "none"))
+    rec.wait_for_text("recording", 20, stream="stderr")
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and (not os.path.exists(killed) or os.path.getsize(killed) < 2_500_000):
+        time.sleep(0.1)
+    rec.signal(signal.SIGKILL)
+    killed_at = time.time_ns()
+    rec.wait(10)
+    alive("a recorder was killed")
+    ctx.check(os.path.getsize(killed) >= 2_500_000, f"killed recorder wrote {os.path.getsize(killed)} bytes in 30 s")
+    check_recover(ctx, killed, "killed recorder")
+
+    # 5: a newcomer after the SIGKILL gets the stream within the lease bound; then a clean stop.
+    r5 = ctx.path("r5.mcap")
+    rec = ctx.rb("record-5", *record_args(ctx, r5, "--max-messages", 600, "--duration", 20))
+    exited_ok(ctx, rec, 40)
+    log5 = Log(r5)
+    t5 = [m[2] for m in log5.messages if m[0] == states]
+    ctx.check(log5.payloads(f"/{ctx.ns}/scene") != [], "recorder 5: no scene description")
+    if ctx.check(len(t5) > 0, f"recorder 5: no body states within 20 s of a subscriber being killed"):
+        stall = (t5[0] - killed_at) * 1e-9
+        ctx.check(stall < 12.0, f"recorder 5: first body state {stall:.1f} s after the SIGKILL (lease bound 12 s)")
+        ctx.note(f"after a subscriber was SIGKILLed the node's stream stalled {stall:.1f} s for newcomers "
+                 f"(until DDS declared the dead reader gone: participant lease duration)")
+    alive("the newcomer left")
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 15, "node stopped with SIGINT")
+
+
+def check_recover(ctx, damaged, what):
+    """`rbsim log recover` (when built) repairs the file; else the complete chunks are read."""
+    fixed = damaged.replace(".mcap", "-recovered.mcap")
+    rc, out, err = ctx.rbrun(f"recover-{os.path.basename(damaged)}", "log", "recover", damaged, fixed, ok=False,
+                             timeout=60)
+    if "recover" in (out + err) and os.path.exists(fixed):
+        ctx.check(rc in (0, 1), f"rbsim log recover exited with {rc}\n{out}{err}")
+        log = Log(fixed)
+        expect_indexed(ctx, log)
+        complete = read_stream_messages(damaged)
+        ctx.check(len(log.messages) > 0 and len(log.messages) == complete,
+                  f"{what}: recovered {len(log.messages)} messages, the complete chunks hold {complete}")
+        ctx.log(f"{what}: rbsim log recover saved {len(log.messages)} messages")
+        return log
+    ctx.note(f"rbsim log recover not available ({rc}): complete chunks read with the Python reader")
+    complete = read_stream_messages(damaged)
+    ctx.check(complete > 0, f"{what}: no complete chunk readable")
+    return None
+
+
+def case_python_subscriber(ctx):
+    """An independent subscriber (Python cyclonedds, types from our IDL) decodes body states and
+    PoseArray equal to `rbsim run --csv`, bit for bit."""
+    scene = ctx.scene("cantilever.xml")
+    every, duration = 20, 2
+    csv_path = ctx.path("run.csv")
+    ctx.rbrun("run-csv", "run", scene, "--duration", duration, "--csv", csv_path)
+    rows = {}
+    with open(csv_path) as f:
+        header = f.readline().strip().split(",")
+        col = {name: i for i, name in enumerate(header)}
+        for line in f:
+            v = line.strip().split(",")
+            rows.setdefault(int(v[col["step"]]), []).append(v)
+    steps = list(range(0, max(rows) + 1, every))
+    ctx.require(steps[-1] == 2000, f"CSV steps end at {max(rows)}")
+    env = ctx.env(uri="file://" + ctx.loopback_xml)
+    out = ctx.path("sub.jsonl")
+    sub = ctx.start("python-sub", [sys.executable, os.path.join(os.path.dirname(__file__), "dds_subscriber.py"),
+                                   "--domain", str(ctx.domain), "--namespace", ctx.ns, "--count", str(len(steps)),
+                                   "--timeout", "60", "--out", out], env=env)
+    sub.wait_for_text("READY", 30)
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 0, "--wait-for-subscribers", 1, "--publish-every", every,
+                                     "--duration", duration), env=env)
+    exited_ok(ctx, node, 60)
+    exited_ok(ctx, sub, 60, "Python subscriber")
+    states, poses = [], []
+    with open(out) as f:
+        for line in f:
+            m = json.loads(line)
+            (states if m["topic"] == "body_states" else poses).append(m)
+    ctx.check([m["step"] for m in states] == steps, f"body states: steps {[m['step'] for m in states][:5]}... "
+                                                    f"({len(states)}), want 0, {every}, ..., 2000")
+    ctx.check(len(poses) == len(steps), f"poses: {len(poses)} messages, want {len(steps)}")
+    dt = 0.001
+    bad = 0
+    for k, step in enumerate(steps):
+        body_rows = rows[step]
+        t_ns = int(math.floor(float(body_rows[0][col["t"]]) * 1e9 + 0.5))
+        stamp = [t_ns // 10**9, t_ns % 10**9]
+        for m in ([states[k]] if k < len(states) else []) + ([poses[k]] if k < len(poses) else []):
+            if [m["sec"], m["nanosec"]] != stamp or m["frame_id"] != "world":
+                bad += 1
+                ctx.check(False, f"{m['topic']} step {step}: stamp {m['sec']}.{m['nanosec']:09d} "
+                                 f"frame {m['frame_id']!r}, want {stamp} 'world'")
+        if k < len(states):
+            got = states[k]["bodies"]
+            want = [[int(r[col["body"]])] + [float(r[col[q]]) for q in ("x", "y", "theta", "vx", "vy", "omega")]
+                    for r in body_rows]
+            got = [[b[0]] + [float(v) for v in b[1:]] for b in got]
+            if got != want:
+                bad += 1
+                ctx.check(False, f"body states step {step}: {got} != CSV {want}")
+        if k < len(poses):
+            want = []
+            for r in body_rows:
+                th = float(r[col["theta"]])
+                want.append([float(r[col["x"]]), float(r[col["y"]]), 0.0, 0.0, 0.0, math.sin(0.5 * th),
+                             math.cos(0.5 * th)])
+            got = [[float(v) for v in p] for p in poses[k]["poses"]]
+            if got != want:
+                bad += 1
+                ctx.check(False, f"poses step {step}: {got} != {want}")
+        if bad > 10:
+            break
+    if bad == 0:
+        ctx.log(f"Python cyclonedds subscriber: {len(states)} BodyStates and {len(poses)} PoseArray of "
+                f"{len(rows[0])} bodies equal to rbsim run --csv, bit for bit")
+
+
+# --- network namespaces ----------------------------------------------------------------------
+
+NETNS_PREFIX = "rbsim-e2e-"
+
+
+def ip(ctx, *args, check=True):
+    r = subprocess.run(["ip", *args], capture_output=True, text=True, timeout=20)
+    if check and r.returncode != 0:
+        raise Failure(f"ip {' '.join(args)}: {r.stderr.strip()}")
+    return r
+
+
+def sweep_stale_netns(ctx):
+    r = subprocess.run(["ip", "netns", "list"], capture_output=True, text=True, timeout=20)
+    for line in r.stdout.splitlines():
+        name = line.split()[0] if line.split() else ""
+        if not name.startswith(NETNS_PREFIX):
+            continue
+        try:
+            pid = int(name[len(NETNS_PREFIX):].split("-")[0])
+        except ValueError:
+            continue
+        if pid != os.getpid() and not os.path.exists(f"/proc/{pid}"):
+            ctx.log(f"removing stale namespace {name} of a dead run")
+            subprocess.run(["ip", "netns", "del", name], capture_output=True, timeout=20)
+
+
+def netns_config(address, peer):
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<CycloneDDS xmlns="https://cdds.io/config">
+  <Domain Id="any">
+    <General>
+      <Interfaces>
+        <NetworkInterface address="{address}"/>
+      </Interfaces>
+      <AllowMulticast>false</AllowMulticast>
+    </General>
+    <Discovery>
+      <ParticipantIndex>auto</ParticipantIndex>
+      <MaxAutoParticipantIndex>20</MaxAutoParticipantIndex>
+      <Peers>
+        <Peer Address="{address}"/>
+        <Peer Address="{peer}"/>
+      </Peers>
+    </Discovery>
+  </Domain>
+</CycloneDDS>
+"""
+
+
+def case_netns(ctx):
+    """Node and recorder on two hosts: network namespaces joined by a veth pair, nothing lost."""
+    if shutil.which("ip") is None:
+        print("SKIP: the 'ip' command (iproute2) is not installed: no network namespaces")
+        return SKIP
+    sweep_stale_netns(ctx)
+    a, b = f"{NETNS_PREFIX}{ctx.pid}-a", f"{NETNS_PREFIX}{ctx.pid}-b"
+    va, vb = f"rbe{ctx.pid % 100000}a", f"rbe{ctx.pid % 100000}b"
+    r = ip(ctx, "netns", "add", a, check=False)
+    if r.returncode != 0:
+        print(f"SKIP: network namespaces are not permitted here (ip netns add: {r.stderr.strip()})")
+        return SKIP
+    created = [a]
+    try:
+        ip(ctx, "netns", "add", b)
+        created.append(b)
+        # The veth pair is created inside namespace a (never in the host's), one end moved to b.
+        r = ip(ctx, "-n", a, "link", "add", va, "type", "veth", "peer", "name", vb, "netns", b, check=False)
+        if r.returncode != 0:
+            print(f"SKIP: cannot create a veth pair between network namespaces here ({r.stderr.strip()})")
+            return SKIP
+        for ns, dev, addr in ((a, va, "10.231.0.1/24"), (b, vb, "10.231.0.2/24")):
+            ip(ctx, "-n", ns, "addr", "add", addr, "dev", dev)
+            ip(ctx, "-n", ns, "link", "set", dev, "up")
+            ip(ctx, "-n", ns, "link", "set", "lo", "up")
+        cfg_a, cfg_b = ctx.path("cyclonedds-a.xml"), ctx.path("cyclonedds-b.xml")
+        with open(cfg_a, "w") as f:
+            f.write(netns_config("10.231.0.1", "10.231.0.2"))
+        with open(cfg_b, "w") as f:
+            f.write(netns_config("10.231.0.2", "10.231.0.1"))
+        def rx_bytes():
+            r = ip(ctx, "-n", b, "-s", "-j", "link", "show", "dev", vb)
+            return json.loads(r.stdout)[0]["stats64"]["rx"]["bytes"]
+
+        rx0 = rx_bytes()
+
+        scene = ctx.scene("airplane.xml")
+        every = 100
+        run = ctx.path("run.mcap")
+        ctx.rbrun("run-record", "run", scene, "--record", run, "--record-every", every, "--namespace", ctx.ns)
+        want = Log(run)
+        n = len(want.messages)
+        out = ctx.path("remote.mcap")
+        rec = ctx.start("record-in-b", ["ip", "netns", "exec", b, ctx.rbsim,
+                                        *map(str, record_args(ctx, out, "--max-messages", n, "--duration", 90))],
+                        env=ctx.env(uri="file://" + cfg_b))
+        node = ctx.start("node-in-a", ["ip", "netns", "exec", a, ctx.rbsim,
+                                       *map(str, node_args(ctx, scene, "--rate", 0, "--publish-every", every,
+                                                           "--wait-for-subscribers", 1))],
+                         env=ctx.env(uri="file://" + cfg_a))
+        exited_ok(ctx, node, 90, "node in namespace a")
+        exited_ok(ctx, rec, 90, "recorder in namespace b")
+        ctx.check(counts_line(rec) == (n, 0), f"remote recorder counts {counts_line(rec)}, want ({n}, 0)")
+        got = Log(out)
+        expect_indexed(ctx, got, n)
+        same_payloads(ctx, got, want, "recording across the veth pair vs rbsim run --record")
+        payload = sum(len(m[5]) for m in got.messages)
+        rx = rx_bytes() - rx0
+        ctx.check(rx > payload, f"veth {vb} received {rx} bytes, less than the {payload} payload bytes recorded")
+        ctx.log(f"veth {vb} (namespace b) received {rx} bytes for {payload} payload bytes")
+    finally:
+        for ns in created:
+            subprocess.run(["ip", "netns", "del", ns], capture_output=True, timeout=20)
+        left = subprocess.run(["ip", "netns", "list"], capture_output=True, text=True, timeout=20).stdout
+        ctx.check(a not in left and b not in left, f"namespaces left behind: {left}")
+    return 0
+
+
+# --- bad input and faults --------------------------------------------------------------------
+
+
+def case_bad_input(ctx):
+    """Clear errors and a nonzero exit for bad names, files, domains and configurations."""
+    x = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", ctx.scene("airplane.xml"), "--duration", 0.1, "--record", x)
+    garbage = ctx.path("garbage.mcap")
+    with open(garbage, "wb") as f:
+        f.write(os.urandom(4096))
+    empty = ctx.path("empty.mcap")
+    open(empty, "wb").close()
+    truncated = ctx.path("truncated.mcap")
+    with open(x, "rb") as f:
+        data = f.read()
+    with open(truncated, "wb") as f:
+        f.write(data[:len(data) // 2])
+    foreign = ctx.path("foreign.mcap")
+    from mcap.writer import Writer
+
+    with open(foreign, "wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2", library="e2e")
+        sid = w.register_schema(name="std_msgs/msg/String", encoding="ros2msg", data=b"string data")
+        cid = w.register_channel(topic="/chatter", message_encoding="cdr", schema_id=sid)
+        w.add_message(channel_id=cid, log_time=1, publish_time=1, data=b"\x00\x01\x00\x00\x03\x00\x00\x00hi\x00\x00")
+        w.finish()
+    # Our type name with another definition (e.g. an older rbsim): not replayed as ours.
+    other_def = ctx.path("other-definition.mcap")
+    with open(other_def, "wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2", library="e2e")
+        sid = w.register_schema(name="rbsim_msgs/msg/BodyStates", encoding="ros2msg", data=b"int32 something_else")
+        cid = w.register_channel(topic="/rbsim/body_states", message_encoding="cdr", schema_id=sid)
+        w.add_message(channel_id=cid, log_time=1, publish_time=1, data=b"\x00\x01\x00\x00\x07\x00\x00\x00")
+        w.finish()
+    bad_xml = ctx.path("bad-config.xml")
+    with open(bad_xml, "w") as f:
+        f.write("<CycloneDDS><Domain><General><NoSuchSetting>1</NoSuchSetting></General></Domain></CycloneDDS>\n")
+    scene = ctx.scene("airplane.xml")
+    d = str(ctx.domain)
+    cases = [
+        ("record unknown topic", ("record", ctx.path("o1.mcap"), "--domain", d, "--topics", "no_such_topic"), None,
+         "unknown topic"),
+        ("replay unknown topic", ("replay", x, "--domain", d, "--topics", "no_such_topic"), None, "unknown topic"),
+        ("replay missing file", ("replay", ctx.path("missing.mcap"), "--domain", d), None, "cannot read"),
+        ("replay garbage", ("replay", garbage, "--domain", d), None, "cannot read"),
+        ("replay empty file", ("replay", empty, "--domain", d), None, "cannot read"),
+        ("replay truncated file", ("replay", truncated, "--domain", d), None, "cannot read"),
+        ("replay log without rbsim topics", ("replay", foreign, "--domain", d), None, "no rbsim topics"),
+        ("replay log with another BodyStates definition", ("replay", other_def, "--domain", d), None,
+         "differs from this build"),
+        ("node domain 233", ("node", scene, "--domain", "233"), None, "out of range"),
+        ("record domain 1000", ("record", ctx.path("o2.mcap"), "--domain", "1000"), None, "out of range"),
+        ("replay domain 233", ("replay", x, "--domain", "233"), None, "out of range"),
+        ("node missing CYCLONEDDS_URI file", ("node", scene, "--domain", d),
+         "file://" + ctx.path("no-such-config.xml"), "CYCLONEDDS_URI"),
+        ("record invalid CYCLONEDDS_URI", ("record", ctx.path("o3.mcap"), "--domain", d), "file://" + bad_xml,
+         "CYCLONEDDS_URI"),
+        ("replay invalid CYCLONEDDS_URI", ("replay", x, "--domain", d), "file://" + bad_xml, "CYCLONEDDS_URI"),
+    ]
+    for i, (what, args, uri, text) in enumerate(cases):
+        rc, out, err = ctx.rbrun(f"bad-{i}", *args, env=ctx.env(uri=uri), ok=False, timeout=30)
+        first = (err.strip().splitlines() or [""])[-1]
+        ctx.check(rc != 0 and rc > 0, f"{what}: exit {rc}, want an error exit\n{out}{err}")
+        ctx.check(text.lower() in err.lower(), f"{what}: stderr does not mention '{text}':\n{err}")
+        ctx.log(f"{what}: exit {rc}: {first}")
+    for name in ("o1.mcap", "o2.mcap"):
+        ctx.check(not os.path.exists(ctx.path(name)) or os.path.getsize(ctx.path(name)) < 64 * 1024,
+                  f"a failed record left a large {name}")
+
+
+def case_record_disk_full(ctx):
+    """A recorder whose writes fail (file-size limit, as a full disk) stops with an error, and
+    the file is recoverable."""
+    scene = ctx.scene("cantilever.xml")
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 2, "--publish-every", 2, "--loop"))
+    node.wait_for_text("rbsim node:", 20, stream="stderr")
+    out = ctx.path("full.mcap")
+    limit = 3 * 1024 * 1024
+    rec = ctx.rb("record-limited", *record_args(ctx, out, "--compression", "none", "--duration", 60),
+                 fsize_limit=limit)
+    rc = rec.wait(60)
+    ctx.check(rc != -signal.SIGXFSZ, "the recorder was killed by SIGXFSZ instead of stopping with an error")
+    ctx.check(rc == 1, f"recorder past its file-size limit exited with {rc}, want 1\n{rec.output()}")
+    ctx.check("file too large" in rec.stderr().lower() or "write" in rec.stderr().lower(),
+              f"recorder error does not say the write failed:\n{rec.stderr()}")
+    ctx.check(node.alive(), "the node stopped when the recorder failed")
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 15, "node stopped with SIGINT")
+    size = os.path.getsize(out)
+    ctx.check(size <= limit, f"{out}: {size} bytes, over the {limit}-byte limit")
+    ctx.log(f"recorder stopped at {size} bytes: {(rec.stderr().strip().splitlines() or [''])[-1]}")
+    check_recover(ctx, out, "recorder past its file-size limit")
+
+
+CASES = {
+    "node_record": case_node_record,
+    "late_recorder": case_late_recorder,
+    "replay_roundtrip": case_replay_roundtrip,
+    "replay_options": case_replay_options,
+    "subscribers_come_and_go": case_subscribers_come_and_go,
+    "python_subscriber": case_python_subscriber,
+    "netns": case_netns,
+    "bad_input": case_bad_input,
+    "record_disk_full": case_record_disk_full,
+}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--case", required=True, choices=sorted(CASES))
+    ap.add_argument("--index", type=int, required=True, help="test index (part of the DDS domain id)")
+    ap.add_argument("--rbsim", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--workdir", required=True)
+    ap.add_argument("--venv", required=True)
+    ap.add_argument("--requirements", required=True)
+    args = ap.parse_args()
+    ensure_venv(args.venv, args.requirements)
+
+    ctx = Ctx(args)
+    # ctest's timeout and Ctrl-C: end the case through the finally block (children killed,
+    # namespaces deleted).
+    def on_signal(sig, _frame):
+        raise Failure(f"interrupted by {signal.Signals(sig).name}")
+    signal.signal(signal.SIGTERM, on_signal)
+    signal.signal(signal.SIGINT, on_signal)
+    status = 1
+    try:
+        status = CASES[args.case](ctx) or 0
+    except Failure as e:
+        ctx.failures.append(str(e))
+        ctx.log(f"FAIL: {e}")
+    except Exception:
+        ctx.failures.append(traceback.format_exc())
+        ctx.log(f"FAIL: {traceback.format_exc()}")
+    finally:
+        ctx.cleanup()
+    elapsed = time.monotonic() - ctx.t0
+    if status == SKIP:
+        print(f"e2e.{args.case}: SKIPPED ({elapsed:.1f} s)")
+        return SKIP
+    for n in ctx.notes:
+        print(f"note: {n}")
+    if ctx.failures:
+        print(f"e2e.{args.case}: FAILED ({len(ctx.failures)} problems, {elapsed:.1f} s)")
+        for f in ctx.failures:
+            print(f"  - {f}")
+        return 1
+    print(f"e2e.{args.case}: PASSED ({elapsed:.1f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
