@@ -38,6 +38,7 @@
 
 #include "generated_types.inc"  // every idlc-generated header, and kGeneratedTypes
 #include "rbsim/builders.hpp"
+#include "raw_serdata.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace {
@@ -392,105 +393,7 @@ std::string hex(std::span<const std::byte> b, std::size_t from, std::size_t to) 
                                        << hex(ours, from, at + 8) << "\n  Cyclone: ..." << hex(cyclone, from, at + 8);
 }
 
-// A sertype whose serdata only carries serialised bytes. It is never registered with a domain:
-// it is the vehicle for handing raw CDR to dds_writecdr, which converts any foreign serdata to
-// the writer's own (default) sertype through ddsi_serdata_ref_as_type, i.e. size + to_ser_ref +
-// the writer sertype's from_ser_iov (a copy plus Cyclone's validation of the data).
-struct RawSerdata {
-  ddsi_serdata c;  // first: Cyclone sees a ddsi_serdata*
-  std::uint32_t size;
-  unsigned char* bytes;  // size rounded up to 4, zero padded
-};
-const RawSerdata& raw(const ddsi_serdata* d) { return *reinterpret_cast<const RawSerdata*>(d); }
-
-ddsi_serdata* raw_from_ser_iov(const ddsi_sertype* type, ddsi_serdata_kind kind, ddsrt_msg_iovlen_t niov,
-                               const ddsrt_iovec_t* iov, std::size_t size) {
-  auto* d = new RawSerdata{};
-  ddsi_serdata_init(&d->c, type, kind);
-  d->size = static_cast<std::uint32_t>(size);
-  d->bytes = new unsigned char[(size + 3) / 4 * 4]();
-  std::size_t at = 0;
-  for (ddsrt_msg_iovlen_t i = 0; i < niov && at < size; ++i) {
-    const std::size_t n = std::min<std::size_t>(iov[i].iov_len, size - at);
-    std::memcpy(d->bytes + at, iov[i].iov_base, n);
-    at += n;
-  }
-  return &d->c;
-}
-std::uint32_t raw_get_size(const ddsi_serdata* d) { return raw(d).size; }
-void raw_to_ser(const ddsi_serdata* d, std::size_t off, std::size_t sz, void* buf) {
-  std::memcpy(buf, raw(d).bytes + off, sz);
-}
-ddsi_serdata* raw_to_ser_ref(const ddsi_serdata* d, std::size_t off, std::size_t sz, ddsrt_iovec_t* ref) {
-  ref->iov_base = raw(d).bytes + off;
-  ref->iov_len = sz;
-  return ddsi_serdata_ref(d);
-}
-void raw_to_ser_unref(ddsi_serdata* d, const ddsrt_iovec_t*) { ddsi_serdata_unref(d); }
-void raw_free(ddsi_serdata* d) {
-  auto* r = reinterpret_cast<RawSerdata*>(d);
-  delete[] r->bytes;
-  delete r;
-}
-bool raw_eqkey(const ddsi_serdata*, const ddsi_serdata*) { return true; }  // keyless
-bool raw_to_sample(const ddsi_serdata*, void*, void**, void*) { return false; }
-ddsi_serdata* raw_to_untyped(const ddsi_serdata* d) { return ddsi_serdata_ref(d); }
-bool raw_untyped_to_sample(const ddsi_sertype*, const ddsi_serdata*, void*, void**, void*) { return false; }
-std::size_t raw_print(const ddsi_sertype*, const ddsi_serdata*, char* buf, std::size_t size) {
-  if (size > 0) buf[0] = 0;
-  return 0;
-}
-void raw_get_keyhash(const ddsi_serdata*, ddsi_keyhash* buf, bool) { std::memset(buf, 0, sizeof *buf); }
-
-const ddsi_serdata_ops kRawSerdataOps = [] {
-  ddsi_serdata_ops ops{};
-  ops.eqkey = raw_eqkey;
-  ops.get_size = raw_get_size;
-  ops.from_ser_iov = raw_from_ser_iov;
-  ops.to_ser = raw_to_ser;
-  ops.to_ser_ref = raw_to_ser_ref;
-  ops.to_ser_unref = raw_to_ser_unref;
-  ops.to_sample = raw_to_sample;
-  ops.to_untyped = raw_to_untyped;
-  ops.untyped_to_sample = raw_untyped_to_sample;
-  ops.free = raw_free;
-  ops.print = raw_print;
-  ops.get_keyhash = raw_get_keyhash;
-  return ops;
-}();
-
-void raw_sertype_free(ddsi_sertype*) {}
-void raw_zero_samples(const ddsi_sertype*, void*, std::size_t) {}
-void raw_realloc_samples(void** ptrs, const ddsi_sertype*, void*, std::size_t, std::size_t) { *ptrs = nullptr; }
-void raw_free_samples(const ddsi_sertype*, void**, std::size_t, dds_free_op_t) {}
-bool raw_sertype_equal(const ddsi_sertype*, const ddsi_sertype*) { return true; }
-std::uint32_t raw_sertype_hash(const ddsi_sertype*) { return 0; }
-
-const ddsi_sertype_ops kRawSertypeOps = [] {
-  ddsi_sertype_ops ops{};
-  ops.version = ddsi_sertype_v0;
-  ops.free = raw_sertype_free;
-  ops.zero_samples = raw_zero_samples;
-  ops.realloc_samples = raw_realloc_samples;
-  ops.free_samples = raw_free_samples;
-  ops.equal = raw_sertype_equal;
-  ops.hash = raw_sertype_hash;
-  return ops;
-}();
-
-class RawSertype {
- public:
-  explicit RawSertype(const char* type_name) {
-    ddsi_sertype_init(&st_, type_name, &kRawSertypeOps, &kRawSerdataOps, /*topickind_no_key=*/true);
-  }
-  ~RawSertype() { ddsi_sertype_fini(&st_); }
-  RawSertype(const RawSertype&) = delete;
-  RawSertype& operator=(const RawSertype&) = delete;
-  const ddsi_sertype* get() const { return &st_; }
-
- private:
-  ddsi_sertype st_{};
-};
+// Raw CDR is handed to dds_writecdr through the node's raw-bytes serdata (node/src/raw_serdata.cpp).
 
 // ---------------------------------------------------------------------------------------------
 // DDS plumbing: one participant per test on a private domain, a topic of the type under test,
@@ -672,12 +575,12 @@ TEST_P(CycloneCdr, WritecdrWithTheTopicSertypePublishesEncoderBytesUnchanged) {
 
 TEST_P(CycloneCdr, WritecdrWithARawBytesSerdataPublishesEncoderBytesUnchanged) {
   // No prior sample needed: the writer converts the raw serdata to its own sertype.
-  const RawSertype carrier(tc_->desc->m_typename);
-  SerdataPtr ours = serdata_from_cdr(carrier.get(), ours_);
+  SerdataPtr ours(rbsim::node::make_raw_serdata(ours_));
   ASSERT_NE(ours, nullptr);
+  const ddsi_sertype* carrier = ours->type;
   const SerdataPtr got = dds_.write_cdr(std::move(ours));
   ASSERT_NE(got, nullptr);
-  EXPECT_NE(got->type, carrier.get()) << "the reader should hold the topic's own sertype";
+  EXPECT_NE(got->type, carrier) << "the reader should hold the topic's own sertype";
   EXPECT_TRUE(same_bytes(serialized(*got), ours_));
   Sample decoded(*tc_->desc);
   EXPECT_TRUE(ddsi_serdata_to_sample(got.get(), decoded.get(), nullptr, nullptr));
