@@ -697,15 +697,17 @@ def case_subscribers_come_and_go(ctx):
     r2 = ctx.path("r2.mcap")
     rec = ctx.rb("record-2", *record_args(ctx, r2))
     rec.wait_for_text("recording", 20, stream="stderr")
-    time.sleep(1.5)
+    # 3 s: discovery of a new participant on loopback can take over a second (seen: 1.4 s), the
+    # gap check below only looks at what arrived after matching.
+    time.sleep(3.0)
     rec.signal(signal.SIGINT)
     exited_ok(ctx, rec, 15, "recorder stopped with SIGINT")
     log2 = Log(r2)
     expect_indexed(ctx, log2)
     n2, gap2 = len(log2.payloads(states)), max_gap(log2)
-    ctx.check(n2 > 150, f"recorder 2 (after a clean leave) got {n2} body states in 1.5 s, want ~300")
+    ctx.check(n2 > 150, f"recorder 2 (after a clean leave) got {n2} body states in 3 s, want ~600")
     ctx.check(gap2 < 0.5, f"recorder 2 (after a clean leave): the body states stalled {gap2:.2f} s")
-    ctx.log(f"after a clean leave: {n2} body states in 1.5 s, largest gap {gap2 * 1e3:.0f} ms")
+    ctx.log(f"after a clean leave: {n2} body states in 3 s, largest gap {gap2 * 1e3:.0f} ms")
     alive("a recorder was stopped with SIGINT")
 
     # 3: a Python subscriber, SIGKILLed.
@@ -714,12 +716,23 @@ def case_subscribers_come_and_go(ctx):
                                    "--timeout", "30", "--out", ctx.path("sub.jsonl")],
                     env=ctx.env(uri="file://" + ctx.loopback_xml))
     sub.wait_for_text("READY", 30)
-    time.sleep(1.0)
+
+    def received():
+        try:
+            with open(ctx.path("sub.jsonl")) as f:
+                return sum(1 for _ in f)
+        except FileNotFoundError:
+            return 0
+
+    # Until it has received something (discovery can take over a second), at most 15 s.
+    deadline = time.monotonic() + 15
+    while received() == 0 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(0.5)
     sub.signal(signal.SIGKILL)
     sub.wait(10)
     alive("a Python subscriber was killed")
-    with open(ctx.path("sub.jsonl")) as f:
-        ctx.check(sum(1 for _ in f) > 0, "the Python subscriber received nothing in 1 s")
+    ctx.check(received() > 0, "the Python subscriber received nothing in 15 s")
 
     # 4: a recorder SIGKILLed after a few chunks: rbsim log recover saves its complete chunks.
     killed = ctx.path("killed.mcap")

@@ -74,8 +74,10 @@ Subcommand add_record_command(CLI::App& parent) {
   auto a = std::make_shared<RecordArgs>();
   CLI::App* app = parent.add_subcommand("record", "Record rbsim topics from DDS into an MCAP file (rosbag2 layout)");
   app->add_option("out", a->rec.path, "MCAP file to write")->required();
-  app->add_option("--topics", a->rec.topics, "Topics to record (names like body_states or /rbsim/body_states); default all")
-      ->expected(1, -1);
+  app->add_option("--topics", a->rec.topics,
+                  "Topics to record, comma-separated or repeated (body_states or /rbsim/body_states); default all")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   app->add_option("--domain", a->domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")->default_str("rbsim");
   app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")->check(CLI::PositiveNumber);
