@@ -56,13 +56,7 @@ bool primitive_kind(std::string_view t, msgs::Scalar::Kind& kind, std::uint8_t& 
   return false;
 }
 
-std::string canonical_type(std::string_view type, std::string_view package) {
-  if (type == "Header") return "std_msgs/msg/Header";
-  const auto slash = type.find('/');
-  if (slash == std::string_view::npos) return std::string(package) + "/msg/" + std::string(type);
-  if (type.find('/', slash + 1) != std::string_view::npos) return std::string(type);
-  return std::string(type.substr(0, slash)) + "/msg/" + std::string(type.substr(slash + 1));
-}
+using msgs::canonical_type;
 
 struct RawField {
   std::string name, type;  // type: primitive name or canonical nested type
@@ -138,25 +132,8 @@ void make_flat(Layout::Field& f) {
 
 class LayoutBuilder {
  public:
-  explicit LayoutBuilder(std::string_view schema, const std::string& root) {
-    std::string current = root, body;
-    std::istringstream lines{std::string(schema)};
-    std::string line;
-    while (std::getline(lines, line)) {
-      if (line.size() >= 3 && line.find_first_not_of('=') == std::string::npos) {
-        sections_[current] = std::move(body);
-        body.clear();
-        current.clear();
-        continue;
-      }
-      if (current.empty() && line.starts_with("MSG: ")) {
-        current = canonical_type(line.substr(5), "");
-        continue;
-      }
-      body += line + "\n";
-    }
-    if (!current.empty()) sections_[current] = std::move(body);
-  }
+  explicit LayoutBuilder(std::string_view schema, const std::string& root)
+      : sections_(msgs::schema_sections(root, schema)) {}
 
   Result<std::vector<Layout::Field>> expand(const std::string& type, const std::string& prefix, int depth,
                                             std::vector<FieldGroup>& groups) {

@@ -30,14 +30,6 @@ int primitive_index(std::string_view t) {
   return -1;
 }
 
-std::string canonical(std::string_view type, std::string_view package) {
-  if (type == "Header") return "std_msgs/msg/Header";
-  const auto slash = type.find('/');
-  if (slash == std::string_view::npos) return std::string(package) + "/msg/" + std::string(type);
-  if (type.find('/', slash + 1) != std::string_view::npos) return std::string(type);
-  return std::string(type.substr(0, slash)) + "/msg/" + std::string(type.substr(slash + 1));
-}
-
 // Walks one message; `Visit` is called with each scalar. Returns false on malformed data.
 class Walker {
  public:
@@ -183,11 +175,17 @@ std::string Scalar::to_string() const {
   return "?";
 }
 
-Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string_view schema) {
-  // Split "text\n====...\nMSG: pkg/Name\ntext..." into named sections.
+std::string canonical_type(std::string_view type, std::string_view package) {
+  if (type == "Header") return "std_msgs/msg/Header";
+  const auto slash = type.find('/');
+  if (slash == std::string_view::npos) return std::string(package) + "/msg/" + std::string(type);
+  if (type.find('/', slash + 1) != std::string_view::npos) return std::string(type);
+  return std::string(type.substr(0, slash)) + "/msg/" + std::string(type.substr(slash + 1));
+}
+
+std::map<std::string, std::string> schema_sections(std::string_view root, std::string_view schema) {
   std::map<std::string, std::string> sections;
-  const std::string root_name = canonical(root, "");
-  std::string current = root_name, body;
+  std::string current = canonical_type(root, ""), body;
   std::istringstream lines{std::string(schema)};
   std::string line;
   while (std::getline(lines, line)) {
@@ -198,12 +196,18 @@ Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string
       continue;
     }
     if (current.empty() && line.starts_with("MSG: ")) {
-      current = canonical(line.substr(5), "");
+      current = canonical_type(line.substr(5), "");
       continue;
     }
     body += line + "\n";
   }
   if (!current.empty()) sections[current] = std::move(body);
+  return sections;
+}
+
+Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string_view schema) {
+  const std::string root_name = canonical_type(root, "");
+  const std::map<std::string, std::string> sections = schema_sections(root_name, schema);
 
   MessageDecoder d;
   std::map<std::string, std::size_t> index;
@@ -245,7 +249,7 @@ Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string
       f.primitive = primitive_index(type);
       if (type == "wstring") return Error{name + ": wstring fields are not supported"};
       if (f.primitive < 0) {
-        const std::string nested = canonical(type, package);
+        const std::string nested = canonical_type(type, package);
         auto [pos, fresh] = index.try_emplace(nested, d.types_.size());
         if (fresh) d.types_.push_back(Type{nested, {}});
         f.nested = pos->second;

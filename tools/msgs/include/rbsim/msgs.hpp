@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -139,6 +140,11 @@ struct Scalar {
   bool operator==(const Scalar&) const = default;
   std::string to_string() const;
 };
+
+// "pkg/Name" or bare "Name" (in `package`) -> "pkg/msg/Name"; bare "Header" is std_msgs'.
+std::string canonical_type(std::string_view type, std::string_view package);
+// A rosbag2-style schema split into its definitions, keyed by canonical type (`root` first).
+std::map<std::string, std::string> schema_sections(std::string_view root, std::string_view schema);
 
 class MessageDecoder {
  public:
