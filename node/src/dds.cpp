@@ -3,6 +3,7 @@
 #include <dds/ddsi/ddsi_serdata.h>
 #include <dds/ddsi/ddsi_sertype.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 
@@ -68,11 +69,11 @@ Participant::~Participant() {
   if (handle_ > 0) dds_delete(handle_);
 }
 
-QosSpec qos_for(const msgs::TopicSpec& spec) {
+QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last) {
   QosSpec q;
   q.transient_local = spec.transient_local;
-  q.keep_all = !spec.transient_local;
-  q.depth = spec.transient_local ? 1 : 1000;
+  q.keep_all = !spec.transient_local && keep_last <= 0;
+  q.depth = spec.transient_local ? 1 : std::max<std::int32_t>(keep_last, 1);
   return q;
 }
 

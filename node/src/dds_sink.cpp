@@ -26,7 +26,7 @@ Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant,
   if (sink->options_.publish_every < 1) sink->options_.publish_every = 1;
   sink->publishers_.resize(msgs::kTopicCount);
   for (const msgs::TopicSpec& spec : msgs::topics()) {
-    auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns), qos_for(spec));
+    auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns), qos_for(spec, options.keep_last));
     if (!pub) return pub.error();
     sink->publishers_[static_cast<std::size_t>(spec.id)].emplace(std::move(pub.value()));
   }

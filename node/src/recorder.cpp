@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <optional>
 
 #include "rbsim/log.hpp"
 #include "rbsim/node.hpp"
@@ -15,7 +17,56 @@ std::uint64_t wall_ns() {
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 mcap::ByteView view(const std::vector<std::byte>& b) { return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()}; }
+
+// The simulated time a per-step message carries, in ns: the first builtin_interfaces/Time in it
+// (the header stamp; the clock of a Clock; the first marker's stamp in a MarkerArray, after the
+// sequence length). Little- or big-endian CDR as the encapsulation header says; nullopt when the
+// message is too short (e.g. an empty MarkerArray).
+std::optional<std::int64_t> stamp_ns(const std::vector<std::byte>& cdr, msgs::TopicId id) {
+  const std::size_t at = 4 + (id == msgs::TopicId::Markers ? 4 : 0);
+  if (cdr.size() < at + 8 || (id == msgs::TopicId::Markers && cdr.size() >= 8 && cdr[4] == std::byte{0} &&
+                              cdr[5] == std::byte{0} && cdr[6] == std::byte{0} && cdr[7] == std::byte{0})) {
+    return std::nullopt;
+  }
+  const bool little = (static_cast<unsigned>(cdr[1]) & 1u) != 0;
+  auto u32 = [&](std::size_t o) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) {
+      const auto b = static_cast<std::uint32_t>(cdr[o + static_cast<std::size_t>(little ? 3 - i : i)]);
+      v = (v << 8) | b;
+    }
+    return v;
+  };
+  const auto sec = static_cast<std::int32_t>(u32(at));
+  return static_cast<std::int64_t>(sec) * 1'000'000'000 + static_cast<std::int64_t>(u32(at + 4));
+}
 }  // namespace
+
+void Recorder::Gaps::add(std::int64_t stamp, double dt) {
+  if (count > 0 && stamp <= last) {  // the scene started again (node --loop): close this run
+    lost_before += lost(dt);
+    count = 0;
+  }
+  if (count == 0) {
+    first = last = stamp;
+    stride = 0;
+  } else {
+    const std::int64_t d = stamp - last;
+    stride = stride == 0 ? d : std::min(stride, d);
+    last = stamp;
+  }
+  ++count;
+}
+
+std::uint64_t Recorder::Gaps::lost(double dt) const {
+  if (count < 2 || stride <= 0) return 0;
+  // In steps when dt is known (exact: a stamp is round(step * dt * 1e9)); else in ns, rounded.
+  const double unit = dt > 0.0 ? dt * 1e9 : 1.0;
+  const auto steps = [unit](std::int64_t ns) { return std::llround(static_cast<double>(ns) / unit); };
+  const std::int64_t k = std::max<std::int64_t>(steps(stride), 1);
+  const std::int64_t expected = (steps(last) - steps(first)) / k + 1;
+  return expected > static_cast<std::int64_t>(count) ? static_cast<std::uint64_t>(expected) - count : 0;
+}
 
 Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participant, const RecorderOptions& options) {
   std::unique_ptr<Recorder> r(new Recorder());
@@ -49,7 +100,7 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
     auto channel = log::add_topic(r->writer_, *spec, options.ns);
     if (!channel.ok()) return Error{options.path + ": " + channel.status().message};
     dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
-    r->topics_.push_back(Topic{std::move(sub.value()), channel.value(), 0});
+    r->topics_.push_back(Topic{std::move(sub.value()), channel.value(), 0, Gaps{}});
   }
   return r;
 }
@@ -74,6 +125,12 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       }
       ++t.received;
       ++received_;
+      const msgs::TopicId id = t.subscription.spec().id;
+      if (id == msgs::TopicId::Scene) {
+        if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
+      } else if (auto stamp = stamp_ns(sample.cdr, id)) {
+        t.gaps.add(*stamp, dt_);
+      }
       if (options_.max_messages > 0 && received_ >= options_.max_messages) return any;
     }
   }
@@ -82,7 +139,9 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
 
 std::vector<Recorder::TopicCount> Recorder::counts() const {
   std::vector<TopicCount> out;
-  for (const Topic& t : topics_) out.push_back({t.subscription.ros_topic(), t.received, t.subscription.lost()});
+  for (const Topic& t : topics_) {
+    out.push_back({t.subscription.ros_topic(), t.received, t.subscription.lost() + t.gaps.lost_before + t.gaps.lost(dt_)});
+  }
   return out;
 }
 

@@ -160,7 +160,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
       }
       return it->second.first;
     }
-    auto pub = Publisher::create(participant, spec, topic, qos_for(spec));
+    auto pub = Publisher::create(participant, spec, topic, qos_for(spec, options.keep_last));
     if (!pub) return pub.error();
     im.publishers.push_back(std::move(pub.value()));
     by_topic.emplace(topic, std::make_pair(im.publishers.size() - 1, &spec));

@@ -274,7 +274,8 @@ TEST(RbsimRun, WarningsGoToStderrAndTheRunSucceeds) {
 }
 
 // A stiff explicit-Euler spring blows up: the run stops with a clear error at the first step
-// whose state is not finite, and the outputs hold every step before it as complete files.
+// whose state is not finite, and the outputs hold every step before it as complete files: the
+// CSVs, and a finished, indexed MCAP recording that exports to the same CSV.
 TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
   TempDir dir;
   std::string text = read_text(kScenes + "/springtests/test00ee.xml");
@@ -284,7 +285,7 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
   }
   test::write_text(dir / "stiff.xml", text);
   const test::Outcome o = rbsim({"run", (dir / "stiff.xml").string(), "-q", "--csv", (dir / "b.csv").string(),
-                                 "--energy-csv", (dir / "e.csv").string()});
+                                 "--energy-csv", (dir / "e.csv").string(), "--record", (dir / "r.mcap").string()});
   EXPECT_EQ(o.exit_code, 1) << describe(o);
   ASSERT_EQ(o.err_lines().size(), 1u) << describe(o);
   EXPECT_NE(o.err.find("not finite"), std::string::npos) << o.err;
@@ -306,6 +307,11 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
     ASSERT_EQ(f.size(), 15u);
     for (int c = 3; c < 9; ++c) EXPECT_TRUE(std::isfinite(parse_double(f[c]))) << "state column " << c << ": " << bodies[i];
   }
+  const test::Outcome doctor = rbsim({"log", "doctor", (dir / "r.mcap").string()});
+  EXPECT_EQ(doctor.exit_code, 0) << describe(doctor);
+  const test::Outcome exported = rbsim({"log", "export", (dir / "r.mcap").string(), "--csv", (dir / "x.csv").string()});
+  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  EXPECT_EQ(read_text(dir / "x.csv"), read_text(dir / "b.csv"));
   // with --allow-nonfinite it runs to the end
   const test::Outcome all =
       rbsim({"run", (dir / "stiff.xml").string(), "-q", "--allow-nonfinite", "--steps", "2000"});

@@ -92,13 +92,17 @@ Subcommand add_node_command(CLI::App& parent) {
   app->add_flag("--loop", a->loop, "Start the scene again when it ends, until Ctrl-C");
   app->add_option("--wait-for-subscribers", a->wait_for, "Wait until N subscribers match the body states first")
       ->check(CLI::NonNegativeNumber);
+  app->add_option("--keep-last", a->node.keep_last,
+                  "Per-step writers keep the last N samples instead of all: the node never waits for a slow "
+                  "subscriber, which may then lose samples (ROS 2's default profile is keep last 10)")
+      ->check(CLI::PositiveNumber);
   app->add_flag("-q,--quiet", a->quiet, "No start and end lines");
   app->footer(
       "Topics (DDS name rt/<namespace>/<name>, type pkg::msg::dds_::Name_, CDR): scene "
       "(rbsim_msgs/SceneDescription, reliable, transient local, keep last 1: late joiners get it), body_states, "
       "spring_states, energy, poses (geometry_msgs/PoseArray), markers (visualization_msgs/MarkerArray) and /clock "
       "(rosgraph_msgs/Clock), all reliable, volatile, keep all: a slow subscriber slows the node down rather than "
-      "losing samples.\n"
+      "losing samples (--keep-last N trades that for a node that never waits).\n"
       "DDS: without CYCLONEDDS_URI the node uses rbsim's loopback configuration (127.0.0.1 only, no multicast); set "
       "CYCLONEDDS_URI to a Cyclone DDS configuration to go onto a real network.\n"
       "Ctrl-C stops cleanly (exit 0).");

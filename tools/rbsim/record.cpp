@@ -85,10 +85,15 @@ Subcommand add_record_command(CLI::App& parent) {
   app->add_option("--compression", a->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
+  app->add_option("--chunk-size", a->rec.chunk_size,
+                  "Uncompressed bytes per MCAP chunk: a killed recorder loses at most the chunk it was filling")
+      ->check(CLI::Range(std::uint64_t{1024}, std::uint64_t{1} << 30))
+      ->default_str("1048576");
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
   app->footer("Writes the exact CDR payloads received: log_time = receive time, publish_time = the sample's source "
               "timestamp (ns since the Unix epoch). Ctrl-C or SIGTERM finishes a valid, indexed file and exits 0; a "
-              "killed recorder leaves a file that 'rbsim log recover' repairs. Reports received and lost counts.");
+              "killed recorder leaves a file that 'rbsim log recover' repairs. Reports received and lost counts: lost "
+              "is what DDS reports plus the steps missing from each per-step topic's sequence.");
   return {app, [a] { return record_command(*a); }};
 }
 

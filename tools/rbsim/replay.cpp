@@ -100,6 +100,10 @@ Subcommand add_replay_command(CLI::App& parent) {
   app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names");
   app->add_option("--wait-for-subscribers", a->wait_for, "Wait until N subscribers match the body states first")
       ->check(CLI::NonNegativeNumber);
+  app->add_option("--keep-last", a->replay.keep_last,
+                  "Per-step writers keep the last N samples instead of all (the replay never waits for a slow "
+                  "subscriber, which may then lose samples)")
+      ->check(CLI::PositiveNumber);
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
   app->footer(
       "Every channel whose schema is an rbsim type (rbsim_msgs/SceneDescription, BodyStates, SpringStates, "

@@ -45,9 +45,12 @@ std::string_view loopback_config();
 struct QosSpec {
   bool transient_local = false;  // late joiners get the last sample (the scene description)
   bool keep_all = false;         // writers: keep all (wait for slow readers) instead of keep last
-  std::int32_t depth = 1000;     // keep-last depth
+  std::int32_t depth = 1;        // keep-last depth
 };
-QosSpec qos_for(const msgs::TopicSpec& spec);
+// The QoS of a topic: the scene description transient local, keep last 1; per-step topics keep
+// all, or keep last `keep_last` when it is positive (the writer then never waits, and a reader
+// that falls more than `keep_last` samples behind loses the oldest).
+QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0);
 
 // Publishes pre-encoded CDR messages on one topic.
 class Publisher {
@@ -104,6 +107,7 @@ struct NodeOptions {
   std::string ns = "rbsim";
   double rate = 1.0;               // real-time factor; 0: as fast as possible
   std::int64_t publish_every = 1;  // publish every k-th step
+  std::int32_t keep_last = 0;      // per-step writers keep last N instead of keep all (0)
 };
 // Publishes the scene description at begin() and the per-step topics on every k-th step,
 // pacing steps to wall time by `rate`.
@@ -138,6 +142,14 @@ class DdsSink final : public Sink {
 // layout), log_time = receive time, publish_time = the sample's source timestamp (both ns since
 // the Unix epoch). Chunks are flushed as they fill, so a killed recorder leaves a file
 // `rbsim log recover` repairs.
+//
+// Lost messages are what DDS reports lost or rejected plus the gaps the recorder sees in the
+// steps of each per-step topic: every per-step message carries its simulated time (header stamp,
+// or the clock), the scene description gives dt, so each message names its step; the node
+// publishes every k-th step, so within one run of the scene (a --loop restarts it) the steps
+// received on a topic are first, first + k, ..., last, and the ones missing from that sequence
+// were lost, e.g. while a link was down for longer than the DDS lease and the reader was
+// dropped (messages that DDS itself never reports). k is the smallest step difference seen.
 
 struct RecorderOptions {
   std::string path;
@@ -158,22 +170,33 @@ class Recorder {
   std::uint64_t received() const { return received_; }
   struct TopicCount {
     std::string topic;
-    std::uint64_t received = 0, lost = 0;
+    std::uint64_t received = 0, lost = 0;  // lost: reported by DDS plus gaps in the steps
   };
   std::vector<TopicCount> counts() const;
 
  private:
   Recorder() = default;
+  // Steps received on one per-step topic since the scene (re)started, as simulated times in ns
+  // (converted with dt once the scene description is known).
+  struct Gaps {
+    std::int64_t first = -1, last = -1, stride = 0;  // ns; stride: smallest difference seen
+    std::uint64_t count = 0;                          // messages in this run of the scene
+    std::uint64_t lost_before = 0;                    // in earlier runs (--loop)
+    void add(std::int64_t stamp_ns, double dt);
+    std::uint64_t lost(double dt) const;
+  };
   struct Topic {
     Subscription subscription;
     std::uint16_t channel;
     std::uint32_t received;
+    Gaps gaps;
   };
   RecorderOptions options_;
   mcap::Writer writer_;
   std::int32_t waitset_ = 0;
   std::vector<Topic> topics_;
   std::uint64_t received_ = 0;
+  double dt_ = 0.0;  // from the scene description; 0 until it arrives
 };
 
 // Looks up a TopicSpec by ROS topic suffix ("body_states") or full name ("/rbsim/body_states").
@@ -197,6 +220,7 @@ struct ReplayOptions {
   bool clock = false;               // publish rosgraph_msgs/Clock on /clock with each message's log time
                                     // (recorded /clock messages are then not replayed)
   std::optional<std::string> ns;    // republish under /<ns>/<name> instead of the recorded names
+  std::int32_t keep_last = 0;       // per-step writers keep last N instead of keep all (0)
 };
 
 class Replay {

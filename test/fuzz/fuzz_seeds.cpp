@@ -1,0 +1,61 @@
+// Writes seed inputs the fuzz targets cannot take from files in the repository as they are:
+//   <out>/cdr/<topic>-<step>   one byte naming the type (TopicId), then a CDR message rbsim encoded
+//   <out>/log/<scene>-<compression>.mcap   short recordings, one per chunk compression
+// from the scenes given (a few steps each), so every seed is produced by the code it exercises.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rbsim/log.hpp"
+#include "rbsim/msgs.hpp"
+#include "rbsim/scene.hpp"
+
+namespace {
+int fail(const std::string& m) {
+  std::fprintf(stderr, "rbsim_fuzz_seeds: %s\n", m.c_str());
+  return 1;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace fs = std::filesystem;
+  if (argc < 3) return fail("usage: rbsim_fuzz_seeds OUT_DIR SCENE.xml...");
+  const fs::path out(argv[1]);
+  fs::create_directories(out / "cdr");
+  fs::create_directories(out / "log");
+  for (int i = 2; i < argc; ++i) {
+    auto scene = rbsim::load_scene(argv[i]);
+    if (!scene) return fail(scene.error().message);
+    auto world = rbsim::World::create(scene.value().world);
+    if (!world) return fail(world.error().message);
+    const std::string stem = fs::path(argv[i]).stem().string();
+    const rbsim::msgs::Encoder encoder(scene.value());
+    rbsim::msgs::Bytes bytes;
+    for (int step = 0; step <= 3; ++step) {
+      for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
+        if (spec.id == rbsim::msgs::TopicId::Scene && step > 0) continue;
+        encoder.encode(spec.id, world.value(), bytes);
+        std::ofstream f(out / "cdr" / (stem + "-" + std::string(spec.suffix) + "-" + std::to_string(step)),
+                        std::ios::binary);
+        f.put(static_cast<char>(spec.id));
+        f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      }
+      world.value().step();
+    }
+    for (const char* name : {"none", "lz4", "zstd"}) {
+      rbsim::log::RecordOptions options;
+      if (!rbsim::log::parse_compression(name, options.compression)) return fail(name);
+      options.chunk_size = 4096;  // several chunks in a small file
+      auto w = rbsim::World::create(scene.value().world);
+      auto sink = rbsim::log::make_mcap_sink((out / "log" / (stem + "-" + name + ".mcap")).string(), options);
+      if (!sink->begin(scene.value(), w.value())) return fail("cannot record " + stem);
+      for (int step = 0; step < 4; ++step) {
+        w.value().step();
+        if (!sink->write(w.value())) return fail("cannot record " + stem);
+      }
+      if (!sink->finish()) return fail("cannot finish " + stem);
+    }
+  }
+  return 0;
+}
