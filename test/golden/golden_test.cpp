@@ -1,30 +1,19 @@
 // Golden logs: every bundled scene rerun and checked against its golden with `rbsim check`, the
 // goldens re-verified independently of the simulator, and the check itself exercised: perturbed
 // runs, topic selection, tolerances, missing/extra messages, bad input, scripts/golden.
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "rbsim/log.hpp"
-
-extern char** environ;
+#include "rbsim/subprocess.hpp"
 
 namespace {
 
@@ -39,104 +28,16 @@ constexpr std::uintmax_t kMaxGoldenBytes = 2u << 20;
 constexpr std::uintmax_t kMaxGoldenTotal = 6u << 20;
 
 // ---------------------------------------------------------------------------------------------
-// Helpers: files, temporary directories, running rbsim (or scripts/golden) with a time limit.
+// Helpers: files, temporary directories and child processes come from test/support.
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  ASSERT_TRUE(out.good()) << path;
-}
-
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() / ("rbsim_golden_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-struct Outcome {
-  int exit_code = -1;  // -1: killed by a signal or the time limit
-  int signal = 0;
-  bool timed_out = false;
-  std::string out, err;
-};
-
-std::ostream& operator<<(std::ostream& os, const Outcome& o) {
-  return os << "exit " << o.exit_code << " signal " << o.signal << (o.timed_out ? " (timed out)" : "")
-            << "\n--- stdout\n" << o.out << "--- stderr\n" << o.err;
-}
+using test::Outcome;
+using test::read_text;
+using test::TempDir;
+using test::write_text;
 
 Outcome run_process(const std::string& exe, const std::vector<std::string>& args,
-                    const std::vector<std::string>& extra_env = {},
-                    std::chrono::seconds timeout = std::chrono::seconds(240)) {
-  TempDir capture;
-  const std::string out_path = (capture / "stdout").string(), err_path = (capture / "stderr").string();
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  std::vector<std::string> argv_storage{exe};
-  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : argv_storage) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::vector<std::string> env_storage;
-  for (char** e = environ; *e != nullptr; ++e) env_storage.emplace_back(*e);
-  env_storage.insert(env_storage.end(), extra_env.begin(), extra_env.end());
-  std::vector<char*> envp;
-  for (std::string& e : env_storage) envp.push_back(e.data());
-  envp.push_back(nullptr);
-
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&actions);
-  Outcome o;
-  if (rc != 0) {
-    o.err = "posix_spawn " + exe + ": " + std::strerror(rc);
-    return o;
-  }
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
-  for (;;) {
-    const pid_t done = ::waitpid(pid, &status, WNOHANG);
-    if (done == pid) break;
-    if (done < 0 && errno != EINTR) break;
-    if (std::chrono::steady_clock::now() >= deadline) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      o.timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  if (!o.timed_out && WIFEXITED(status)) o.exit_code = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) o.signal = WTERMSIG(status);
-  o.out = read_text(out_path);
-  o.err = read_text(err_path);
-  return o;
+                    const std::vector<std::string>& extra_env = {}) {
+  return test::run_process(exe, args, std::chrono::seconds(240), extra_env);
 }
 
 Outcome rbsim(const std::vector<std::string>& args) { return run_process(RBSIM_EXE, args); }

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <ostream>
 #include <stdexcept>
 #include <thread>
 
@@ -30,6 +31,7 @@ std::string read_text(const fs::path& path) {
 }
 
 void write_text(const fs::path& path, const std::string& text) {
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
   std::ofstream out(path, std::ios::binary);
   out << text;
   if (!out) throw std::runtime_error("cannot write " + path.string());
@@ -75,7 +77,13 @@ TempDir::~TempDir() {
   fs::remove_all(path_, ec);
 }
 
-Outcome run_process(const std::string& exe, const std::vector<std::string>& args, std::chrono::milliseconds timeout) {
+std::ostream& operator<<(std::ostream& os, const Outcome& o) {
+  return os << "exit " << o.exit_code << " signal " << o.signal << (o.timed_out ? " (timed out)" : "")
+            << "\n--- stdout\n" << o.out << "--- stderr\n" << o.err;
+}
+
+Outcome run_process(const std::string& exe, const std::vector<std::string>& args, std::chrono::milliseconds timeout,
+                    const std::vector<std::string>& extra_env) {
   TempDir capture;
   const std::string out_path = (capture / "stdout").string(), err_path = (capture / "stderr").string();
   posix_spawn_file_actions_t actions;
@@ -89,9 +97,15 @@ Outcome run_process(const std::string& exe, const std::vector<std::string>& args
   std::vector<char*> argv;
   for (std::string& a : argv_storage) argv.push_back(a.data());
   argv.push_back(nullptr);
+  std::vector<std::string> env_storage;
+  for (char** e = environ; *e != nullptr; ++e) env_storage.emplace_back(*e);
+  env_storage.insert(env_storage.end(), extra_env.begin(), extra_env.end());
+  std::vector<char*> envp;
+  for (std::string& e : env_storage) envp.push_back(e.data());
+  envp.push_back(nullptr);
 
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw std::runtime_error("posix_spawn " + exe + ": " + std::strerror(rc));
 

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -15,16 +16,20 @@ struct Outcome {
   std::string out, err;    // everything written to stdout and stderr
   std::vector<std::string> err_lines() const;
 };
+// "exit N signal S", then stdout and stderr: for test failure messages.
+std::ostream& operator<<(std::ostream& os, const Outcome& o);
 
-// Runs `exe args...` with stdout and stderr captured; kills it after `timeout`.
+// Runs `exe args...` with stdout and stderr captured; kills it after `timeout`. `extra_env`
+// ("NAME=value") is added to this process's environment for the child.
 Outcome run_process(const std::string& exe, const std::vector<std::string>& args,
-                    std::chrono::milliseconds timeout = std::chrono::seconds(60));
+                    std::chrono::milliseconds timeout = std::chrono::seconds(60),
+                    const std::vector<std::string>& extra_env = {});
 
 // Runs the rbsim binary under test.
 Outcome rbsim(const std::vector<std::string>& args, std::chrono::milliseconds timeout = std::chrono::seconds(60));
 
 std::string read_text(const std::filesystem::path& path);
-void write_text(const std::filesystem::path& path, const std::string& text);
+void write_text(const std::filesystem::path& path, const std::string& text);  // creates its folder
 std::vector<std::string> lines_of(const std::string& text);  // without the newlines
 std::vector<std::string> split(const std::string& line, char sep);
 
