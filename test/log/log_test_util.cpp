@@ -87,7 +87,7 @@ std::vector<RawRecord> top_level_records(const mcap::Bytes& file) {
   return out;
 }
 
-const RawRecord& find_record(const std::vector<RawRecord>& records, mcap::Opcode opcode, std::size_t nth) {
+RawRecord find_record(const std::vector<RawRecord>& records, mcap::Opcode opcode, std::size_t nth) {
   for (const RawRecord& r : records) {
     if (r.opcode == static_cast<std::uint8_t>(opcode) && nth-- == 0) return r;
   }

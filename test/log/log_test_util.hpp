@@ -36,7 +36,8 @@ struct RawRecord {
 };
 // Top-level records of a well-formed file, magic to Footer.
 std::vector<RawRecord> top_level_records(const mcap::Bytes& file);
-const RawRecord& find_record(const std::vector<RawRecord>& records, mcap::Opcode opcode, std::size_t nth = 0);
+// By value: callers pass top_level_records(...) straight in, a temporary.
+RawRecord find_record(const std::vector<RawRecord>& records, mcap::Opcode opcode, std::size_t nth = 0);
 
 // Replaces the record at `at` with `record` (its serialisation must have the same length).
 void overwrite_record(mcap::Bytes& file, const RawRecord& at, const mcap::Record& record);

@@ -14,6 +14,13 @@
 
 #include "rbsim/render.hpp"
 
+#if defined(__SANITIZE_ADDRESS__)
+// Cairo's text goes through fontconfig, which keeps its parsed configuration for the life of the
+// process on purpose (no API frees it while Cairo may still use it). LeakSanitizer reads this
+// function in any process that draws, so only that library's allocations are excused.
+extern "C" const char* __lsan_default_suppressions() { return "leak:libfontconfig.so\n"; }
+#endif
+
 namespace rbsim::render {
 
 namespace {
