@@ -200,7 +200,8 @@ void register_all() {
   }
 #ifdef RBSIM_BENCH_BOX2D
   for (bool wind : {false, true}) {
-    auto* b = benchmark::RegisterBenchmark(wind ? "BM_Box2D/wind_springs" : "BM_Box2D/gravity", bm_box2d, wind);
+    auto* b =
+        benchmark::RegisterBenchmark(wind ? "BM_Box2D/wind_springs" : "BM_Box2D/gravity", bm_box2d, wind);
     for (std::int64_t n : kSizes) b->Arg(n);
     b->Unit(benchmark::kMicrosecond);
   }

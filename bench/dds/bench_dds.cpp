@@ -30,7 +30,8 @@ rbsim::msgs::Bytes body_states(int bodies) {
   return out;
 }
 
-bool wait_take(rbsim::node::Subscription& sub, dds_entity_t waitset, rbsim::node::Received& got, double seconds) {
+bool wait_take(rbsim::node::Subscription& sub, dds_entity_t waitset, rbsim::node::Received& got,
+               double seconds) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
   while (Clock::now() < deadline) {
     if (sub.take(got)) return true;
@@ -61,8 +62,10 @@ int main(int argc, char** argv) {
   const auto& spec = rbsim::msgs::topic(rbsim::msgs::TopicId::BodyStates);
   rbsim::node::QosSpec qos;
   qos.depth = 1;
-  auto pub = rbsim::node::Publisher::create(participant.value(), spec, ping ? "/bench/ping" : "/bench/pong", qos);
-  auto sub = rbsim::node::Subscription::create(participant.value(), spec, ping ? "/bench/pong" : "/bench/ping", qos);
+  auto pub =
+      rbsim::node::Publisher::create(participant.value(), spec, ping ? "/bench/ping" : "/bench/pong", qos);
+  auto sub =
+      rbsim::node::Subscription::create(participant.value(), spec, ping ? "/bench/pong" : "/bench/ping", qos);
   if (!pub || !sub) return std::fprintf(stderr, "cannot create endpoints\n"), 1;
   const dds_entity_t waitset = dds_create_waitset(participant->handle());
   const dds_entity_t cond = dds_create_readcondition(sub->reader(), DDS_ANY_STATE);
@@ -104,7 +107,9 @@ int main(int argc, char** argv) {
     if (i >= warmup) half_rtt_us.push_back(us);
   }
   std::sort(half_rtt_us.begin(), half_rtt_us.end());
-  const auto pct = [&](double p) { return half_rtt_us[static_cast<std::size_t>(p * static_cast<double>(half_rtt_us.size() - 1))]; };
+  const auto pct = [&](double p) {
+    return half_rtt_us[static_cast<std::size_t>(p * static_cast<double>(half_rtt_us.size() - 1))];
+  };
   std::printf("rbsim ping: %zu samples of %zu bytes, latency (half round trip) median %.1f us, p99 %.1f us\n",
               half_rtt_us.size(), sample.size(), pct(0.5), pct(0.99));
   return 0;

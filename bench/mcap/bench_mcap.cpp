@@ -51,7 +51,7 @@ namespace {
 using namespace rbsim;
 
 constexpr std::int64_t kSizes[] = {100, 10'000};
-constexpr std::size_t kFileBytes = 8u << 20;  // uncompressed message bytes per file
+constexpr std::size_t kFileBytes = 8u << 20;   // uncompressed message bytes per file
 constexpr std::size_t kChunkBytes = 1u << 20;  // the recorder's chunk size (log::RecordOptions)
 constexpr std::int32_t kRecordBodies = 1000;
 
@@ -61,7 +61,9 @@ std::string temp_path(const std::string& tag) {
          std::to_string(::getpid()) + "_" + tag + ".mcap";
 }
 
-mcap::ByteView view(const msgs::Bytes& b) { return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()}; }
+mcap::ByteView view(const msgs::Bytes& b) {
+  return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
+}
 
 // A Scene around builders::grid (the encoders need its colours).
 Scene grid_scene(std::int32_t n, bool wind_and_springs) {
@@ -121,7 +123,8 @@ struct Codec {
 };
 
 std::uint64_t write_file(benchmark::State& state, const std::string& path, const Codec& codec,
-                         const Snapshots& snaps, const msgs::Encoder& encoder, std::size_t count, msgs::Bytes& buf) {
+                         const Snapshots& snaps, const msgs::Encoder& encoder, std::size_t count,
+                         msgs::Bytes& buf) {
   mcap::Writer writer;
   mcap::WriterOptions options = log::writer_options(codec.compression);
   options.compression_level = codec.level;
@@ -138,7 +141,8 @@ std::uint64_t write_file(benchmark::State& state, const std::string& path, const
   for (std::size_t i = 0; i < count; ++i) {
     encoder.body_states(snaps.worlds[i % snaps.worlds.size()], buf);
     const mcap::Timestamp t = static_cast<mcap::Timestamp>(i) * 1'000'000;
-    if (auto st = writer.write_message(channel.value(), static_cast<std::uint32_t>(i), t, t, view(buf)); !st.ok()) {
+    if (auto st = writer.write_message(channel.value(), static_cast<std::uint32_t>(i), t, t, view(buf));
+        !st.ok()) {
       state.SkipWithError(st.message.c_str());
       return 0;
     }
@@ -196,7 +200,8 @@ void bm_write(benchmark::State& state, Codec codec) {
   std::filesystem::remove(path, ec);
   set_throughput(state, bytes, count);
   state.counters["messages_per_file"] = static_cast<double>(count);
-  state.counters["file_per_raw"] = bytes > 0 ? static_cast<double>(file_size) / static_cast<double>(bytes) : 0.0;
+  state.counters["file_per_raw"] =
+      bytes > 0 ? static_cast<double>(file_size) / static_cast<double>(bytes) : 0.0;
 }
 
 enum class Decode { None, Generic, Typed };
@@ -206,7 +211,9 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
   const Snapshots& snaps = snapshots(static_cast<std::int32_t>(state.range(0)));
   const msgs::Encoder encoder(snaps.scene);
   const std::size_t count = messages_per_file(body_states_size(snaps));
-  const std::string path = temp_path(mode == Decode::None ? "read" : mode == Decode::Generic ? "read_decode" : "read_typed");
+  const std::string path = temp_path(mode == Decode::None      ? "read"
+                                     : mode == Decode::Generic ? "read_decode"
+                                                               : "read_typed");
   msgs::Bytes buf;
   const std::uint64_t bytes = write_file(state, path, codec, snaps, encoder, count, buf);
   if (bytes == 0) return;
@@ -254,7 +261,8 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
     });
     if (!st.ok()) error = st.message;
     if (!error.empty() || seen_messages != count || seen_bytes != bytes) {
-      if (error.empty()) error = "read " + std::to_string(seen_messages) + " messages, wrote " + std::to_string(count);
+      if (error.empty())
+        error = "read " + std::to_string(seen_messages) + " messages, wrote " + std::to_string(count);
       state.SkipWithError(error.c_str());
       break;
     }
@@ -336,13 +344,16 @@ void bm_record(benchmark::State& state, const RecordVariant& v) {
 
 void register_all() {
   for (std::int64_t n : kSizes) benchmark::RegisterBenchmark("BM_Encode", bm_encode)->Arg(n);
-  const Codec codecs[] = {{"none", mcap::Compression::None, 0}, {"lz4", mcap::Compression::Lz4, 0},
+  const Codec codecs[] = {{"none", mcap::Compression::None, 0},
+                          {"lz4", mcap::Compression::Lz4, 0},
                           {"zstd", mcap::Compression::Zstd, 0}};
   for (const Codec& c : codecs) {
     const std::string codec = c.name;
     for (std::int64_t n : kSizes) {
-      benchmark::RegisterBenchmark(("BM_Write/" + codec).c_str(), bm_write, c)->Arg(n)->UseRealTime()->Unit(
-          benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("BM_Write/" + codec).c_str(), bm_write, c)
+          ->Arg(n)
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
       benchmark::RegisterBenchmark(("BM_Read/" + codec).c_str(), bm_read, c, Decode::None)
           ->Arg(n)
           ->UseRealTime()
@@ -358,7 +369,8 @@ void register_all() {
     }
   }
   // Other zstd levels (rbsim records with the default, 3): what a cheaper level would buy.
-  const Codec levels[] = {{"zstd_level1", mcap::Compression::Zstd, 1}, {"zstd_level-3", mcap::Compression::Zstd, -3}};
+  const Codec levels[] = {{"zstd_level1", mcap::Compression::Zstd, 1},
+                          {"zstd_level-3", mcap::Compression::Zstd, -3}};
   for (const Codec& c : levels) {
     benchmark::RegisterBenchmark((std::string("BM_Write/") + c.name).c_str(), bm_write, c)
         ->Arg(10'000)
@@ -374,8 +386,11 @@ void register_all() {
       {"all_none", true, mcap::Compression::None, all, 1},
       {"body_states", true, mcap::Compression::Zstd, {T::BodyStates}, 1},
       {"markers", true, mcap::Compression::Zstd, {T::Markers}, 1},
-      {"all_but_markers", true, mcap::Compression::Zstd,
-       {T::Scene, T::BodyStates, T::SpringStates, T::Energy, T::Poses, T::Clock}, 1},
+      {"all_but_markers",
+       true,
+       mcap::Compression::Zstd,
+       {T::Scene, T::BodyStates, T::SpringStates, T::Energy, T::Poses, T::Clock},
+       1},
       {"every10", true, mcap::Compression::Zstd, all, 10},
       {"every100", true, mcap::Compression::Zstd, all, 100},
       {"body_states_every10", true, mcap::Compression::Zstd, {T::BodyStates}, 10},

@@ -41,7 +41,8 @@ void BM_Draw(benchmark::State& state) {
     canvas.draw(f.stage, f.poses, 1.0, f.camera);
     benchmark::DoNotOptimize(canvas.pixel(640, 360));
   }
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Draw)->Unit(benchmark::kMillisecond);
 
@@ -49,13 +50,15 @@ void BM_DrawAndWritePng(benchmark::State& state) {
   Fixture f = Fixture::make();
   rbsim::render::Canvas canvas(1280, 720);
   const std::string path =
-      (std::filesystem::temp_directory_path() / ("rbsim_bench_frame_" + std::to_string(::getpid()) + ".png")).string();
+      (std::filesystem::temp_directory_path() / ("rbsim_bench_frame_" + std::to_string(::getpid()) + ".png"))
+          .string();
   for (auto _ : state) {
     canvas.draw(f.stage, f.poses, 1.0, f.camera);
     if (!canvas.write_png(path).ok()) state.SkipWithError("PNG write failed");
   }
   std::filesystem::remove(path);
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_DrawAndWritePng)->Unit(benchmark::kMillisecond);
 

@@ -14,7 +14,9 @@
 namespace rbsim::node {
 
 namespace {
-Error dds_error(const std::string& what, dds_return_t rc) { return Error{what + ": " + dds_strretcode(rc)}; }
+Error dds_error(const std::string& what, dds_return_t rc) {
+  return Error{what + ": " + dds_strretcode(rc)};
+}
 
 dds_qos_t* make_qos(const QosSpec& q, bool reader) {
   dds_qos_t* qos = dds_create_qos();
@@ -33,7 +35,8 @@ dds_qos_t* make_qos(const QosSpec& q, bool reader) {
   return qos;
 }
 
-Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec& spec, std::string_view ros_topic) {
+Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec& spec,
+                                std::string_view ros_topic) {
   const dds_topic_descriptor_t* desc = descriptor(spec.id);
   const std::string name = msgs::dds_topic_name(ros_topic);
   const dds_entity_t topic = dds_create_topic(participant, desc, name.c_str(), nullptr, nullptr);
@@ -42,11 +45,14 @@ Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec&
 }
 }  // namespace
 
-std::string_view loopback_config() { return kLoopbackConfig; }
+std::string_view loopback_config() {
+  return kLoopbackConfig;
+}
 
 Result<Participant> Participant::create(std::uint32_t domain) {
   if (domain > kMaxDomainId) {
-    return Error{"domain id " + std::to_string(domain) + " out of range [0, " + std::to_string(kMaxDomainId) + "]"};
+    return Error{"domain id " + std::to_string(domain) + " out of range [0, " + std::to_string(kMaxDomainId) +
+                 "]"};
   }
   const char* uri = std::getenv("CYCLONEDDS_URI");
   if (uri == nullptr || *uri == '\0') {
@@ -58,13 +64,16 @@ Result<Participant> Participant::create(std::uint32_t domain) {
   }
   const dds_entity_t p = dds_create_participant(domain, nullptr, nullptr);
   if (p < 0) {
-    std::string hint = uri != nullptr && *uri != '\0' ? std::string(" (check CYCLONEDDS_URI=") + uri + ")" : "";
+    std::string hint =
+        uri != nullptr && *uri != '\0' ? std::string(" (check CYCLONEDDS_URI=") + uri + ")" : "";
     return dds_error("cannot create a DDS participant on domain " + std::to_string(domain) + hint, p);
   }
   return Participant(p, domain);
 }
 
-Participant::Participant(Participant&& o) noexcept : handle_(o.handle_), domain_(o.domain_) { o.handle_ = 0; }
+Participant::Participant(Participant&& o) noexcept : handle_(o.handle_), domain_(o.domain_) {
+  o.handle_ = 0;
+}
 Participant::~Participant() {
   if (handle_ > 0) dds_delete(handle_);
 }
@@ -93,7 +102,8 @@ Result<Publisher> Publisher::create(const Participant& participant, const msgs::
   return p;
 }
 
-Publisher::Publisher(Publisher&& o) noexcept : writer_(o.writer_), topic_(o.topic_), ros_topic_(std::move(o.ros_topic_)) {
+Publisher::Publisher(Publisher&& o) noexcept
+    : writer_(o.writer_), topic_(o.topic_), ros_topic_(std::move(o.ros_topic_)) {
   o.writer_ = o.topic_ = 0;
 }
 Publisher::~Publisher() {
@@ -110,7 +120,8 @@ Status Publisher::publish(std::span<const std::byte> cdr) {
 
 Status Publisher::flush(double timeout_s) {
   const dds_return_t rc = dds_wait_for_acks(writer_, static_cast<dds_duration_t>(timeout_s * 1e9));
-  if (rc < 0) return dds_error("subscribers of " + ros_topic_ + " did not acknowledge everything in time", rc);
+  if (rc < 0)
+    return dds_error("subscribers of " + ros_topic_ + " did not acknowledge everything in time", rc);
   return Ok{};
 }
 
@@ -129,7 +140,8 @@ Result<Subscription> Subscription::create(const Participant& participant, const 
   const dds_entity_t reader = dds_create_reader(participant.handle(), topic.value(), qos, nullptr);
   dds_delete_qos(qos);
   if (reader < 0) return dds_error("cannot create DDS reader for " + std::string(ros_topic), reader);
-  dds_set_status_mask(reader, DDS_DATA_AVAILABLE_STATUS | DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS);
+  dds_set_status_mask(reader,
+                      DDS_DATA_AVAILABLE_STATUS | DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS);
   Subscription s;
   s.reader_ = reader;
   s.topic_ = topic.value();

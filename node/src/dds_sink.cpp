@@ -14,7 +14,8 @@ std::int64_t monotonic_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 void sleep_until(std::int64_t deadline_ns) {
-  timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000),
+              static_cast<long>(deadline_ns % 1'000'000'000)};
   // Interrupted by a signal (Ctrl-C): return early and let the caller look at its stop flag.
   (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
 }
@@ -26,7 +27,8 @@ Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant,
   if (sink->options_.publish_every < 1) sink->options_.publish_every = 1;
   sink->publishers_.resize(msgs::kTopicCount);
   for (const msgs::TopicSpec& spec : msgs::topics()) {
-    auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns), qos_for(spec, options.keep_last));
+    auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns),
+                                 qos_for(spec, options.keep_last));
     if (!pub) return pub.error();
     sink->publishers_[static_cast<std::size_t>(spec.id)].emplace(std::move(pub.value()));
   }
@@ -48,7 +50,9 @@ Status DdsSink::begin(const Scene& scene, const World& world) {
   return write(world);
 }
 
-void DdsSink::restart_clock() { start_ns_ = monotonic_ns(); }
+void DdsSink::restart_clock() {
+  start_ns_ = monotonic_ns();
+}
 
 Status DdsSink::write(const World& world) {
   if (world.step_index() % options_.publish_every != 0) return Ok{};

@@ -15,7 +15,9 @@ struct RawSerdata {
   std::uint32_t size;
   unsigned char* bytes;  // size rounded up to 4, zero padded
 };
-const RawSerdata& raw(const ddsi_serdata* d) { return *reinterpret_cast<const RawSerdata*>(d); }
+const RawSerdata& raw(const ddsi_serdata* d) {
+  return *reinterpret_cast<const RawSerdata*>(d);
+}
 
 ddsi_serdata* from_ser_iov(const ddsi_sertype* type, ddsi_serdata_kind kind, ddsrt_msg_iovlen_t niov,
                            const ddsrt_iovec_t* iov, std::size_t size) {
@@ -31,28 +33,44 @@ ddsi_serdata* from_ser_iov(const ddsi_sertype* type, ddsi_serdata_kind kind, dds
   }
   return &d->c;
 }
-std::uint32_t get_size(const ddsi_serdata* d) { return raw(d).size; }
-void to_ser(const ddsi_serdata* d, std::size_t off, std::size_t sz, void* buf) { std::memcpy(buf, raw(d).bytes + off, sz); }
+std::uint32_t get_size(const ddsi_serdata* d) {
+  return raw(d).size;
+}
+void to_ser(const ddsi_serdata* d, std::size_t off, std::size_t sz, void* buf) {
+  std::memcpy(buf, raw(d).bytes + off, sz);
+}
 ddsi_serdata* to_ser_ref(const ddsi_serdata* d, std::size_t off, std::size_t sz, ddsrt_iovec_t* ref) {
   ref->iov_base = raw(d).bytes + off;
   ref->iov_len = sz;
   return ddsi_serdata_ref(d);
 }
-void to_ser_unref(ddsi_serdata* d, const ddsrt_iovec_t*) { ddsi_serdata_unref(d); }
+void to_ser_unref(ddsi_serdata* d, const ddsrt_iovec_t*) {
+  ddsi_serdata_unref(d);
+}
 void free_serdata(ddsi_serdata* d) {
   auto* r = reinterpret_cast<RawSerdata*>(d);
   delete[] r->bytes;
   delete r;
 }
-bool eqkey(const ddsi_serdata*, const ddsi_serdata*) { return true; }  // keyless topics
-bool to_sample(const ddsi_serdata*, void*, void**, void*) { return false; }
-ddsi_serdata* to_untyped(const ddsi_serdata* d) { return ddsi_serdata_ref(d); }
-bool untyped_to_sample(const ddsi_sertype*, const ddsi_serdata*, void*, void**, void*) { return false; }
+bool eqkey(const ddsi_serdata*, const ddsi_serdata*) {
+  return true;
+}  // keyless topics
+bool to_sample(const ddsi_serdata*, void*, void**, void*) {
+  return false;
+}
+ddsi_serdata* to_untyped(const ddsi_serdata* d) {
+  return ddsi_serdata_ref(d);
+}
+bool untyped_to_sample(const ddsi_sertype*, const ddsi_serdata*, void*, void**, void*) {
+  return false;
+}
 std::size_t print(const ddsi_sertype*, const ddsi_serdata*, char* buf, std::size_t size) {
   if (size > 0) buf[0] = 0;
   return 0;
 }
-void get_keyhash(const ddsi_serdata*, ddsi_keyhash* buf, bool) { std::memset(buf, 0, sizeof *buf); }
+void get_keyhash(const ddsi_serdata*, ddsi_keyhash* buf, bool) {
+  std::memset(buf, 0, sizeof *buf);
+}
 
 const ddsi_serdata_ops kSerdataOps = [] {
   ddsi_serdata_ops ops{};
@@ -73,10 +91,16 @@ const ddsi_serdata_ops kSerdataOps = [] {
 
 void sertype_free(ddsi_sertype*) {}
 void zero_samples(const ddsi_sertype*, void*, std::size_t) {}
-void realloc_samples(void** ptrs, const ddsi_sertype*, void*, std::size_t, std::size_t) { *ptrs = nullptr; }
+void realloc_samples(void** ptrs, const ddsi_sertype*, void*, std::size_t, std::size_t) {
+  *ptrs = nullptr;
+}
 void free_samples(const ddsi_sertype*, void**, std::size_t, dds_free_op_t) {}
-bool sertype_equal(const ddsi_sertype*, const ddsi_sertype*) { return true; }
-std::uint32_t sertype_hash(const ddsi_sertype*) { return 0; }
+bool sertype_equal(const ddsi_sertype*, const ddsi_sertype*) {
+  return true;
+}
+std::uint32_t sertype_hash(const ddsi_sertype*) {
+  return 0;
+}
 
 const ddsi_sertype_ops kSertypeOps = [] {
   ddsi_sertype_ops ops{};

@@ -13,10 +13,13 @@ namespace rbsim::node {
 
 namespace {
 std::uint64_t wall_ns() {
-  return static_cast<std::uint64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
 }
-mcap::ByteView view(const std::vector<std::byte>& b) { return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()}; }
+mcap::ByteView view(const std::vector<std::byte>& b) {
+  return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
+}
 
 // The simulated time a per-step message carries, in ns: the first builtin_interfaces/Time in it
 // (the header stamp; the clock of a Clock; the first marker's stamp in a MarkerArray, after the
@@ -68,7 +71,8 @@ std::uint64_t Recorder::Gaps::lost(double dt) const {
   return expected > static_cast<std::int64_t>(count) ? static_cast<std::uint64_t>(expected) - count : 0;
 }
 
-Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participant, const RecorderOptions& options) {
+Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participant,
+                                                   const RecorderOptions& options) {
   std::unique_ptr<Recorder> r(new Recorder());
   r->options_ = options;
   std::vector<const msgs::TopicSpec*> wanted;
@@ -79,7 +83,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
       const msgs::TopicSpec* spec = find_topic(name, options.ns);
       if (spec == nullptr) {
         std::string known;
-        for (const msgs::TopicSpec& s : msgs::topics()) known += (known.empty() ? "" : ", ") + msgs::topic_name(s, options.ns);
+        for (const msgs::TopicSpec& s : msgs::topics())
+          known += (known.empty() ? "" : ", ") + msgs::topic_name(s, options.ns);
         return Error{"unknown topic \"" + name + "\" (rbsim topics: " + known + ")"};
       }
       wanted.push_back(spec);
@@ -89,7 +94,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   // every other reader exists by the time the node starts publishing.
   std::stable_partition(wanted.begin(), wanted.end(),
                         [](const msgs::TopicSpec* s) { return s->id != msgs::TopicId::BodyStates; });
-  if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size)); !st.ok()) {
+  if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size));
+      !st.ok()) {
     return Error{options.path + ": " + st.message};
   }
   r->waitset_ = dds_create_waitset(participant.handle());
@@ -119,7 +125,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
     while (t.subscription.take(sample)) {
       any = true;
       const std::uint64_t now = wall_ns();
-      const std::uint64_t source = sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : now;
+      const std::uint64_t source =
+          sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : now;
       if (auto st = writer_.write_message(t.channel, t.received, now, source, view(sample.cdr)); !st.ok()) {
         return Error{options_.path + ": " + st.message};
       }
@@ -127,7 +134,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       ++received_;
       const msgs::TopicId id = t.subscription.spec().id;
       if (id == msgs::TopicId::Scene) {
-        if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
+        if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0)
+          dt_ = scene.value().dt;
       } else if (auto stamp = stamp_ns(sample.cdr, id)) {
         t.gaps.add(*stamp, dt_);
       }
@@ -140,7 +148,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
 std::vector<Recorder::TopicCount> Recorder::counts() const {
   std::vector<TopicCount> out;
   for (const Topic& t : topics_) {
-    out.push_back({t.subscription.ros_topic(), t.received, t.subscription.lost() + t.gaps.lost_before + t.gaps.lost(dt_)});
+    out.push_back({t.subscription.ros_topic(), t.received,
+                   t.subscription.lost() + t.gaps.lost_before + t.gaps.lost(dt_)});
   }
   return out;
 }

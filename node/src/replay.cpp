@@ -36,7 +36,8 @@ bool sleep_until(std::int64_t deadline_ns, bool (*stop)()) {
 // "pkg/Name" -> "pkg/msg/Name" (rosbag2 writes the long form; older tools the short one).
 std::string canonical_type(std::string_view type) {
   const auto a = type.find('/');
-  if (a == std::string_view::npos || type.find('/', a + 1) != std::string_view::npos) return std::string(type);
+  if (a == std::string_view::npos || type.find('/', a + 1) != std::string_view::npos)
+    return std::string(type);
   return std::string(type.substr(0, a)) + "/msg/" + std::string(type.substr(a + 1));
 }
 
@@ -53,7 +54,9 @@ std::string last_component(std::string_view topic) {
   return std::string(slash == std::string_view::npos ? topic : topic.substr(slash + 1));
 }
 
-std::span<const std::byte> bytes(const mcap::Bytes& b) { return std::as_bytes(std::span(b.data(), b.size())); }
+std::span<const std::byte> bytes(const mcap::Bytes& b) {
+  return std::as_bytes(std::span(b.data(), b.size()));
+}
 
 // rosgraph_msgs/msg/Clock in CDR: encapsulation header (CDR_LE), int32 sec, uint32 nanosec.
 std::array<std::byte, 12> clock_cdr(std::uint64_t t_ns) {
@@ -88,7 +91,8 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   const std::string& path = options.path;
   if (auto st = im.reader.open(path); !st.ok()) {
     std::string hint;
-    if (st.code == mcap::StatusCode::Truncated) hint = " (an unfinished recording: 'rbsim log recover' repairs it)";
+    if (st.code == mcap::StatusCode::Truncated)
+      hint = " (an unfinished recording: 'rbsim log recover' repairs it)";
     return Error{"cannot read " + path + ": " + st.message + hint};
   }
 
@@ -104,13 +108,14 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     const msgs::TopicSpec* spec = spec_for_type(schema_it->second.name);
     if (spec == nullptr) continue;
     if (channel.message_encoding != "cdr") {
-      r->warnings_.push_back("skipping " + channel.topic + ": message encoding \"" + channel.message_encoding +
-                             "\", not cdr");
+      r->warnings_.push_back("skipping " + channel.topic + ": message encoding \"" +
+                             channel.message_encoding + "\", not cdr");
       continue;
     }
     Result<std::string> ours = msgs::ros2msg_schema(spec->type);
     const mcap::Bytes& theirs = schema_it->second.data;
-    if (!ours || std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) != ours.value()) {
+    if (!ours ||
+        std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) != ours.value()) {
       r->warnings_.push_back("skipping " + channel.topic + ": its " + std::string(spec->type) +
                              " definition differs from this build's");
       continue;
@@ -131,7 +136,8 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
       for (const Candidate& c : candidates) {
         if (name == c.channel->topic || name == last_component(c.channel->topic) || name == c.spec->suffix) {
           found = true;
-          if (std::none_of(chosen.begin(), chosen.end(), [&](const Candidate& x) { return x.channel == c.channel; })) {
+          if (std::none_of(chosen.begin(), chosen.end(),
+                           [&](const Candidate& x) { return x.channel == c.channel; })) {
             chosen.push_back(c);
           }
         }
@@ -142,12 +148,14 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
         return Error{"unknown topic \"" + name + "\": " + path + " has " + known};
       }
     }
-    std::sort(chosen.begin(), chosen.end(), [](const Candidate& a, const Candidate& b) { return a.channel->id < b.channel->id; });
+    std::sort(chosen.begin(), chosen.end(),
+              [](const Candidate& a, const Candidate& b) { return a.channel->id < b.channel->id; });
     candidates = std::move(chosen);
   }
   if (options.clock) {
     std::erase_if(candidates, [](const Candidate& c) { return c.spec->id == msgs::TopicId::Clock; });
-    if (candidates.empty()) return Error{"nothing to replay: --topics selects only /clock, which --clock replaces"};
+    if (candidates.empty())
+      return Error{"nothing to replay: --topics selects only /clock, which --clock replaces"};
   }
 
   // One publisher per published topic name (channels that map onto the same name share it).
@@ -155,8 +163,8 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   auto publisher_for = [&](const msgs::TopicSpec& spec, const std::string& topic) -> Result<std::size_t> {
     if (auto it = by_topic.find(topic); it != by_topic.end()) {
       if (it->second.second != &spec) {
-        return Error{"cannot publish " + std::string(spec.type) + " and " + std::string(it->second.second->type) +
-                     " on the same topic " + topic};
+        return Error{"cannot publish " + std::string(spec.type) + " and " +
+                     std::string(it->second.second->type) + " on the same topic " + topic};
       }
       return it->second.first;
     }
@@ -178,7 +186,8 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     im.topics.push_back(c.channel->topic);
     std::uint64_t count = 0;
     if (stats) {
-      if (auto it = stats->channel_message_counts.find(c.channel->id); it != stats->channel_message_counts.end()) {
+      if (auto it = stats->channel_message_counts.find(c.channel->id);
+          it != stats->channel_message_counts.end()) {
         count = it->second;
       }
     }
@@ -206,7 +215,8 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
   if (!any) return Error{path + ": the log has rbsim topics but no messages on them"};
   r->last_log_time_ = r->first_log_time_;
-  for (const mcap::ChunkIndex& ci : im.reader.chunk_indexes()) r->last_log_time_ = std::max(r->last_log_time_, ci.message_end_time);
+  for (const mcap::ChunkIndex& ci : im.reader.chunk_indexes())
+    r->last_log_time_ = std::max(r->last_log_time_, ci.message_end_time);
   if (stats) r->last_log_time_ = std::max(r->last_log_time_, stats->message_end_time);
   return r;
 }

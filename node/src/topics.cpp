@@ -11,13 +11,20 @@
 namespace rbsim::node {
 const dds_topic_descriptor_t* descriptor(msgs::TopicId id) {
   switch (id) {
-    case msgs::TopicId::Scene: return &rbsim_msgs_msg_dds__SceneDescription__desc;
-    case msgs::TopicId::BodyStates: return &rbsim_msgs_msg_dds__BodyStates__desc;
-    case msgs::TopicId::SpringStates: return &rbsim_msgs_msg_dds__SpringStates__desc;
-    case msgs::TopicId::Energy: return &rbsim_msgs_msg_dds__EnergyTerms__desc;
-    case msgs::TopicId::Poses: return &geometry_msgs_msg_dds__PoseArray__desc;
-    case msgs::TopicId::Markers: return &visualization_msgs_msg_dds__MarkerArray__desc;
-    case msgs::TopicId::Clock: return &rosgraph_msgs_msg_dds__Clock__desc;
+    case msgs::TopicId::Scene:
+      return &rbsim_msgs_msg_dds__SceneDescription__desc;
+    case msgs::TopicId::BodyStates:
+      return &rbsim_msgs_msg_dds__BodyStates__desc;
+    case msgs::TopicId::SpringStates:
+      return &rbsim_msgs_msg_dds__SpringStates__desc;
+    case msgs::TopicId::Energy:
+      return &rbsim_msgs_msg_dds__EnergyTerms__desc;
+    case msgs::TopicId::Poses:
+      return &geometry_msgs_msg_dds__PoseArray__desc;
+    case msgs::TopicId::Markers:
+      return &visualization_msgs_msg_dds__MarkerArray__desc;
+    case msgs::TopicId::Clock:
+      return &rosgraph_msgs_msg_dds__Clock__desc;
   }
   return nullptr;
 }

@@ -22,8 +22,12 @@
 namespace rbsim {
 
 namespace {
-double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-Vec2 perp(const Vec2& a) { return {-a.y(), a.x()}; }  // J a
+double cross(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+Vec2 perp(const Vec2& a) {
+  return {-a.y(), a.x()};
+}  // J a
 }  // namespace
 
 detail::WindMoments compute_wind_moments(std::span<const Vec2> hull, int points_per_edge) {

@@ -11,17 +11,23 @@ namespace rbsim {
 
 const char* to_string(Integrator integrator) {
   switch (integrator) {
-    case Integrator::ExplicitEuler: return "explicit-euler";
-    case Integrator::SymplecticEuler: return "symplectic-euler";
+    case Integrator::ExplicitEuler:
+      return "explicit-euler";
+    case Integrator::SymplecticEuler:
+      return "symplectic-euler";
   }
   return "?";
 }
 
 namespace {
 
-Error invalid(const std::string& what) { return Error{"invalid world: " + what}; }
+Error invalid(const std::string& what) {
+  return Error{"invalid world: " + what};
+}
 
-bool finite(const Vec2& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
+bool finite(const Vec2& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y());
+}
 
 // Hash of the exact bits of a body-space hull, so bit-identical hulls share one Shape.
 struct HullKey {
@@ -42,7 +48,8 @@ Status validate(const WorldDef& def) {
     if (body.masses.size() != body.hull.size()) return invalid(who + "one mass per hull vertex");
     for (std::size_t v = 0; v < body.hull.size(); ++v) {
       if (!finite(body.hull[v])) return invalid(who + "vertex position not finite");
-      if (!(std::isfinite(body.masses[v]) && body.masses[v] > 0)) return invalid(who + "vertex mass must be > 0");
+      if (!(std::isfinite(body.masses[v]) && body.masses[v] > 0))
+        return invalid(who + "vertex mass must be > 0");
     }
     if (!finite(body.velocity) || !std::isfinite(body.omega)) return invalid(who + "velocity not finite");
     if (!(std::isfinite(body.radius) && body.radius > 0)) return invalid(who + "radius must be > 0");

@@ -23,7 +23,8 @@ std::string describe(const test::Outcome& o) {
 }
 
 // Copies `scene` into `dir` with the first `from` replaced by `to`.
-std::string perturbed(const TempDir& dir, const std::string& scene, const std::string& from, const std::string& to) {
+std::string perturbed(const TempDir& dir, const std::string& scene, const std::string& from,
+                      const std::string& to) {
   std::string text = read_text(scene);
   const auto at = text.find(from);
   if (at == std::string::npos) throw std::runtime_error(from + " not in " + scene);
@@ -36,7 +37,8 @@ std::string perturbed(const TempDir& dir, const std::string& scene, const std::s
 // A reference written by rbsim itself (--fosssim-out) grades as PASS with zero differences.
 TEST(RbsimGrade, PassesAgainstItsOwnFosssimOutput) {
   TempDir dir;
-  for (const char* name : {"/springtests/test02sym.xml", "/windtests/test03ee.xml", "/gravitytests/test01sym.xml"}) {
+  for (const char* name :
+       {"/springtests/test02sym.xml", "/windtests/test03ee.xml", "/gravitytests/test01sym.xml"}) {
     const std::string scene = kScenes + name, ref = (dir / "ref.bin").string();
     const test::Outcome run = rbsim({"run", scene, "-q", "--fosssim-out", ref});
     ASSERT_EQ(run.exit_code, 0) << describe(run);
@@ -102,7 +104,8 @@ class RbsimGradeFosssim : public ::testing::TestWithParam<const char*> {};
 TEST_P(RbsimGradeFosssim, PassesAndFailsWhenPerturbed) {
   const std::string name = GetParam();
   const std::string ref = kReference + "/" + name + ".bin.zst";
-  if (!fs::exists(ref)) GTEST_SKIP() << "no FOSSSim reference at " << ref << " (set RBSIM_FOSSSIM_REFERENCE_DIR)";
+  if (!fs::exists(ref))
+    GTEST_SKIP() << "no FOSSSim reference at " << ref << " (set RBSIM_FOSSSIM_REFERENCE_DIR)";
   const std::string scene = kScenes + "/" + name + ".xml";
   const test::Outcome g = rbsim({"grade", scene, ref}, std::chrono::seconds(120));
   EXPECT_EQ(g.exit_code, 0) << describe(g);
@@ -116,8 +119,8 @@ TEST_P(RbsimGradeFosssim, PassesAndFailsWhenPerturbed) {
 }
 
 INSTANTIATE_TEST_SUITE_P(PublicScenes, RbsimGradeFosssim,
-                         ::testing::Values("gravitytests/test00ee", "springtests/test02sym", "windtests/test03ee",
-                                           "inertiatests/test02sym"),
+                         ::testing::Values("gravitytests/test00ee", "springtests/test02sym",
+                                           "windtests/test03ee", "inertiatests/test02sym"),
                          [](const auto& tp) {
                            std::string n = tp.param;
                            for (char& c : n) c = c == '/' ? '_' : c;

@@ -30,7 +30,8 @@ const std::string kEnergyHeader = "step,t,U,T_point,T_spin,T,E,U_gravity,U_sprin
 // Describes a finished process for failure messages.
 std::string describe(const test::Outcome& o) {
   return "exit " + std::to_string(o.exit_code) + (o.timed_out ? " (timed out)" : "") +
-         (o.signal ? " signal " + std::to_string(o.signal) : "") + "\nstdout: " + o.out + "\nstderr: " + o.err;
+         (o.signal ? " signal " + std::to_string(o.signal) : "") + "\nstdout: " + o.out +
+         "\nstderr: " + o.err;
 }
 
 double parse_double(const std::string& s) {
@@ -40,7 +41,9 @@ double parse_double(const std::string& s) {
   return v;
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 World world_of(const std::string& scene_path) {
   Result<Scene> s = load_scene(scene_path);
@@ -108,7 +111,8 @@ TEST(RbsimRun, OutputsHaveExactHeadersRowCountsAndBitExactValues) {
   const auto energy = lines_of(read_text(out.energy));
   ASSERT_EQ(energy.size(), static_cast<std::size_t>(1 + steps + 1));
   EXPECT_EQ(energy[0], kEnergyHeader);
-  EXPECT_EQ(fs::file_size(out.fosssim), sizeof(double) * static_cast<std::size_t>((16 * bodies + 1) + steps * (12 * bodies + 1)));
+  EXPECT_EQ(fs::file_size(out.fosssim),
+            sizeof(double) * static_cast<std::size_t>((16 * bodies + 1) + steps * (12 * bodies + 1)));
   EXPECT_TRUE(read_text(out.csv).ends_with("\n"));
 
   std::size_t row = 1;
@@ -122,12 +126,13 @@ TEST(RbsimRun, OutputsHaveExactHeadersRowCountsAndBitExactValues) {
       EXPECT_EQ(f[2], std::to_string(b));
       const BodyState s = w.state(BodyId{b});
       const BodyQuantities q = w.quantities(BodyId{b});
-      const double expected[] = {s.position.x(), s.position.y(), s.theta, s.velocity.x(), s.velocity.y(), s.omega,
-                                 q.momentum.x(), q.momentum.y(), q.l_point, q.l_spin, q.t_point, q.t_spin};
+      const double expected[] = {s.position.x(), s.position.y(), s.theta,        s.velocity.x(),
+                                 s.velocity.y(), s.omega,        q.momentum.x(), q.momentum.y(),
+                                 q.l_point,      q.l_spin,       q.t_point,      q.t_spin};
       for (int k = 0; k < 12; ++k) {
         ASSERT_TRUE(same_bits(parse_double(f[3 + k]), expected[k]))
-            << "step " << step << " body " << b << " column " << split(kCsvHeader, ',')[3 + k] << ": " << f[3 + k]
-            << " vs " << expected[k];
+            << "step " << step << " body " << b << " column " << split(kCsvHeader, ',')[3 + k] << ": "
+            << f[3 + k] << " vs " << expected[k];
       }
     }
     const auto e = split(energy[step + 1], ',');
@@ -169,7 +174,8 @@ TEST(RbsimRun, TwoRunsWriteBitIdenticalFiles) {
     const test::Outcome o = rbsim(args);
     ASSERT_EQ(o.exit_code, 0) << describe(o);
   }
-  for (auto [x, y] : {std::pair{a.csv, b.csv}, std::pair{a.energy, b.energy}, std::pair{a.fosssim, b.fosssim}}) {
+  for (auto [x, y] :
+       {std::pair{a.csv, b.csv}, std::pair{a.energy, b.energy}, std::pair{a.fosssim, b.fosssim}}) {
     const std::string tx = read_text(x), ty = read_text(y);
     EXPECT_GT(tx.size(), 1000u) << x;
     EXPECT_TRUE(tx == ty) << x << " and " << y << " differ";
@@ -250,7 +256,8 @@ TEST(RbsimRun, MissingSceneFileIsAClearError) {
   const test::Outcome o = rbsim({"run", path});
   EXPECT_EQ(o.exit_code, 1) << describe(o);
   ASSERT_EQ(o.err_lines().size(), 1u) << describe(o);
-  EXPECT_EQ(o.err_lines()[0], "rbsim run: error: " + path + ": cannot open scene file: No such file or directory");
+  EXPECT_EQ(o.err_lines()[0],
+            "rbsim run: error: " + path + ": cannot open scene file: No such file or directory");
 }
 
 TEST(RbsimRun, UnwritableOutputIsAnError) {
@@ -284,8 +291,9 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
     text.replace(at + k.size(), text.find('"', at + k.size()) - (at + k.size()), "1e9");
   }
   test::write_text(dir / "stiff.xml", text);
-  const test::Outcome o = rbsim({"run", (dir / "stiff.xml").string(), "-q", "--csv", (dir / "b.csv").string(),
-                                 "--energy-csv", (dir / "e.csv").string(), "--record", (dir / "r.mcap").string()});
+  const test::Outcome o =
+      rbsim({"run", (dir / "stiff.xml").string(), "-q", "--csv", (dir / "b.csv").string(), "--energy-csv",
+             (dir / "e.csv").string(), "--record", (dir / "r.mcap").string()});
   EXPECT_EQ(o.exit_code, 1) << describe(o);
   ASSERT_EQ(o.err_lines().size(), 1u) << describe(o);
   EXPECT_NE(o.err.find("not finite"), std::string::npos) << o.err;
@@ -305,11 +313,13 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
   for (std::size_t i = 1; i < bodies.size(); ++i) {
     const auto f = split(bodies[i], ',');
     ASSERT_EQ(f.size(), 15u);
-    for (int c = 3; c < 9; ++c) EXPECT_TRUE(std::isfinite(parse_double(f[c]))) << "state column " << c << ": " << bodies[i];
+    for (int c = 3; c < 9; ++c)
+      EXPECT_TRUE(std::isfinite(parse_double(f[c]))) << "state column " << c << ": " << bodies[i];
   }
   const test::Outcome doctor = rbsim({"log", "doctor", (dir / "r.mcap").string()});
   EXPECT_EQ(doctor.exit_code, 0) << describe(doctor);
-  const test::Outcome exported = rbsim({"log", "export", (dir / "r.mcap").string(), "--csv", (dir / "x.csv").string()});
+  const test::Outcome exported =
+      rbsim({"log", "export", (dir / "r.mcap").string(), "--csv", (dir / "x.csv").string()});
   ASSERT_EQ(exported.exit_code, 0) << describe(exported);
   EXPECT_EQ(read_text(dir / "x.csv"), read_text(dir / "b.csv"));
   // with --allow-nonfinite it runs to the end

@@ -50,7 +50,9 @@ TEST_P(WorldStepNoForces, MomentumExactAngularMomentumToRounding) {
 
 INSTANTIATE_TEST_SUITE_P(BothIntegrators, WorldStepNoForces,
                          ::testing::Values(Integrator::ExplicitEuler, Integrator::SymplecticEuler),
-                         [](const auto& tp) { return tp.param == Integrator::ExplicitEuler ? "Explicit" : "Symplectic"; });
+                         [](const auto& tp) {
+                           return tp.param == Integrator::ExplicitEuler ? "Explicit" : "Symplectic";
+                         });
 
 // Two bodies joined by springs at off-centre anchors (internal forces only, with torques).
 WorldDef spring_pair(Integrator integrator, double dt) {

@@ -26,7 +26,9 @@ struct FreeFallCase {
   double sign;  // -1 for n (n - 1), +1 for n (n + 1)
 };
 
-void PrintTo(const FreeFallCase& c, std::ostream* os) { *os << to_string(c.integrator); }
+void PrintTo(const FreeFallCase& c, std::ostream* os) {
+  *os << to_string(c.integrator);
+}
 
 class WorldStepFreeFall : public ::testing::TestWithParam<FreeFallCase> {};
 
@@ -75,7 +77,8 @@ INSTANTIATE_TEST_SUITE_P(BothIntegrators, WorldStepFreeFall,
                          ::testing::Values(FreeFallCase{Integrator::ExplicitEuler, -1.0},
                                            FreeFallCase{Integrator::SymplecticEuler, +1.0}),
                          [](const auto& tp) {
-                           return tp.param.integrator == Integrator::ExplicitEuler ? "Explicit" : "Symplectic";
+                           return tp.param.integrator == Integrator::ExplicitEuler ? "Explicit"
+                                                                                   : "Symplectic";
                          });
 
 TEST(WorldStep, GravityForceIsMassTimesG) {
@@ -111,7 +114,8 @@ TEST(WorldStep, FixedSpringOscillatesWithAnalyticPeriod) {
     World w = make_world(builders::fixed_spring(Integrator::SymplecticEuler, dt, k, 1.0, 0.5));
     const auto crossings = downward_crossings(w, 1.0, static_cast<std::int64_t>(10.5 * 5000));
     ASSERT_GE(crossings.size(), 10u) << "k = " << k;
-    const double measured = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+    const double measured =
+        (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
     EXPECT_NEAR(measured / period, 1.0, 1e-3) << "k = " << k;
     // the motion stays on the spring's line: no sideways drift, no rotation
     EXPECT_EQ(w.state(BodyId{0}).position.y(), 0.0);
@@ -124,10 +128,13 @@ TEST(WorldStep, FixedSpringFirstStepForceIsMinusKStretch) {
   w.step();
   EXPECT_DOUBLE_EQ(w.force(BodyId{0}).x(), -3.0 * 0.5);  // pulls back towards the fixed point
   EXPECT_EQ(w.force(BodyId{0}).y(), 0.0);
-  EXPECT_DOUBLE_EQ(w.spring_state(SpringId{0}).potential, 0.5 * 3.0 * std::pow(w.state(BodyId{0}).position.x() - 1.0, 2));
+  EXPECT_DOUBLE_EQ(w.spring_state(SpringId{0}).potential,
+                   0.5 * 3.0 * std::pow(w.state(BodyId{0}).position.x() - 1.0, 2));
 }
 
-double spring_energy(const World& w) { return w.energy().total(); }
+double spring_energy(const World& w) {
+  return w.energy().total();
+}
 
 // Symplectic Euler exactly conserves the modified energy Q = v^2 + w^2 u^2 - h w^2 u v of the
 // harmonic oscillator, so E stays within O(h w) of E0 forever. Explicit Euler multiplies
@@ -297,7 +304,8 @@ TEST(WorldFindNonfinite, NamesTheBodyAndQuantity) {
     for (double bad : {std::nan(""), static_cast<double>(INFINITY), -static_cast<double>(INFINITY)}) {
       World w = make_world(builders::free_bodies(Integrator::SymplecticEuler, 0.01, 3));
       BodyState s = w.state(BodyId{2});
-      double* fields[] = {&s.position.x(), &s.position.y(), &s.theta, &s.velocity.x(), &s.velocity.y(), &s.omega};
+      double* fields[] = {&s.position.x(), &s.position.y(), &s.theta,
+                          &s.velocity.x(), &s.velocity.y(), &s.omega};
       *fields[q] = bad;
       w.set_state(BodyId{2}, s);
       const auto found = w.find_nonfinite();

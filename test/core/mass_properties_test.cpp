@@ -102,11 +102,11 @@ TEST(WorldQuantities, MatchTheirDefinitions) {
   BodyDef b = builders::square({2.0, -3.0}, {0.5, 1.5}, -0.75);
   const World w = make_world(one_body(b));
   const BodyQuantities q = w.quantities(BodyId{0});
-  EXPECT_EQ(q.momentum, Vec2(2.0, 6.0));                      // M V
-  EXPECT_EQ(q.l_point, 4.0 * (2.0 * 1.5 - (-3.0) * 0.5));    // M X x V = 18
-  EXPECT_EQ(q.l_spin, 8.0 * -0.75);                           // I omega
-  EXPECT_EQ(q.t_point, 0.5 * 4.0 * (0.25 + 2.25));           // M |V|^2 / 2
-  EXPECT_EQ(q.t_spin, 0.5 * 8.0 * 0.75 * 0.75);               // I omega^2 / 2
+  EXPECT_EQ(q.momentum, Vec2(2.0, 6.0));                   // M V
+  EXPECT_EQ(q.l_point, 4.0 * (2.0 * 1.5 - (-3.0) * 0.5));  // M X x V = 18
+  EXPECT_EQ(q.l_spin, 8.0 * -0.75);                        // I omega
+  EXPECT_EQ(q.t_point, 0.5 * 4.0 * (0.25 + 2.25));         // M |V|^2 / 2
+  EXPECT_EQ(q.t_spin, 0.5 * 8.0 * 0.75 * 0.75);            // I omega^2 / 2
 }
 
 TEST(WorldQuantities, SpinEnergyEqualsSumOfVertexKineticEnergies) {

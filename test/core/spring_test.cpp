@@ -20,7 +20,8 @@ struct Generalised {
 };
 Generalised forces_at(const WorldDef& def, const std::vector<BodyState>& states) {
   World w = make_world(def);
-  for (std::size_t b = 0; b < states.size(); ++b) w.set_state(BodyId{static_cast<std::int32_t>(b)}, states[b]);
+  for (std::size_t b = 0; b < states.size(); ++b)
+    w.set_state(BodyId{static_cast<std::int32_t>(b)}, states[b]);
   w.step();
   Generalised g;
   for (std::int32_t b = 0; b < w.body_count(); ++b) {
@@ -32,7 +33,8 @@ Generalised forces_at(const WorldDef& def, const std::vector<BodyState>& states)
 
 double potential_at(const WorldDef& def, const std::vector<BodyState>& states) {
   World w = make_world(def);
-  for (std::size_t b = 0; b < states.size(); ++b) w.set_state(BodyId{static_cast<std::int32_t>(b)}, states[b]);
+  for (std::size_t b = 0; b < states.size(); ++b)
+    w.set_state(BodyId{static_cast<std::int32_t>(b)}, states[b]);
   return w.energy().u_spring;
 }
 

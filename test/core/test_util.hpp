@@ -17,15 +17,21 @@ inline World make_world(const WorldDef& def) {
   return std::move(w.value());
 }
 
-inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-inline Vec2 perp(const Vec2& a) { return {-a.y(), a.x()}; }  // J a: +90 degrees
+inline double cross(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+inline Vec2 perp(const Vec2& a) {
+  return {-a.y(), a.x()};
+}  // J a: +90 degrees
 inline Vec2 rotate(double theta, const Vec2& v) {
   const double c = std::cos(theta), s = std::sin(theta);
   return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
 }
 
 // Bit-for-bit equality (distinguishes -0.0 and +0.0, treats equal NaNs as equal).
-inline bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+inline bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 struct Totals {
   Vec2 p{0.0, 0.0};
@@ -44,7 +50,8 @@ inline Totals totals(const World& w) {
 }
 
 // Definitions by field name, so the tests do not depend on the order of the struct members.
-inline SpringDef spring(std::int32_t body_i, Vec2 anchor_i, std::int32_t body_j, Vec2 anchor_j, double k, double l0) {
+inline SpringDef spring(std::int32_t body_i, Vec2 anchor_i, std::int32_t body_j, Vec2 anchor_j, double k,
+                        double l0) {
   SpringDef s;
   s.body_i = body_i;
   s.anchor_i = anchor_i;

@@ -62,7 +62,8 @@ BodyDef random_hull(std::mt19937_64& rng, int vertices) {
 
 TEST(WorldStepWind, ClosedFormEqualsSampleSumForRandomHulls) {
   std::mt19937_64 rng(20240607);
-  std::uniform_real_distribution<double> u(-3.0, 3.0), angle(-std::numbers::pi, std::numbers::pi), pos_beta(0.1, 2.0);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), angle(-std::numbers::pi, std::numbers::pi),
+      pos_beta(0.1, 2.0);
   int checked = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const int points = std::array{2, 3, 7}[trial % 3];
@@ -76,7 +77,8 @@ TEST(WorldStepWind, ClosedFormEqualsSampleSumForRandomHulls) {
     for (Vec2& v : shared.hull) v += Vec2(8.0, -4.0);
     def.bodies.push_back(shared);
     def.winds.push_back(test::wind(pos_beta(rng), {u(rng), u(rng)}, points));
-    if (trial % 4 == 0) def.winds.push_back(test::wind(pos_beta(rng), {u(rng), u(rng)}, std::array{2, 3, 7}[(trial + 1) % 3]));
+    if (trial % 4 == 0)
+      def.winds.push_back(test::wind(pos_beta(rng), {u(rng), u(rng)}, std::array{2, 3, 7}[(trial + 1) % 3]));
     Result<World> created = World::create(def);
     ASSERT_TRUE(created) << created.error().message;
     World w = std::move(created.value());
@@ -99,9 +101,12 @@ TEST(WorldStepWind, ClosedFormEqualsSampleSumForRandomHulls) {
     for (std::int32_t b = 0; b < w.body_count(); ++b) {
       const Sampled& e = expected[b];
       const double ftol = 1e-12 * e.force_scale, ttol = 1e-12 * e.torque_scale;
-      EXPECT_NEAR(w.force(BodyId{b}).x(), e.force.x(), ftol) << "trial " << trial << " body " << b << " P " << points;
-      EXPECT_NEAR(w.force(BodyId{b}).y(), e.force.y(), ftol) << "trial " << trial << " body " << b << " P " << points;
-      EXPECT_NEAR(w.torque(BodyId{b}), e.torque, ttol) << "trial " << trial << " body " << b << " P " << points;
+      EXPECT_NEAR(w.force(BodyId{b}).x(), e.force.x(), ftol)
+          << "trial " << trial << " body " << b << " P " << points;
+      EXPECT_NEAR(w.force(BodyId{b}).y(), e.force.y(), ftol)
+          << "trial " << trial << " body " << b << " P " << points;
+      EXPECT_NEAR(w.torque(BodyId{b}), e.torque, ttol)
+          << "trial " << trial << " body " << b << " P " << points;
       ++checked;
     }
   }
@@ -204,8 +209,10 @@ TEST(WorldStepWind, BodyAtRestIsPushedDownwindProportionallyToBeta) {
     a.step();
     b.step();
     EXPECT_GT(a.force(BodyId{0}).dot(wind), 0.0) << trial;
-    EXPECT_NEAR((b.force(BodyId{0}) - 2.0 * a.force(BodyId{0})).norm(), 0.0, 1e-12 * b.force(BodyId{0}).norm());
-    EXPECT_NEAR(b.torque(BodyId{0}), 2.0 * a.torque(BodyId{0}), 1e-12 * (1.0 + std::abs(b.torque(BodyId{0}))));
+    EXPECT_NEAR((b.force(BodyId{0}) - 2.0 * a.force(BodyId{0})).norm(), 0.0,
+                1e-12 * b.force(BodyId{0}).norm());
+    EXPECT_NEAR(b.torque(BodyId{0}), 2.0 * a.torque(BodyId{0}),
+                1e-12 * (1.0 + std::abs(b.torque(BodyId{0}))));
   }
 }
 

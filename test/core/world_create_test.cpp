@@ -34,7 +34,9 @@ struct InvalidCase {
   const char* expected;  // a piece of the message
 };
 
-void PrintTo(const InvalidCase& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const InvalidCase& c, std::ostream* os) {
+  *os << c.name;
+}
 
 class WorldCreateRejects : public ::testing::TestWithParam<InvalidCase> {};
 
@@ -58,17 +60,21 @@ const InvalidCase kInvalid[] = {
     {"mass_negative", [](WorldDef& d) { d.bodies[0].masses[0] = -1.0; }, "body 0: vertex mass must be > 0"},
     {"mass_nan", [](WorldDef& d) { d.bodies[0].masses[3] = kNaN; }, "mass"},
     {"no_vertices", [](WorldDef& d) { d.bodies[0].hull.clear(), d.bodies[0].masses.clear(); }, "at least 2"},
-    {"one_vertex", [](WorldDef& d) { d.bodies[1].hull.resize(1), d.bodies[1].masses.resize(1); }, "body 1: needs at least 2"},
+    {"one_vertex", [](WorldDef& d) { d.bodies[1].hull.resize(1), d.bodies[1].masses.resize(1); },
+     "body 1: needs at least 2"},
     {"mass_count_mismatch", [](WorldDef& d) { d.bodies[0].masses.pop_back(); }, "one mass per hull vertex"},
     {"coincident_vertices",
-     [](WorldDef& d) { d.bodies[1].hull.assign(d.bodies[1].hull.size(), Vec2(2.0, 3.0)); }, "body 1: all vertices coincide"},
+     [](WorldDef& d) { d.bodies[1].hull.assign(d.bodies[1].hull.size(), Vec2(2.0, 3.0)); },
+     "body 1: all vertices coincide"},
     {"vertex_nan", [](WorldDef& d) { d.bodies[0].hull[1].y() = kNaN; }, "vertex position not finite"},
     {"vertex_inf", [](WorldDef& d) { d.bodies[0].hull[1].x() = -kInf; }, "vertex position not finite"},
     {"velocity_nan", [](WorldDef& d) { d.bodies[0].velocity.x() = kNaN; }, "velocity not finite"},
     {"omega_inf", [](WorldDef& d) { d.bodies[1].omega = kInf; }, "body 1: velocity not finite"},
     {"radius_zero", [](WorldDef& d) { d.bodies[0].radius = 0.0; }, "radius"},
-    {"spring_i_out_of_range", [](WorldDef& d) { d.springs[0].body_i = 2; }, "spring 0: body index out of range"},
-    {"spring_j_out_of_range", [](WorldDef& d) { d.springs[1].body_j = 7; }, "spring 1: body index out of range"},
+    {"spring_i_out_of_range", [](WorldDef& d) { d.springs[0].body_i = 2; },
+     "spring 0: body index out of range"},
+    {"spring_j_out_of_range", [](WorldDef& d) { d.springs[1].body_j = 7; },
+     "spring 1: body index out of range"},
     {"spring_index_minus_two", [](WorldDef& d) { d.springs[0].body_j = -2; }, "body index out of range"},
     {"spring_anchor_nan", [](WorldDef& d) { d.springs[1].anchor_i.x() = kNaN; }, "anchor not finite"},
     {"spring_k_negative", [](WorldDef& d) { d.springs[0].stiffness = -1.0; }, "k must be >= 0"},

@@ -37,8 +37,8 @@
 #include <vector>
 
 #include "generated_types.inc"  // every idlc-generated header, and kGeneratedTypes
-#include "rbsim/builders.hpp"
 #include "raw_serdata.hpp"
+#include "rbsim/builders.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace {
@@ -78,7 +78,9 @@ constexpr int kSteps = 9;  // t = 9 * 0.125 s = 1.125 s
 // visualisation messages, from the documentation in encode.cpp). Memory comes from dds_alloc /
 // dds_string_dup so dds_sample_free releases it.
 
-char* str(std::string_view s) { return dds_string_dup(std::string(s).c_str()); }
+char* str(std::string_view s) {
+  return dds_string_dup(std::string(s).c_str());
+}
 
 template <class Seq>
 auto* alloc_seq(Seq& seq, std::size_t n) {
@@ -101,18 +103,23 @@ builtin_interfaces_msg_dds__Time_ stamp_of(const World& w) {
   return {static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
 }
 
-void set_header(std_msgs_msg_dds__Header_& h, builtin_interfaces_msg_dds__Time_ stamp, std::string_view frame) {
+void set_header(std_msgs_msg_dds__Header_& h, builtin_interfaces_msg_dds__Time_ stamp,
+                std::string_view frame) {
   h.stamp = stamp;
   h.frame_id = str(frame);
 }
 
-rbsim_msgs_msg_dds__Vector2_ vec2(const rbsim::Vec2& v) { return {v.x(), v.y()}; }
+rbsim_msgs_msg_dds__Vector2_ vec2(const rbsim::Vec2& v) {
+  return {v.x(), v.y()};
+}
 
 std_msgs_msg_dds__ColorRGBA_ rgba(const rbsim::Color& c) {
   return {static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b), 1.0f};
 }
 
-geometry_msgs_msg_dds__Point_ point3(const rbsim::Vec2& p) { return {p.x(), p.y(), 0.0}; }
+geometry_msgs_msg_dds__Point_ point3(const rbsim::Vec2& p) {
+  return {p.x(), p.y(), 0.0};
+}
 
 // A planar pose: (x, y, 0), rotated by theta about +z.
 geometry_msgs_msg_dds__Pose_ planar_pose(double x, double y, double theta) {
@@ -127,7 +134,8 @@ void fill_scene(const Scene& s, const World& w, void* out) {
   set_header(m.header, stamp_of(w), "world");
   m.name = str(s.name);
   m.description = str(s.description);
-  m.integrator = str(w.integrator() == rbsim::Integrator::ExplicitEuler ? "explicit-euler" : "symplectic-euler");
+  m.integrator =
+      str(w.integrator() == rbsim::Integrator::ExplicitEuler ? "explicit-euler" : "symplectic-euler");
   m.dt = w.dt();
   m.duration = s.duration;
   m.step_count = static_cast<std::uint64_t>(std::ceil(s.duration / w.dt()));
@@ -156,7 +164,8 @@ void fill_scene(const Scene& s, const World& w, void* out) {
     d.color = rgba(s.spring_colors[static_cast<std::size_t>(k)]);
   }
   auto* gravity = alloc_seq(m.gravity, w.gravity().size());
-  for (std::size_t g = 0; g < w.gravity().size(); ++g) gravity[g].acceleration = vec2(w.gravity()[g].acceleration);
+  for (std::size_t g = 0; g < w.gravity().size(); ++g)
+    gravity[g].acceleration = vec2(w.gravity()[g].acceleration);
   auto* winds = alloc_seq(m.winds, w.winds().size());
   for (std::size_t i = 0; i < w.winds().size(); ++i) {
     winds[i].beta = w.winds()[i].beta;
@@ -188,7 +197,8 @@ void fill_spring_states(const Scene&, const World& w, void* out) {
   auto* springs = alloc_seq(m.springs, static_cast<std::size_t>(w.spring_count()));
   for (std::int32_t k = 0; k < w.spring_count(); ++k) {
     const rbsim::SpringState st = w.spring_state(rbsim::SpringId{k});
-    springs[k] = {k, vec2(st.end_i), vec2(st.end_j), st.length, w.spring(rbsim::SpringId{k}).rest_length, st.potential};
+    springs[k] = {
+        k, vec2(st.end_i), vec2(st.end_j), st.length, w.spring(rbsim::SpringId{k}).rest_length, st.potential};
   }
 }
 
@@ -224,7 +234,8 @@ void fill_energy(const Scene&, const World& w, void* out) {
   }
   for (std::int32_t k = 0; k < w.spring_count(); ++k) {
     const double u = w.spring_state(rbsim::SpringId{k}).potential;
-    forces[n_gravity + static_cast<std::size_t>(k)] = {rbsim_msgs_msg_dds__ForcePotential_Constants_SPRING, k, u};
+    forces[n_gravity + static_cast<std::size_t>(k)] = {rbsim_msgs_msg_dds__ForcePotential_Constants_SPRING, k,
+                                                       u};
     potential += u;
   }
   m.momentum = {px, py};
@@ -243,8 +254,8 @@ void fill_poses(const Scene&, const World& w, void* out) {
 }
 
 // Everything not described by the marker is empty: no texture, mesh, text or per-vertex UVs.
-void marker_defaults(visualization_msgs_msg_dds__Marker_& mk, builtin_interfaces_msg_dds__Time_ stamp, std::string_view ns,
-                     std::int32_t id, std::int32_t type) {
+void marker_defaults(visualization_msgs_msg_dds__Marker_& mk, builtin_interfaces_msg_dds__Time_ stamp,
+                     std::string_view ns, std::int32_t id, std::int32_t type) {
   set_header(mk.header, stamp, "world");
   mk.ns = str(ns);
   mk.id = id;
@@ -385,12 +396,13 @@ std::string hex(std::span<const std::byte> b, std::size_t from, std::size_t to) 
   if (ours.size() == cyclone.size() && std::equal(ours.begin(), ours.end(), cyclone.begin())) {
     return ::testing::AssertionSuccess() << ours.size() << " identical bytes";
   }
-  const auto at = static_cast<std::size_t>(std::mismatch(ours.begin(), ours.end(), cyclone.begin(), cyclone.end()).first -
-                                           ours.begin());
+  const auto at = static_cast<std::size_t>(
+      std::mismatch(ours.begin(), ours.end(), cyclone.begin(), cyclone.end()).first - ours.begin());
   const std::size_t from = at < 8 ? 0 : at - 8;
-  return ::testing::AssertionFailure() << "ours " << ours.size() << " bytes, Cyclone " << cyclone.size()
-                                       << " bytes; first difference at byte " << at << "\n  ours:    ..."
-                                       << hex(ours, from, at + 8) << "\n  Cyclone: ..." << hex(cyclone, from, at + 8);
+  return ::testing::AssertionFailure()
+         << "ours " << ours.size() << " bytes, Cyclone " << cyclone.size()
+         << " bytes; first difference at byte " << at << "\n  ours:    ..." << hex(ours, from, at + 8)
+         << "\n  Cyclone: ..." << hex(cyclone, from, at + 8);
 }
 
 // Raw CDR is handed to dds_writecdr through the node's raw-bytes serdata (node/src/raw_serdata.cpp).
@@ -530,7 +542,8 @@ TEST_P(CycloneCdr, EncoderBytesEqualCycloneSerialisation) {
   const auto pad = static_cast<std::size_t>(ours_[3]);
   ASSERT_LE(pad, 3u);
   EXPECT_EQ(ours_.size() % 4, 0u);
-  for (std::size_t i = ours_.size() - pad; i < ours_.size(); ++i) EXPECT_EQ(ours_[i], std::byte{0}) << "pad byte " << i;
+  for (std::size_t i = ours_.size() - pad; i < ours_.size(); ++i)
+    EXPECT_EQ(ours_[i], std::byte{0}) << "pad byte " << i;
   if (GetParam() == TopicId::Markers) {
     EXPECT_EQ(pad, 3u);
   } else {
@@ -681,12 +694,14 @@ std::vector<MsgField> msg_fields(std::string_view text) {
     std::istringstream words(line);
     std::string type, name, third;
     if (!(words >> type >> name)) continue;
-    if (name.find('=') != std::string::npos || ((words >> third) && third.starts_with('='))) continue;  // constant
+    if (name.find('=') != std::string::npos || ((words >> third) && third.starts_with('=')))
+      continue;  // constant
     MsgField f;
     f.name = name;
     if (const auto bracket = type.find('['); bracket != std::string::npos) {
       const std::string inside = type.substr(bracket + 1, type.size() - bracket - 2);
-      f.array = inside.empty() || inside.starts_with("<=") ? MsgField::Array::Sequence : MsgField::Array::Fixed;
+      f.array =
+          inside.empty() || inside.starts_with("<=") ? MsgField::Array::Sequence : MsgField::Array::Fixed;
       type.resize(bracket);
     }
     f.type = type;
@@ -735,12 +750,18 @@ std::size_t adr_length(std::uint32_t op) {
   const bool sub_complex = sub == DDS_OP_VAL_STU || sub == DDS_OP_VAL_UNI || sub == DDS_OP_VAL_SEQ ||
                            sub == DDS_OP_VAL_BSQ || sub == DDS_OP_VAL_ARR;
   switch (type) {
-    case DDS_OP_VAL_EXT: return 3;
-    case DDS_OP_VAL_BST: return 3;
-    case DDS_OP_VAL_SEQ: return sub_complex ? 4 : (sub == DDS_OP_VAL_BST || sub == DDS_OP_VAL_ENU ? 3 : 2);
-    case DDS_OP_VAL_BSQ: return sub_complex ? 5 : (sub == DDS_OP_VAL_BST || sub == DDS_OP_VAL_ENU ? 4 : 3);
-    case DDS_OP_VAL_ARR: return sub_complex ? 5 : (sub == DDS_OP_VAL_BST || sub == DDS_OP_VAL_ENU ? 4 : 3);
-    default: return 2;
+    case DDS_OP_VAL_EXT:
+      return 3;
+    case DDS_OP_VAL_BST:
+      return 3;
+    case DDS_OP_VAL_SEQ:
+      return sub_complex ? 4 : (sub == DDS_OP_VAL_BST || sub == DDS_OP_VAL_ENU ? 3 : 2);
+    case DDS_OP_VAL_BSQ:
+      return sub_complex ? 5 : (sub == DDS_OP_VAL_BST || sub == DDS_OP_VAL_ENU ? 4 : 3);
+    case DDS_OP_VAL_ARR:
+      return sub_complex ? 5 : (sub == DDS_OP_VAL_BST || sub == DDS_OP_VAL_ENU ? 4 : 3);
+    default:
+      return 2;
   }
 }
 
@@ -777,7 +798,8 @@ TEST(GeneratedIdl, MatchesTheMsgFieldByField) {
         EXPECT_EQ(flags, e.flags);
       } else {
         const Expected e = expected_op(f.type, true);
-        EXPECT_EQ(type, f.array == MsgField::Array::Sequence ? std::uint32_t{DDS_OP_VAL_SEQ} : std::uint32_t{DDS_OP_VAL_ARR});
+        EXPECT_EQ(type, f.array == MsgField::Array::Sequence ? std::uint32_t{DDS_OP_VAL_SEQ}
+                                                             : std::uint32_t{DDS_OP_VAL_ARR});
         EXPECT_EQ(static_cast<std::uint32_t>(DDS_OP_SUBTYPE(*op)), e.kind);
         EXPECT_EQ(flags, e.flags);
       }

@@ -25,6 +25,7 @@ import json
 import math
 import os
 import random
+import re
 import resource
 import shutil
 import signal
@@ -1100,9 +1101,16 @@ def case_bad_input(ctx):
     bad_xml = ctx.path("bad-config.xml")
     with open(bad_xml, "w") as f:
         f.write("<CycloneDDS><Domain><General><NoSuchSetting>1</NoSuchSetting></General></Domain></CycloneDDS>\n")
+    # A stiff explicit-Euler spring that blows up (as in the command-line test of `rbsim run`).
+    stiff = ctx.path("stiff.xml")
+    with open(os.path.join(ctx.src, "test", "data", "fosssim", "scenes", "springtests", "test00ee.xml")) as f:
+        text = f.read()
+    with open(stiff, "w") as f:
+        f.write(re.sub(r'k="[^"]*"', 'k="1e9"', text))
     scene = ctx.scene("airplane.xml")
     d = str(ctx.domain)
     cases = [
+        ("node on a diverging scene", ("node", stiff, "--domain", d, "--rate", "0"), None, "step 64: body 0 T_point is not finite"),
         ("record unknown topic", ("record", ctx.path("o1.mcap"), "--domain", d, "--topics", "no_such_topic"), None,
          "unknown topic"),
         ("replay unknown topic", ("replay", x, "--domain", d, "--topics", "no_such_topic"), None, "unknown topic"),

@@ -40,11 +40,14 @@ Outcome run_process(const std::string& exe, const std::vector<std::string>& args
   return test::run_process(exe, args, std::chrono::seconds(240), extra_env);
 }
 
-Outcome rbsim(const std::vector<std::string>& args) { return run_process(RBSIM_EXE, args); }
+Outcome rbsim(const std::vector<std::string>& args) {
+  return run_process(RBSIM_EXE, args);
+}
 
 // Records `scene` to `out` (all topics, zstd) with the given extra options; asserts success.
 void record(const fs::path& scene, const fs::path& out, const std::vector<std::string>& extra) {
-  std::vector<std::string> args{"run", scene.string(), "--record", out.string(), "--progress", "never", "--quiet"};
+  std::vector<std::string> args{"run",        scene.string(), "--record", out.string(),
+                                "--progress", "never",        "--quiet"};
   args.insert(args.end(), extra.begin(), extra.end());
   const Outcome o = rbsim(args);
   ASSERT_EQ(o.exit_code, 0) << o;
@@ -63,7 +66,9 @@ fs::path edited(const fs::path& dir, const fs::path& scene, const std::string& f
   return out;
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 // Scenes under scenes/ (subfolders included), as paths relative to it without ".xml".
 std::vector<std::string> scene_names() {
@@ -78,8 +83,12 @@ std::vector<std::string> scene_names() {
   return names;
 }
 
-fs::path scene_path(const std::string& name) { return kScenes / (name + ".xml"); }
-fs::path golden_path(const std::string& name) { return kGoldens / (name + ".mcap"); }
+fs::path scene_path(const std::string& name) {
+  return kScenes / (name + ".xml");
+}
+fs::path golden_path(const std::string& name) {
+  return kGoldens / (name + ".mcap");
+}
 
 std::string to_string(const log::GoldenVerification& v) {
   std::string s = "rule " + v.rule + "\n";
@@ -112,16 +121,18 @@ TEST_P(GoldenScene, GoldenIsVerified) {
   ASSERT_TRUE(fs::exists(golden)) << "no golden for " << scene_path(GetParam());
   log::GoldenVerifyOptions options;
   options.fosssim_dir = kFosssim.string();
-  Result<log::GoldenVerification> v = log::verify_golden(scene_path(GetParam()).string(), golden.string(), options);
+  Result<log::GoldenVerification> v =
+      log::verify_golden(scene_path(GetParam()).string(), golden.string(), options);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_TRUE(v->passed) << to_string(v.value());
   // Every golden is re-integrated independently; against the FOSSSim reference when there is one,
   // else, for conservative symplectic scenes, checked for energy conservation.
-  const log::FosssimMatch match = log::find_fosssim_reference(scene_path(GetParam()).string(), kFosssim.string());
+  const log::FosssimMatch match =
+      log::find_fosssim_reference(scene_path(GetParam()).string(), kFosssim.string());
   Result<Scene> scene = load_scene(scene_path(GetParam()).string());
   ASSERT_TRUE(scene) << scene.error().message;
-  const bool conservative =
-      scene->world.integrator == Integrator::SymplecticEuler && scene->world.winds.empty() && match.reference.empty();
+  const bool conservative = scene->world.integrator == Integrator::SymplecticEuler &&
+                            scene->world.winds.empty() && match.reference.empty();
   EXPECT_TRUE(contains(v->rule, "independent-integration")) << to_string(v.value());
   EXPECT_EQ(contains(v->rule, "fosssim-reference"), !match.reference.empty()) << to_string(v.value());
   EXPECT_EQ(contains(v->rule, "symplectic-energy"), conservative) << to_string(v.value());
@@ -157,7 +168,8 @@ TEST(GoldenDir, OneGoldenPerSceneAndSmallInTotal) {
     }
   }
   EXPECT_EQ(goldens, std::set<std::string>(scenes.begin(), scenes.end()))
-      << "every scene in scenes/ needs test/golden/<name>.mcap (scripts/golden), and no golden may outlive its scene";
+      << "every scene in scenes/ needs test/golden/<name>.mcap (scripts/golden), and no golden may outlive "
+         "its scene";
   EXPECT_LE(total, kMaxGoldenTotal);
 }
 
@@ -184,7 +196,8 @@ TEST(Check, IdenticalFilesMatch) {
   fs::copy_file(kChainGolden, tmp / "copy.mcap");
   o = rbsim({"check", (tmp / "copy.mcap").string(), kChainGolden.string(), "--all-fields"});
   EXPECT_EQ(o.exit_code, 0) << o;
-  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(/rbsim/body_states +bodies\[\]\.x +float)"))) << o;  // all fields
+  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(/rbsim/body_states +bodies\[\]\.x +float)")))
+      << o;  // all fields
 }
 
 TEST(Check, ChangedTimeStepDivergesAtTheSceneDescription) {
@@ -195,14 +208,16 @@ TEST(Check, ChangedTimeStepDivergesAtTheSceneDescription) {
   Outcome o = rbsim({"check", run.string(), kChainGolden.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_TRUE(contains(o.out, ": DIVERGED")) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/scene, message 0, field dt: expected 0.001, actual "
-                              "0.0009, difference -0.0001"))
+  EXPECT_TRUE(contains(o.out,
+                       "first divergence: topic /rbsim/scene, message 0, field dt: expected 0.001, actual "
+                       "0.0009, difference -0.0001"))
       << o;
   // Without the scene description, the first difference is the stamp of the first step recorded.
   o = rbsim({"check", run.string(), kChainGolden.string(), "--exclude-topics", "/rbsim/scene"});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 200, field header.stamp.nanosec: "
-                              "expected 200000000, actual 180000000, difference -20000000"))
+  EXPECT_TRUE(contains(o.out,
+                       "first divergence: topic /rbsim/body_states, step 200, field header.stamp.nanosec: "
+                       "expected 200000000, actual 180000000, difference -20000000"))
       << o;
   EXPECT_TRUE(contains(o.out, "/rbsim/body_states")) << o;  // in the per-field table
 }
@@ -216,13 +231,15 @@ TEST(Check, ChangedMassDivergesInTheBodyStates) {
   record(scene, run, {"--record-every", kChainEvery});
   Outcome o = rbsim({"check", run.string(), kChainGolden.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/scene, message 0, field bodies[0].mass: expected 2, "
-                              "actual 2.5, difference 0.5"))
+  EXPECT_TRUE(contains(o.out,
+                       "first divergence: topic /rbsim/scene, message 0, field bodies[0].mass: expected 2, "
+                       "actual 2.5, difference 0.5"))
       << o;
   o = rbsim({"check", run.string(), kChainGolden.string(), "--topics", "/rbsim/body_states"});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 0, field bodies[0].x: expected 0.5, "
-                              "actual 0.4, difference -0.1"))
+  EXPECT_TRUE(contains(o.out,
+                       "first divergence: topic /rbsim/body_states, step 0, field bodies[0].x: expected 0.5, "
+                       "actual 0.4, difference -0.1"))
       << o;
   // Table rows: topic, collapsed field path, kind, values, max |diff|, max rel, at, over tol.
   const std::regex row(R"(/rbsim/body_states +bodies\[\]\.y +float +(\d+) +(\S+) +\S+ +step \d+ +(\d+))");
@@ -237,7 +254,8 @@ TEST(Check, ChangedMassDivergesInTheBodyStates) {
   record(heavier, run2, {"--record-every", kChainEvery});
   o = rbsim({"check", run2.string(), kChainGolden.string(), "--topics", "/rbsim/body_states"});
   EXPECT_EQ(o.exit_code, 1) << o;
-  const std::regex first(R"(first divergence: topic /rbsim/body_states, step 200, field bodies\[[0-4]\]\.(x|y|theta|vx|vy|omega): expected \S+, actual \S+, difference \S+)");
+  const std::regex first(
+      R"(first divergence: topic /rbsim/body_states, step 200, field bodies\[[0-4]\]\.(x|y|theta|vx|vy|omega): expected \S+, actual \S+, difference \S+)");
   EXPECT_TRUE(std::regex_search(o.out, first)) << o;
   // Topics the change does not reach still match when they are all that is compared.
   o = rbsim({"check", run.string(), kChainGolden.string(), "--topics", "/clock"});
@@ -272,13 +290,16 @@ TEST(Check, TopicInOnlyOneFileAndTopicSelection) {
   copy_without(kChainGolden, partial, "/rbsim/markers");
   Outcome o = rbsim({"check", partial.string(), kChainGolden.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/markers: topic only in the golden (501 messages)")) << o;
+  EXPECT_TRUE(
+      contains(o.out, "first divergence: topic /rbsim/markers: topic only in the golden (501 messages)"))
+      << o;
   o = rbsim({"check", kChainGolden.string(), partial.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_TRUE(contains(o.out, "topic /rbsim/markers: topic only in the run")) << o;
   o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "/rbsim/markers"});
   EXPECT_EQ(o.exit_code, 0) << o;
-  o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/body_states,/rbsim/energy"});
+  o = rbsim(
+      {"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/body_states,/rbsim/energy"});
   EXPECT_EQ(o.exit_code, 0) << o;
   EXPECT_TRUE(contains(o.out, "2 topics")) << o;
   o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/nope"});
@@ -320,9 +341,11 @@ TEST(Check, TolerancesAcceptSmallDifferencesAndRejectLargeOnes) {
   // A relative tolerance: the scene description's mass and inertia differ by 2.5e-10 relative.
   o = rbsim({"check", tiny.other.string(), tiny.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-9"});
   EXPECT_EQ(o.exit_code, 0) << o;
-  o = rbsim({"check", tiny.other.string(), tiny.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-11"});
+  o = rbsim(
+      {"check", tiny.other.string(), tiny.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-11"});
   EXPECT_EQ(o.exit_code, 1) << o;
-  o = rbsim({"check", large.other.string(), large.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-9"});
+  o = rbsim(
+      {"check", large.other.string(), large.base.string(), "--topics", "/rbsim/scene", "--rtol", "1e-9"});
   EXPECT_EQ(o.exit_code, 1) << o;
 }
 
@@ -332,12 +355,14 @@ TEST(Check, MissingAndExtraMessages) {
   record(kChain, shorter, {"--steps", "99800", "--record-every", kChainEvery});
   Outcome o = rbsim({"check", shorter.string(), kChainGolden.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 100000: message missing from the "
-                              "run: the golden has 501 messages on this topic, the run 500"))
+  EXPECT_TRUE(contains(o.out,
+                       "first divergence: topic /rbsim/body_states, step 100000: message missing from the "
+                       "run: the golden has 501 messages on this topic, the run 500"))
       << o;
   o = rbsim({"check", kChainGolden.string(), shorter.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/body_states, step 100000: extra message in the run"))
+  EXPECT_TRUE(
+      contains(o.out, "first divergence: topic /rbsim/body_states, step 100000: extra message in the run"))
       << o;
 }
 
@@ -366,14 +391,18 @@ TEST(Check, BadInputIsAnErrorWithExitStatus2) {
       EXPECT_EQ(o.exit_code, 2) << o;
       EXPECT_EQ(o.signal, 0) << o;
       EXPECT_FALSE(o.timed_out) << o;
-      EXPECT_EQ(o.err.rfind("rbsim check: error: " + std::string(as_run ? "run" : "golden") + " log " + path.string(), 0),
-                0u)
+      EXPECT_EQ(
+          o.err.rfind(
+              "rbsim check: error: " + std::string(as_run ? "run" : "golden") + " log " + path.string(), 0),
+          0u)
           << o;
     }
   }
-  EXPECT_TRUE(contains(rbsim({"check", bad["not MCAP"].string(), kChainGolden.string()}).err, "not an MCAP file"));
+  EXPECT_TRUE(
+      contains(rbsim({"check", bad["not MCAP"].string(), kChainGolden.string()}).err, "not an MCAP file"));
   EXPECT_TRUE(contains(rbsim({"check", bad["truncated"].string(), kChainGolden.string()}).err, "truncated"));
-  EXPECT_TRUE(contains(rbsim({"check", bad["flipped byte"].string(), kChainGolden.string()}).err, "corrupted"));
+  EXPECT_TRUE(
+      contains(rbsim({"check", bad["flipped byte"].string(), kChainGolden.string()}).err, "corrupted"));
   // Usage errors are errors too.
   EXPECT_EQ(rbsim({"check", kChainGolden.string()}).exit_code, 2);
   EXPECT_EQ(rbsim({"check", kChainGolden.string(), kChainGolden.string(), "--atol", "-1"}).exit_code, 2);
@@ -393,7 +422,8 @@ TEST(CheckLibrary, TruncatedAndFlippedBytesAreErrors) {
   auto expect_error = [&](const std::string& what) {
     ++n;
     Result<log::CheckReport> r = log::check_logs(base.string(), bad.string());
-    EXPECT_FALSE(r.ok()) << what << ": " << (r ? (r->passed() ? "match" : "divergence " + r->first->line()) : "");
+    EXPECT_FALSE(r.ok()) << what << ": "
+                         << (r ? (r->passed() ? "match" : "divergence " + r->first->line()) : "");
   };
   auto sampled = [&](std::size_t i) { return i < 64 || i + 640 >= bytes.size() || i % 13 == 0; };
   for (std::size_t len = 0; len < bytes.size(); ++len) {
@@ -437,7 +467,8 @@ TEST(CheckLibrary, ConformanceFilesMatchTheirOtherLayouts) {
 
 // The per-field maxima agree with an independent decode of both files (msgs::MessageDecoder and
 // path(), nothing of the checker's own walking).
-std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs::path& run, const fs::path& golden) {
+std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs::path& run,
+                                                                        const fs::path& golden) {
   auto read = [](const fs::path& path) {
     std::map<std::string, std::vector<mcap::Bytes>> messages;
     std::map<std::string, std::pair<std::string, std::string>> schemas;
@@ -573,7 +604,8 @@ TEST(Script, RegeneratesAVerifiedGolden) {
                                 {std::string("RBSIM=") + RBSIM_EXE, "RBSIM_GOLDEN_DIR=" + tmp.path().string(),
                                  "RBSIM_FOSSSIM_DIR=" + kFosssim.string()});
   ASSERT_EQ(o.exit_code, 0) << o;
-  EXPECT_TRUE(contains(o.out, "verified (symplectic-energy, independent-integration), --record-every 200")) << o;
+  EXPECT_TRUE(contains(o.out, "verified (symplectic-energy, independent-integration), --record-every 200"))
+      << o;
   const Outcome c = rbsim({"check", (tmp / "chain.mcap").string(), kChainGolden.string()});
   EXPECT_EQ(c.exit_code, 0) << c;
   for (const auto& entry : fs::directory_iterator(tmp.path())) {
@@ -587,8 +619,9 @@ TEST(Script, RefusesAGoldenThatFailsVerification) {
   TempDir tmp;
   const fs::path wrong = edited(tmp / "wrong", kChain, "fy=\"-1.0\"", "fy=\"-1.05\"");
   const fs::path fake = tmp / "fake-rbsim";
-  write_text(fake, "#!/bin/bash\nif [ \"$1\" = run ]; then shift 2; exec '" + std::string(RBSIM_EXE) + "' run '" +
-                       wrong.string() + "' \"$@\"; fi\nexec '" + std::string(RBSIM_EXE) + "' \"$@\"\n");
+  write_text(fake, "#!/bin/bash\nif [ \"$1\" = run ]; then shift 2; exec '" + std::string(RBSIM_EXE) +
+                       "' run '" + wrong.string() + "' \"$@\"; fi\nexec '" + std::string(RBSIM_EXE) +
+                       "' \"$@\"\n");
   fs::permissions(fake, fs::perms::owner_all);
   fs::create_directories(tmp / "out");
   const fs::path old_golden = tmp / "out" / "chain.mcap";

@@ -80,7 +80,8 @@ TEST(EncoderClock, MatchesHandEncodedCdr) {
   rbsim::msgs::Encoder(scene).clock(w.value(), out);
   const std::vector<int> expected = {0, 1, 0, 0, 1, 0, 0, 0, 0x00, 0x65, 0xCD, 0x1D};
   ASSERT_EQ(out.size(), expected.size());
-  for (std::size_t i = 0; i < out.size(); ++i) EXPECT_EQ(static_cast<int>(out[i]), expected[i]) << "byte " << i;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    EXPECT_EQ(static_cast<int>(out[i]), expected[i]) << "byte " << i;
 }
 
 TEST(EncoderBodyStates, DecodesToTheWorldState) {
@@ -221,7 +222,8 @@ TEST(DecodeScene, RoundTripsTheEncodedDescription) {
   EXPECT_EQ(m->winds[0].points_per_edge, 4);
   ASSERT_TRUE(m->viewport.has_value());
   EXPECT_EQ(m->viewport->size, 7.0);
-  for (std::size_t n = 0; n + 1 < out.size(); n += 7) EXPECT_FALSE(rbsim::msgs::decode_scene(std::span(out).first(n)).ok());
+  for (std::size_t n = 0; n + 1 < out.size(); n += 7)
+    EXPECT_FALSE(rbsim::msgs::decode_scene(std::span(out).first(n)).ok());
 }
 
 TEST(DecodeBodyStates, RoundTripsAndRejectsTruncation) {

@@ -32,7 +32,8 @@ class Reference : public testing::TestWithParam<std::string> {
   void SetUp() override {
     const std::string rel = GetParam();
     const std::string stem = rel.substr(0, rel.size() - std::string(".bin.zst").size());
-    rbsim::Result<rbsim::Scene> s = rbsim::load_scene((kData / "fosssim" / "scenes" / (stem + ".xml")).string());
+    rbsim::Result<rbsim::Scene> s =
+        rbsim::load_scene((kData / "fosssim" / "scenes" / (stem + ".xml")).string());
     ASSERT_TRUE(s.ok()) << s.error().message;
     scene_ = s.value();
     auto bytes = rbsim::read_file((kData / "fosssim" / "reference" / rel).string());
@@ -59,7 +60,8 @@ TEST_P(Reference, GradeMatchesReferenceRule) {
 // A free run from t = 0 (no reloading) stays within 1e-9 of the reference's free run, value by
 // value, for the whole duration, through the --fosssim-out sink.
 TEST_P(Reference, FreeRunTracksReference) {
-  const fs::path out = fs::path(testing::TempDir()) / (scene_.name + "_" + std::to_string(::getpid()) + ".bin");
+  const fs::path out =
+      fs::path(testing::TempDir()) / (scene_.name + "_" + std::to_string(::getpid()) + ".bin");
   {
     auto created = rbsim::World::create(scene_.world);
     ASSERT_TRUE(created.ok());
@@ -85,12 +87,13 @@ TEST_P(Reference, FreeRunTracksReference) {
     const auto& a = mine->frames[k];
     const auto& b = reference_.frames[k];
     for (std::size_t i = 0; i < a.states.size(); ++i) {
-      for (double d : {a.states[i].position.x() - b.states[i].position.x(),
-                       a.states[i].position.y() - b.states[i].position.y(), a.states[i].theta - b.states[i].theta,
-                       a.states[i].velocity.x() - b.states[i].velocity.x(),
-                       a.states[i].velocity.y() - b.states[i].velocity.y(), a.states[i].omega - b.states[i].omega,
-                       a.quantities[i].l_point - b.quantities[i].l_point,
-                       a.quantities[i].t_point - b.quantities[i].t_point}) {
+      for (double d :
+           {a.states[i].position.x() - b.states[i].position.x(),
+            a.states[i].position.y() - b.states[i].position.y(), a.states[i].theta - b.states[i].theta,
+            a.states[i].velocity.x() - b.states[i].velocity.x(),
+            a.states[i].velocity.y() - b.states[i].velocity.y(), a.states[i].omega - b.states[i].omega,
+            a.quantities[i].l_point - b.quantities[i].l_point,
+            a.quantities[i].t_point - b.quantities[i].t_point}) {
         worst = std::max(worst, std::abs(d));
       }
     }
@@ -100,12 +103,15 @@ TEST_P(Reference, FreeRunTracksReference) {
   RecordProperty("free_run_max_diff", std::to_string(worst));
 }
 
-INSTANTIATE_TEST_SUITE_P(Fosssim, Reference, testing::ValuesIn(cases()), [](const testing::TestParamInfo<std::string>& param_info) {
-  std::string name = param_info.param.substr(0, param_info.param.find('.'));
-  std::replace(name.begin(), name.end(), '/', '_');
-  return name;
-});
+INSTANTIATE_TEST_SUITE_P(Fosssim, Reference, testing::ValuesIn(cases()),
+                         [](const testing::TestParamInfo<std::string>& param_info) {
+                           std::string name = param_info.param.substr(0, param_info.param.find('.'));
+                           std::replace(name.begin(), name.end(), '/', '_');
+                           return name;
+                         });
 
-TEST(ReferenceData, AllPublicReferencesPresent) { EXPECT_EQ(cases().size(), 38u); }
+TEST(ReferenceData, AllPublicReferencesPresent) {
+  EXPECT_EQ(cases().size(), 38u);
+}
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Pictures that would be wrong if a body, a colour, the viewport or the frame timing were.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <png.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -41,7 +41,8 @@ Image read_png(const fs::path& path) {
 }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::path(testing::TempDir()) / ("rbsim_render_" + name + "_" + std::to_string(::getpid()));
+  const fs::path d =
+      fs::path(testing::TempDir()) / ("rbsim_render_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
 }
@@ -157,15 +158,16 @@ TEST(Render, McapDrivenEqualsSceneDrivenPixelForPixel) {
   }
   EXPECT_EQ(differing_frames, 0);
   // and the frames do change over time (a moving scene)
-  EXPECT_NE(read_png(dir / "from_scene" / "frame00000.png").rgb, read_png(dir / "from_scene" / "frame00035.png").rgb);
+  EXPECT_NE(read_png(dir / "from_scene" / "frame00000.png").rgb,
+            read_png(dir / "from_scene" / "frame00035.png").rgb);
 }
 
 TEST(Plot, WritesAPngOfTheRequestedSize) {
   const fs::path dir = temp_dir("plot");
   fs::create_directories(dir);
   const std::string scene = std::string(RBSIM_SOURCE_DIR) + "/scenes/cantilever.xml";
-  ASSERT_EQ(run({RBSIM_BINARY, "plot", scene, "--out", (dir / "p.png").string(), "--size", "640x480", "--duration",
-                 "2"}),
+  ASSERT_EQ(run({RBSIM_BINARY, "plot", scene, "--out", (dir / "p.png").string(), "--size", "640x480",
+                 "--duration", "2"}),
             0);
   const Image img = read_png(dir / "p.png");
   EXPECT_EQ(img.width, 640);
@@ -173,7 +175,8 @@ TEST(Plot, WritesAPngOfTheRequestedSize) {
   // from a recording too
   const fs::path log = dir / "run.mcap";
   ASSERT_EQ(run({RBSIM_BINARY, "run", scene, "--steps", "500", "--record", log.string(), "-q"}), 0);
-  ASSERT_EQ(run({RBSIM_BINARY, "plot", log.string(), "--out", (dir / "q.png").string(), "--size", "800x600"}), 0);
+  ASSERT_EQ(run({RBSIM_BINARY, "plot", log.string(), "--out", (dir / "q.png").string(), "--size", "800x600"}),
+            0);
   EXPECT_EQ(read_png(dir / "q.png").width, 800);
 }
 
@@ -181,9 +184,12 @@ TEST(RenderCli, BadInputGivesAClearErrorAndNonzeroExit) {
   const fs::path dir = temp_dir("bad");
   const fs::path scene = write_scene(dir, kSquareScene);
   std::string err;
-  EXPECT_EQ(run({RBSIM_BINARY, "render", scene.string(), "--out", (dir / "f").string(), "--size", "12x"}, &err), 1);
+  EXPECT_EQ(
+      run({RBSIM_BINARY, "render", scene.string(), "--out", (dir / "f").string(), "--size", "12x"}, &err), 1);
   EXPECT_NE(err.find("invalid --size"), std::string::npos) << err;
-  EXPECT_EQ(run({RBSIM_BINARY, "render", scene.string(), "--out", (dir / "f").string(), "--size", "0x100"}, &err), 1);
+  EXPECT_EQ(
+      run({RBSIM_BINARY, "render", scene.string(), "--out", (dir / "f").string(), "--size", "0x100"}, &err),
+      1);
   // unwritable output folder: a path below a regular file
   const fs::path file = dir / "plain-file";
   std::ofstream(file) << "x";

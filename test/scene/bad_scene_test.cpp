@@ -41,7 +41,9 @@ TEST_P(ParseSceneBadFile, ReportsTheGivenName) {
   EXPECT_TRUE(mismatch.empty()) << mismatch << "\n  got: " << s.error().message;
 }
 
-std::vector<test::BadScene> manifest() { return test::read_bad_scene_manifest(kBad); }
+std::vector<test::BadScene> manifest() {
+  return test::read_bad_scene_manifest(kBad);
+}
 std::vector<test::BadScene> manifest_files() {  // the rows that have text (not the directory)
   std::vector<test::BadScene> out;
   for (const auto& b : manifest()) {
@@ -69,10 +71,11 @@ TEST(LoadSceneBadManifest, ListsEveryFileAndCoversEveryRule) {
   }
   for (const auto& f : listed) EXPECT_TRUE(fs::exists(kBad + "/" + f)) << f;
   // the rules of the brief, each with at least one scene
-  for (const char* rule : {"empty file", "not well-formed XML", "required attribute is missing", "must be a number",
-                           "must be a finite number", "must be > 0", "must be >= 0", "unknown integrator",
-                           "unknown simtype", "vertex index", "at least 2 hull vertices", "body index -2",
-                           "spring index", "must be an integer in [2", "colour component", "is a directory"}) {
+  for (const char* rule :
+       {"empty file", "not well-formed XML", "required attribute is missing", "must be a number",
+        "must be a finite number", "must be > 0", "must be >= 0", "unknown integrator", "unknown simtype",
+        "vertex index", "at least 2 hull vertices", "body index -2", "spring index",
+        "must be an integer in [2", "colour component", "is a directory"}) {
     bool found = false;
     for (const auto& r : rows) found = found || r.message.find(rule) != std::string::npos;
     EXPECT_TRUE(found) << rule;
@@ -110,7 +113,9 @@ struct InlineBad {
   const char* text;
   const char* expected;  // whole message
 };
-void PrintTo(const InlineBad& b, std::ostream* os) { *os << b.name; }
+void PrintTo(const InlineBad& b, std::ostream* os) {
+  *os << b.name;
+}
 
 class ParseSceneBad : public ::testing::TestWithParam<InlineBad> {};
 
@@ -120,7 +125,9 @@ TEST_P(ParseSceneBad, GivesTheDocumentedOneLineError) {
   EXPECT_EQ(s.error().message, GetParam().expected);
 }
 
-#define HEAD "<scene>\n<simtype type=\"rigid-body\"/>\n<duration time=\"1\"/>\n<rigidbodyintegrator type=\"symplectic-euler\" dt=\"0.1\"/>\n"
+#define HEAD                                                                               \
+  "<scene>\n<simtype type=\"rigid-body\"/>\n<duration time=\"1\"/>\n<rigidbodyintegrator " \
+  "type=\"symplectic-euler\" dt=\"0.1\"/>\n"
 const InlineBad kInline[] = {
     {"only_whitespace", "  \n\n ", "inline.xml:1: empty file (expected a <scene>)"},
     {"vertex_missing_y", HEAD "<rigidbodyvertex x=\"1\" m=\"1\"/>\n</scene>",
@@ -131,18 +138,26 @@ const InlineBad kInline[] = {
      "inline.xml:5: <rigidbodyvertex> attribute 'x': must be a finite number (got \"-inf\")"},
     {"hex_float_is_not_a_scene_number", HEAD "<rigidbodyvertex x=\"0x10\" y=\"0\" m=\"1\"/>\n</scene>",
      "inline.xml:5: <rigidbodyvertex> attribute 'x': must be a number (got \"0x10\")"},
-    {"spring_index_not_integer", HEAD "<rigidbodyspringforce i=\"a\" pix=\"0\" piy=\"0\" j=\"-1\" pjx=\"0\" pjy=\"0\" k=\"1\" l0=\"1\"/>\n</scene>",
+    {"spring_index_not_integer",
+     HEAD "<rigidbodyspringforce i=\"a\" pix=\"0\" piy=\"0\" j=\"-1\" pjx=\"0\" pjy=\"0\" k=\"1\" "
+          "l0=\"1\"/>\n</scene>",
      "inline.xml:5: <rigidbodyspringforce> attribute 'i': must be an integer (got \"a\")"},
-    {"spring_without_bodies", HEAD "<rigidbodyspringforce i=\"-1\" pix=\"0\" piy=\"0\" j=\"0\" pjx=\"0\" pjy=\"0\" k=\"1\" l0=\"1\"/>\n</scene>",
-     "inline.xml:5: <rigidbodyspringforce> attribute 'j': body index 0 out of range [-1, -1] (-1 = fixed point)"},
+    {"spring_without_bodies",
+     HEAD "<rigidbodyspringforce i=\"-1\" pix=\"0\" piy=\"0\" j=\"0\" pjx=\"0\" pjy=\"0\" k=\"1\" "
+          "l0=\"1\"/>\n</scene>",
+     "inline.xml:5: <rigidbodyspringforce> attribute 'j': body index 0 out of range [-1, -1] (-1 = fixed "
+     "point)"},
     {"colour_without_bodies", HEAD "<rigidbodycolor body=\"0\" r=\"0\" g=\"0\" b=\"0\"/>\n</scene>",
      "inline.xml:5: <rigidbodycolor> attribute 'body': body index 0 out of range [0, -1]"},
     {"background_colour", HEAD "<backgroundcolor r=\"0\" g=\"2\" b=\"0\"/>\n</scene>",
      "inline.xml:5: <backgroundcolor> attribute 'g': colour component must be in [0, 1] (got 2)"},
     {"viewport_size", HEAD "<viewport cx=\"0\" cy=\"0\" size=\"0\"/>\n</scene>",
      "inline.xml:5: <viewport> attribute 'size': must be > 0 (got 0)"},
-    {"huge_points_per_edge", HEAD "<rigidbodywindforce beta=\"1\" fx=\"0\" fy=\"0\" pointsperedge=\"99999999999999999999\"/>\n</scene>",
-     "inline.xml:5: <rigidbodywindforce> attribute 'pointsperedge': must be an integer (got \"99999999999999999999\")"},
+    {"huge_points_per_edge",
+     HEAD
+     "<rigidbodywindforce beta=\"1\" fx=\"0\" fy=\"0\" pointsperedge=\"99999999999999999999\"/>\n</scene>",
+     "inline.xml:5: <rigidbodywindforce> attribute 'pointsperedge': must be an integer (got "
+     "\"99999999999999999999\")"},
     // a value may span lines; the message must still be one line
     {"value_spanning_lines", HEAD "<rigidbodyvertex x=\"1\n2\" y=\"0\" m=\"1\"/>\n</scene>",
      "inline.xml:5: <rigidbodyvertex> attribute 'x': must be a number (got \"1\\n2\")"},

@@ -10,9 +10,9 @@
 namespace rbsim::test {
 
 struct BadScene {
-  std::string file;      // name inside the bad_scenes directory
-  int line = 0;          // 0: the message has no line number ("<path>: ...")
-  bool exact = true;     // the message after "<path>:<line>: " is exactly `message`, else starts with it
+  std::string file;   // name inside the bad_scenes directory
+  int line = 0;       // 0: the message has no line number ("<path>: ...")
+  bool exact = true;  // the message after "<path>:<line>: " is exactly `message`, else starts with it
   std::string message;
 
   // The start every error for this scene must have.
@@ -26,14 +26,17 @@ struct BadScene {
     if (error.rfind(head, 0) != 0) return "message does not start with \"" + head + "\"";
     const std::string tail = error.substr(head.size());
     if (exact ? tail != message : tail.rfind(message, 0) != 0) {
-      return std::string("expected ") + (exact ? "exactly" : "a message starting with") + " \"" + message + "\"";
+      return std::string("expected ") + (exact ? "exactly" : "a message starting with") + " \"" + message +
+             "\"";
     }
     return {};
   }
 };
 
 // Names the case in test output (instead of the bytes of the struct).
-inline void PrintTo(const BadScene& b, std::ostream* os) { *os << b.file; }
+inline void PrintTo(const BadScene& b, std::ostream* os) {
+  *os << b.file;
+}
 
 inline std::string trim_copy(const std::string& s) {
   const auto b = s.find_first_not_of(' '), e = s.find_last_not_of(' ');

@@ -137,17 +137,18 @@ TEST(LoadScene, PublicSceneColoursAreApplied) {
 }
 
 TEST(ParseScene, RepeatedPAttributesKeepDocumentOrder) {
-  const Scene s = parse_ok(scene_with("  <rigidbody p=\"2\" p=\"0\" p=\"3\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\" p=\"1\"/>\n"));
+  const Scene s = parse_ok(
+      scene_with("  <rigidbody p=\"2\" p=\"0\" p=\"3\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\" p=\"1\"/>\n"));
   ASSERT_EQ(s.world.bodies.size(), 1u);
   EXPECT_EQ(s.world.bodies[0].hull, (std::vector<Vec2>{{1.0, 1.0}, {-1.0, -1.0}, {1.0, -1.0}, {-1.0, 1.0}}));
 }
 
 TEST(ParseScene, VerticesAreOneGlobalListAndBodiesMayReferAhead) {
-  const Scene s = parse_ok(scene_with(
-      "  <rigidbody p=\"4\" p=\"5\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"
-      "  <rigidbodyvertex x=\"5\" y=\"0\" m=\"2\"/>\n"
-      "  <rigidbodyvertex x=\"7\" y=\"0\" m=\"3\"/>\n"
-      "  <rigidbody p=\"0\" p=\"1\" p=\"2\" p=\"3\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"));
+  const Scene s = parse_ok(
+      scene_with("  <rigidbody p=\"4\" p=\"5\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"
+                 "  <rigidbodyvertex x=\"5\" y=\"0\" m=\"2\"/>\n"
+                 "  <rigidbodyvertex x=\"7\" y=\"0\" m=\"3\"/>\n"
+                 "  <rigidbody p=\"0\" p=\"1\" p=\"2\" p=\"3\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"));
   ASSERT_EQ(s.world.bodies.size(), 2u);
   EXPECT_EQ(s.world.bodies[0].hull, (std::vector<Vec2>{{5.0, 0.0}, {7.0, 0.0}}));
   EXPECT_EQ(s.world.bodies[0].masses, (std::vector<double>{2.0, 3.0}));
@@ -155,9 +156,9 @@ TEST(ParseScene, VerticesAreOneGlobalListAndBodiesMayReferAhead) {
 }
 
 TEST(ParseScene, NumbersMayCarrySpacesAndSigns) {
-  const Scene s = parse_ok(scene_with(
-      "  <rigidbodyvertex x=\"  2.5 \" y=\"\t-3\" m=\" 1e1\"/>\n"
-      "  <rigidbody p=\" 0\" p=\"4 \" vx=\"+1.5\" vy=\" -0.25 \" omega=\" 2\" r=\" 0.1\"/>\n"));
+  const Scene s = parse_ok(
+      scene_with("  <rigidbodyvertex x=\"  2.5 \" y=\"\t-3\" m=\" 1e1\"/>\n"
+                 "  <rigidbody p=\" 0\" p=\"4 \" vx=\"+1.5\" vy=\" -0.25 \" omega=\" 2\" r=\" 0.1\"/>\n"));
   ASSERT_EQ(s.world.bodies.size(), 1u);
   const BodyDef& b = s.world.bodies[0];
   EXPECT_EQ(b.hull[1], Vec2(2.5, -3.0));
@@ -171,8 +172,10 @@ TEST(ParseScene, ReadsEveryNodeKind) {
   const Scene s = parse_ok(
       scene_with("  <rigidbody p=\"0\" p=\"1\" p=\"2\" p=\"3\" vx=\"1\" vy=\"2\" omega=\"-0.5\" r=\"0.3\"/>\n"
                  "  <rigidbody p=\"1\" p=\"2\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"
-                 "  <rigidbodyspringforce i=\"0\" pix=\"1\" piy=\"2\" j=\"-1\" pjx=\"3\" pjy=\"4\" k=\"5\" l0=\"6\"/>\n"
-                 "  <rigidbodyspringforce i=\"-1\" pix=\"0\" piy=\"0\" j=\"1\" pjx=\"0\" pjy=\"0\" k=\"0\" l0=\"0\"/>\n"
+                 "  <rigidbodyspringforce i=\"0\" pix=\"1\" piy=\"2\" j=\"-1\" pjx=\"3\" pjy=\"4\" k=\"5\" "
+                 "l0=\"6\"/>\n"
+                 "  <rigidbodyspringforce i=\"-1\" pix=\"0\" piy=\"0\" j=\"1\" pjx=\"0\" pjy=\"0\" k=\"0\" "
+                 "l0=\"0\"/>\n"
                  "  <rigidbodygravityforce fx=\"0.5\" fy=\"-9.81\"/>\n"
                  "  <rigidbodygravityforce fx=\"1\" fy=\"0\"/>\n"
                  "  <rigidbodywindforce beta=\"0.5\" fx=\"2\" fy=\"-1\" pointsperedge=\"7\"/>\n"
@@ -267,8 +270,10 @@ TEST(ParseScene, UnknownNodeAndAttributeAreWarningsNotErrors) {
 }
 
 TEST(ParseScene, CommentsAndDeclarationsAreIgnored) {
-  const Scene s = parse_ok("<?xml version=\"1.0\"?>\n<!-- p=\"1\" p=\"2\" -->\n" +
-                           scene_with("  <!-- a body -->\n  <rigidbody p=\"0\" p=\"1\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"));
+  const Scene s = parse_ok(
+      "<?xml version=\"1.0\"?>\n<!-- p=\"1\" p=\"2\" -->\n" +
+      scene_with(
+          "  <!-- a body -->\n  <rigidbody p=\"0\" p=\"1\" vx=\"0\" vy=\"0\" omega=\"0\" r=\"0.1\"/>\n"));
   EXPECT_EQ(s.world.bodies.size(), 1u);
   EXPECT_TRUE(s.warnings.empty());
 }
@@ -283,7 +288,8 @@ TEST(ParseScene, LineNumbersSurviveMultiLineTagsWithRepeatedAttributes) {
   Result<Scene> s = parse_scene(text, "lines.xml");
   ASSERT_FALSE(s);
   EXPECT_EQ(s.error().message,
-            "lines.xml:13: <rigidbodywindforce> attribute 'pointsperedge': must be an integer in [2, 1000000] (got 1)");
+            "lines.xml:13: <rigidbodywindforce> attribute 'pointsperedge': must be an integer in [2, "
+            "1000000] (got 1)");
 }
 
 TEST(StepsFor, CeilingOfDurationOverDtInDoublePrecision) {

@@ -39,7 +39,8 @@ TEST(ParseSceneFuzz, EveryPrefixTruncation) {
     const std::string text = read(kScenes + name);
     ASSERT_GT(text.size(), 500u);
     int ok = 0, errors = 0;
-    for (std::size_t n = 0; n <= text.size(); ++n) check(text.substr(0, n), "prefix " + std::to_string(n), ok, errors);
+    for (std::size_t n = 0; n <= text.size(); ++n)
+      check(text.substr(0, n), "prefix " + std::to_string(n), ok, errors);
     EXPECT_GT(errors, 0);
     EXPECT_GE(ok, 1);  // at least the whole file
   }
@@ -56,9 +57,15 @@ TEST(ParseSceneFuzz, RandomSingleByteMutations) {
     const std::size_t at = rng() % mutated.size();
     const char c = i % 2 ? static_cast<char>(rng() % 256) : interesting[rng() % interesting.size()];
     switch (i % 3) {
-      case 0: mutated[at] = c; break;
-      case 1: mutated.erase(at, 1); break;
-      default: mutated.insert(at, 1, c); break;
+      case 0:
+        mutated[at] = c;
+        break;
+      case 1:
+        mutated.erase(at, 1);
+        break;
+      default:
+        mutated.insert(at, 1, c);
+        break;
     }
     check(mutated, "mutation " + std::to_string(i) + " at byte " + std::to_string(at), ok, errors);
   }

@@ -49,18 +49,20 @@ void print_table(const log::CheckReport& r, bool all_fields) {
   std::printf("per-field max error (run - golden, array indices collapsed):\n");
   if (!rows.empty()) {
     std::printf("  %-*s  %-*s  %-6s  %10s  %10s  %10s  %12s  %10s\n", static_cast<int>(topic_w), "topic",
-                static_cast<int>(field_w), "field", "kind", "values", "max |diff|", "max rel", "at", "over tol");
+                static_cast<int>(field_w), "field", "kind", "values", "max |diff|", "max rel", "at",
+                "over tol");
     for (const log::FieldStats* f : rows) {
-      const std::string at = f->max_abs == 0.0 ? "-" : (f->has_step ? "step " : "msg ") + std::to_string(f->step_at_max);
-      std::printf("  %-*s  %-*s  %-6s  %10llu  %10s  %10s  %12s  %10llu\n", static_cast<int>(topic_w), f->topic.c_str(),
-                  static_cast<int>(field_w), f->field.c_str(), f->kind.c_str(),
-                  static_cast<unsigned long long>(f->values), g(f->max_abs).c_str(), g(f->max_rel).c_str(), at.c_str(),
-                  static_cast<unsigned long long>(f->over));
+      const std::string at =
+          f->max_abs == 0.0 ? "-" : (f->has_step ? "step " : "msg ") + std::to_string(f->step_at_max);
+      std::printf("  %-*s  %-*s  %-6s  %10llu  %10s  %10s  %12s  %10llu\n", static_cast<int>(topic_w),
+                  f->topic.c_str(), static_cast<int>(field_w), f->field.c_str(), f->kind.c_str(),
+                  static_cast<unsigned long long>(f->values), g(f->max_abs).c_str(), g(f->max_rel).c_str(),
+                  at.c_str(), static_cast<unsigned long long>(f->over));
     }
   }
   if (identical > 0) {
-    std::printf("  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical, identical == 1 ? "" : "s",
-                all_fields || rows.empty() ? "" : " (--all-fields lists them)");
+    std::printf("  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical,
+                identical == 1 ? "" : "s", all_fields || rows.empty() ? "" : " (--all-fields lists them)");
   }
 }
 
@@ -73,7 +75,8 @@ int compare(const CheckArgs& a) {
   if (!result) return fail(result.error().message);
   const log::CheckReport& r = result.value();
   std::printf("rbsim check: %s vs golden %s (atol %s, rtol %s): %s\n", run.c_str(), golden.c_str(),
-              g(a.options.atol, "%g").c_str(), g(a.options.rtol, "%g").c_str(), r.passed() ? "MATCH" : "DIVERGED");
+              g(a.options.atol, "%g").c_str(), g(a.options.rtol, "%g").c_str(),
+              r.passed() ? "MATCH" : "DIVERGED");
   if (r.first) std::printf("first divergence: %s\n", r.first->line().c_str());
   for (const std::string& p : r.topic_problems) std::printf("topic difference: %s\n", p.c_str());
   print_table(r, a.all_fields);
@@ -117,7 +120,8 @@ int check_command(const CheckArgs& a) {
     return golden_every(a);
   }
   if (a.files.size() != 2) {
-    return fail(a.verify_golden ? "--verify-golden needs SCENE and GOLDEN" : "expected two files: RUN.mcap GOLDEN.mcap");
+    return fail(a.verify_golden ? "--verify-golden needs SCENE and GOLDEN"
+                                : "expected two files: RUN.mcap GOLDEN.mcap");
   }
   return a.verify_golden ? verify(a) : compare(a);
 }
@@ -127,19 +131,23 @@ int check_command(const CheckArgs& a) {
 Subcommand add_check_command(CLI::App& parent) {
   auto a = std::make_shared<CheckArgs>();
   CLI::App* app = parent.add_subcommand(
-      "check", "Compare a recording with a golden log message by message and field by field (or verify a golden)");
+      "check",
+      "Compare a recording with a golden log message by message and field by field (or verify a golden)");
   app->add_option("files", a->files, "RUN.mcap GOLDEN.mcap (with --verify-golden: SCENE.xml GOLDEN.mcap)")
       ->expected(0, 2);
-  app->add_option("--atol", a->options.atol, "Absolute tolerance for floating-point fields (default 0: exact)");
+  app->add_option("--atol", a->options.atol,
+                  "Absolute tolerance for floating-point fields (default 0: exact)");
   app->add_option("--rtol", a->options.rtol,
                   "Relative tolerance: a float matches when |actual - expected| <= atol + rtol * |expected| "
                   "(default 0: exact)");
   app->add_option("--topics", a->options.topics, "Compare only these topics (comma-separated or repeated)")
       ->delimiter(',');
-  app->add_option("--exclude-topics", a->options.exclude_topics, "Leave these topics out (comma-separated or repeated)")
+  app->add_option("--exclude-topics", a->options.exclude_topics,
+                  "Leave these topics out (comma-separated or repeated)")
       ->delimiter(',');
-  app->add_flag("--ignore-log-time", [a](std::int64_t) { a->options.compare_log_time = false; },
-                "Compare payloads only, not log times (a live recording against rbsim run --record)");
+  app->add_flag(
+      "--ignore-log-time", [a](std::int64_t) { a->options.compare_log_time = false; },
+      "Compare payloads only, not log times (a live recording against rbsim run --record)");
   app->add_flag("--all-fields", a->all_fields, "List every field in the table, also the identical ones");
   app->add_flag("--verify-golden", a->verify_golden,
                 "Verify GOLDEN.mcap as a golden log of SCENE.xml, independently of the simulator: the scene "
@@ -148,14 +156,18 @@ Subcommand add_check_command(CLI::App& parent) {
                 "--fosssim-dir) or energy conservation (test/golden/README.md)");
   app->add_option("--fosssim-dir", a->fosssim_dir,
                   "With --verify-golden: FOSSSim scenes and reference outputs (test/data/fosssim)");
-  app->add_option("--golden-every", a->golden_every,
-                  "Print the --record-every K a golden of this scene is recorded with (about 500 steps) and exit");
+  app->add_option(
+      "--golden-every", a->golden_every,
+      "Print the --record-every K a golden of this scene is recorded with (about 500 steps) and exit");
   app->footer(
-      "Messages pair up per topic in order; a missing or extra message, a topic in only one file, a different "
+      "Messages pair up per topic in order; a missing or extra message, a topic in only one file, a "
+      "different "
       "schema or log time, or a value outside the tolerance is a divergence. Integers, strings, booleans and "
-      "array lengths compare exactly. Prints the first divergence (topic, step, field path, expected, actual, "
+      "array lengths compare exactly. Prints the first divergence (topic, step, field path, expected, "
+      "actual, "
       "difference) and the largest difference per field.\n"
-      "Exit status: 0 match (or golden verified), 1 divergence (or verification failed), 2 error (unreadable, "
+      "Exit status: 0 match (or golden verified), 1 divergence (or verification failed), 2 error "
+      "(unreadable, "
       "truncated, corrupted or non-MCAP input, bad arguments).");
   return {app, [a] { return check_command(*a); }};
 }

@@ -10,7 +10,9 @@ namespace rbsim::cli {
 
 namespace {
 std::atomic<int> g_stop_signal{0};
-extern "C" void on_stop_signal(int sig) { g_stop_signal.store(sig, std::memory_order_relaxed); }
+extern "C" void on_stop_signal(int sig) {
+  g_stop_signal.store(sig, std::memory_order_relaxed);
+}
 }  // namespace
 
 void install_stop_handlers() {
@@ -20,8 +22,12 @@ void install_stop_handlers() {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 }
-bool stop_requested() { return g_stop_signal.load(std::memory_order_relaxed) != 0; }
-int stop_signal() { return g_stop_signal.load(std::memory_order_relaxed); }
+bool stop_requested() {
+  return g_stop_signal.load(std::memory_order_relaxed) != 0;
+}
+int stop_signal() {
+  return g_stop_signal.load(std::memory_order_relaxed);
+}
 
 std::string format_seconds(double seconds) {
   char buf[32];
@@ -30,7 +36,8 @@ std::string format_seconds(double seconds) {
   } else if (seconds < 120.0) {
     std::snprintf(buf, sizeof buf, "%.2f s", seconds);
   } else {
-    std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(seconds) / 60, static_cast<int>(seconds) % 60);
+    std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(seconds) / 60,
+                  static_cast<int>(seconds) % 60);
   }
   return buf;
 }
@@ -41,7 +48,9 @@ Progress::Progress(std::int64_t total, Mode mode, std::chrono::milliseconds dela
   if (mode == Mode::Always) delay_ = std::chrono::milliseconds(0);
 }
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 void Progress::tick(std::int64_t done) {
   calls_ = 0;
@@ -69,6 +78,14 @@ void Progress::finish() {
     shown_ = false;
   }
   enabled_ = false;
+}
+
+std::string describe_divergence(std::int64_t step, std::int32_t body, const char* quantity) {
+  const std::string where = body >= 0 ? "body " + std::to_string(body) + " " : "";
+  return "step " + std::to_string(step) + ": " + where + quantity +
+         " is not finite: the simulation diverged (try a smaller dt or symplectic-euler; --allow-nonfinite "
+         "keeps "
+         "going)";
 }
 
 }  // namespace rbsim::cli

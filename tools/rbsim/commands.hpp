@@ -19,7 +19,7 @@ Subcommand add_plot_command(CLI::App& parent);    // render.cpp
 Subcommand add_node_command(CLI::App& parent);    // node.cpp
 Subcommand add_record_command(CLI::App& parent);  // record.cpp
 Subcommand add_replay_command(CLI::App& parent);  // replay.cpp
-Subcommand add_log_command(CLI::App& parent);    // log.cpp: info, doctor, recover, export
-Subcommand add_check_command(CLI::App& parent);  // check.cpp: golden-log comparison
+Subcommand add_log_command(CLI::App& parent);     // log.cpp: info, doctor, recover, export
+Subcommand add_check_command(CLI::App& parent);   // check.cpp: golden-log comparison
 
 }  // namespace rbsim::cli

@@ -8,14 +8,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer("Run 'rbsim <command> --help' for a command's options.");
   const std::vector<rbsim::cli::Subcommand> subcommands = {
-      rbsim::cli::add_run_command(app),
-      rbsim::cli::add_grade_command(app),
-      rbsim::cli::add_render_command(app),
-      rbsim::cli::add_plot_command(app),
-      rbsim::cli::add_node_command(app),
-      rbsim::cli::add_record_command(app),
-      rbsim::cli::add_replay_command(app),
-      rbsim::cli::add_log_command(app),
+      rbsim::cli::add_run_command(app),    rbsim::cli::add_grade_command(app),
+      rbsim::cli::add_render_command(app), rbsim::cli::add_plot_command(app),
+      rbsim::cli::add_node_command(app),   rbsim::cli::add_record_command(app),
+      rbsim::cli::add_replay_command(app), rbsim::cli::add_log_command(app),
       rbsim::cli::add_check_command(app),
   };
   try {

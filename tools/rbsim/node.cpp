@@ -15,6 +15,7 @@ struct NodeArgs {
   node::NodeOptions node;
   std::optional<double> duration;
   bool loop = false;
+  bool allow_nonfinite = false;
   std::int32_t wait_for = 0;
   bool quiet = false;
 };
@@ -37,7 +38,8 @@ int node_command(const NodeArgs& a) {
   if (!sink) return fail(sink.error().message);
   install_stop_handlers();
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim node: %s on domain %u, topics under /%s (and /clock), rate %s, %lld steps%s\n",
+    std::fprintf(stderr,
+                 "rbsim node: %s on domain %u, topics under /%s (and /clock), rate %s, %lld steps%s\n",
                  scene.name.c_str(), a.node.domain, a.node.ns.c_str(),
                  a.node.rate > 0 ? (std::to_string(a.node.rate) + "x").c_str() : "as fast as possible",
                  static_cast<long long>(steps), a.loop ? ", looping" : "");
@@ -56,9 +58,12 @@ int node_command(const NodeArgs& a) {
     while (world.step_index() < steps && !stop_requested()) {
       world.step();
       ++total_steps;
-      if (const auto bad = world.find_nonfinite()) {
-        return fail("step " + std::to_string(world.step_index()) + ": " + bad->quantity +
-                    " is not finite: the simulation diverged");
+      if (const auto bad = a.allow_nonfinite ? std::nullopt : world.find_nonfinite()) {
+        // Subscribers still get every step before it (bounded wait for their acknowledgements).
+        const Status flushed = sink.value()->finish();
+        return fail(describe_divergence(world.step_index(), bad->body.index, bad->quantity) +
+                    ". Published steps up to " + std::to_string(world.step_index() - 1) +
+                    (flushed ? "." : " (" + flushed.error().message + ")."));
       }
       if (Status st = sink.value()->write(world); !st) return fail(st.error().message);
     }
@@ -77,20 +82,28 @@ int node_command(const NodeArgs& a) {
 
 Subcommand add_node_command(CLI::App& parent) {
   auto a = std::make_shared<NodeArgs>();
-  CLI::App* app = parent.add_subcommand("node", "Run a scene and publish it live over DDS (ROS 2 conventions)");
+  CLI::App* app =
+      parent.add_subcommand("node", "Run a scene and publish it live over DDS (ROS 2 conventions)");
   app->add_option("scene", a->scene, "FOSSSim XML scene file")->required();
-  app->add_option("--rate", a->node.rate, "Real-time factor (2 = twice as fast as real time; 0 = as fast as possible)")
+  app->add_option("--rate", a->node.rate,
+                  "Real-time factor (2 = twice as fast as real time; 0 = as fast as possible)")
       ->check(CLI::NonNegativeNumber)
       ->default_str("1");
   app->add_option("--publish-every", a->node.publish_every, "Publish every k-th step")
       ->check(CLI::PositiveNumber)
       ->default_str("1");
   app->add_option("--domain", a->node.domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
-  app->add_option("--namespace", a->node.ns, "ROS namespace: topics are /<namespace>/<name>")->default_str("rbsim");
+  app->add_option("--namespace", a->node.ns, "ROS namespace: topics are /<namespace>/<name>")
+      ->default_str("rbsim");
   app->add_option("--duration", a->duration, "Simulated seconds per run (default: the scene's)")
       ->check(CLI::NonNegativeNumber);
   app->add_flag("--loop", a->loop, "Start the scene again when it ends, until Ctrl-C");
-  app->add_option("--wait-for-subscribers", a->wait_for, "Wait until N subscribers match the body states first")
+  app->add_flag(
+      "--allow-nonfinite", a->allow_nonfinite,
+      "Keep going when the simulation diverges (default: stop at the first inf/NaN with an error naming "
+      "the step, body and quantity)");
+  app->add_option("--wait-for-subscribers", a->wait_for,
+                  "Wait until N subscribers match the body states first")
       ->check(CLI::NonNegativeNumber);
   app->add_option("--keep-last", a->node.keep_last,
                   "Per-step writers keep the last N samples instead of all: the node never waits for a slow "
@@ -99,11 +112,15 @@ Subcommand add_node_command(CLI::App& parent) {
   app->add_flag("-q,--quiet", a->quiet, "No start and end lines");
   app->footer(
       "Topics (DDS name rt/<namespace>/<name>, type pkg::msg::dds_::Name_, CDR): scene "
-      "(rbsim_msgs/SceneDescription, reliable, transient local, keep last 1: late joiners get it), body_states, "
-      "spring_states, energy, poses (geometry_msgs/PoseArray), markers (visualization_msgs/MarkerArray) and /clock "
-      "(rosgraph_msgs/Clock), all reliable, volatile, keep all: a slow subscriber slows the node down rather than "
+      "(rbsim_msgs/SceneDescription, reliable, transient local, keep last 1: late joiners get it), "
+      "body_states, "
+      "spring_states, energy, poses (geometry_msgs/PoseArray), markers (visualization_msgs/MarkerArray) and "
+      "/clock "
+      "(rosgraph_msgs/Clock), all reliable, volatile, keep all: a slow subscriber slows the node down rather "
+      "than "
       "losing samples (--keep-last N trades that for a node that never waits).\n"
-      "DDS: without CYCLONEDDS_URI the node uses rbsim's loopback configuration (127.0.0.1 only, no multicast); set "
+      "DDS: without CYCLONEDDS_URI the node uses rbsim's loopback configuration (127.0.0.1 only, no "
+      "multicast); set "
       "CYCLONEDDS_URI to a Cyclone DDS configuration to go onto a real network.\n"
       "Ctrl-C stops cleanly (exit 0).");
   return {app, [a] { return node_command(*a); }};

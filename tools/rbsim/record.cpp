@@ -26,7 +26,8 @@ int fail(const std::string& m) {
 }
 
 int record_command(RecordArgs a) {
-  if (!log::parse_compression(a.compression, a.rec.compression)) return fail("unknown compression " + a.compression);
+  if (!log::parse_compression(a.compression, a.rec.compression))
+    return fail("unknown compression " + a.compression);
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
   // error, leaving a recoverable file, instead of SIGXFSZ killing it.
   std::signal(SIGXFSZ, SIG_IGN);
@@ -37,7 +38,8 @@ int record_command(RecordArgs a) {
   install_stop_handlers();
   if (!a.quiet) {
     std::fprintf(stderr, "rbsim record: recording %s topics under /%s on domain %u to %s (Ctrl-C to stop)\n",
-                 a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(), a.domain, a.rec.path.c_str());
+                 a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(), a.domain,
+                 a.rec.path.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = a.duration ? start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -53,7 +55,8 @@ int record_command(RecordArgs a) {
     if (a.rec.max_messages > 0 && recorder.value()->received() >= a.rec.max_messages) break;
   }
   // Whatever stopped us, finish a valid indexed file.
-  if (Status st = recorder.value()->close(); !st) return fail(st.error().message + " (the file can be repaired with rbsim log recover)");
+  if (Status st = recorder.value()->close(); !st)
+    return fail(st.error().message + " (the file can be repaired with rbsim log recover)");
   if (!a.quiet || failure) {
     std::uint64_t lost = 0;
     for (const auto& c : recorder.value()->counts()) {
@@ -62,8 +65,8 @@ int record_command(RecordArgs a) {
       lost += c.lost;
     }
     std::fprintf(stderr, "rbsim record: %llu messages received, %llu lost, written to %s\n",
-                 static_cast<unsigned long long>(recorder.value()->received()), static_cast<unsigned long long>(lost),
-                 a.rec.path.c_str());
+                 static_cast<unsigned long long>(recorder.value()->received()),
+                 static_cast<unsigned long long>(lost), a.rec.path.c_str());
   }
   if (failure) return fail(*failure + " (the file was finished up to that point)");
   return 0;
@@ -72,28 +75,34 @@ int record_command(RecordArgs a) {
 
 Subcommand add_record_command(CLI::App& parent) {
   auto a = std::make_shared<RecordArgs>();
-  CLI::App* app = parent.add_subcommand("record", "Record rbsim topics from DDS into an MCAP file (rosbag2 layout)");
+  CLI::App* app =
+      parent.add_subcommand("record", "Record rbsim topics from DDS into an MCAP file (rosbag2 layout)");
   app->add_option("out", a->rec.path, "MCAP file to write")->required();
-  app->add_option("--topics", a->rec.topics,
-                  "Topics to record, comma-separated or repeated (body_states or /rbsim/body_states); default all")
+  app->add_option(
+         "--topics", a->rec.topics,
+         "Topics to record, comma-separated or repeated (body_states or /rbsim/body_states); default all")
       ->delimiter(',')
       ->allow_extra_args(false);
   app->add_option("--domain", a->domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")->default_str("rbsim");
-  app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")->check(CLI::PositiveNumber);
+  app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")
+      ->check(CLI::PositiveNumber);
   app->add_option("--max-messages", a->rec.max_messages, "Stop after this many messages");
   app->add_option("--compression", a->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
-  app->add_option("--chunk-size", a->rec.chunk_size,
-                  "Uncompressed bytes per MCAP chunk: a killed recorder loses at most the chunk it was filling")
+  app->add_option(
+         "--chunk-size", a->rec.chunk_size,
+         "Uncompressed bytes per MCAP chunk: a killed recorder loses at most the chunk it was filling")
       ->check(CLI::Range(std::uint64_t{1024}, std::uint64_t{1} << 30))
       ->default_str("1048576");
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
-  app->footer("Writes the exact CDR payloads received: log_time = receive time, publish_time = the sample's source "
-              "timestamp (ns since the Unix epoch). Ctrl-C or SIGTERM finishes a valid, indexed file and exits 0; a "
-              "killed recorder leaves a file that 'rbsim log recover' repairs. Reports received and lost counts: lost "
-              "is what DDS reports plus the steps missing from each per-step topic's sequence.");
+  app->footer(
+      "Writes the exact CDR payloads received: log_time = receive time, publish_time = the sample's source "
+      "timestamp (ns since the Unix epoch). Ctrl-C or SIGTERM finishes a valid, indexed file and exits 0; a "
+      "killed recorder leaves a file that 'rbsim log recover' repairs. Reports received and lost counts: "
+      "lost "
+      "is what DDS reports plus the steps missing from each per-step topic's sequence.");
   return {app, [a] { return record_command(*a); }};
 }
 

@@ -29,8 +29,8 @@ int render_command(const RenderArgs& a) {
   o.duration = a.duration;
   Result<std::int64_t> frames = render::render(a.input, o);
   if (!frames) return fail(frames.error().message);
-  std::fprintf(stderr, "rbsim render: %lld frames (%dx%d at %g fps) in %s\n", static_cast<long long>(frames.value()),
-               o.width, o.height, o.fps, a.out.c_str());
+  std::fprintf(stderr, "rbsim render: %lld frames (%dx%d at %g fps) in %s\n",
+               static_cast<long long>(frames.value()), o.width, o.height, o.fps, a.out.c_str());
   if (!a.mp4.empty()) {
     if (Status st = render::make_movie(a.out, a.fps, a.mp4); !st) return fail(st.error().message);
     std::fprintf(stderr, "rbsim render: movie %s\n", a.mp4.c_str());
@@ -61,24 +61,28 @@ int plot_command(const PlotArgs& a) {
 
 Subcommand add_render_command(CLI::App& parent) {
   auto a = std::make_shared<RenderArgs>();
-  CLI::App* app = parent.add_subcommand("render", "Draw a scene (simulated on the fly) or an MCAP recording as PNG frames");
+  CLI::App* app = parent.add_subcommand(
+      "render", "Draw a scene (simulated on the fly) or an MCAP recording as PNG frames");
   app->add_option("input", a->input, "FOSSSim XML scene, or an rbsim MCAP recording")->required();
-  app->add_option("--out", a->out, "Folder for frame00000.png, frame00001.png, ... (created if needed)")->required();
+  app->add_option("--out", a->out, "Folder for frame00000.png, frame00001.png, ... (created if needed)")
+      ->required();
   app->add_option("--fps", a->fps, "Frames per simulated second")->default_str("24");
   app->add_option("--size", a->size, "Frame size WxH in pixels")->default_str("1280x720");
   app->add_option("--duration", a->duration, "Simulated seconds to draw (default: the scene's duration)")
       ->check(CLI::PositiveNumber);
   app->add_option("--mp4", a->mp4, "Also assemble the frames into an H.264 (yuv420p) movie with ffmpeg");
-  app->footer("Frame k shows time k / fps (the first step at or after it); duration x fps frames in all. Bodies are "
-              "filled hulls grown by their radius r in their scene colours, springs are lines in theirs (fixed ends "
-              "ringed), on the scene's background, framed by its viewport (or fitted to the bodies).");
+  app->footer(
+      "Frame k shows time k / fps (the first step at or after it); duration x fps frames in all. Bodies are "
+      "filled hulls grown by their radius r in their scene colours, springs are lines in theirs (fixed ends "
+      "ringed), on the scene's background, framed by its viewport (or fitted to the bodies).");
   return {app, [a] { return render_command(*a); }};
 }
 
 Subcommand add_plot_command(CLI::App& parent) {
   auto a = std::make_shared<PlotArgs>();
-  CLI::App* app = parent.add_subcommand(
-      "plot", "Plot kinetic (centre of mass, spin), potential and total energy and total momentum over time (gnuplot)");
+  CLI::App* app = parent.add_subcommand("plot",
+                                        "Plot kinetic (centre of mass, spin), potential and total energy and "
+                                        "total momentum over time (gnuplot)");
   app->add_option("input", a->input, "FOSSSim XML scene (simulated), or an rbsim MCAP recording")->required();
   app->add_option("--out", a->out, "PNG file to write")->required();
   app->add_option("--size", a->size, "Image size WxH in pixels")->default_str("1200x900");

@@ -30,19 +30,22 @@ int replay_command(ReplayArgs a) {
   auto opened = node::Replay::open(participant.value(), a.replay);
   if (!opened) return fail(opened.error().message);
   node::Replay& replay = *opened.value();
-  for (const std::string& w : replay.warnings()) std::fprintf(stderr, "rbsim replay: warning: %s\n", w.c_str());
+  for (const std::string& w : replay.warnings())
+    std::fprintf(stderr, "rbsim replay: warning: %s\n", w.c_str());
   install_stop_handlers();
   if (!a.quiet) {
     const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
     char rate[32] = "as fast as possible";
     if (a.replay.rate > 0) std::snprintf(rate, sizeof rate, "%gx", a.replay.rate);
-    std::fprintf(stderr, "rbsim replay: %s (%s of log time) on domain %u, rate %s%s:\n", a.replay.path.c_str(),
-                 format_seconds(span).c_str(), a.domain, rate, a.loop ? ", looping" : "");
+    std::fprintf(stderr, "rbsim replay: %s (%s of log time) on domain %u, rate %s%s:\n",
+                 a.replay.path.c_str(), format_seconds(span).c_str(), a.domain, rate,
+                 a.loop ? ", looping" : "");
     for (const auto& o : replay.outputs()) {
       if (o.recorded.empty()) {
         std::fprintf(stderr, "  %-28s (log time of each message)\n", o.topic.c_str());
       } else if (o.recorded == o.topic) {
-        std::fprintf(stderr, "  %-28s %llu messages\n", o.topic.c_str(), static_cast<unsigned long long>(o.messages));
+        std::fprintf(stderr, "  %-28s %llu messages\n", o.topic.c_str(),
+                     static_cast<unsigned long long>(o.messages));
       } else {
         std::fprintf(stderr, "  %-28s %llu messages, as %s\n", o.recorded.c_str(),
                      static_cast<unsigned long long>(o.messages), o.topic.c_str());
@@ -69,8 +72,8 @@ int replay_command(ReplayArgs a) {
   }
   if (!a.quiet) {
     std::fprintf(stderr, "rbsim replay: %s after %llu complete pass%s, %llu messages published\n",
-                 complete ? "done" : "stopped", static_cast<unsigned long long>(passes), passes == 1 ? "" : "es",
-                 static_cast<unsigned long long>(replay.published()));
+                 complete ? "done" : "stopped", static_cast<unsigned long long>(passes),
+                 passes == 1 ? "" : "es", static_cast<unsigned long long>(replay.published()));
   }
   return 0;
 }
@@ -78,7 +81,8 @@ int replay_command(ReplayArgs a) {
 
 Subcommand add_replay_command(CLI::App& parent) {
   auto a = std::make_shared<ReplayArgs>();
-  CLI::App* app = parent.add_subcommand("replay", "Republish a recording (MCAP) over DDS with its recorded timing");
+  CLI::App* app =
+      parent.add_subcommand("replay", "Republish a recording (MCAP) over DDS with its recorded timing");
   app->add_option("in", a->replay.path, "MCAP recording (rbsim run --record or rbsim record)")->required();
   app->add_option("--rate", a->replay.rate,
                   "Real-time factor on the recorded log times (2 = twice as fast; 0 = as fast as possible)")
@@ -90,25 +94,30 @@ Subcommand add_replay_command(CLI::App& parent) {
                   "body_states); default all")
       ->delimiter(',')
       ->allow_extra_args(false);
-  app->add_option("--start-offset", a->replay.start_offset,
-                  "Skip this many seconds of log time at the start (the scene description is still published first)")
+  app->add_option(
+         "--start-offset", a->replay.start_offset,
+         "Skip this many seconds of log time at the start (the scene description is still published first)")
       ->check(CLI::NonNegativeNumber);
-  app->add_flag("--clock", a->replay.clock,
-                "Publish rosgraph_msgs/Clock on /clock carrying the log time of each message replayed (recorded "
-                "/clock messages are then left out)");
+  app->add_flag(
+      "--clock", a->replay.clock,
+      "Publish rosgraph_msgs/Clock on /clock carrying the log time of each message replayed (recorded "
+      "/clock messages are then left out)");
   app->add_option("--domain", a->domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
   app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names");
-  app->add_option("--wait-for-subscribers", a->wait_for, "Wait until N subscribers match the body states first")
+  app->add_option("--wait-for-subscribers", a->wait_for,
+                  "Wait until N subscribers match the body states first")
       ->check(CLI::NonNegativeNumber);
-  app->add_option("--keep-last", a->replay.keep_last,
-                  "Per-step writers keep the last N samples instead of all (the replay never waits for a slow "
-                  "subscriber, which may then lose samples)")
+  app->add_option(
+         "--keep-last", a->replay.keep_last,
+         "Per-step writers keep the last N samples instead of all (the replay never waits for a slow "
+         "subscriber, which may then lose samples)")
       ->check(CLI::PositiveNumber);
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
   app->footer(
       "Every channel whose schema is an rbsim type (rbsim_msgs/SceneDescription, BodyStates, SpringStates, "
       "EnergyTerms, geometry_msgs/PoseArray, visualization_msgs/MarkerArray, rosgraph_msgs/Clock) is "
-      "republished byte for byte with the node's QoS (the scene description transient local), in log-time order. "
+      "republished byte for byte with the node's QoS (the scene description transient local), in log-time "
+      "order. "
       "DDS configuration as for 'rbsim node'. Ctrl-C stops cleanly (exit 0).");
   return {app, [a] { return replay_command(*a); }};
 }

@@ -56,12 +56,14 @@ int run(const RunOptions& o) {
     log::RecordOptions ro;
     ro.every = o.record_every;
     ro.ns = o.ns;
-    if (!log::parse_compression(o.compression, ro.compression)) return fail("unknown compression " + o.compression);
+    if (!log::parse_compression(o.compression, ro.compression))
+      return fail("unknown compression " + o.compression);
     sinks.push_back(log::make_mcap_sink(o.record, ro));
   }
   if (!o.frames.empty()) {
     int width = 0, height = 0;
-    if (!render::parse_size(o.size, width, height)) return fail("invalid --size \"" + o.size + "\" (expected WxH)");
+    if (!render::parse_size(o.size, width, height))
+      return fail("invalid --size \"" + o.size + "\" (expected WxH)");
     if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
     sinks.push_back(render::make_frame_sink(o.frames, width, height, o.fps));
   }
@@ -71,18 +73,16 @@ int run(const RunOptions& o) {
 
   install_stop_handlers();
   Progress progress(steps, o.progress == "always"  ? Progress::Mode::Always
-                          : o.progress == "never" ? Progress::Mode::Never
-                                                  : Progress::Mode::Auto);
+                           : o.progress == "never" ? Progress::Mode::Never
+                                                   : Progress::Mode::Auto);
   const auto start = std::chrono::steady_clock::now();
   std::optional<std::string> failure;
   while (world.step_index() < steps && !stop_requested()) {
     world.step();
     if (!o.allow_nonfinite) {
       if (const auto bad = world.find_nonfinite()) {
-        const std::string where = bad->body.index >= 0 ? "body " + std::to_string(bad->body.index) + " " : "";
-        failure = "step " + std::to_string(world.step_index()) + ": " + where + bad->quantity + " is not finite: the simulation diverged (try a smaller dt or "
-                  "symplectic-euler; --allow-nonfinite keeps going). Outputs hold steps 0.." +
-                  std::to_string(world.step_index() - 1) + ".";
+        failure = describe_divergence(world.step_index(), bad->body.index, bad->quantity) +
+                  ". Outputs hold steps 0.." + std::to_string(world.step_index() - 1) + ".";
         break;
       }
     }
@@ -101,7 +101,9 @@ int run(const RunOptions& o) {
   const std::int64_t done = world.step_index();
   if (!o.quiet) {
     const double rate = wall > 0 ? static_cast<double>(done) / wall : 0.0;
-    std::fprintf(stderr, "rbsim run: %s: %d bodies, %d springs, %lld steps (%.6g s simulated) in %s: %.4g steps/s, %.4g body-steps/s\n",
+    std::fprintf(stderr,
+                 "rbsim run: %s: %d bodies, %d springs, %lld steps (%.6g s simulated) in %s: %.4g steps/s, "
+                 "%.4g body-steps/s\n",
                  scene.name.c_str(), world.body_count(), world.spring_count(), static_cast<long long>(done),
                  world.time(), format_seconds(wall).c_str(), rate, rate * world.body_count());
   }
@@ -117,11 +119,15 @@ int run(const RunOptions& o) {
 
 Subcommand add_run_command(CLI::App& parent) {
   auto o = std::make_shared<RunOptions>();
-  CLI::App* app = parent.add_subcommand("run", "Run a scene offline as fast as possible and write its outputs");
-  app->add_option("scene", o->scene, "FOSSSim XML scene file")->required();  // the loader reports a missing file (exit 1)
-  auto* steps = app->add_option("--steps", o->steps, "Number of steps to run (overrides the scene's duration)")
-                    ->check(CLI::NonNegativeNumber);
-  app->add_option("--duration", o->duration, "Simulated seconds to run: ceil(T / dt) steps (overrides the scene)")
+  CLI::App* app =
+      parent.add_subcommand("run", "Run a scene offline as fast as possible and write its outputs");
+  app->add_option("scene", o->scene, "FOSSSim XML scene file")
+      ->required();  // the loader reports a missing file (exit 1)
+  auto* steps =
+      app->add_option("--steps", o->steps, "Number of steps to run (overrides the scene's duration)")
+          ->check(CLI::NonNegativeNumber);
+  app->add_option("--duration", o->duration,
+                  "Simulated seconds to run: ceil(T / dt) steps (overrides the scene)")
       ->check(CLI::NonNegativeNumber)
       ->excludes(steps);
   app->add_option("--csv", o->csv,
@@ -133,9 +139,10 @@ Subcommand add_run_command(CLI::App& parent) {
   app->add_option("--fosssim-out", o->fosssim_out,
                   "FOSSSim reference binary output (raw little-endian doubles), comparable byte for byte "
                   "with the reference solver's");
-  app->add_option("--record", o->record,
-                  "Record every topic (scene description once, then body states, spring states, energy terms, "
-                  "PoseArray, MarkerArray and /clock per step) to an MCAP file in the rosbag2 layout");
+  app->add_option(
+      "--record", o->record,
+      "Record every topic (scene description once, then body states, spring states, energy terms, "
+      "PoseArray, MarkerArray and /clock per step) to an MCAP file in the rosbag2 layout");
   app->add_option("--record-every", o->record_every, "Record every k-th step (step 0 always)")
       ->check(CLI::PositiveNumber);
   app->add_option("--compression", o->compression, "MCAP chunk compression")
@@ -143,15 +150,18 @@ Subcommand add_run_command(CLI::App& parent) {
       ->default_str("zstd");
   app->add_option("--namespace", o->ns, "ROS namespace of the recorded topics (/<namespace>/body_states ...)")
       ->default_str("rbsim");
-  app->add_option("--frames", o->frames, "Draw PNG frames into this folder during the run (see rbsim render)");
+  app->add_option("--frames", o->frames,
+                  "Draw PNG frames into this folder during the run (see rbsim render)");
   app->add_option("--fps", o->fps, "Frames per simulated second for --frames")->default_str("24");
   app->add_option("--size", o->size, "Frame size WxH for --frames")->default_str("1280x720");
-  app->add_option("--progress", o->progress, "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
+  app->add_option("--progress", o->progress,
+                  "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
       ->check(CLI::IsMember({"auto", "always", "never"}))
       ->default_str("auto");
   app->add_flag("-q,--quiet", o->quiet, "No closing summary line");
-  app->add_flag("--allow-nonfinite", o->allow_nonfinite,
-                "Keep going when the state becomes inf/NaN (by default the run stops at the first non-finite value)");
+  app->add_flag(
+      "--allow-nonfinite", o->allow_nonfinite,
+      "Keep going when the state becomes inf/NaN (by default the run stops at the first non-finite value)");
   app->footer(
       "Outputs are written to a temporary file and renamed into place when complete. Ctrl-C stops the run "
       "cleanly: outputs then hold every step done so far, and the exit status is 130.\n"

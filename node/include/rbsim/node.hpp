@@ -55,8 +55,8 @@ QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0);
 // Publishes pre-encoded CDR messages on one topic.
 class Publisher {
  public:
-  static Result<Publisher> create(const Participant& participant, const msgs::TopicSpec& spec, std::string_view ros_topic,
-                                  const QosSpec& qos);
+  static Result<Publisher> create(const Participant& participant, const msgs::TopicSpec& spec,
+                                  std::string_view ros_topic, const QosSpec& qos);
   Publisher(Publisher&&) noexcept;
   Publisher& operator=(Publisher&&) = delete;
   ~Publisher();
@@ -132,7 +132,7 @@ class DdsSink final : public Sink {
   std::vector<std::optional<Publisher>> publishers_;  // by TopicId
   std::unique_ptr<msgs::Encoder> encoder_;
   msgs::Bytes buffer_;
-  std::int64_t start_ns_ = 0;       // monotonic clock at the paced step
+  std::int64_t start_ns_ = 0;  // monotonic clock at the paced step
   std::int64_t start_step_ = 0;
   std::uint64_t published_ = 0;
 };
@@ -157,12 +157,13 @@ struct RecorderOptions {
   std::vector<std::string> topics;  // names ("body_states" or "/rbsim/body_states"); empty: all
   mcap::Compression compression = mcap::Compression::Zstd;
   std::uint64_t chunk_size = 1 << 20;
-  std::uint64_t max_messages = 0;   // 0: no limit
+  std::uint64_t max_messages = 0;  // 0: no limit
 };
 
 class Recorder {
  public:
-  static Result<std::unique_ptr<Recorder>> create(const Participant& participant, const RecorderOptions& options);
+  static Result<std::unique_ptr<Recorder>> create(const Participant& participant,
+                                                  const RecorderOptions& options);
   ~Recorder();
   // Waits up to `timeout_ns` for data and records everything available; true if anything came.
   Result<bool> poll(std::int64_t timeout_ns);
@@ -180,8 +181,8 @@ class Recorder {
   // (converted with dt once the scene description is known).
   struct Gaps {
     std::int64_t first = -1, last = -1, stride = 0;  // ns; stride: smallest difference seen
-    std::uint64_t count = 0;                          // messages in this run of the scene
-    std::uint64_t lost_before = 0;                    // in earlier runs (--loop)
+    std::uint64_t count = 0;                         // messages in this run of the scene
+    std::uint64_t lost_before = 0;                   // in earlier runs (--loop)
     void add(std::int64_t stamp_ns, double dt);
     std::uint64_t lost(double dt) const;
   };
@@ -214,13 +215,15 @@ namespace rbsim::node {
 
 struct ReplayOptions {
   std::string path;
-  double rate = 1.0;                // real-time factor on log time; 0: as fast as possible
-  std::vector<std::string> topics;  // recorded names ("/rbsim/body_states") or suffixes ("body_states"); empty: all
-  double start_offset = 0.0;        // seconds of log time skipped at the start (the scene description is still sent)
-  bool clock = false;               // publish rosgraph_msgs/Clock on /clock with each message's log time
-                                    // (recorded /clock messages are then not replayed)
-  std::optional<std::string> ns;    // republish under /<ns>/<name> instead of the recorded names
-  std::int32_t keep_last = 0;       // per-step writers keep last N instead of keep all (0)
+  double rate = 1.0;  // real-time factor on log time; 0: as fast as possible
+  std::vector<std::string>
+      topics;  // recorded names ("/rbsim/body_states") or suffixes ("body_states"); empty: all
+  double start_offset =
+      0.0;             // seconds of log time skipped at the start (the scene description is still sent)
+  bool clock = false;  // publish rosgraph_msgs/Clock on /clock with each message's log time
+                       // (recorded /clock messages are then not replayed)
+  std::optional<std::string> ns;  // republish under /<ns>/<name> instead of the recorded names
+  std::int32_t keep_last = 0;     // per-step writers keep last N instead of keep all (0)
 };
 
 class Replay {
@@ -231,8 +234,9 @@ class Replay {
   ~Replay();
 
   struct Output {
-    std::string recorded;  // channel topic in the log ("/rbsim/body_states"), empty for the synthesized /clock
-    std::string topic;     // topic published
+    std::string
+        recorded;       // channel topic in the log ("/rbsim/body_states"), empty for the synthesized /clock
+    std::string topic;  // topic published
     std::uint64_t messages = 0;  // messages of the channel in the log (0 when unknown)
   };
   const std::vector<Output>& outputs() const { return outputs_; }

@@ -32,7 +32,7 @@ struct Error {
 template <class T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
   Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
   bool ok() const { return v_.index() == 0; }
   explicit operator bool() const { return ok(); }
@@ -60,11 +60,11 @@ enum class Integrator : std::uint8_t {
 const char* to_string(Integrator integrator);
 
 struct BodyDef {
-  std::vector<Vec2> hull;       // world positions at t = 0, clockwise order; >= 2 vertices
-  std::vector<double> masses;   // one per hull vertex, each > 0
-  Vec2 velocity{0.0, 0.0};      // centre-of-mass velocity
-  double omega = 0.0;           // angular velocity about the centre of mass (rad/s, CCW > 0)
-  double radius = 0.1;          // rendering radius (not used by the dynamics)
+  std::vector<Vec2> hull;      // world positions at t = 0, clockwise order; >= 2 vertices
+  std::vector<double> masses;  // one per hull vertex, each > 0
+  Vec2 velocity{0.0, 0.0};     // centre-of-mass velocity
+  double omega = 0.0;          // angular velocity about the centre of mass (rad/s, CCW > 0)
+  double radius = 0.1;         // rendering radius (not used by the dynamics)
 };
 
 inline constexpr std::int32_t kFixed = -1;  // spring end fixed in space
@@ -72,19 +72,19 @@ inline constexpr std::int32_t kFixed = -1;  // spring end fixed in space
 struct SpringDef {
   std::int32_t body_i = kFixed;  // body index or kFixed
   std::int32_t body_j = kFixed;
-  Vec2 anchor_i{0.0, 0.0};       // body space offset from the centre of mass, or world point if fixed
+  Vec2 anchor_i{0.0, 0.0};  // body space offset from the centre of mass, or world point if fixed
   Vec2 anchor_j{0.0, 0.0};
-  double stiffness = 0.0;        // k
-  double rest_length = 0.0;      // l0
+  double stiffness = 0.0;    // k
+  double rest_length = 0.0;  // l0
 };
 
 struct GravityDef {
-  Vec2 acceleration{0.0, 0.0};   // g: every vertex feels m_i g (FOSSSim's fx, fy)
+  Vec2 acceleration{0.0, 0.0};  // g: every vertex feels m_i g (FOSSSim's fx, fy)
 };
 
 struct WindDef {
-  double beta = 1.0;             // drag coefficient per unit edge length
-  Vec2 velocity{0.0, 0.0};       // wind velocity
+  double beta = 1.0;        // drag coefficient per unit edge length
+  Vec2 velocity{0.0, 0.0};  // wind velocity
   std::int32_t points_per_edge = 2;
 };
 
@@ -145,7 +145,7 @@ namespace detail {
 struct WindMoments {
   double axx = 0, axy = 0, ayy = 0;  // F_body = beta (A u - omega b), A symmetric
   double bx = 0, by = 0;
-  double cx = 0, cy = 0, d = 0;      // torque = beta (c . u - omega d)
+  double cx = 0, cy = 0, d = 0;  // torque = beta (c . u - omega d)
 };
 }  // namespace detail
 

@@ -5,8 +5,8 @@
 
 #include <cerrno>
 #include <charconv>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,7 +22,9 @@ std::int64_t steps_for(double duration, double dt) {
   return n <= 0.0 ? 0 : static_cast<std::int64_t>(n);
 }
 
-std::int64_t Scene::step_count() const { return steps_for(duration, world.dt); }
+std::int64_t Scene::step_count() const {
+  return steps_for(duration, world.dt);
+}
 
 Color default_body_color(std::int32_t index) {
   // A qualitative palette (Tableau 10) that reads well on a white background.
@@ -116,7 +118,8 @@ class Loader {
   }
   double unit(const tinyxml2::XMLElement* e, const char* attr) const {
     const double v = number(e, attr);
-    if (!(v >= 0 && v <= 1)) fail(e, attr, "colour component must be in [0, 1] (got " + std::string(raw(e, attr)) + ")");
+    if (!(v >= 0 && v <= 1))
+      fail(e, attr, "colour component must be in [0, 1] (got " + std::string(raw(e, attr)) + ")");
     return v;
   }
   std::int64_t integer(const tinyxml2::XMLElement* e, const char* attr, const char* value) const {
@@ -149,10 +152,12 @@ class Loader {
 
   void once(const tinyxml2::XMLElement* e) {
     auto [it, fresh] = seen_once_.try_emplace(e->Name(), e->GetLineNum());
-    if (!fresh) fail(e->GetLineNum(), "<" + std::string(e->Name()) + ">: node may appear only once (first at line " +
-                                          std::to_string(it->second) + ")");
+    if (!fresh)
+      fail(e->GetLineNum(), "<" + std::string(e->Name()) + ">: node may appear only once (first at line " +
+                                std::to_string(it->second) + ")");
   }
-  void check_attributes(const tinyxml2::XMLElement* e, std::initializer_list<const char*> known, bool repeat_p);
+  void check_attributes(const tinyxml2::XMLElement* e, std::initializer_list<const char*> known,
+                        bool repeat_p);
   void element(const tinyxml2::XMLElement* e);
 
   std::string path_;
@@ -175,7 +180,8 @@ void Loader::check_attributes(const tinyxml2::XMLElement* e, std::initializer_li
     }
     bool ok = false;
     for (const char* k : known) ok = ok || original == k;
-    if (!ok) warn(a->GetLineNum(), "<" + std::string(e->Name()) + "> unknown attribute '" + original + "' ignored");
+    if (!ok)
+      warn(a->GetLineNum(), "<" + std::string(e->Name()) + "> unknown attribute '" + original + "' ignored");
   }
 }
 
@@ -185,7 +191,8 @@ void Loader::element(const tinyxml2::XMLElement* e) {
     once(e);
     check_attributes(e, {"type"}, false);
     const std::string type = raw(e, "type");
-    if (type == "particle-system") fail(e, "type", "simtype 'particle-system' is not supported (rbsim simulates 'rigid-body')");
+    if (type == "particle-system")
+      fail(e, "type", "simtype 'particle-system' is not supported (rbsim simulates 'rigid-body')");
     if (type != "rigid-body") fail(e, "type", "unknown simtype \"" + type + "\" (expected 'rigid-body')");
   } else if (name == "duration") {
     once(e);
@@ -231,10 +238,12 @@ void Loader::element(const tinyxml2::XMLElement* e) {
     check_attributes(e, {"p", "vx", "vy", "omega", "r"}, true);
     BodyRef body{e, {}, {}};
     for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
-      if (original_attribute_name(a->Name()) == "p") body.vertices.push_back({e, "p", integer(e, "p", a->Value())});
+      if (original_attribute_name(a->Name()) == "p")
+        body.vertices.push_back({e, "p", integer(e, "p", a->Value())});
     }
     if (body.vertices.size() < 2) {
-      fail(e, "p", "a rigid body needs at least 2 hull vertices (got " + std::to_string(body.vertices.size()) + ")");
+      fail(e, "p",
+           "a rigid body needs at least 2 hull vertices (got " + std::to_string(body.vertices.size()) + ")");
     }
     body.def.velocity = {number(e, "vx"), number(e, "vy")};
     body.def.omega = number(e, "omega");
@@ -284,7 +293,8 @@ Scene Loader::load(const tinyxml2::XMLDocument& doc) {
     element(e);
   }
   const int end_line = root->GetLineNum();
-  if (!seen_once_.contains("rigidbodyintegrator")) fail(end_line, "<scene>: missing node <rigidbodyintegrator>");
+  if (!seen_once_.contains("rigidbodyintegrator"))
+    fail(end_line, "<scene>: missing node <rigidbodyintegrator>");
   if (!seen_once_.contains("duration")) fail(end_line, "<scene>: missing node <duration>");
 
   // Vertices form one global list in file order; bodies and forces may refer ahead.
@@ -292,8 +302,9 @@ Scene Loader::load(const tinyxml2::XMLDocument& doc) {
   for (BodyRef& body : bodies_) {
     for (const Deferred& v : body.vertices) {
       if (v.value < 0 || v.value >= vertex_count) {
-        fail(v.element, v.attr, "vertex index " + std::to_string(v.value) + " out of range [0, " +
-                                    std::to_string(vertex_count - 1) + "]");
+        fail(v.element, v.attr,
+             "vertex index " + std::to_string(v.value) + " out of range [0, " +
+                 std::to_string(vertex_count - 1) + "]");
       }
       body.def.hull.push_back(vertex_pos_[v.value]);
       body.def.masses.push_back(vertex_mass_[v.value]);
@@ -306,7 +317,8 @@ Scene Loader::load(const tinyxml2::XMLDocument& doc) {
     const auto& [i, j] = spring_ends_[s];
     for (const Deferred* end : {&i, &j}) {
       if (end->value < -1 || end->value >= body_count) {
-        fail(end->element, end->attr, "body index " + std::to_string(end->value) + " out of range " + body_range);
+        fail(end->element, end->attr,
+             "body index " + std::to_string(end->value) + " out of range " + body_range);
       }
     }
     scene_.world.springs[s].body_i = static_cast<std::int32_t>(i.value);
@@ -317,8 +329,9 @@ Scene Loader::load(const tinyxml2::XMLDocument& doc) {
   auto apply_colors = [&](const auto& list, std::vector<Color>& target, const char* what) {
     for (const auto& [ref, c] : list) {
       if (ref.value < 0 || ref.value >= static_cast<std::int64_t>(target.size())) {
-        fail(ref.element, ref.attr, std::string(what) + " index " + std::to_string(ref.value) + " out of range [0, " +
-                                        std::to_string(static_cast<std::int64_t>(target.size()) - 1) + "]");
+        fail(ref.element, ref.attr,
+             std::string(what) + " index " + std::to_string(ref.value) + " out of range [0, " +
+                 std::to_string(static_cast<std::int64_t>(target.size()) - 1) + "]");
       }
       target[ref.value] = c;
     }
@@ -331,12 +344,15 @@ Scene Loader::load(const tinyxml2::XMLDocument& doc) {
     const BodyDef& def = scene_.world.bodies[b];
     bool all_same = true;
     for (const Vec2& v : def.hull) all_same = all_same && v == def.hull.front();
-    if (all_same) fail(bodies_[b].element, "p", "all hull vertices coincide (the body has no moment of inertia)");
+    if (all_same)
+      fail(bodies_[b].element, "p", "all hull vertices coincide (the body has no moment of inertia)");
   }
   return std::move(scene_);
 }
 
-std::string stem_of(const std::string& path) { return std::filesystem::path(path).stem().string(); }
+std::string stem_of(const std::string& path) {
+  return std::filesystem::path(path).stem().string();
+}
 
 }  // namespace
 
@@ -347,7 +363,8 @@ Result<Scene> parse_scene(std::string_view text, const std::string& path) {
   tinyxml2::XMLDocument doc;
   doc.Parse(rewritten.data(), rewritten.size());
   if (doc.Error()) {
-    if (doc.ErrorID() == tinyxml2::XML_ERROR_EMPTY_DOCUMENT) return Error{path + ":1: empty file (expected a <scene>)"};
+    if (doc.ErrorID() == tinyxml2::XML_ERROR_EMPTY_DOCUMENT)
+      return Error{path + ":1: empty file (expected a <scene>)"};
     std::string detail = doc.ErrorStr();
     // tinyxml2 prefixes "Error=XML_ERROR_... ErrorID=n (0x..) Line number=n: "; keep its tail.
     // Without a tail (e.g. XML_ERROR_PARSING_TEXT) it only repeats the name and line: drop it.

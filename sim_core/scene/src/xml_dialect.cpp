@@ -8,13 +8,16 @@ namespace rbsim {
 
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
 bool is_name_char(char c) {
   return !is_space(c) && c != '=' && c != '>' && c != '/' && c != '<' && c != '"' && c != '\'';
 }
 
 // Copies text[pos..] up to and including `terminator`; returns the position after it.
-std::size_t copy_through(std::string_view text, std::size_t pos, std::string_view terminator, std::string& out) {
+std::size_t copy_through(std::string_view text, std::size_t pos, std::string_view terminator,
+                         std::string& out) {
   const std::size_t end = text.find(terminator, pos);
   const std::size_t stop = end == std::string_view::npos ? text.size() : end + terminator.size();
   out.append(text.substr(pos, stop - pos));
@@ -23,7 +26,8 @@ std::size_t copy_through(std::string_view text, std::size_t pos, std::string_vie
 
 // Rewrites one start tag beginning at text[pos] == '<'. Returns the position after the tag, or
 // npos when it does not scan as a start tag (the caller then copies the rest verbatim).
-std::size_t rewrite_start_tag(std::string_view text, std::size_t pos, std::string& out, std::size_t& too_many) {
+std::size_t rewrite_start_tag(std::string_view text, std::size_t pos, std::string& out,
+                              std::size_t& too_many) {
   std::size_t i = pos + 1;
   while (i < text.size() && is_name_char(text[i])) ++i;
   std::string tag(text.substr(pos, i - pos));
@@ -91,7 +95,8 @@ Result<std::string> rename_repeated_attributes(std::string_view text) {
       std::size_t too_many = std::string_view::npos;
       const std::size_t next = rewrite_start_tag(text, lt, out, too_many);
       if (too_many != std::string_view::npos) {
-        const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(too_many), '\n');
+        const auto line =
+            1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(too_many), '\n');
         return Error{std::to_string(line) + ": a start tag has more than " + std::to_string(kMaxAttributes) +
                      " attributes (limit of the scene loader)"};
       }

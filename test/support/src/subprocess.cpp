@@ -10,8 +10,8 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <ostream>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -21,7 +21,9 @@ namespace rbsim::test {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> Outcome::err_lines() const { return lines_of(err); }
+std::vector<std::string> Outcome::err_lines() const {
+  return lines_of(err);
+}
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -79,18 +81,22 @@ TempDir::~TempDir() {
 
 std::ostream& operator<<(std::ostream& os, const Outcome& o) {
   return os << "exit " << o.exit_code << " signal " << o.signal << (o.timed_out ? " (timed out)" : "")
-            << "\n--- stdout\n" << o.out << "--- stderr\n" << o.err;
+            << "\n--- stdout\n"
+            << o.out << "--- stderr\n"
+            << o.err;
 }
 
-Outcome run_process(const std::string& exe, const std::vector<std::string>& args, std::chrono::milliseconds timeout,
-                    const std::vector<std::string>& extra_env) {
+Outcome run_process(const std::string& exe, const std::vector<std::string>& args,
+                    std::chrono::milliseconds timeout, const std::vector<std::string>& extra_env) {
   TempDir capture;
   const std::string out_path = (capture / "stdout").string(), err_path = (capture / "stderr").string();
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0600);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0600);
   std::vector<std::string> argv_storage;
   argv_storage.push_back(exe);
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());

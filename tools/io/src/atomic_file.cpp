@@ -14,7 +14,9 @@ Error io_error(const std::string& what, const std::string& path) {
 }
 }  // namespace
 
-AtomicFile::~AtomicFile() { discard(); }
+AtomicFile::~AtomicFile() {
+  discard();
+}
 
 Status AtomicFile::open(const std::string& path) {
   discard();

@@ -147,7 +147,8 @@ Result<GradeReport> grade(const Scene& scene, const FosssimLog& ref, const Grade
   r.max_quantity_diff = q.worst;
   r.worst_quantity = q.where;
   if (!(r.max_step_diff < options.max_step_diff)) {
-    r.message = "state differs by " + std::to_string(r.max_step_diff) + " at step " + std::to_string(r.worst_step);
+    r.message =
+        "state differs by " + std::to_string(r.max_step_diff) + " at step " + std::to_string(r.worst_step);
   } else if (!(r.sum_step_diff < options.sum_step_diff)) {
     r.message = "summed state difference " + std::to_string(r.sum_step_diff) + " too large";
   } else if (!(r.max_quantity_diff < options.quantity_tol)) {

@@ -140,7 +140,8 @@ class FosssimSink final : public Sink {
  private:
   void state(const World& w) {
     for (std::int32_t b = 0; b < w.body_count(); ++b) {
-      for (double v : {w.x()[b], w.y()[b], w.theta()[b], w.vx()[b], w.vy()[b], w.omega()[b]}) values_.push_back(v);
+      for (double v : {w.x()[b], w.y()[b], w.theta()[b], w.vx()[b], w.vy()[b], w.omega()[b]})
+        values_.push_back(v);
     }
   }
   void quantities(const World& w) {
@@ -170,10 +171,14 @@ class FosssimSink final : public Sink {
 
 }  // namespace
 
-std::unique_ptr<Sink> make_csv_sink(std::string path) { return std::make_unique<CsvSink>(std::move(path)); }
+std::unique_ptr<Sink> make_csv_sink(std::string path) {
+  return std::make_unique<CsvSink>(std::move(path));
+}
 std::unique_ptr<Sink> make_energy_csv_sink(std::string path) {
   return std::make_unique<EnergyCsvSink>(std::move(path));
 }
-std::unique_ptr<Sink> make_fosssim_sink(std::string path) { return std::make_unique<FosssimSink>(std::move(path)); }
+std::unique_ptr<Sink> make_fosssim_sink(std::string path) {
+  return std::make_unique<FosssimSink>(std::move(path));
+}
 
 }  // namespace rbsim

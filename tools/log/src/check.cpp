@@ -37,10 +37,12 @@ struct PrimitiveInfo {
   std::uint8_t size;  // 0: string
 };
 constexpr PrimitiveInfo kPrimitiveKinds[] = {
-    {"bool", msgs::Scalar::Kind::Bool, 1},     {"byte", msgs::Scalar::Kind::UInt, 1},   {"char", msgs::Scalar::Kind::UInt, 1},
-    {"int8", msgs::Scalar::Kind::Int, 1},      {"uint8", msgs::Scalar::Kind::UInt, 1},  {"int16", msgs::Scalar::Kind::Int, 2},
-    {"uint16", msgs::Scalar::Kind::UInt, 2},   {"int32", msgs::Scalar::Kind::Int, 4},   {"uint32", msgs::Scalar::Kind::UInt, 4},
-    {"int64", msgs::Scalar::Kind::Int, 8},     {"uint64", msgs::Scalar::Kind::UInt, 8}, {"float32", msgs::Scalar::Kind::Float, 4},
+    {"bool", msgs::Scalar::Kind::Bool, 1},     {"byte", msgs::Scalar::Kind::UInt, 1},
+    {"char", msgs::Scalar::Kind::UInt, 1},     {"int8", msgs::Scalar::Kind::Int, 1},
+    {"uint8", msgs::Scalar::Kind::UInt, 1},    {"int16", msgs::Scalar::Kind::Int, 2},
+    {"uint16", msgs::Scalar::Kind::UInt, 2},   {"int32", msgs::Scalar::Kind::Int, 4},
+    {"uint32", msgs::Scalar::Kind::UInt, 4},   {"int64", msgs::Scalar::Kind::Int, 8},
+    {"uint64", msgs::Scalar::Kind::UInt, 8},   {"float32", msgs::Scalar::Kind::Float, 4},
     {"float64", msgs::Scalar::Kind::Float, 8}, {"string", msgs::Scalar::Kind::String, 0},
 };
 
@@ -105,8 +107,8 @@ void make_flat(Layout::Field& f) {
   std::map<std::uint32_t, std::uint64_t> groups;
   for (const Layout::Field& c : f.children) {
     const std::uint64_t count = c.array == Layout::Field::Array::Fixed ? c.fixed : 1;
-    if (c.array == Layout::Field::Array::Sequence || (c.primitive && c.size == 0) || (!c.primitive && !c.flat) ||
-        count > 4096) {
+    if (c.array == Layout::Field::Array::Sequence || (c.primitive && c.size == 0) ||
+        (!c.primitive && !c.flat) || count > 4096) {
       f.flat = false;
       return;
     }
@@ -198,7 +200,8 @@ class LayoutBuilder {
         } else {
           char* end = nullptr;
           const unsigned long n = std::strtoul(inside.c_str(), &end, 10);
-          if (end == inside.c_str() || *end != '\0' || n > UINT32_MAX) return Error{name + ": bad array size in " + text};
+          if (end == inside.c_str() || *end != '\0' || n > UINT32_MAX)
+            return Error{name + ": bad array size in " + text};
           f.array = Layout::Field::Array::Fixed;
           f.fixed = static_cast<std::uint32_t>(n);
         }
@@ -226,8 +229,8 @@ class LayoutBuilder {
 
 // Walks the scalars of one message along the fields; `plan` may be null (skipping an element).
 // `budget` bounds the elements visited, so no schema can make the walk run away.
-bool walk(const std::vector<Layout::Field>& fields, std::span<const msgs::Scalar> s, std::size_t& pos, Plan* plan,
-          bool root, std::uint64_t& budget) {
+bool walk(const std::vector<Layout::Field>& fields, std::span<const msgs::Scalar> s, std::size_t& pos,
+          Plan* plan, bool root, std::uint64_t& budget) {
   using Array = Layout::Field::Array;
   for (const Layout::Field& f : fields) {
     std::uint64_t count = 1;
@@ -249,7 +252,8 @@ bool walk(const std::vector<Layout::Field>& fields, std::span<const msgs::Scalar
       for (std::uint64_t k = 0; k < count; ++k, ++pos) {
         if (s[pos].kind != f.kind) return false;
         if (plan != nullptr) {
-          if (root && f.array == Array::None && f.name == "step") plan->step = static_cast<std::ptrdiff_t>(pos);
+          if (root && f.array == Array::None && f.name == "step")
+            plan->step = static_cast<std::ptrdiff_t>(pos);
           plan->group.push_back(f.group);
         }
       }
@@ -414,7 +418,8 @@ bool Layout::map(std::span<const msgs::Scalar> s, Plan& plan) const {
   return walk(root_, s, pos, &plan, true, budget) && pos == s.size();
 }
 
-bool Layout::pair(std::span<const msgs::Scalar> a, std::span<const msgs::Scalar> b, std::vector<Pair>& out) const {
+bool Layout::pair(std::span<const msgs::Scalar> a, std::span<const msgs::Scalar> b,
+                  std::vector<Pair>& out) const {
   out.clear();
   Pairer p{a, b, 0, 0, &out, 8 * static_cast<std::uint64_t>(a.size() + b.size()) + 1024};
   return p.fields(root_) && p.pa == a.size() && p.pb == b.size();
@@ -430,7 +435,9 @@ constexpr int kGolden = 1;
 // Messages one file may be ahead of the other on a topic before we give up (memory bound).
 constexpr std::uint64_t kMaxQueuedBytes = std::uint64_t{1} << 30;
 
-std::span<const std::byte> cdr(const mcap::Bytes& b) { return std::as_bytes(std::span<const std::uint8_t>(b)); }
+std::span<const std::byte> cdr(const mcap::Bytes& b) {
+  return std::as_bytes(std::span<const std::uint8_t>(b));
+}
 std::string fmt_short(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.6g", v);
@@ -445,16 +452,24 @@ std::string text(const Scalar& s) {
   return ec == std::errc() ? std::string(buf, end) : s.to_string();
 }
 
-std::uint64_t step_value(const Scalar& s) { return s.kind == Kind::Int ? static_cast<std::uint64_t>(s.i) : s.u; }
+std::uint64_t step_value(const Scalar& s) {
+  return s.kind == Kind::Int ? static_cast<std::uint64_t>(s.i) : s.u;
+}
 
 const char* kind_label(Kind k) {
   switch (k) {
-    case Kind::Bool: return "bool";
-    case Kind::Int: return "int";
-    case Kind::UInt: return "uint";
-    case Kind::Float: return "float";
-    case Kind::String: return "string";
-    case Kind::Length: return "length";
+    case Kind::Bool:
+      return "bool";
+    case Kind::Int:
+      return "int";
+    case Kind::UInt:
+      return "uint";
+    case Kind::Float:
+      return "float";
+    case Kind::String:
+      return "string";
+    case Kind::Length:
+      return "length";
   }
   return "?";
 }
@@ -498,7 +513,7 @@ struct Topic {
   std::uint64_t queued_bytes = 0;
   std::uint64_t count[2] = {0, 0};
   std::vector<std::uint64_t> identical_counts;  // values of byte-identical message pairs, per group
-  bool diverged_message = false;  // scratch: current message pair has a difference
+  bool diverged_message = false;                // scratch: current message pair has a difference
 };
 
 // Reads one file on its own thread (decompression and CRCs are most of the work), handing its
@@ -600,7 +615,9 @@ struct Side {
   bool done = false;
 };
 
-std::string with_path(const Side& s, const std::string& what) { return s.role + " log " + s.path + ": " + what; }
+std::string with_path(const Side& s, const std::string& what) {
+  return s.role + " log " + s.path + ": " + what;
+}
 
 class Comparer {
  public:
@@ -659,17 +676,23 @@ class Comparer {
   static std::string describe(const mcap::Status& st) {
     switch (st.code) {
       case mcap::StatusCode::BadMagic:
-        return st.message.starts_with("not an MCAP file") ? st.message : "not an MCAP file (" + st.message + ")";
-      case mcap::StatusCode::Truncated: return "truncated or incomplete MCAP file (" + st.message + ")";
-      case mcap::StatusCode::CrcMismatch: return "corrupted MCAP file (" + st.message + ")";
+        return st.message.starts_with("not an MCAP file") ? st.message
+                                                          : "not an MCAP file (" + st.message + ")";
+      case mcap::StatusCode::Truncated:
+        return "truncated or incomplete MCAP file (" + st.message + ")";
+      case mcap::StatusCode::CrcMismatch:
+        return "corrupted MCAP file (" + st.message + ")";
       case mcap::StatusCode::Malformed:
-      case mcap::StatusCode::DecompressionFailed: return "corrupted MCAP file (" + st.message + ")";
-      default: return st.message;
+      case mcap::StatusCode::DecompressionFailed:
+        return "corrupted MCAP file (" + st.message + ")";
+      default:
+        return st.message;
     }
   }
 
   bool selected(const std::string& topic) const {
-    if (std::find(o_.exclude_topics.begin(), o_.exclude_topics.end(), topic) != o_.exclude_topics.end()) return false;
+    if (std::find(o_.exclude_topics.begin(), o_.exclude_topics.end(), topic) != o_.exclude_topics.end())
+      return false;
     return o_.topics.empty() || std::find(o_.topics.begin(), o_.topics.end(), topic) != o_.topics.end();
   }
 
@@ -742,17 +765,18 @@ class Comparer {
     if (g.message_encoding == "cdr" && g.schema_encoding == "ros2msg") {
       for (int si : {kRun, kGolden}) {
         const SideInfo& info = t.side[si];
-        const std::string_view text(reinterpret_cast<const char*>(info.schema_data.data()), info.schema_data.size());
+        const std::string_view text(reinterpret_cast<const char*>(info.schema_data.data()),
+                                    info.schema_data.size());
         auto decoder = msgs::MessageDecoder::create(info.schema_name, text);
         if (!decoder) {
-          return Error{with_path(side_[si], "schema " + info.schema_name + " of " + t.name + ": " +
-                                                decoder.error().message)};
+          return Error{with_path(
+              side_[si], "schema " + info.schema_name + " of " + t.name + ": " + decoder.error().message)};
         }
         t.decoder[si] = std::move(decoder.value());
         auto layout = Layout::create(info.schema_name, text);
         if (!layout) {
-          return Error{with_path(side_[si], "schema " + info.schema_name + " of " + t.name + ": " +
-                                                layout.error().message)};
+          return Error{with_path(
+              side_[si], "schema " + info.schema_name + " of " + t.name + ": " + layout.error().message)};
         }
         if (si == kRun) {
           t.layout = std::move(layout.value());
@@ -849,8 +873,13 @@ class Comparer {
           st.step_at_max = g.index;
         }
         if (!report_.first || key < first_key_) {
-          Divergence d{t.name, false, g.index, "(message bytes)", std::to_string(g.data.size()) + " bytes",
-                       std::to_string(r.data.size()) + " bytes", "bytes differ"};
+          Divergence d{t.name,
+                       false,
+                       g.index,
+                       "(message bytes)",
+                       std::to_string(g.data.size()) + " bytes",
+                       std::to_string(r.data.size()) + " bytes",
+                       "bytes differ"};
           consider(key, std::move(d));
         }
       }
@@ -873,14 +902,20 @@ class Comparer {
     ++report_.diverging_values;
     if (std::fabs(diff) > st.max_abs) {
       st.max_abs = std::fabs(diff);
-      st.max_rel = g.log_time == 0 ? std::numeric_limits<double>::infinity() : st.max_abs / static_cast<double>(g.log_time);
+      st.max_rel = g.log_time == 0 ? std::numeric_limits<double>::infinity()
+                                   : st.max_abs / static_cast<double>(g.log_time);
       st.step_at_max = last_step_;
     }
     if (!t.diverged_message) {
       t.diverged_message = true;
       if (!report_.first || key < first_key_) {
-        Divergence d{t.name, last_has_step_, last_step_, "(log_time)", std::to_string(g.log_time) + " ns",
-                     std::to_string(r.log_time) + " ns", fmt_short(diff) + " ns"};
+        Divergence d{t.name,
+                     last_has_step_,
+                     last_step_,
+                     "(log_time)",
+                     std::to_string(g.log_time) + " ns",
+                     std::to_string(r.log_time) + " ns",
+                     fmt_short(diff) + " ns"};
         consider(key, std::move(d));
       }
     }
@@ -888,7 +923,8 @@ class Comparer {
 
   Status decode(Topic& t, int si, const Pending& p, std::vector<Scalar>& out) {
     if (Status st = t.decoder[si]->decode(cdr(p.data), out); !st) {
-      return Error{with_path(side_[si], t.name + " message " + std::to_string(p.index) + ": " + st.error().message)};
+      return Error{
+          with_path(side_[si], t.name + " message " + std::to_string(p.index) + ": " + st.error().message)};
     }
     return Ok{};
   }
@@ -942,8 +978,12 @@ class Comparer {
           s.i = static_cast<std::int64_t>(u << shift) >> shift;
           break;
         }
-        case Kind::Bool: s.i = *p != std::byte{0}; break;
-        default: std::memcpy(&s.u, p, size); break;
+        case Kind::Bool:
+          s.i = *p != std::byte{0};
+          break;
+        default:
+          std::memcpy(&s.u, p, size);
+          break;
       }
       return s;
     }
@@ -971,7 +1011,8 @@ class Comparer {
         ++index;
         return;
       }
-      if (!c.differs(st, load(x, size, kind), load(y, size, kind)) && first_bad == UINT64_MAX) first_bad = index;
+      if (!c.differs(st, load(x, size, kind), load(y, size, kind)) && first_bad == UINT64_MAX)
+        first_bad = index;
       ++index;
     }
     Walk fields(const std::vector<Layout::Field>& fs, bool root) {
@@ -1077,7 +1118,8 @@ class Comparer {
       if (Status st = decode(t, kGolden, g, golden_); !st) return st;
       decoded = true;
       if (!t.layout->pair(run_, golden_, pairs_)) {
-        return Error{with_path(side_[kRun], t.name + " message " + std::to_string(r.index) + " does not fit its schema")};
+        return Error{with_path(side_[kRun],
+                               t.name + " message " + std::to_string(r.index) + " does not fit its schema")};
       }
       for (const Pair& p : pairs_) {
         if (p.b < ls.index) continue;
@@ -1101,8 +1143,9 @@ class Comparer {
         }
         const Scalar& a = run_[first_bad_run];
         const Scalar& b = golden_[first_bad];
-        Divergence d{t.name, ls.has_step, step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b), text(a),
-                     difference(a, b)};
+        Divergence d{
+            t.name,  ls.has_step,     step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b),
+            text(a), difference(a, b)};
         consider(key, std::move(d));
       }
     }
@@ -1111,13 +1154,16 @@ class Comparer {
 
   static std::string difference(const Scalar& a, const Scalar& b) {
     switch (b.kind) {
-      case Kind::Float: return fmt_short(a.f - b.f);
-      case Kind::Int: return std::to_string(static_cast<long long>(a.i) - static_cast<long long>(b.i));
+      case Kind::Float:
+        return fmt_short(a.f - b.f);
+      case Kind::Int:
+        return std::to_string(static_cast<long long>(a.i) - static_cast<long long>(b.i));
       case Kind::UInt:
       case Kind::Length:
         return a.u >= b.u ? std::to_string(a.u - b.u) : "-" + std::to_string(b.u - a.u);
       case Kind::Bool:
-      case Kind::String: return "differs";
+      case Kind::String:
+        return "differs";
     }
     return "differs";
   }
@@ -1151,14 +1197,16 @@ class Comparer {
       case Kind::Float:
         if (a.f == b.f || (std::isnan(a.f) && std::isnan(b.f))) return true;
         abs_diff = std::fabs(a.f - b.f);
-        if (std::isnan(abs_diff)) abs_diff = std::numeric_limits<double>::infinity();  // NaN vs number, inf vs -inf
+        if (std::isnan(abs_diff))
+          abs_diff = std::numeric_limits<double>::infinity();  // NaN vs number, inf vs -inf
         rel = b.f != 0.0 ? abs_diff / std::fabs(b.f) : std::numeric_limits<double>::infinity();
         ok = abs_diff <= o_.atol + o_.rtol * std::fabs(b.f);
         break;
       case Kind::Int:
         if (a.i == b.i) return true;
         abs_diff = std::fabs(static_cast<double>(a.i) - static_cast<double>(b.i));
-        rel = b.i != 0 ? abs_diff / std::fabs(static_cast<double>(b.i)) : std::numeric_limits<double>::infinity();
+        rel = b.i != 0 ? abs_diff / std::fabs(static_cast<double>(b.i))
+                       : std::numeric_limits<double>::infinity();
         break;
       case Kind::UInt:
       case Kind::Length:
@@ -1204,18 +1252,21 @@ class Comparer {
       if (topic_index_.count(name) == 0) {
         std::string known;
         for (const Topic& t : topics_) known += (known.empty() ? "" : ", ") + t.name;
-        return Error{"--topics: " + name + " is in neither log (topics: " + (known.empty() ? "none" : known) + ")"};
+        return Error{"--topics: " + name + " is in neither log (topics: " + (known.empty() ? "none" : known) +
+                     ")"};
       }
     }
     std::vector<std::size_t> order(topics_.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return topics_[a].name < topics_[b].name; });
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return topics_[a].name < topics_[b].name; });
     for (std::size_t i : order) {
       Topic& t = topics_[i];
       if (!t.selected) continue;
       for (int si : {kRun, kGolden}) {
         if (t.side[si].has && !t.side[1 - si].has) {
-          topic_problem(t, "topic only in the " + side_[si].role + " (" + std::to_string(t.count[si]) + " messages)");
+          topic_problem(
+              t, "topic only in the " + side_[si].role + " (" + std::to_string(t.count[si]) + " messages)");
           report_.diverging_messages += t.count[si];
         }
       }
@@ -1226,10 +1277,11 @@ class Comparer {
         const Pending& p = t.queue[si].front();
         const auto [has_step, step] = step_of(t, si, p);
         const std::string what =
-            si == kGolden ? "message missing from the run: the golden has " + std::to_string(t.count[kGolden]) +
-                                " messages on this topic, the run " + std::to_string(t.count[kRun])
-                          : "extra message in the run: the run has " + std::to_string(t.count[kRun]) +
-                                " messages on this topic, the golden " + std::to_string(t.count[kGolden]);
+            si == kGolden
+                ? "message missing from the run: the golden has " + std::to_string(t.count[kGolden]) +
+                      " messages on this topic, the run " + std::to_string(t.count[kRun])
+                : "extra message in the run: the run has " + std::to_string(t.count[kRun]) +
+                      " messages on this topic, the golden " + std::to_string(t.count[kGolden]);
         Divergence d{t.name, has_step, step, "(" + what + ")", "", "", ""};
         consider(Key{p.log_time, p.ordinal}, std::move(d));
         report_.diverging_messages += t.queue[si].size();
@@ -1249,11 +1301,13 @@ class Comparer {
         report_.fields.push_back(std::move(f));
       };
       const bool has_step = t.mode == Topic::Mode::Fields && t.layout->has_step();
-      for (std::size_t gi = 0; gi < t.identical_counts.size(); ++gi) t.stats[gi].values += t.identical_counts[gi];
+      for (std::size_t gi = 0; gi < t.identical_counts.size(); ++gi)
+        t.stats[gi].values += t.identical_counts[gi];
       if (t.mode == Topic::Mode::Fields) {
         const auto& groups = t.layout->groups();
         for (std::size_t gi = 0; gi < groups.size(); ++gi) {
-          if (t.stats[gi].values > 0) row(groups[gi].path, kind_label(groups[gi].kind), t.stats[gi], has_step);
+          if (t.stats[gi].values > 0)
+            row(groups[gi].path, kind_label(groups[gi].kind), t.stats[gi], has_step);
         }
       } else {
         row("(bytes)", "bytes", t.stats[t.bytes_stat], false);
@@ -1287,12 +1341,14 @@ class Comparer {
 std::string Divergence::line() const {
   if (topic_level) return "topic " + topic + ": " + field.substr(1, field.size() - 2);
   std::string out = "topic " + topic + ", " + (has_step ? "step " : "message ") + std::to_string(step);
-  if (!field.empty() && field.front() == '(' && expected.empty()) return out + ": " + field.substr(1, field.size() - 2);
+  if (!field.empty() && field.front() == '(' && expected.empty())
+    return out + ": " + field.substr(1, field.size() - 2);
   out += ", field " + field + ": expected " + expected + ", actual " + actual + ", difference " + difference;
   return out;
 }
 
-Result<CheckReport> check_logs(const std::string& run_path, const std::string& golden_path, const CheckOptions& options) {
+Result<CheckReport> check_logs(const std::string& run_path, const std::string& golden_path,
+                               const CheckOptions& options) {
   Comparer c(options, run_path, golden_path);
   return c.compare();
 }

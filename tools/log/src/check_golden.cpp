@@ -41,12 +41,16 @@ std::string g3(double v) {
 
 double number(const Scalar& s) {
   switch (s.kind) {
-    case Kind::Float: return s.f;
+    case Kind::Float:
+      return s.f;
     case Kind::Int:
-    case Kind::Bool: return static_cast<double>(s.i);
+    case Kind::Bool:
+      return static_cast<double>(s.i);
     case Kind::UInt:
-    case Kind::Length: return static_cast<double>(s.u);
-    case Kind::String: return std::nan("");
+    case Kind::Length:
+      return static_cast<double>(s.u);
+    case Kind::String:
+      return std::nan("");
   }
   return std::nan("");
 }
@@ -112,11 +116,13 @@ Result<std::map<std::string, TopicLog>> read_log(const std::string& path) {
     if (t.topic.empty()) {
       t.topic = e.channel->topic;
       t.type = e.schema->name;
-      const std::string_view text(reinterpret_cast<const char*>(e.schema->data.data()), e.schema->data.size());
+      const std::string_view text(reinterpret_cast<const char*>(e.schema->data.data()),
+                                  e.schema->data.size());
       auto decoder = msgs::MessageDecoder::create(t.type, text);
       auto layout = Layout::create(t.type, text);
       if (!decoder || !layout) {
-        failure = Error{path + ": schema " + t.type + ": " + (!decoder ? decoder.error().message : layout.error().message)};
+        failure = Error{path + ": schema " + t.type + ": " +
+                        (!decoder ? decoder.error().message : layout.error().message)};
         return false;
       }
       t.decoder = std::move(decoder.value());
@@ -129,11 +135,13 @@ Result<std::map<std::string, TopicLog>> read_log(const std::string& path) {
     m.log_time = e.message.log_time;
     m.data = e.message.data;
     if (Status d = t.decoder->decode(std::as_bytes(std::span<const std::uint8_t>(m.data)), m.scalars); !d) {
-      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) + ": " + d.error().message};
+      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) + ": " +
+                      d.error().message};
       return false;
     }
     if (!t.layout->map(m.scalars, m.plan)) {
-      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) + " does not fit its schema"};
+      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) +
+                      " does not fit its schema"};
       return false;
     }
     t.messages.push_back(std::move(m));
@@ -153,7 +161,8 @@ class Tally {
     if (std::isnan(d)) d = got == want ? 0.0 : HUGE_VAL;
     if (d > max_) max_ = d;
     if (!(d <= tol) && fails_++ == 0) {
-      first_ = where() + ": recorded " + g17(got) + ", expected " + g17(want) + " (tolerance " + g3(tol) + ")";
+      first_ =
+          where() + ": recorded " + g17(got) + ", expected " + g17(want) + " (tolerance " + g3(tol) + ")";
     }
   }
   void fail(const std::string& what) {
@@ -164,7 +173,8 @@ class Tally {
   std::uint64_t count() const { return count_; }
   std::string summary() const {
     return ok() ? "max diff " + g3(max_)
-                : std::to_string(fails_) + " of " + std::to_string(count_) + " outside tolerance, first " + first_;
+                : std::to_string(fails_) + " of " + std::to_string(count_) + " outside tolerance, first " +
+                      first_;
   }
 
  private:
@@ -264,7 +274,8 @@ Terms terms_of(const Model& m, const State& s) {
     for (std::size_t b = 0; b < n; ++b) {
       u -= m.mass[b] * (g.acceleration.x() * s.x[b] + g.acceleration.y() * s.y[b]);
       force[b] += m.mass[b] * g.acceleration;
-      t.scale += std::fabs(m.mass[b] * g.acceleration.x() * s.x[b]) + std::fabs(m.mass[b] * g.acceleration.y() * s.y[b]);
+      t.scale += std::fabs(m.mass[b] * g.acceleration.x() * s.x[b]) +
+                 std::fabs(m.mass[b] * g.acceleration.y() * s.y[b]);
     }
     t.force_potential.push_back(u);
   }
@@ -329,8 +340,10 @@ void step_state(const Model& m, const Scene& scene, State& s) {
     for (std::size_t b = 0; b < n; ++b) force[b] += m.mass[b] * g.acceleration;
   }
   for (const SpringDef& sp : m.springs) {
-    const Vec2 arm_i = sp.body_i < 0 ? Vec2(0.0, 0.0) : rotate(static_cast<std::size_t>(sp.body_i), sp.anchor_i);
-    const Vec2 arm_j = sp.body_j < 0 ? Vec2(0.0, 0.0) : rotate(static_cast<std::size_t>(sp.body_j), sp.anchor_j);
+    const Vec2 arm_i =
+        sp.body_i < 0 ? Vec2(0.0, 0.0) : rotate(static_cast<std::size_t>(sp.body_i), sp.anchor_i);
+    const Vec2 arm_j =
+        sp.body_j < 0 ? Vec2(0.0, 0.0) : rotate(static_cast<std::size_t>(sp.body_j), sp.anchor_j);
     const Vec2 pi = sp.body_i < 0 ? sp.anchor_i : Vec2(s.x[sp.body_i], s.y[sp.body_i]) + arm_i;
     const Vec2 pj = sp.body_j < 0 ? sp.anchor_j : Vec2(s.x[sp.body_j], s.y[sp.body_j]) + arm_j;
     const Vec2 d = pj - pi;
@@ -443,7 +456,8 @@ Result<std::int64_t> read_record_every(const std::string& golden_path) {
   auto log = read_log(golden_path);
   if (!log) return log.error();
   const auto it = log->find(std::string(kBodyStatesType));
-  if (it == log->end() || it->second.messages.empty()) return Error{golden_path + ": no body states recorded"};
+  if (it == log->end() || it->second.messages.empty())
+    return Error{golden_path + ": no body states recorded"};
   const TopicLog& t = it->second;
   if (t.messages.size() < 2) return std::int64_t{1};
   return static_cast<std::int64_t>(t.step(1) - t.step(0));
@@ -474,7 +488,9 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   const TopicLog* springs = topic(kSpringStatesType);
   const TopicLog* energy = topic(kEnergyType);
   const TopicLog* poses = topic(kPosesType);
-  for (auto [t, type] : {std::pair{desc, kSceneType}, {states, kBodyStatesType}, {springs, kSpringStatesType},
+  for (auto [t, type] : {std::pair{desc, kSceneType},
+                         {states, kBodyStatesType},
+                         {springs, kSpringStatesType},
                          {energy, kEnergyType}}) {
     if (t == nullptr) r.line(false, "recording: no " + std::string(type) + " messages");
   }
@@ -483,15 +499,19 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   // 1. The recorded scene description against the scene file.
   {
     Tally tally;
-    auto exact = [&](double got, double want, const std::string& what) { tally.add(got, want, 0.0, [&] { return what; }); };
+    auto exact = [&](double got, double want, const std::string& what) {
+      tally.add(got, want, 0.0, [&] { return what; });
+    };
     auto rel = [&](double got, double want, const std::string& what) {
       tally.add(got, want, 1e-12 * std::max(1.0, std::fabs(want)), [&] { return what; });
     };
     if (desc->messages.size() != 1 || desc->messages[0].log_time != 0) {
-      tally.fail("expected one scene description at log time 0, found " + std::to_string(desc->messages.size()));
+      tally.fail("expected one scene description at log time 0, found " +
+                 std::to_string(desc->messages.size()));
     }
     if (desc->text(0, "integrator") != to_string(scene.world.integrator)) {
-      tally.fail("integrator '" + desc->text(0, "integrator") + "', scene " + to_string(scene.world.integrator));
+      tally.fail("integrator '" + desc->text(0, "integrator") + "', scene " +
+                 to_string(scene.world.integrator));
     }
     exact(desc->one(0, "dt"), dt, "dt");
     exact(desc->one(0, "duration"), scene.duration, "duration");
@@ -529,7 +549,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       exact(k[s], sp.stiffness, id + " stiffness");
       exact(l0[s], sp.rest_length, id + " rest_length");
     }
-    const auto gx = desc->numbers(0, "gravity[].acceleration.x"), gy = desc->numbers(0, "gravity[].acceleration.y");
+    const auto gx = desc->numbers(0, "gravity[].acceleration.x"),
+               gy = desc->numbers(0, "gravity[].acceleration.y");
     exact(static_cast<double>(gx.size()), static_cast<double>(model.gravity.size()), "gravity count");
     for (std::size_t g = 0; g < std::min(gx.size(), model.gravity.size()); ++g) {
       exact(gx[g], model.gravity[g].acceleration.x(), "gravity " + std::to_string(g) + " x");
@@ -545,11 +566,14 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       exact(wy[w], wd.velocity.y(), "wind " + std::to_string(w) + " velocity.y");
       exact(ppe[w], wd.points_per_edge, "wind " + std::to_string(w) + " points_per_edge");
     }
-    r.line(tally.ok(), "scene description: " + std::to_string(bodies) + " bodies (M, I and body-space hulls recomputed "
-                       "from the vertices), " + std::to_string(model.springs.size()) + " springs, " +
-                       std::to_string(model.gravity.size()) + " gravity, " + std::to_string(scene.world.winds.size()) +
-                       " wind, dt " + g17(dt) + ", " + to_string(scene.world.integrator) + ", " +
-                       std::to_string(v.steps) + " steps: " + tally.summary());
+    r.line(tally.ok(), "scene description: " + std::to_string(bodies) +
+                           " bodies (M, I and body-space hulls recomputed "
+                           "from the vertices), " +
+                           std::to_string(model.springs.size()) + " springs, " +
+                           std::to_string(model.gravity.size()) + " gravity, " +
+                           std::to_string(scene.world.winds.size()) + " wind, dt " + g17(dt) + ", " +
+                           to_string(scene.world.integrator) + ", " + std::to_string(v.steps) +
+                           " steps: " + tally.summary());
     // With other counts the recording cannot be read against this scene; with other values it
     // can, and the checks below show what they break.
     if (mass.size() != bodies || k.size() != model.springs.size() || gx.size() != model.gravity.size() ||
@@ -581,7 +605,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         break;
       }
       for (std::size_t b = 0; b < bodies; ++b) {
-        if (ids[b] != static_cast<double>(b)) tally.fail("message " + std::to_string(m) + " body ids out of order");
+        if (ids[b] != static_cast<double>(b))
+          tally.fail("message " + std::to_string(m) + " body ids out of order");
       }
     }
     const std::uint64_t K = steps.size() >= 2 ? steps[1] - steps[0] : 1;
@@ -590,7 +615,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     if (steps.empty() || steps[0] != 0) tally.fail("the first recorded step is not step 0");
     for (std::size_t m = 0; m < steps.size(); ++m) {
       if (steps[m] != m * K) {
-        tally.fail("recorded step " + std::to_string(steps[m]) + " where step " + std::to_string(m * K) + " was expected");
+        tally.fail("recorded step " + std::to_string(steps[m]) + " where step " + std::to_string(m * K) +
+                   " was expected");
         break;
       }
       const std::uint64_t ns = stamp_ns(steps[m], dt);
@@ -600,20 +626,22 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       tally.add(sec * 1e9 + nsec, static_cast<double>(ns), 0.0,
                 [&] { return "step " + std::to_string(steps[m]) + " header stamp"; });
     }
-    if (!steps.empty() && (steps.back() > static_cast<std::uint64_t>(v.steps) ||
-                           static_cast<std::uint64_t>(v.steps) - steps.back() >= std::max<std::uint64_t>(K, 1))) {
+    if (!steps.empty() &&
+        (steps.back() > static_cast<std::uint64_t>(v.steps) ||
+         static_cast<std::uint64_t>(v.steps) - steps.back() >= std::max<std::uint64_t>(K, 1))) {
       tally.fail("the recording ends at step " + std::to_string(steps.back()) + ", the scene runs " +
                  std::to_string(v.steps) + " steps");
     }
     for (const TopicLog* t : {springs, energy, poses}) {
       if (t == nullptr) continue;
       if (t->messages.size() != states->messages.size()) {
-        tally.fail(t->topic + " has " + std::to_string(t->messages.size()) + " messages, " + states->topic + " " +
-                   std::to_string(states->messages.size()));
+        tally.fail(t->topic + " has " + std::to_string(t->messages.size()) + " messages, " + states->topic +
+                   " " + std::to_string(states->messages.size()));
         continue;
       }
       for (std::size_t m = 0; m < steps.size(); ++m) {
-        tally.add(static_cast<double>(t->messages[m].log_time), static_cast<double>(states->messages[m].log_time), 0.0,
+        tally.add(static_cast<double>(t->messages[m].log_time),
+                  static_cast<double>(states->messages[m].log_time), 0.0,
                   [&] { return t->topic + " message " + std::to_string(m) + " log time"; });
         if (t->layout->has_step()) {
           tally.add(static_cast<double>(t->step(m)), static_cast<double>(steps[m]), 0.0,
@@ -635,9 +663,9 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         tally.add(s0.omega[b], def.omega, 0.0, [&] { return id + " omega"; });
       }
     }
-    r.line(tally.ok(), "recording: steps 0.." + std::to_string(v.last_step) + " every " + std::to_string(K) + " (" +
-                           std::to_string(steps.size()) + " per topic), stamps = step * dt, initial state = scene: " +
-                           tally.summary());
+    r.line(tally.ok(), "recording: steps 0.." + std::to_string(v.last_step) + " every " + std::to_string(K) +
+                           " (" + std::to_string(steps.size()) +
+                           " per topic), stamps = step * dt, initial state = scene: " + tally.summary());
     if (!tally.ok()) return v;
   }
 
@@ -655,10 +683,12 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
           return at + " " + what + (i == SIZE_MAX ? std::string() : " [" + std::to_string(i) + "]");
         });
       };
-      auto each = [&](Tally& tally, const TopicLog* t_log, const char* path, const std::vector<double>& want) {
+      auto each = [&](Tally& tally, const TopicLog* t_log, const char* path,
+                      const std::vector<double>& want) {
         const auto got = t_log->numbers(m, path);
         if (got.size() != want.size()) {
-          tally.fail(at + " " + path + ": " + std::to_string(got.size()) + " values, expected " + std::to_string(want.size()));
+          tally.fail(at + " " + path + ": " + std::to_string(got.size()) + " values, expected " +
+                     std::to_string(want.size()));
           return;
         }
         for (std::size_t i = 0; i < got.size(); ++i) near(tally, got[i], want[i], path, i);
@@ -707,12 +737,14 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       }
     }
     const std::string tol = " (tolerance " + g3(rtol) + " x max(1, |value|))";
-    r.line(e.ok(), "energy terms: P, L_point, L_spin, T_point, T_spin per body, U per force and the totals of " +
-                       std::to_string(state.size()) + " steps recomputed from the recorded states" + tol + ": " +
-                       e.summary());
-    r.line(sp.ok(), "spring states: endpoints, lengths and potentials recomputed from the recorded poses" + tol + ": " +
-                        sp.summary());
-    if (poses != nullptr) r.line(po.ok(), "poses: positions and orientation quaternions" + tol + ": " + po.summary());
+    r.line(e.ok(),
+           "energy terms: P, L_point, L_spin, T_point, T_spin per body, U per force and the totals of " +
+               std::to_string(state.size()) + " steps recomputed from the recorded states" + tol + ": " +
+               e.summary());
+    r.line(sp.ok(), "spring states: endpoints, lengths and potentials recomputed from the recorded poses" +
+                        tol + ": " + sp.summary());
+    if (poses != nullptr)
+      r.line(po.ok(), "poses: positions and orientation quaternions" + tol + ": " + po.summary());
   }
 
   // 4. The dynamics, re-integrated independently: from each recorded state, K steps of the
@@ -737,10 +769,12 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         add(s.omega[b], want.omega[b], "omega");
       }
     }
-    r.line(tally.ok(), "independent integration: from each recorded state, " + std::to_string(v.record_every) +
-                           " steps of the verifier's own " + to_string(scene.world.integrator) +
-                           " (gravity, springs, wind summed over its sample points) reach the next recorded state "
-                           "(tolerance " + g3(tol) + " x max(1, |value|)): " + tally.summary());
+    r.line(tally.ok(),
+           "independent integration: from each recorded state, " + std::to_string(v.record_every) +
+               " steps of the verifier's own " + to_string(scene.world.integrator) +
+               " (gravity, springs, wind summed over its sample points) reach the next recorded state "
+               "(tolerance " +
+               g3(tol) + " x max(1, |value|)): " + tally.summary());
     if (tally.ok()) v.rule = "independent-integration";
   }
 
@@ -758,18 +792,22 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     if (!graded) return graded.error();
     const GradeReport& gr = graded.value();
     r.line(gr.passed, "grade (the reference's rule, as rbsim grade): " + std::to_string(gr.steps) +
-                          " steps, max step diff " + g3(gr.max_step_diff) + ", summed " + g3(gr.sum_step_diff) +
-                          ", max quantity diff " + g3(gr.max_quantity_diff) + (gr.passed ? "" : ": " + gr.message));
+                          " steps, max step diff " + g3(gr.max_step_diff) + ", summed " +
+                          g3(gr.sum_step_diff) + ", max quantity diff " + g3(gr.max_quantity_diff) +
+                          (gr.passed ? "" : ": " + gr.message));
     Tally st, q;
     const FosssimLog& rl = ref.value();
     for (std::size_t b = 0; b < bodies; ++b) {
       const std::string id = "body " + std::to_string(b);
-      q.add(desc->numbers(0, "bodies[].mass")[b], rl.mass[b], options.quantity_tol, [&] { return id + " M"; });
-      q.add(desc->numbers(0, "bodies[].inertia")[b], rl.inertia[b], options.quantity_tol, [&] { return id + " I"; });
+      q.add(desc->numbers(0, "bodies[].mass")[b], rl.mass[b], options.quantity_tol,
+            [&] { return id + " M"; });
+      q.add(desc->numbers(0, "bodies[].inertia")[b], rl.inertia[b], options.quantity_tol,
+            [&] { return id + " I"; });
     }
     for (std::size_t m = 0; m < state.size(); ++m) {
       if (steps[m] >= rl.frames.size()) {
-        st.fail("step " + std::to_string(steps[m]) + " is past the reference's " + std::to_string(rl.frames.size() - 1));
+        st.fail("step " + std::to_string(steps[m]) + " is past the reference's " +
+                std::to_string(rl.frames.size() - 1));
         break;
       }
       const FosssimFrame& f = rl.frames[steps[m]];
@@ -778,7 +816,9 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       for (std::size_t b = 0; b < bodies; ++b) {
         const BodyState& want = f.states[b];
         const double tol = options.state_tol;
-        auto where = [&](const char* what) { return [&, what] { return at + std::to_string(b) + " " + what; }; };
+        auto where = [&](const char* what) {
+          return [&, what] { return at + std::to_string(b) + " " + what; };
+        };
         st.add(s.x[b], want.position.x(), tol, where("x"));
         st.add(s.y[b], want.position.y(), tol, where("y"));
         st.add(s.theta[b], want.theta, tol, where("theta"));
@@ -800,11 +840,14 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     r.line(st.ok(), "body states of the " + std::to_string(state.size()) +
                         " recorded steps against the reference's free run (absolute tolerance " +
                         g3(options.state_tol) + "): " + st.summary());
-    r.line(q.ok(), "M, I, P, L_point, L_spin, T_point, T_spin, U of the recorded steps against the reference's "
-                   "(absolute tolerance " + g3(options.quantity_tol) + "): " + q.summary());
+    r.line(q.ok(),
+           "M, I, P, L_point, L_spin, T_point, T_spin, U of the recorded steps against the reference's "
+           "(absolute tolerance " +
+               g3(options.quantity_tol) + "): " + q.summary());
   } else if (scene.world.integrator == Integrator::SymplecticEuler && scene.world.winds.empty()) {
     v.rule = "symplectic-energy, " + v.rule;
-    if (!match.scene.empty()) r.info("the scene is FOSSSim's " + match.scene + ", which has no reference output");
+    if (!match.scene.empty())
+      r.info("the scene is FOSSSim's " + match.scene + ", which has no reference output");
     // Symplectic Euler on H = T(P, L) + U(X, theta) (separable: I is constant in 2D) conserves the
     // modified energy E + (dt / 2) Pi up to O(dt^2), Pi being the power of the conservative
     // forces.
@@ -828,17 +871,22 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     const double bound = dt * (max_power + std::fabs(terms.front().power)) + 1e-12 * max_scale;
     v.energy_error = err;
     v.energy_bound = bound;
-    r.line(err <= bound, "energy conservation (symplectic Euler, gravity and springs): E = T + U recomputed from the "
-                         "recorded states; max |E - E0| = " + g3(err) + " at step " + std::to_string(worst) +
-                         " <= dt * (max|Pi| + |Pi_0|) + 1e-12 * max(sum |terms|) = " + g3(bound) + " (ratio " +
-                         g3(bound > 0 ? err / bound : 0.0) + ", E0 = " + g17(e0) + ", max|Pi| = " + g3(max_power) + ")");
-    r.info("modified energy E + dt/2 Pi drifts by at most " + g3(modified) + " (first-order backward error analysis)");
+    r.line(err <= bound,
+           "energy conservation (symplectic Euler, gravity and springs): E = T + U recomputed from the "
+           "recorded states; max |E - E0| = " +
+               g3(err) + " at step " + std::to_string(worst) +
+               " <= dt * (max|Pi| + |Pi_0|) + 1e-12 * max(sum |terms|) = " + g3(bound) + " (ratio " +
+               g3(bound > 0 ? err / bound : 0.0) + ", E0 = " + g17(e0) + ", max|Pi| = " + g3(max_power) +
+               ")");
+    r.info("modified energy E + dt/2 Pi drifts by at most " + g3(modified) +
+           " (first-order backward error analysis)");
   } else if (!match.scene.empty()) {
     r.info("the scene is FOSSSim's " + match.scene + ", which has no reference output; with " +
            (scene.world.winds.empty() ? "explicit Euler" : "wind") + " energy is not conserved");
   } else {
-    r.info(std::string("no FOSSSim reference output") + (options.fosssim_dir.empty() ? " (no FOSSSim directory given)" : "") +
-           "; with " + (scene.world.winds.empty() ? "explicit Euler" : "wind") + " energy is not conserved");
+    r.info(std::string("no FOSSSim reference output") +
+           (options.fosssim_dir.empty() ? " (no FOSSSim directory given)" : "") + "; with " +
+           (scene.world.winds.empty() ? "explicit Euler" : "wind") + " energy is not conserved");
   }
   v.passed = !r.failed && !v.rule.empty();
   return v;

@@ -7,9 +7,13 @@ namespace rbsim::log {
 
 namespace {
 
-mcap::ByteView view(const msgs::Bytes& b) { return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()}; }
+mcap::ByteView view(const msgs::Bytes& b) {
+  return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
+}
 
-Error fail(const std::string& path, const mcap::Status& st) { return Error{path + ": " + st.message}; }
+Error fail(const std::string& path, const mcap::Status& st) {
+  return Error{path + ": " + st.message};
+}
 
 class McapSink final : public Sink {
  public:
@@ -78,7 +82,8 @@ mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t 
   return o;
 }
 
-mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns) {
+mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec,
+                                      std::string_view ns) {
   Result<std::string> schema = msgs::ros2msg_schema(spec.type);
   if (!schema) return mcap::Status::Error(mcap::StatusCode::InvalidArgument, schema.error().message);
   const std::string& text = schema.value();

@@ -13,7 +13,8 @@
 
 namespace rbsim::msgs::detail {
 
-static_assert(std::endian::native == std::endian::little, "the CDR writer copies native little-endian values");
+static_assert(std::endian::native == std::endian::little,
+              "the CDR writer copies native little-endian values");
 
 class CdrWriter {
  public:

@@ -15,10 +15,12 @@ struct Primitive {
   Scalar::Kind kind;
 };
 constexpr Primitive kPrimitives[] = {
-    {"bool", 1, Scalar::Kind::Bool},     {"byte", 1, Scalar::Kind::UInt},     {"char", 1, Scalar::Kind::UInt},
-    {"int8", 1, Scalar::Kind::Int},      {"uint8", 1, Scalar::Kind::UInt},    {"int16", 2, Scalar::Kind::Int},
-    {"uint16", 2, Scalar::Kind::UInt},   {"int32", 4, Scalar::Kind::Int},     {"uint32", 4, Scalar::Kind::UInt},
-    {"int64", 8, Scalar::Kind::Int},     {"uint64", 8, Scalar::Kind::UInt},   {"float32", 4, Scalar::Kind::Float},
+    {"bool", 1, Scalar::Kind::Bool},     {"byte", 1, Scalar::Kind::UInt},
+    {"char", 1, Scalar::Kind::UInt},     {"int8", 1, Scalar::Kind::Int},
+    {"uint8", 1, Scalar::Kind::UInt},    {"int16", 2, Scalar::Kind::Int},
+    {"uint16", 2, Scalar::Kind::UInt},   {"int32", 4, Scalar::Kind::Int},
+    {"uint32", 4, Scalar::Kind::UInt},   {"int64", 8, Scalar::Kind::Int},
+    {"uint64", 8, Scalar::Kind::UInt},   {"float32", 4, Scalar::Kind::Float},
     {"float64", 8, Scalar::Kind::Float}, {"string", 0, Scalar::Kind::String},
 };
 
@@ -33,7 +35,8 @@ int primitive_index(std::string_view t) {
 // Walks one message; `Visit` is called with each scalar. Returns false on malformed data.
 class Walker {
  public:
-  Walker(const std::vector<MessageDecoder::Type>& types, std::span<const std::byte> cdr) : types_(types), cdr_(cdr) {}
+  Walker(const std::vector<MessageDecoder::Type>& types, std::span<const std::byte> cdr)
+      : types_(types), cdr_(cdr) {}
   std::string error;
 
   template <class Visit>
@@ -67,7 +70,8 @@ class Walker {
       }
       for (std::uint64_t k = 0; k < count; ++k) {
         if (f.array != MessageDecoder::Field::Array::None) visit.index(k);
-        if (f.primitive >= 0 ? !primitive(kPrimitives[f.primitive], visit) : !type(f.nested, visit)) return false;
+        if (f.primitive >= 0 ? !primitive(kPrimitives[f.primitive], visit) : !type(f.nested, visit))
+          return false;
         if (f.array != MessageDecoder::Field::Array::None) visit.unindex();
       }
       visit.leave();
@@ -105,8 +109,12 @@ class Walker {
           s.i = static_cast<std::int64_t>(u << shift) >> shift;
           break;
         }
-        case Scalar::Kind::Bool: s.i = raw[0] != 0; break;
-        default: std::memcpy(&s.u, raw, p.size); break;
+        case Scalar::Kind::Bool:
+          s.i = raw[0] != 0;
+          break;
+        default:
+          std::memcpy(&s.u, raw, p.size);
+          break;
       }
     }
     visit.scalar(s, false);
@@ -161,11 +169,15 @@ struct PathOf {
 
 std::string Scalar::to_string() const {
   switch (kind) {
-    case Kind::Bool: return i ? "true" : "false";
-    case Kind::Int: return std::to_string(i);
+    case Kind::Bool:
+      return i ? "true" : "false";
+    case Kind::Int:
+      return std::to_string(i);
     case Kind::UInt:
-    case Kind::Length: return std::to_string(u);
-    case Kind::String: return "\"" + std::string(s) + "\"";
+    case Kind::Length:
+      return std::to_string(u);
+    case Kind::String:
+      return "\"" + std::string(s) + "\"";
     case Kind::Float: {
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.17g", f);
@@ -257,7 +269,8 @@ Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string
       d.types_[t].fields.push_back(std::move(f));
     }
     // rosidl gives a message without fields one uint8 member, so every element has a size.
-    if (d.types_[t].fields.empty()) d.types_[t].fields.push_back(Field{"structure_needs_at_least_one_member", 4});
+    if (d.types_[t].fields.empty())
+      d.types_[t].fields.push_back(Field{"structure_needs_at_least_one_member", 4});
   }
   return d;
 }

@@ -105,7 +105,8 @@ void Encoder::body_states(const World& world, Bytes& out) const {
   w.sequence_length(static_cast<std::size_t>(world.body_count()));
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     w.i32(b);
-    for (double v : {world.x()[b], world.y()[b], world.theta()[b], world.vx()[b], world.vy()[b], world.omega()[b]}) {
+    for (double v :
+         {world.x()[b], world.y()[b], world.theta()[b], world.vx()[b], world.vy()[b], world.omega()[b]}) {
       w.f64(v);
     }
   }
@@ -204,16 +205,16 @@ void Encoder::markers(const World& world, Bytes& out) const {
     w.boolean(false);  // frame_locked
   };
   auto marker_rest = [&] {
-    w.string("");            // texture_resource
-    w.header(Time{}, "");    // texture: sensor_msgs/CompressedImage
+    w.string("");          // texture_resource
+    w.header(Time{}, "");  // texture: sensor_msgs/CompressedImage
     w.string("");
     w.sequence_length(0);
-    w.sequence_length(0);    // uv_coordinates
-    w.string("");            // text
-    w.string("");            // mesh_resource
-    w.string("");            // mesh_file.filename
-    w.sequence_length(0);    // mesh_file.data
-    w.boolean(false);        // mesh_use_embedded_materials
+    w.sequence_length(0);  // uv_coordinates
+    w.string("");          // text
+    w.string("");          // mesh_resource
+    w.string("");          // mesh_file.filename
+    w.sequence_length(0);  // mesh_file.data
+    w.boolean(false);      // mesh_use_embedded_materials
   };
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     const BodyId id{b};
@@ -262,13 +263,20 @@ void Encoder::clock(const World& world, Bytes& out) const {
 
 void Encoder::encode(TopicId id, const World& world, Bytes& out) const {
   switch (id) {
-    case TopicId::Scene: return scene(world, out);
-    case TopicId::BodyStates: return body_states(world, out);
-    case TopicId::SpringStates: return spring_states(world, out);
-    case TopicId::Energy: return energy(world, out);
-    case TopicId::Poses: return poses(world, out);
-    case TopicId::Markers: return markers(world, out);
-    case TopicId::Clock: return clock(world, out);
+    case TopicId::Scene:
+      return scene(world, out);
+    case TopicId::BodyStates:
+      return body_states(world, out);
+    case TopicId::SpringStates:
+      return spring_states(world, out);
+    case TopicId::Energy:
+      return energy(world, out);
+    case TopicId::Poses:
+      return poses(world, out);
+    case TopicId::Markers:
+      return markers(world, out);
+    case TopicId::Clock:
+      return clock(world, out);
   }
 }
 

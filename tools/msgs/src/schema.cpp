@@ -29,9 +29,9 @@ std::string canonical(std::string_view type) {
 }
 
 bool is_primitive(std::string_view t) {
-  static constexpr std::string_view kPrimitives[] = {"bool",   "byte",   "char",  "float32", "float64",
-                                                     "int8",   "uint8",  "int16", "uint16",  "int32",
-                                                     "uint32", "int64",  "uint64", "string", "wstring"};
+  static constexpr std::string_view kPrimitives[] = {"bool",   "byte",  "char",   "float32", "float64",
+                                                     "int8",   "uint8", "int16",  "uint16",  "int32",
+                                                     "uint32", "int64", "uint64", "string",  "wstring"};
   if (t.starts_with("string<=") || t.starts_with("wstring<=")) return true;
   return std::find(std::begin(kPrimitives), std::end(kPrimitives), t) != std::end(kPrimitives);
 }
@@ -55,8 +55,12 @@ std::set<std::string> dependencies(std::string_view text, std::string_view packa
 }
 }  // namespace
 
-std::span<const TopicSpec> topics() { return kTopics; }
-const TopicSpec& topic(TopicId id) { return kTopics[static_cast<std::size_t>(id)]; }
+std::span<const TopicSpec> topics() {
+  return kTopics;
+}
+const TopicSpec& topic(TopicId id) {
+  return kTopics[static_cast<std::size_t>(id)];
+}
 
 std::string topic_name(const TopicSpec& spec, std::string_view ns) {
   if (spec.id == TopicId::Clock || ns.empty()) return "/" + std::string(spec.suffix);

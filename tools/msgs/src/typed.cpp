@@ -68,7 +68,9 @@ class Reader {
   bool ok_ = true;
 };
 
-Error bad(const char* type) { return Error{std::string("malformed or truncated ") + type + " message"}; }
+Error bad(const char* type) {
+  return Error{std::string("malformed or truncated ") + type + " message"};
+}
 
 }  // namespace
 

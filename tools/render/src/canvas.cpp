@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "rbsim/render.hpp"
@@ -18,7 +18,9 @@
 // Cairo's text goes through fontconfig, which keeps its parsed configuration for the life of the
 // process on purpose (no API frees it while Cairo may still use it). LeakSanitizer reads this
 // function in any process that draws, so only that library's allocations are excused.
-extern "C" const char* __lsan_default_suppressions() { return "leak:libfontconfig.so\n"; }
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libfontconfig.so\n";
+}
 #endif
 
 namespace rbsim::render {
@@ -92,7 +94,8 @@ Camera camera_for(const Stage& stage, std::span<const Pose> poses, int width, in
     }
   }
   for (const SpringDef& s : stage.springs) {
-    for (const Vec2& w : {spring_end(stage, poses, s.body_i, s.anchor_i), spring_end(stage, poses, s.body_j, s.anchor_j)}) {
+    for (const Vec2& w :
+         {spring_end(stage, poses, s.body_i, s.anchor_i), spring_end(stage, poses, s.body_j, s.anchor_j)}) {
       lo_x = std::min(lo_x, w.x()), hi_x = std::max(hi_x, w.x());
       lo_y = std::min(lo_y, w.y()), hi_y = std::max(hi_y, w.y());
     }
@@ -134,7 +137,8 @@ Canvas::~Canvas() {
 void Canvas::draw(const Stage& stage, std::span<const Pose> poses, double time, const Camera& cam) {
   cairo_t* cr = impl_->cr;
   const auto px = [&](const Vec2& w) {
-    return Vec2((w.x() - cam.cx) * cam.scale + 0.5 * cam.width, 0.5 * cam.height - (w.y() - cam.cy) * cam.scale);
+    return Vec2((w.x() - cam.cx) * cam.scale + 0.5 * cam.width,
+                0.5 * cam.height - (w.y() - cam.cy) * cam.scale);
   };
   cairo_identity_matrix(cr);
   cairo_set_source_rgb(cr, stage.background.r, stage.background.g, stage.background.b);
@@ -197,12 +201,12 @@ void Canvas::draw(const Stage& stage, std::span<const Pose> poses, double time, 
 
 namespace {
 // libpng reports errors by longjmp, so nothing with a destructor lives in this frame.
-bool encode_png(png_structp png, png_infop info, std::FILE* f, const unsigned char* data, int stride, int width,
-                int height, unsigned char* row) {
+bool encode_png(png_structp png, png_infop info, std::FILE* f, const unsigned char* data, int stride,
+                int width, int height, unsigned char* row) {
   if (setjmp(png_jmpbuf(png)) != 0) return false;
   png_init_io(png, f);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_compression_level(png, 1);
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
   png_write_info(png, info);

@@ -41,7 +41,8 @@ Result<std::vector<Sample>> samples_from_scene(const std::string& path, std::opt
     }
     if (w.step_index() >= steps) break;
     w.step();
-    if (w.find_nonfinite()) return Error{path + ": the simulation diverged at step " + std::to_string(w.step_index())};
+    if (w.find_nonfinite())
+      return Error{path + ": the simulation diverged at step " + std::to_string(w.step_index())};
   }
   return out;
 }
@@ -60,7 +61,8 @@ Result<std::vector<Sample>> samples_from_log(const std::string& path) {
                                           e.message.data.size());
     if (!decoder) {
       auto d = msgs::MessageDecoder::create(
-          e.schema->name, std::string_view(reinterpret_cast<const char*>(e.schema->data.data()), e.schema->data.size()));
+          e.schema->name,
+          std::string_view(reinterpret_cast<const char*>(e.schema->data.data()), e.schema->data.size()));
       if (!d) return failure = d.error().message, false;
       decoder = std::move(d.value());
     }
@@ -77,14 +79,16 @@ Result<std::vector<Sample>> samples_from_log(const std::string& path) {
   });
   if (!st.ok()) return Error{path + ": " + st.message};
   if (!failure.empty()) return Error{path + ": " + failure};
-  if (out.empty()) return Error{path + ": the log has no energy terms (topic of type rbsim_msgs/msg/EnergyTerms)"};
+  if (out.empty())
+    return Error{path + ": the log has no energy terms (topic of type rbsim_msgs/msg/EnergyTerms)"};
   return out;
 }
 
 }  // namespace
 
 Status plot(const std::string& input, const PlotOptions& o) {
-  Result<std::vector<Sample>> samples = detail::is_mcap(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
+  Result<std::vector<Sample>> samples =
+      detail::is_mcap(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
   if (!samples) return samples.error();
 
   const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp", temp = o.out_png + ".tmp";
@@ -92,8 +96,8 @@ Status plot(const std::string& input, const PlotOptions& o) {
     std::ofstream f(data);
     for (const Sample& s : samples.value()) {
       char line[256];
-      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t, s.t_point, s.t_spin,
-                    s.u, s.e, s.px, s.py, s.l);
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t, s.t_point,
+                    s.t_spin, s.u, s.e, s.px, s.py, s.l);
       f << line;
     }
     if (!f) return Error{o.out_png + ": cannot write temporary data beside it"};
@@ -106,10 +110,12 @@ Status plot(const std::string& input, const PlotOptions& o) {
       << "set multiplot layout 2,1 title '" << fs::path(input).filename().string() << "'\n"
       << "set title 'Energy'\nset ylabel 'energy'\n"
       << "plot '" << data << "' using 1:2 with lines lw 1.5 title 'T_{point} (centre of mass)', "
-      << "'' using 1:3 with lines lw 1.5 title 'T_{spin}', '' using 1:4 with lines lw 1.5 title 'U (potential)', "
+      << "'' using 1:3 with lines lw 1.5 title 'T_{spin}', '' using 1:4 with lines lw 1.5 title 'U "
+         "(potential)', "
       << "'' using 1:5 with lines lw 2.5 title 'E = T + U'\n"
       << "set title 'Momentum'\nset ylabel 'momentum'\n"
-      << "plot '" << data << "' using 1:6 with lines lw 1.5 title 'P_x', '' using 1:7 with lines lw 1.5 title 'P_y', "
+      << "plot '" << data
+      << "' using 1:6 with lines lw 1.5 title 'P_x', '' using 1:7 with lines lw 1.5 title 'P_y', "
       << "'' using 1:8 with lines lw 2 title 'L = L_{point} + L_{spin}'\n"
       << "unset multiplot\n";
   }

@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "rbsim/log.hpp"
 #include "process.hpp"
+#include "rbsim/log.hpp"
 #include "rbsim/render.hpp"
 
 extern char** environ;
@@ -62,12 +62,14 @@ namespace {
 
 void poses_of(const World& world, std::vector<Pose>& out) {
   out.resize(static_cast<std::size_t>(world.body_count()));
-  for (std::int32_t b = 0; b < world.body_count(); ++b) out[b] = {world.x()[b], world.y()[b], world.theta()[b]};
+  for (std::int32_t b = 0; b < world.body_count(); ++b)
+    out[b] = {world.x()[b], world.y()[b], world.theta()[b]};
 }
 
 class FrameSink final : public Sink {
  public:
-  FrameSink(std::string dir, int width, int height, double fps) : frames_(std::move(dir), width, height, fps) {}
+  FrameSink(std::string dir, int width, int height, double fps)
+      : frames_(std::move(dir), width, height, fps) {}
   Status begin(const Scene& scene, const World& world) override {
     stage_ = stage_of(scene, world);
     stage_.duration = INFINITY;  // a run decides its own length (--steps / --duration)
@@ -91,7 +93,8 @@ std::span<const std::byte> bytes_of(const mcap::Message& m) {
 }
 
 // Calls on_scene once, then on_states for each recorded body-state message in step order.
-Status read_recording(const std::string& path, const std::function<Status(const msgs::SceneMessage&)>& on_scene,
+Status read_recording(const std::string& path,
+                      const std::function<Status(const msgs::SceneMessage&)>& on_scene,
                       const std::function<Status(const msgs::BodyStatesMessage&)>& on_states) {
   mcap::IndexedReader reader;
   if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
@@ -119,7 +122,8 @@ Status read_recording(const std::string& path, const std::function<Status(const 
   });
   if (!st.ok()) return Error{path + ": " + st.message};
   if (!result) return result;
-  if (!scene) return Error{path + ": the log has no scene description (topic of type rbsim_msgs/msg/SceneDescription)"};
+  if (!scene)
+    return Error{path + ": the log has no scene description (topic of type rbsim_msgs/msg/SceneDescription)"};
   return Ok{};
 }
 
@@ -140,7 +144,8 @@ Result<int> run_process(const std::vector<std::string>& args) {
   pid_t pid = 0;
   const int err = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ);
   if (err != 0) {
-    return Error{args[0] + " could not be started (" + std::strerror(err) + "): install it (scripts/setup installs it)"};
+    return Error{args[0] + " could not be started (" + std::strerror(err) +
+                 "): install it (scripts/setup installs it)"};
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -168,7 +173,8 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
         },
         [&](const msgs::BodyStatesMessage& m) {
           poses.clear();
-          for (const auto& b : m.bodies) poses.push_back({b.state.position.x(), b.state.position.y(), b.state.theta});
+          for (const auto& b : m.bodies)
+            poses.push_back({b.state.position.x(), b.state.position.y(), b.state.theta});
           return frames.offer(stage, static_cast<std::int64_t>(m.step), stage.dt, poses);
         });
     if (!st) return st.error();
@@ -190,7 +196,8 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
     if (world.step_index() >= last_step) break;
     world.step();
     if (const auto bad = world.find_nonfinite()) {
-      return Error{"step " + std::to_string(world.step_index()) + ": " + bad->quantity + " is not finite: the simulation diverged"};
+      return Error{"step " + std::to_string(world.step_index()) + ": " + bad->quantity +
+                   " is not finite: the simulation diverged"};
     }
   }
   return frames.frames();
@@ -200,9 +207,10 @@ Status make_movie(const std::string& frames_dir, double fps, const std::string& 
   const std::string temp = mp4 + ".tmp.mp4";
   char rate[32];
   std::snprintf(rate, sizeof rate, "%g", fps);
-  Result<int> code = detail::run_process({"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i",
-                                  (fs::path(frames_dir) / "frame%05d.png").string(), "-c:v", "libx264", "-pix_fmt",
-                                  "yuv420p", "-crf", "20", "-movflags", "+faststart", temp});
+  Result<int> code =
+      detail::run_process({"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i",
+                           (fs::path(frames_dir) / "frame%05d.png").string(), "-c:v", "libx264", "-pix_fmt",
+                           "yuv420p", "-crf", "20", "-movflags", "+faststart", temp});
   if (!code) return Error{"ffmpeg: " + code.error().message};
   if (code.value() != 0) {
     std::remove(temp.c_str());

@@ -22,17 +22,17 @@ struct Viewport {
 };
 
 struct Scene {
-  std::string path;         // as given to load_scene
-  std::string name;         // file stem, e.g. "test00ee"
+  std::string path;  // as given to load_scene
+  std::string name;  // file stem, e.g. "test00ee"
   std::string description;
-  std::string tag;          // <scenetag>
+  std::string tag;  // <scenetag>
   WorldDef world;
-  double duration = 0.0;    // seconds of simulated time
+  double duration = 0.0;  // seconds of simulated time
   std::optional<double> max_sim_freq;
   std::optional<Viewport> viewport;
   Color background{1.0, 1.0, 1.0};
-  std::vector<Color> body_colors;    // one per body
-  std::vector<Color> spring_colors;  // one per spring
+  std::vector<Color> body_colors;     // one per body
+  std::vector<Color> spring_colors;   // one per spring
   std::vector<std::string> warnings;  // "file:line: warning: ..." lines, e.g. unknown nodes
 
   // Steps to cover `duration`: ceil(duration / dt) in double precision, so 0.07 / 0.01 gives 8.

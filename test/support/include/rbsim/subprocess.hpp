@@ -10,10 +10,10 @@
 namespace rbsim::test {
 
 struct Outcome {
-  int exit_code = -1;      // exit status, or -1 if killed by a signal / the timeout
-  int signal = 0;          // the signal that ended it, if any
+  int exit_code = -1;  // exit status, or -1 if killed by a signal / the timeout
+  int signal = 0;      // the signal that ended it, if any
   bool timed_out = false;
-  std::string out, err;    // everything written to stdout and stderr
+  std::string out, err;  // everything written to stdout and stderr
   std::vector<std::string> err_lines() const;
 };
 // "exit N signal S", then stdout and stderr: for test failure messages.
@@ -26,11 +26,12 @@ Outcome run_process(const std::string& exe, const std::vector<std::string>& args
                     const std::vector<std::string>& extra_env = {});
 
 // Runs the rbsim binary under test.
-Outcome rbsim(const std::vector<std::string>& args, std::chrono::milliseconds timeout = std::chrono::seconds(60));
+Outcome rbsim(const std::vector<std::string>& args,
+              std::chrono::milliseconds timeout = std::chrono::seconds(60));
 
 std::string read_text(const std::filesystem::path& path);
 void write_text(const std::filesystem::path& path, const std::string& text);  // creates its folder
-std::vector<std::string> lines_of(const std::string& text);  // without the newlines
+std::vector<std::string> lines_of(const std::string& text);                   // without the newlines
 std::vector<std::string> split(const std::string& line, char sep);
 
 // A fresh directory, removed with its contents at the end of the scope.

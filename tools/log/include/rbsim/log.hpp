@@ -15,10 +15,10 @@ namespace rbsim::log {
 
 struct RecordOptions {
   mcap::Compression compression = mcap::Compression::Zstd;
-  std::uint64_t chunk_size = 1 << 20;      // uncompressed bytes per chunk
-  std::int64_t every = 1;                   // record every k-th step (step 0 always)
-  std::string ns = "rbsim";                 // ROS namespace of the topics
-  std::vector<msgs::TopicId> topics;        // empty: every topic
+  std::uint64_t chunk_size = 1 << 20;  // uncompressed bytes per chunk
+  std::int64_t every = 1;              // record every k-th step (step 0 always)
+  std::string ns = "rbsim";            // ROS namespace of the topics
+  std::vector<msgs::TopicId> topics;   // empty: every topic
 };
 
 // A Sink that records a run: the scene description once at step 0, then every per-step topic.
@@ -58,7 +58,7 @@ struct CheckOptions {
 // or topic-level difference a description in parentheses ("(message missing from the run)").
 struct Divergence {
   std::string topic;
-  bool has_step = false;        // true: `step` is the message's step field; false: message index
+  bool has_step = false;  // true: `step` is the message's step field; false: message index
   std::uint64_t step = 0;
   std::string field;
   std::string expected, actual, difference;  // golden value, run value, actual - expected
@@ -69,23 +69,23 @@ struct Divergence {
 // Per topic, per field with array indices collapsed ("bodies[].x"): the largest difference.
 struct FieldStats {
   std::string topic, field;
-  std::string kind;             // "float", "int", "uint", "bool", "string", "length", "bytes", "time"
-  std::uint64_t values = 0;     // values compared
-  std::uint64_t over = 0;       // values outside the tolerance (or unequal, for exact kinds)
-  double max_abs = 0.0;         // max |actual - expected| (1 for an unequal string/bool/bytes)
-  double max_rel = 0.0;         // max |actual - expected| / |expected| (inf when expected is 0)
+  std::string kind;          // "float", "int", "uint", "bool", "string", "length", "bytes", "time"
+  std::uint64_t values = 0;  // values compared
+  std::uint64_t over = 0;    // values outside the tolerance (or unequal, for exact kinds)
+  double max_abs = 0.0;      // max |actual - expected| (1 for an unequal string/bool/bytes)
+  double max_rel = 0.0;      // max |actual - expected| / |expected| (inf when expected is 0)
   bool has_step = false;
   std::uint64_t step_at_max = 0;  // step (or message index) of max_abs
 };
 
 struct CheckReport {
-  std::optional<Divergence> first;       // none: the recordings match
-  std::uint64_t diverging_values = 0;    // values outside the tolerance
-  std::uint64_t diverging_messages = 0;  // messages with such a value, plus missing and extra ones
-  std::vector<std::string> topic_problems;  // topic-level differences (only in one file, schema)
-  std::vector<FieldStats> fields;        // topics by name, then fields in message order
-  std::vector<std::string> topics;       // topics compared
-  std::uint64_t messages = 0;            // message pairs compared
+  std::optional<Divergence> first;                // none: the recordings match
+  std::uint64_t diverging_values = 0;             // values outside the tolerance
+  std::uint64_t diverging_messages = 0;           // messages with such a value, plus missing and extra ones
+  std::vector<std::string> topic_problems;        // topic-level differences (only in one file, schema)
+  std::vector<FieldStats> fields;                 // topics by name, then fields in message order
+  std::vector<std::string> topics;                // topics compared
+  std::uint64_t messages = 0;                     // message pairs compared
   std::uint64_t run_bytes = 0, golden_bytes = 0;  // uncompressed message data read
   bool passed() const { return !first.has_value(); }
 };
@@ -126,15 +126,15 @@ struct GoldenVerification {
   // The independent results it was checked against, e.g. "fosssim-reference,
   // independent-integration" or "symplectic-energy, independent-integration".
   std::string rule;
-  std::vector<std::string> lines;   // "PASS ..." / "FAIL ..." per check, "info ..." notes
+  std::vector<std::string> lines;  // "PASS ..." / "FAIL ..." per check, "info ..." notes
   std::int64_t record_every = 0, last_step = 0, steps = 0;
   double energy_error = 0.0, energy_bound = 0.0;  // symplectic-energy rule
 };
 
 // Verifies a golden log of a scene independently of the simulator (its own code throughout; of
-// sim_core only the scene loader, and grade() for the reference rule): the recorded scene description against the scene file (M, I and hulls
-// recomputed from the vertices), the recording's steps and stamps, every recorded energy, spring
-// and pose term recomputed from the recorded body states, and the dynamics:
+// sim_core only the scene loader, and grade() for the reference rule): the recorded scene description against
+// the scene file (M, I and hulls recomputed from the vertices), the recording's steps and stamps, every
+// recorded energy, spring and pose term recomputed from the recorded body states, and the dynamics:
 //  - independent-integration (every scene): from each recorded state, K steps of the verifier's
 //    own integrator (forces summed as the spec states them, the wind over its sample points) land
 //    on the next recorded state within integration_tol;
@@ -176,8 +176,8 @@ struct ChannelSummary {
 struct LogInfo {
   mcap::Header header;
   std::uint64_t file_size = 0;
-  bool scanned = false;         // true: no usable summary, the whole file was read record by record
-  std::string scan_reason;      // why (when scanned)
+  bool scanned = false;     // true: no usable summary, the whole file was read record by record
+  std::string scan_reason;  // why (when scanned)
   std::uint64_t messages = 0;
   mcap::Timestamp start = 0, end = 0;  // log times (ns) of the first and last message
   std::uint64_t chunks = 0;
@@ -239,7 +239,8 @@ struct RecoverReport {
 // `out`, written under a temporary name and renamed into place. An Error means nothing was
 // written: `in` cannot be read at all (not MCAP, empty, no complete Header), `out` is `in`, or
 // `out` cannot be written. A damaged input is not an Error: see RecoverReport::input_intact.
-Result<RecoverReport> recover(const std::string& in, const std::string& out, const RecoverOptions& options = {});
+Result<RecoverReport> recover(const std::string& in, const std::string& out,
+                              const RecoverOptions& options = {});
 
 // export --------------------------------------------------------------------------------------
 struct ExportOptions {
@@ -248,7 +249,7 @@ struct ExportOptions {
   std::string ns;          // ROS namespace of the topics; empty: the only one in the file
 };
 struct ExportReport {
-  std::uint64_t steps = 0;     // steps written
+  std::uint64_t steps = 0;  // steps written
   std::uint64_t first_step = 0, last_step = 0;
   std::vector<std::string> warnings;
 };

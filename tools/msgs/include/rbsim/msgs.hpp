@@ -31,10 +31,10 @@ inline constexpr std::size_t kTopicCount = 7;
 
 struct TopicSpec {
   TopicId id;
-  std::string_view suffix;   // "body_states": the ROS name is /<namespace>/<suffix>
-  std::string_view type;     // "rbsim_msgs/msg/BodyStates"
-  bool transient_local;      // latched: late subscribers get the last sample
-  bool per_step;             // published every (published) step
+  std::string_view suffix;  // "body_states": the ROS name is /<namespace>/<suffix>
+  std::string_view type;    // "rbsim_msgs/msg/BodyStates"
+  bool transient_local;     // latched: late subscribers get the last sample
+  bool per_step;            // published every (published) step
 };
 std::span<const TopicSpec> topics();
 const TopicSpec& topic(TopicId id);
@@ -133,10 +133,10 @@ Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
 struct Scalar {
   enum class Kind : std::uint8_t { Bool, Int, UInt, Float, String, Length };
   Kind kind = Kind::Float;
-  double f = 0.0;          // Float (float32 widened)
-  std::int64_t i = 0;      // Bool, Int
-  std::uint64_t u = 0;     // UInt, Length
-  std::string_view s;      // String: points into the decoded buffer
+  double f = 0.0;       // Float (float32 widened)
+  std::int64_t i = 0;   // Bool, Int
+  std::uint64_t u = 0;  // UInt, Length
+  std::string_view s;   // String: points into the decoded buffer
   bool operator==(const Scalar&) const = default;
   std::string to_string() const;
 };
@@ -167,8 +167,8 @@ class MessageDecoder {
 
 struct MessageDecoder::Field {
   std::string name;
-  int primitive = -1;       // index into the primitive table, or -1 for a nested type
-  std::size_t nested = 0;   // index into types_ when primitive < 0
+  int primitive = -1;      // index into the primitive table, or -1 for a nested type
+  std::size_t nested = 0;  // index into types_ when primitive < 0
   enum class Array : std::uint8_t { None, Fixed, Sequence } array = Array::None;
   std::uint32_t fixed_size = 0;
 };
