@@ -174,6 +174,21 @@ bool Subscription::take(Received& out) {
     ddsi_serdata_to_ser(d, 0, size, out.cdr.data());
     out.source_time_ns = info.source_timestamp;
     ddsi_serdata_unref(d);
+    auto known = std::find_if(writers_.begin(), writers_.end(),
+                              [&](const auto& w) { return w.first == info.publication_handle; });
+    if (known == writers_.end()) {
+      std::array<std::uint8_t, 16> guid{};
+      if (dds_builtintopic_endpoint_t* e =
+              dds_get_matched_publication_data(reader_, info.publication_handle)) {
+        std::memcpy(guid.data(), e->key.v, guid.size());
+        dds_builtintopic_free_endpoint(e);
+      } else {  // the writer is gone already: its handle is all there is to tell it apart
+        std::memcpy(guid.data(), &info.publication_handle, sizeof info.publication_handle);
+      }
+      writers_.emplace_back(info.publication_handle, guid);
+      known = writers_.end() - 1;
+    }
+    out.writer = known->second;
     return true;
   }
 }

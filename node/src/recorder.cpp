@@ -124,6 +124,17 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   for (Topic& t : topics_) {
     while (t.subscription.take(sample)) {
       any = true;
+      auto newest = std::find_if(t.newest.begin(), t.newest.end(),
+                                 [&](const auto& w) { return w.first == sample.writer; });
+      if (newest != t.newest.end() && sample.source_time_ns <= newest->second) {
+        ++t.duplicates;
+        continue;
+      }
+      if (newest == t.newest.end()) {
+        t.newest.emplace_back(sample.writer, sample.source_time_ns);
+      } else {
+        newest->second = sample.source_time_ns;
+      }
       const std::uint64_t now = wall_ns();
       const std::uint64_t source =
           sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : now;

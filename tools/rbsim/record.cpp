@@ -58,11 +58,19 @@ int record_command(RecordArgs a) {
   if (Status st = recorder.value()->close(); !st)
     return fail(st.error().message + " (the file can be repaired with rbsim log recover)");
   if (!a.quiet || failure) {
-    std::uint64_t lost = 0;
+    std::uint64_t lost = 0, duplicates = 0;
     for (const auto& c : recorder.value()->counts()) {
-      std::fprintf(stderr, "  %-28s received %8llu  lost %llu\n", c.topic.c_str(),
-                   static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.lost));
+      std::fprintf(stderr, "  %-28s received %8llu  lost %llu%s\n", c.topic.c_str(),
+                   static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.lost),
+                   c.duplicates > 0 ? ("  delivered twice " + std::to_string(c.duplicates)).c_str() : "");
       lost += c.lost;
+      duplicates += c.duplicates;
+    }
+    if (duplicates > 0) {
+      std::fprintf(
+          stderr,
+          "rbsim record: %llu samples DDS delivered again (after a reconnection) were recorded once\n",
+          static_cast<unsigned long long>(duplicates));
     }
     std::fprintf(stderr, "rbsim record: %llu messages received, %llu lost, written to %s\n",
                  static_cast<unsigned long long>(recorder.value()->received()),

@@ -5,6 +5,7 @@
 // bytes go to DDS, to MCAP and back.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -77,6 +78,7 @@ class Publisher {
 struct Received {
   std::vector<std::byte> cdr;
   std::int64_t source_time_ns = 0;
+  std::array<std::uint8_t, 16> writer{};  // the sending writer's GUID (stable when it is rediscovered)
 };
 class Subscription {
  public:
@@ -97,6 +99,7 @@ class Subscription {
   std::int32_t reader_ = 0, topic_ = 0;
   std::string ros_topic_;
   const msgs::TopicSpec* spec_ = nullptr;
+  std::vector<std::pair<std::uint64_t, std::array<std::uint8_t, 16>>> writers_;  // instance handle -> GUID
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -172,6 +175,7 @@ class Recorder {
   struct TopicCount {
     std::string topic;
     std::uint64_t received = 0, lost = 0;  // lost: reported by DDS plus gaps in the steps
+    std::uint64_t duplicates = 0;          // samples delivered again, not recorded twice
   };
   std::vector<TopicCount> counts() const;
 
@@ -191,6 +195,11 @@ class Recorder {
     std::uint16_t channel;
     std::uint32_t received;
     Gaps gaps;
+    // Per writer, the newest source timestamp recorded. A sample not newer than that is one
+    // delivered again: after a reconnection DDS can resend what a reader already had (seen when
+    // a link came back after the lease expired), and a log must hold each message once.
+    std::vector<std::pair<std::array<std::uint8_t, 16>, std::int64_t>> newest{};
+    std::uint64_t duplicates = 0;
   };
   RecorderOptions options_;
   mcap::Writer writer_;
