@@ -1,25 +1,10 @@
 // The node's output: every topic of a step published over DDS, paced to wall time.
-#include <time.h>
-
 #include <cmath>
 
+#include "clock.hpp"
 #include "rbsim/node.hpp"
 
 namespace rbsim::node {
-
-namespace {
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-void sleep_until(std::int64_t deadline_ns) {
-  timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000),
-              static_cast<long>(deadline_ns % 1'000'000'000)};
-  // Interrupted by a signal (Ctrl-C): return early and let the caller look at its stop flag.
-  (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
-}
-}  // namespace
 
 Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant, const NodeOptions& options) {
   std::unique_ptr<DdsSink> sink(new DdsSink());

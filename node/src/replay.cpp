@@ -1,6 +1,4 @@
 // The replay: an MCAP recording republished over DDS with its recorded timing.
-#include <time.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,41 +6,27 @@
 #include <map>
 #include <set>
 
+#include "clock.hpp"
 #include "rbsim/node.hpp"
 
 namespace rbsim::node {
 
 namespace {
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 // Sleeps until `deadline_ns` (monotonic) in slices of at most 50 ms, so a stop request is seen
 // promptly whichever thread the signal went to; false when `stop` turned true.
-bool sleep_until(std::int64_t deadline_ns, bool (*stop)()) {
+bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
   constexpr std::int64_t kSlice = 50'000'000;
   while (true) {
     if (stop()) return false;
     const std::int64_t now = monotonic_ns();
     if (now >= deadline_ns) return true;
-    const std::int64_t until = std::min(deadline_ns, now + kSlice);
-    timespec ts{static_cast<time_t>(until / 1'000'000'000), static_cast<long>(until % 1'000'000'000)};
-    (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+    sleep_until(std::min(deadline_ns, now + kSlice));
   }
 }
 
-// "pkg/Name" -> "pkg/msg/Name" (rosbag2 writes the long form; older tools the short one).
-std::string canonical_type(std::string_view type) {
-  const auto a = type.find('/');
-  if (a == std::string_view::npos || type.find('/', a + 1) != std::string_view::npos)
-    return std::string(type);
-  return std::string(type.substr(0, a)) + "/msg/" + std::string(type.substr(a + 1));
-}
-
+// rosbag2 writes "pkg/msg/Name"; older tools "pkg/Name".
 const msgs::TopicSpec* spec_for_type(std::string_view type) {
-  const std::string t = canonical_type(type);
+  const std::string t = msgs::canonical_type(type, "");
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (spec.type == t) return &spec;
   }
@@ -224,7 +208,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
 bool Replay::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
   const Publisher& pub = impl_->publishers[impl_->wait_publisher];
   while (pub.matched() < count) {
-    if (!sleep_until(monotonic_ns() + 20'000'000, stop)) return false;
+    if (!sleep_until_or_stop(monotonic_ns() + 20'000'000, stop)) return false;
   }
   return true;
 }
@@ -295,7 +279,7 @@ Result<bool> Replay::play(bool (*stop)()) {
     }
     if (rate > 0.0) {
       const double due = static_cast<double>(m.log_time - t0) / rate;
-      if (!sleep_until(wall0 + static_cast<std::int64_t>(std::llround(due)), stop)) {
+      if (!sleep_until_or_stop(wall0 + static_cast<std::int64_t>(std::llround(due)), stop)) {
         stopped = true;
         return false;
       }

@@ -1,0 +1,22 @@
+// Monotonic time for pacing (node, replay), in ns.
+#pragma once
+#include <time.h>
+
+#include <cstdint>
+
+namespace rbsim::node {
+
+inline std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// Sleeps until `deadline_ns` (monotonic). A signal (Ctrl-C) ends the sleep early: callers look at
+// their stop flag afterwards.
+inline void sleep_until(std::int64_t deadline_ns) {
+  const timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+}
+
+}  // namespace rbsim::node
