@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <optional>
 
 #include "rbsim/log.hpp"
 #include "rbsim/node.hpp"
@@ -19,29 +18,6 @@ std::uint64_t wall_ns() {
 }
 mcap::ByteView view(const std::vector<std::byte>& b) {
   return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
-}
-
-// The simulated time a per-step message carries, in ns: the first builtin_interfaces/Time in it
-// (the header stamp; the clock of a Clock; the first marker's stamp in a MarkerArray, after the
-// sequence length). Little- or big-endian CDR as the encapsulation header says; nullopt when the
-// message is too short (e.g. an empty MarkerArray).
-std::optional<std::int64_t> stamp_ns(const std::vector<std::byte>& cdr, msgs::TopicId id) {
-  const std::size_t at = 4 + (id == msgs::TopicId::Markers ? 4 : 0);
-  if (cdr.size() < at + 8 || (id == msgs::TopicId::Markers && cdr.size() >= 8 && cdr[4] == std::byte{0} &&
-                              cdr[5] == std::byte{0} && cdr[6] == std::byte{0} && cdr[7] == std::byte{0})) {
-    return std::nullopt;
-  }
-  const bool little = (static_cast<unsigned>(cdr[1]) & 1u) != 0;
-  auto u32 = [&](std::size_t o) {
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) {
-      const auto b = static_cast<std::uint32_t>(cdr[o + static_cast<std::size_t>(little ? 3 - i : i)]);
-      v = (v << 8) | b;
-    }
-    return v;
-  };
-  const auto sec = static_cast<std::int32_t>(u32(at));
-  return static_cast<std::int64_t>(sec) * 1'000'000'000 + static_cast<std::int64_t>(u32(at + 4));
 }
 }  // namespace
 
@@ -147,8 +123,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       if (id == msgs::TopicId::Scene) {
         if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0)
           dt_ = scene.value().dt;
-      } else if (auto stamp = stamp_ns(sample.cdr, id)) {
-        t.gaps.add(*stamp, dt_);
+      } else if (const auto stamp = msgs::decode_stamp(id, sample.cdr)) {
+        t.gaps.add(static_cast<std::int64_t>(stamp->sec) * 1'000'000'000 + stamp->nanosec, dt_);
       }
       if (options_.max_messages > 0 && received_ >= options_.max_messages) return any;
     }

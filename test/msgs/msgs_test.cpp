@@ -250,4 +250,36 @@ TEST(DecodeBodyStates, RoundTripsAndRejectsTruncation) {
   }
 }
 
+// Every per-step message names its simulated time (what the recorder counts gaps by); the scene
+// description and bytes too short to hold a stamp give none.
+TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {
+  rbsim::Scene scene = spring_wind_scene();
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  for (int i = 0; i < 1234; ++i) w->step();
+  const rbsim::msgs::Time want = rbsim::msgs::sim_time(w.value());
+  ASSERT_GT(want.sec, 0);
+  ASSERT_GT(want.nanosec, 0u);
+  const rbsim::msgs::Encoder encoder(scene);
+  rbsim::msgs::Bytes out;
+  for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
+    encoder.encode(spec.id, w.value(), out);
+    const auto got = rbsim::msgs::decode_stamp(spec.id, out);
+    if (spec.id == TopicId::Scene) {
+      EXPECT_FALSE(got.has_value());
+      continue;
+    }
+    ASSERT_TRUE(got.has_value()) << spec.suffix;
+    EXPECT_EQ(got->sec, want.sec) << spec.suffix;
+    EXPECT_EQ(got->nanosec, want.nanosec) << spec.suffix;
+    const std::size_t header = spec.id == TopicId::Markers ? 16 : 12;  // encapsulation, [length,] stamp
+    EXPECT_FALSE(rbsim::msgs::decode_stamp(spec.id, std::span(out).first(header - 1)).has_value())
+        << spec.suffix;
+  }
+  // An empty MarkerArray carries no stamp.
+  const std::byte empty[] = {std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0},
+                             std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0}};
+  EXPECT_FALSE(rbsim::msgs::decode_stamp(TopicId::Markers, empty).has_value());
+}
+
 }  // namespace

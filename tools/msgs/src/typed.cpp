@@ -148,4 +148,13 @@ Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out
   return Ok{};
 }
 
+std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr) {
+  if (id == TopicId::Scene) return std::nullopt;
+  Reader r(cdr);
+  if (id == TopicId::Markers && r.get<std::uint32_t>() == 0) return std::nullopt;
+  const Time t = r.time();
+  if (!r.ok()) return std::nullopt;
+  return t;
+}
+
 }  // namespace rbsim::msgs

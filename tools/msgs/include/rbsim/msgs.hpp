@@ -124,6 +124,10 @@ struct BodyStatesMessage {
 Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
 // Reuses `out`'s storage: decoding a stream of messages does not allocate once warmed up.
 [[nodiscard]] Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out);
+// The simulated time a per-step message carries: its header stamp, a Clock's clock, a
+// MarkerArray's first marker's stamp. nullopt for the scene description, an empty MarkerArray or
+// bytes too short to hold it.
+std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr);
 
 // ---------------------------------------------------------------------------------------------
 // Schema-driven decoding: any CDR message whose ros2msg schema is known (e.g. read from an MCAP
