@@ -35,42 +35,10 @@ import sys
 import time
 import traceback
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support", "python"))
+from rbsim_venv import ensure_venv  # noqa: E402  (test/support/python: into the venv scripts/setup makes)
+
 SKIP = 77
-
-
-# ---------------------------------------------------------------------------------------------
-# Bootstrapping into the venv (same policy as test/python/check_mcap.py)
-
-
-def ensure_venv(venv: str, requirements: str) -> None:
-    venv = os.path.abspath(venv)
-    python = os.path.join(venv, "bin", "python")
-    if os.path.realpath(sys.prefix) != os.path.realpath(venv):
-        if not os.path.exists(python):
-            print(f"FAIL: the Python venv is missing: {python} does not exist.\n"
-                  f"Run scripts/setup to create it (for a build folder other than build/: "
-                  f"BUILD_DIR={os.path.dirname(venv)} scripts/setup). This test never skips for it.", file=sys.stderr)
-            sys.exit(1)
-        os.execv(python, [python, os.path.abspath(__file__)] + sys.argv[1:])
-    from importlib import metadata
-
-    wrong = []
-    with open(requirements) as f:
-        for line in f:
-            line = line.split("#", 1)[0].strip()
-            if "==" not in line:
-                continue
-            name, version = (s.strip() for s in line.split("==", 1))
-            try:
-                have = metadata.version(name)
-            except metadata.PackageNotFoundError:
-                have = None
-            if have != version:
-                wrong.append(f"{name}=={version} (installed: {have})")
-    if wrong:
-        print(f"FAIL: the venv {venv} does not match {requirements}: {', '.join(wrong)}; run scripts/setup",
-              file=sys.stderr)
-        sys.exit(1)
 
 
 # ---------------------------------------------------------------------------------------------

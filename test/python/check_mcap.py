@@ -36,40 +36,8 @@ import sys
 import warnings
 import zlib
 
-# ---------------------------------------------------------------------------------------------
-# Bootstrapping into the venv
-
-
-def ensure_venv(venv: str, requirements: str) -> None:
-    venv = os.path.abspath(venv)
-    python = os.path.join(venv, "bin", "python")
-    if os.path.realpath(sys.prefix) != os.path.realpath(venv):
-        if not os.path.exists(python):
-            build_dir = os.path.dirname(venv)
-            fail_now(
-                f"the Python venv with the official MCAP readers is missing: {python} does not exist.\n"
-                f"Run scripts/setup to create it (for a build folder other than build/: "
-                f"BUILD_DIR={build_dir} scripts/setup). This test never skips."
-            )
-        os.execv(python, [python, os.path.abspath(__file__)] + sys.argv[1:])
-    # Inside the venv: the pinned versions must be the ones installed.
-    from importlib import metadata
-
-    wrong = []
-    with open(requirements) as f:
-        for line in f:
-            line = line.split("#", 1)[0].strip()
-            if "==" not in line:
-                continue
-            name, version = (s.strip() for s in line.split("==", 1))
-            try:
-                have = metadata.version(name)
-            except metadata.PackageNotFoundError:
-                have = None
-            if have != version:
-                wrong.append(f"{name}=={version} (installed: {have})")
-    if wrong:
-        fail_now(f"the venv {venv} does not match {requirements}: {', '.join(wrong)}; run scripts/setup")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support", "python"))
+from rbsim_venv import ensure_venv  # noqa: E402  (test/support/python: into the venv scripts/setup makes)
 
 
 def fail_now(message: str) -> None:
