@@ -249,6 +249,27 @@ struct Terms {
   double scale = 0.0;  // sum of |term|: the size of the rounding error of the total
 };
 
+// The force of a spring on end i, pulling it towards end j when stretched (with l0 = 0 it is k d,
+// no 0/0), added to the body at each end with its torque; d = end_j - end_i, length = |d|, arm_*
+// the ends' offsets from their centres of mass.
+void add_spring_force(const SpringDef& sp, const Vec2& d, double length, const Vec2& arm_i, const Vec2& arm_j,
+                      std::vector<Vec2>& force, std::vector<double>& torque) {
+  Vec2 f(0.0, 0.0);
+  if (sp.rest_length == 0.0) {
+    f = sp.stiffness * d;
+  } else if (length > 0.0) {
+    f = sp.stiffness * (length - sp.rest_length) / length * d;
+  }
+  if (sp.body_i >= 0) {
+    force[sp.body_i] += f;
+    torque[sp.body_i] += arm_i.x() * f.y() - arm_i.y() * f.x();
+  }
+  if (sp.body_j >= 0) {
+    force[sp.body_j] -= f;
+    torque[sp.body_j] -= arm_j.x() * f.y() - arm_j.y() * f.x();
+  }
+}
+
 Terms terms_of(const Model& m, const State& s) {
   const std::size_t n = m.mass.size();
   Terms t;
@@ -300,21 +321,7 @@ Terms terms_of(const Model& m, const State& s) {
     t.springs.push_back(e);
     t.force_potential.push_back(e.potential);
     t.scale += e.potential;
-    // Force on end i pulls it towards end j when stretched; with l0 = 0 it is k d (no 0/0).
-    Vec2 f(0.0, 0.0);
-    if (sp.rest_length == 0.0) {
-      f = sp.stiffness * d;
-    } else if (e.length > 0.0) {
-      f = sp.stiffness * stretch / e.length * d;
-    }
-    if (sp.body_i >= 0) {
-      force[sp.body_i] += f;
-      torque[sp.body_i] += arm_i.x() * f.y() - arm_i.y() * f.x();
-    }
-    if (sp.body_j >= 0) {
-      force[sp.body_j] -= f;
-      torque[sp.body_j] -= arm_j.x() * f.y() - arm_j.y() * f.x();
-    }
+    add_spring_force(sp, d, e.length, arm_i, arm_j, force, torque);
   }
   for (double u : t.force_potential) t.potential += u;
   t.total = t.potential + t.kinetic_point + t.kinetic_spin;
@@ -348,20 +355,7 @@ void step_state(const Model& m, const Scene& scene, State& s) {
     const Vec2 pj = sp.body_j < 0 ? sp.anchor_j : Vec2(s.x[sp.body_j], s.y[sp.body_j]) + arm_j;
     const Vec2 d = pj - pi;
     const double l = d.norm();
-    Vec2 f(0.0, 0.0);  // on end i, towards j when stretched
-    if (sp.rest_length == 0.0) {
-      f = sp.stiffness * d;
-    } else if (l > 0.0) {
-      f = sp.stiffness * (l - sp.rest_length) / l * d;
-    }
-    if (sp.body_i >= 0) {
-      force[sp.body_i] += f;
-      torque[sp.body_i] += arm_i.x() * f.y() - arm_i.y() * f.x();
-    }
-    if (sp.body_j >= 0) {
-      force[sp.body_j] -= f;
-      torque[sp.body_j] -= arm_j.x() * f.y() - arm_j.y() * f.x();
-    }
+    add_spring_force(sp, d, l, arm_i, arm_j, force, torque);
   }
   // F = sum over edges i and sample points j of beta l_i / P ((v_wind - v_j) . n_i) n_i, the
   // hull clockwise, so n = (-e.y, e.x) / |e| points out; sample j at (j + 1/2) / P along the edge.
