@@ -1053,25 +1053,25 @@ def case_bad_input(ctx):
         data = f.read()
     with open(truncated, "wb") as f:
         f.write(data[:len(data) // 2])
-    foreign = ctx.path("foreign.mcap")
     from mcap.writer import Writer
 
-    with open(foreign, "wb") as f:
-        w = Writer(f)
-        w.start(profile="ros2", library="e2e")
-        sid = w.register_schema(name="std_msgs/msg/String", encoding="ros2msg", data=b"string data")
-        cid = w.register_channel(topic="/chatter", message_encoding="cdr", schema_id=sid)
-        w.add_message(channel_id=cid, log_time=1, publish_time=1, data=b"\x00\x01\x00\x00\x03\x00\x00\x00hi\x00\x00")
-        w.finish()
+    def one_message_log(name, schema_name, schema, topic, data):
+        """A ros2-profile MCAP file (official writer) holding one message."""
+        path = ctx.path(name)
+        with open(path, "wb") as f:
+            w = Writer(f)
+            w.start(profile="ros2", library="e2e")
+            sid = w.register_schema(name=schema_name, encoding="ros2msg", data=schema)
+            cid = w.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
+            w.add_message(channel_id=cid, log_time=1, publish_time=1, data=data)
+            w.finish()
+        return path
+
+    foreign = one_message_log("foreign.mcap", "std_msgs/msg/String", b"string data", "/chatter",
+                              b"\x00\x01\x00\x00\x03\x00\x00\x00hi\x00\x00")
     # Our type name with another definition (e.g. an older rbsim): not replayed as ours.
-    other_def = ctx.path("other-definition.mcap")
-    with open(other_def, "wb") as f:
-        w = Writer(f)
-        w.start(profile="ros2", library="e2e")
-        sid = w.register_schema(name="rbsim_msgs/msg/BodyStates", encoding="ros2msg", data=b"int32 something_else")
-        cid = w.register_channel(topic="/rbsim/body_states", message_encoding="cdr", schema_id=sid)
-        w.add_message(channel_id=cid, log_time=1, publish_time=1, data=b"\x00\x01\x00\x00\x07\x00\x00\x00")
-        w.finish()
+    other_def = one_message_log("other-definition.mcap", "rbsim_msgs/msg/BodyStates", b"int32 something_else",
+                                "/rbsim/body_states", b"\x00\x01\x00\x00\x07\x00\x00\x00")
     bad_xml = ctx.path("bad-config.xml")
     with open(bad_xml, "w") as f:
         f.write("<CycloneDDS><Domain><General><NoSuchSetting>1</NoSuchSetting></General></Domain></CycloneDDS>\n")
