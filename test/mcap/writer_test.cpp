@@ -184,10 +184,15 @@ INSTANTIATE_TEST_SUITE_P(All, WriterRoundTrip,
                                             ::testing::Bool(), ::testing::Bool()),
                          param_name);
 
-TEST(Writer, FileOutputMatchesBufferAndFlushesChunks) {
-  const std::string path = (std::filesystem::temp_directory_path() / "rbsim_mcap_writer_test.mcap").string();
+class WriterFile : public ::testing::TestWithParam<bool /*background_compression*/> {};
+
+TEST_P(WriterFile, FileOutputMatchesBufferAndFlushesChunks) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("rbsim_mcap_writer_test" + std::to_string(GetParam()) + ".mcap"))
+                               .string();
   WriterOptions o;
   o.chunk_size = 1024;
+  o.background_compression = GetParam();
   const auto input = samples();
   Writer w;
   ASSERT_TRUE(w.open(path, o).ok());
@@ -216,6 +221,10 @@ TEST(Writer, FileOutputMatchesBufferAndFlushesChunks) {
   EXPECT_EQ(read_file(path), mem.buffer());
   std::remove(path.c_str());
 }
+
+INSTANTIATE_TEST_SUITE_P(All, WriterFile, ::testing::Bool(), [](const ::testing::TestParamInfo<bool>& i) {
+  return i.param ? "Background" : "Inline";
+});
 
 TEST(Writer, RejectsBadUse) {
   Writer w;
@@ -264,6 +273,48 @@ TEST(Writer, EmptyFileIsValid) {
   EXPECT_EQ(r.header().library, "rbsim-mcap");
   ASSERT_TRUE(r.statistics().has_value());
   EXPECT_EQ(r.statistics()->message_count, 0u);
+}
+
+// The worker thread changes when chunks are compressed, never the bytes: every codec, chunk sizes
+// from one message per chunk up, with and without CRCs, attachments and metadata between chunks.
+TEST(Writer, BackgroundCompressionWritesTheSameBytes) {
+  const auto input = samples();
+  for (Compression c : {Compression::None, Compression::Lz4, Compression::Zstd}) {
+    for (std::uint64_t chunk_size : {1u, 700u, 2048u, 1u << 20}) {
+      for (bool crcs : {true, false}) {
+        WriterOptions o;
+        o.compression = c;
+        o.chunk_size = chunk_size;
+        o.enable_crcs = crcs;
+        const Bytes inline_file = write_sample_file(o, input);
+        o.background_compression = true;
+        EXPECT_EQ(write_sample_file(o, input), inline_file)
+            << compression_name(c) << " chunk_size " << chunk_size << " crcs " << crcs;
+      }
+    }
+  }
+}
+
+// A full disk surfaces as an error from the writer's calls (not a crash or a hang), with or
+// without the worker.
+TEST(Writer, ReportsWriteErrorsWithBackgroundCompression) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  for (bool background : {false, true}) {
+    WriterOptions o;
+    o.chunk_size = 256;
+    o.background_compression = background;
+    Writer w;
+    ASSERT_TRUE(w.open("/dev/full", o).ok());
+    const std::uint16_t ch = w.add_channel(0, "/t", "raw").value();
+    Status first;
+    for (const Sample& s : samples()) {
+      first = w.write_message(ch, s.sequence, s.log_time, s.log_time, s.data);
+      if (!first.ok()) break;
+    }
+    const Status closed = w.close();
+    EXPECT_FALSE(first.ok() && closed.ok()) << "background " << background;
+    EXPECT_EQ((first.ok() ? closed : first).code, StatusCode::IoError) << "background " << background;
+  }
 }
 
 TEST(Crc32, MatchesZlib) {

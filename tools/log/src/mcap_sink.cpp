@@ -79,6 +79,8 @@ mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t 
   o.library = "rbsim 0.1.0";
   o.compression = compression;
   o.chunk_size = chunk_size;
+  // Recordings compress beside the simulation or DDS reception that feeds them (same bytes).
+  o.background_compression = true;
   return o;
 }
 

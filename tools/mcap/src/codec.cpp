@@ -32,8 +32,11 @@ Status Compressor::compress(ByteView in, Bytes& out) {
     case Compression::Zstd: {
       if (impl_->zstd == nullptr) return Status::Error(StatusCode::IoError, "out of memory for zstd context");
       out.resize(ZSTD_compressBound(in.size()));
+      // Level 0 is the MCAP C++ library's default for zstd chunks, 1 (zstd's own default, 3, costs
+      // 1.4x the time for 15% smaller chunks of simulation state).
+      const int level = impl_->level == 0 ? 1 : impl_->level;
       const std::size_t n =
-          ZSTD_compressCCtx(impl_->zstd, out.data(), out.size(), in.data(), in.size(), impl_->level);
+          ZSTD_compressCCtx(impl_->zstd, out.data(), out.size(), in.data(), in.size(), level);
       if (ZSTD_isError(n)) {
         return Status::Error(StatusCode::IoError, std::string("zstd: ") + ZSTD_getErrorName(n));
       }
@@ -53,6 +56,62 @@ Status Compressor::compress(ByteView in, Bytes& out) {
     }
   }
   return Status::Error(StatusCode::UnsupportedCompression, "unknown compression");
+}
+
+ChunkWorker::ChunkWorker(Compression compression, int level, bool crc)
+    : compressor_(compression, level),
+      compression_(compression),
+      with_crc_(crc),
+      thread_([this] { run(); }) {}
+
+ChunkWorker::~ChunkWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+}
+
+void ChunkWorker::submit() {
+  pending_ = true;
+  finished_.store(false, std::memory_order_relaxed);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    start_ = true;
+  }
+  cv_.notify_all();
+}
+
+Status ChunkWorker::wait() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  cv_.wait(lock, [this] { return finished_.load(std::memory_order_relaxed); });
+  return status_;
+}
+
+ByteView ChunkWorker::payload() const {
+  return compression_ == Compression::None ? ByteView(records_) : ByteView(compressed_);
+}
+
+void ChunkWorker::release() {
+  records_.clear();
+  pending_ = false;
+}
+
+void ChunkWorker::run() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    cv_.wait(lock, [this] { return start_ || stop_; });
+    if (stop_) return;
+    start_ = false;
+    lock.unlock();
+    crc_ = with_crc_ ? crc32(records_) : 0;
+    Status s = compression_ == Compression::None ? Status::Ok() : compressor_.compress(records_, compressed_);
+    lock.lock();
+    status_ = std::move(s);
+    finished_.store(true, std::memory_order_release);
+    cv_.notify_all();
+  }
 }
 
 Result<Compression> compression_from_name(std::string_view name) {

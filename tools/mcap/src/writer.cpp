@@ -28,13 +28,18 @@ struct Writer::Impl {
   std::vector<AttachmentIndex> attachment_indexes;
   std::vector<MetadataIndex> metadata_indexes;
 
-  // Pending chunk: uncompressed records plus a message index per channel (spec: Message Index
-  // offsets are relative to the start of the uncompressed records).
-  Bytes chunk;
-  std::map<std::uint16_t, std::vector<std::pair<Timestamp, std::uint64_t>>> chunk_message_index;
-  Timestamp chunk_start_time = 0;
-  Timestamp chunk_end_time = 0;
-  bool chunk_has_messages = false;
+  // What a chunk's index needs besides its records: a message index per channel (spec: Message
+  // Index offsets are relative to the start of the uncompressed records) and its time range.
+  struct ChunkMeta {
+    std::map<std::uint16_t, std::vector<std::pair<Timestamp, std::uint64_t>>> message_index;
+    Timestamp start_time = 0;
+    Timestamp end_time = 0;
+    bool has_messages = false;
+  };
+  Bytes chunk;  // the open chunk's uncompressed records
+  ChunkMeta chunk_meta;
+  std::unique_ptr<ChunkWorker> worker;  // background_compression: the chunk being compressed
+  ChunkMeta worker_meta;                // and its index data
 
   Bytes scratch;
   Bytes compressed;
@@ -73,45 +78,84 @@ struct Writer::Impl {
     *this = Impl{};
     options = opts;
     sink = std::move(s);
-    compressor = std::make_unique<Compressor>(options.compression, options.compression_level);
+    if (options.use_chunks && options.background_compression) {
+      worker =
+          std::make_unique<ChunkWorker>(options.compression, options.compression_level, options.enable_crcs);
+    } else {
+      compressor = std::make_unique<Compressor>(options.compression, options.compression_level);
+    }
     open = true;
     Status st = write(ByteView(kMagic));
     if (!st.ok()) return st;
     return emit(Header{options.profile, options.library}, false);
   }
 
+  // Closes the open chunk: compressed here, or handed to the worker (which first finishes and
+  // writes the chunk before it, keeping file order).
   Status flush_chunk() {
     if (chunk.empty()) return Status::Ok();
-    // An uncompressed chunk is written straight from `chunk`, without a copy through the compressor.
     Status s;
+    if (worker) {
+      if (!(s = finish_pending()).ok()) return s;
+      std::swap(chunk, worker->records());  // `chunk` gets the worker's emptied buffer back
+      worker_meta = std::move(chunk_meta);
+      chunk_meta = ChunkMeta{};
+      worker->submit();
+      return Status::Ok();
+    }
+    // An uncompressed chunk is written straight from `chunk`, without a copy through the compressor.
     ByteView payload = chunk;
     if (options.compression != Compression::None) {
       if (!(s = compressor->compress(chunk, compressed)).ok()) return error = s;
       payload = compressed;
     }
+    s = write_chunk(chunk, payload, options.enable_crcs ? crc32(chunk) : 0, chunk_meta);
+    chunk.clear();
+    chunk_meta = ChunkMeta{};
+    return s;
+  }
+
+  // Writes the chunk the worker holds, once compressed (waiting for it if need be).
+  Status finish_pending() {
+    if (!worker || !worker->pending()) return Status::Ok();
+    Status s = worker->wait();
+    if (!s.ok()) {
+      worker->release();
+      return error = s;
+    }
+    s = write_chunk(worker->records(), worker->payload(), worker->crc(), worker_meta);
+    worker->release();
+    worker_meta = ChunkMeta{};
+    return s;
+  }
+
+  Status write_chunk(ByteView records, ByteView payload, std::uint32_t crc, ChunkMeta& meta) {
+    Status s;
     const std::string_view compression = compression_name(options.compression);
+    const Timestamp start_time = meta.has_messages ? meta.start_time : 0;
+    const Timestamp end_time = meta.has_messages ? meta.end_time : 0;
     // Chunk header written by hand so the (possibly large) records are not copied again.
     scratch.clear();
     put_u8(scratch, static_cast<std::uint8_t>(Opcode::Chunk));
     put_u64(scratch, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + payload.size());
-    put_u64(scratch, chunk_has_messages ? chunk_start_time : 0);
-    put_u64(scratch, chunk_has_messages ? chunk_end_time : 0);
-    put_u64(scratch, chunk.size());
-    put_u32(scratch, options.enable_crcs ? crc32(chunk) : 0);
+    put_u64(scratch, start_time);
+    put_u64(scratch, end_time);
+    put_u64(scratch, records.size());
+    put_u32(scratch, crc);
     put_string(scratch, compression);
     put_u64(scratch, payload.size());
     ChunkIndex index;
-    index.message_start_time = chunk_has_messages ? chunk_start_time : 0;
-    index.message_end_time = chunk_has_messages ? chunk_end_time : 0;
+    index.message_start_time = start_time;
+    index.message_end_time = end_time;
     index.chunk_start_offset = offset;
     index.compression = std::string(compression);
     index.compressed_size = payload.size();
-    index.uncompressed_size = chunk.size();
+    index.uncompressed_size = records.size();
     if (!(s = write(scratch)).ok() || !(s = write(payload)).ok()) return s;
     index.chunk_length = offset - index.chunk_start_offset;
     if (options.emit_message_indexes) {
       const std::uint64_t start = offset;
-      for (auto& [channel_id, entries] : chunk_message_index) {
+      for (auto& [channel_id, entries] : meta.message_index) {
         index.message_index_offsets[channel_id] = offset;
         if (!(s = emit(MessageIndex{channel_id, std::move(entries)}, false)).ok()) return s;
       }
@@ -119,9 +163,6 @@ struct Writer::Impl {
     }
     if (options.emit_chunk_indexes) chunk_indexes.push_back(std::move(index));
     ++stats.chunk_count;
-    chunk.clear();
-    chunk_message_index.clear();
-    chunk_has_messages = false;
     // A completed chunk reaches the OS now, so a killed process leaves it readable.
     if (!(s = sink->flush()).ok()) error = s;
     return s;
@@ -141,6 +182,8 @@ struct Writer::Impl {
 
   Status finish() {
     Status s = flush_chunk();
+    if (s.ok()) s = finish_pending();
+    worker.reset();
     if (!s.ok()) return s;
     if (!(s = emit(DataEnd{options.enable_crcs ? data_crc : 0}, false)).ok()) return s;
     in_summary = true;
@@ -297,10 +340,15 @@ Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, T
   put_u64(out, publish_time);
   put_raw(out, data);
   if (!w.options.use_chunks) return w.write(out);
-  w.chunk_message_index[channel_id].emplace_back(log_time, record_offset);
-  w.chunk_start_time = w.chunk_has_messages ? std::min(w.chunk_start_time, log_time) : log_time;
-  w.chunk_end_time = w.chunk_has_messages ? std::max(w.chunk_end_time, log_time) : log_time;
-  w.chunk_has_messages = true;
+  Impl::ChunkMeta& meta = w.chunk_meta;
+  meta.message_index[channel_id].emplace_back(log_time, record_offset);
+  meta.start_time = meta.has_messages ? std::min(meta.start_time, log_time) : log_time;
+  meta.end_time = meta.has_messages ? std::max(meta.end_time, log_time) : log_time;
+  meta.has_messages = true;
+  // A compressed chunk goes to the file as soon as it is ready, not only when the next one is full.
+  if (w.worker && w.worker->pending() && w.worker->finished()) {
+    if (Status s = w.finish_pending(); !s.ok()) return s;
+  }
   if (w.chunk.size() >= w.options.chunk_size) return w.flush_chunk();
   return Status::Ok();
 }
@@ -309,6 +357,7 @@ Status Writer::add_attachment(Timestamp log_time, Timestamp create_time, std::st
                               std::string_view media_type, ByteView data) {
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
+  if (Status s = w.finish_pending(); !s.ok()) return s;
   // Attachments never go inside chunks (spec: Attachment); the CRC covers every preceding field.
   Bytes& out = w.scratch;
   out.clear();
@@ -331,6 +380,7 @@ Status Writer::add_attachment(Timestamp log_time, Timestamp create_time, std::st
 Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) {
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
+  if (Status s = w.finish_pending(); !s.ok()) return s;
   const std::uint64_t start = w.offset;
   if (Status s = w.emit(Metadata{std::string(name), metadata}, false); !s.ok()) return s;
   if (w.options.emit_metadata_indexes) {
@@ -342,13 +392,15 @@ Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) 
 
 Status Writer::flush_chunk() {
   if (Status s = impl_->check_open(); !s.ok()) return s;
-  return impl_->flush_chunk();
+  if (Status s = impl_->flush_chunk(); !s.ok()) return s;
+  return impl_->finish_pending();
 }
 
 Status Writer::close() {
   if (!impl_->open) return Status::Error(StatusCode::NotOpen, "writer is not open");
   impl_->open = false;
   if (!impl_->error.ok()) {
+    impl_->worker.reset();
     (void)impl_->sink->close();
     return impl_->error;
   }

@@ -249,7 +249,7 @@ struct WriterOptions {
   std::string profile;
   std::string library = "rbsim-mcap";
   Compression compression = Compression::Zstd;
-  int compression_level = 0;  // 0: codec default
+  int compression_level = 0;  // 0: the MCAP C++ library's default (zstd 1, lz4 frame default)
   bool use_chunks = true;
   std::uint64_t chunk_size = 1024 * 1024;  // uncompressed bytes after which a chunk is flushed
   bool emit_message_indexes = true;
@@ -261,6 +261,10 @@ struct WriterOptions {
   bool repeat_schemas = true;   // copy Schema records into the summary
   bool repeat_channels = true;  // copy Channel records into the summary
   bool enable_crcs = true;      // chunk, attachment, data section and summary CRCs
+  // Compress each full chunk (and take its CRC) on a second thread while the next one fills. Same
+  // bytes as without; a completed chunk reaches the file once compressed, or at the next write
+  // or flush after that, so a killed process may lose one more chunk than without.
+  bool background_compression = false;
 };
 
 class Writer {
