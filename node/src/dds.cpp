@@ -35,6 +35,20 @@ dds_qos_t* make_qos(const QosSpec& q, bool reader) {
   return qos;
 }
 
+// A matched writer's history and durability, as rosbag2 records them from its discovery data.
+void offered_by(const dds_qos_t* qos, msgs::OfferedQos& out) {
+  dds_history_kind_t history{};
+  std::int32_t depth = 0;
+  if (qos != nullptr && dds_qget_history(qos, &history, &depth)) {
+    out.keep_all = history == DDS_HISTORY_KEEP_ALL;
+    out.depth = out.keep_all ? 0 : depth;
+  }
+  dds_durability_kind_t durability{};
+  if (qos != nullptr && dds_qget_durability(qos, &durability)) {
+    out.transient_local = durability != DDS_DURABILITY_VOLATILE;
+  }
+}
+
 Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec& spec,
                                 std::string_view ros_topic) {
   const dds_topic_descriptor_t* desc = descriptor(spec.id);
@@ -76,14 +90,6 @@ Participant::Participant(Participant&& o) noexcept : handle_(o.handle_), domain_
 }
 Participant::~Participant() {
   if (handle_ > 0) dds_delete(handle_);
-}
-
-QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last) {
-  QosSpec q;
-  q.transient_local = spec.transient_local;
-  q.keep_all = !spec.transient_local && keep_last <= 0;
-  q.depth = spec.transient_local ? 1 : std::max<std::int32_t>(keep_last, 1);
-  return q;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -175,20 +181,22 @@ bool Subscription::take(Received& out) {
     out.source_time_ns = info.source_timestamp;
     ddsi_serdata_unref(d);
     auto known = std::find_if(writers_.begin(), writers_.end(),
-                              [&](const auto& w) { return w.first == info.publication_handle; });
+                              [&](const Writer& w) { return w.handle == info.publication_handle; });
     if (known == writers_.end()) {
-      std::array<std::uint8_t, 16> guid{};
+      Writer w{info.publication_handle, {}, msgs::offered_qos(*spec_)};
       if (dds_builtintopic_endpoint_t* e =
               dds_get_matched_publication_data(reader_, info.publication_handle)) {
-        std::memcpy(guid.data(), e->key.v, guid.size());
+        std::memcpy(w.guid.data(), e->key.v, w.guid.size());
+        offered_by(e->qos, w.offered);
         dds_builtintopic_free_endpoint(e);
       } else {  // the writer is gone already: its handle is all there is to tell it apart
-        std::memcpy(guid.data(), &info.publication_handle, sizeof info.publication_handle);
+        std::memcpy(w.guid.data(), &info.publication_handle, sizeof info.publication_handle);
       }
-      writers_.emplace_back(info.publication_handle, guid);
+      writers_.push_back(w);
       known = writers_.end() - 1;
     }
-    out.writer = known->second;
+    out.writer = known->guid;
+    out.offered = known->offered;
     return true;
   }
 }

@@ -79,10 +79,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
     const std::string ros = msgs::topic_name(*spec, options.ns);
     auto sub = Subscription::create(participant, *spec, ros, qos_for(*spec));
     if (!sub) return sub.error();
-    auto channel = log::add_topic(r->writer_, *spec, options.ns);
-    if (!channel.ok()) return Error{options.path + ": " + channel.status().message};
     dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
-    r->topics_.push_back(Topic{std::move(sub.value()), channel.value(), 0, Gaps{}});
+    r->topics_.push_back(Topic{std::move(sub.value()), 0, 0, Gaps{}});
   }
   return r;
 }
@@ -110,6 +108,11 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
         t.newest.emplace_back(sample.writer, sample.source_time_ns);
       } else {
         newest->second = sample.source_time_ns;
+      }
+      if (t.channel == 0) {  // like rosbag2: the channel says what the (first) publisher offers
+        auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
+        if (!channel.ok()) return Error{options_.path + ": " + channel.status().message};
+        t.channel = channel.value();
       }
       const std::uint64_t now = wall_ns();
       const std::uint64_t source =

@@ -268,6 +268,15 @@ class Log:
     def payloads(self, topic):
         return [m[5] for m in self.messages if m[0] == topic]
 
+    def offered(self, suffix):
+        """(history, depth) of the offered_qos_profiles metadata of the topic ending in `suffix`."""
+        for ch in self.summary.channels.values():
+            if ch.topic.rsplit("/", 1)[-1] == suffix:
+                text = ch.metadata.get("offered_qos_profiles", "")
+                fields = dict(line.strip("- ").split(": ", 1) for line in text.split("\n") if ": " in line)
+                return fields.get("history"), fields.get("depth")
+        return None
+
     def by_suffix(self):
         """payloads per topic name without its namespace ("body_states", "clock")."""
         out = {}
@@ -431,6 +440,10 @@ def case_node_record(ctx):
     ctx.check(first_published(got).endswith("/scene"), f"first published message is {first_published(got)}, "
                                                        f"not the scene")
     same_payloads(ctx, got, want, "live recording vs rbsim run --record")
+    for suffix in ("scene", "body_states", "clock"):  # what the node offered, as rbsim run says
+        ctx.check(got.offered(suffix) == want.offered(suffix) == (("keep_last", "1") if suffix == "scene"
+                                                                  else ("keep_all", "0")),
+                  f"offered_qos_profiles of {suffix}: live {got.offered(suffix)}, run {want.offered(suffix)}")
     golden = os.path.join(ctx.src, "test", "golden", "airplane.mcap")
     if os.path.exists(golden):
         same_payloads(ctx, got, Log(golden), "live recording vs golden test/golden/airplane.mcap", by_suffix=True)
@@ -557,7 +570,11 @@ def case_replay_options(ctx):
     ctx.log(f"--rate 2: body states spread over {span:.3f} s of wall time (replay process {wall:.2f} s)")
 
     # --topics: only the scene description and the body states.
-    got, _ = replay_into("topics", ("--rate", 0, "--topics", f"body_states,/{ctx.ns}/scene"))
+    # (with --keep-last 5000, more than the log holds: nothing can be dropped, and the recording
+    # says what the replay offered, like rosbag2 records a publisher's QoS)
+    got, _ = replay_into("topics", ("--rate", 0, "--topics", f"body_states,/{ctx.ns}/scene", "--keep-last", 5000))
+    ctx.check(got.offered("body_states") == ("keep_last", "5000") and got.offered("scene") == ("keep_last", "1"),
+              f"replay --keep-last 5000: recorded offers {got.offered('body_states')}, {got.offered('scene')}")
     g = got.by_suffix()
     ctx.check(sorted(g) == ["body_states", "scene"], f"replay --topics: recorded {sorted(g)}")
     ctx.check(g.get("body_states") == w["body_states"] and g.get("scene") == w["scene"],

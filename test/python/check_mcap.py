@@ -209,8 +209,9 @@ def check_qos(c: Checks, topic: str, text: str, transient_local: bool) -> None:
     for key in ("history", "depth", "reliability", "durability", "deadline", "lifespan", "liveliness",
                 "liveliness_lease_duration", "avoid_ros_namespace_conventions"):
         c.check(key in p, kind, f"{topic}: no {key!r} in {p}")
-    c.equal(p.get("history"), "keep_last", kind, f"{topic} history")
-    c.check(str(p.get("depth", "")).isdigit() and int(p["depth"]) >= 1, kind, f"{topic}: depth {p.get('depth')!r}")
+    # What rbsim's node offers: the scene keep last 1, per-step topics keep all (no depth).
+    c.equal(p.get("history"), "keep_last" if transient_local else "keep_all", kind, f"{topic} history")
+    c.equal(p.get("depth"), "1" if transient_local else "0", kind, f"{topic} depth")
     c.equal(p.get("reliability"), "reliable", kind, f"{topic} reliability")
     c.equal(p.get("durability"), "transient_local" if transient_local else "volatile", kind, f"{topic} durability")
     c.equal(p.get("liveliness"), "automatic", kind, f"{topic} liveliness")

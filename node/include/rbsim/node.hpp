@@ -43,15 +43,11 @@ class Participant {
 // The loopback configuration compiled into rbsim (node/config/cyclonedds-loopback.xml).
 std::string_view loopback_config();
 
-struct QosSpec {
-  bool transient_local = false;  // late joiners get the last sample (the scene description)
-  bool keep_all = false;         // writers: keep all (wait for slow readers) instead of keep last
-  std::int32_t depth = 1;        // keep-last depth
-};
-// The QoS of a topic: the scene description transient local, keep last 1; per-step topics keep
-// all, or keep last `keep_last` when it is positive (the writer then never waits, and a reader
-// that falls more than `keep_last` samples behind loses the oldest).
-QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0);
+using QosSpec = msgs::OfferedQos;
+// The QoS rbsim's writers use (msgs::offered_qos: what recordings say they offered).
+inline QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0) {
+  return msgs::offered_qos(spec, keep_last);
+}
 
 // Publishes pre-encoded CDR messages on one topic.
 class Publisher {
@@ -79,6 +75,7 @@ struct Received {
   std::vector<std::byte> cdr;
   std::int64_t source_time_ns = 0;
   std::array<std::uint8_t, 16> writer{};  // the sending writer's GUID (stable when it is rediscovered)
+  msgs::OfferedQos offered;               // what that writer offers (history, depth, durability)
 };
 class Subscription {
  public:
@@ -99,7 +96,12 @@ class Subscription {
   std::int32_t reader_ = 0, topic_ = 0;
   std::string ros_topic_;
   const msgs::TopicSpec* spec_ = nullptr;
-  std::vector<std::pair<std::uint64_t, std::array<std::uint8_t, 16>>> writers_;  // instance handle -> GUID
+  struct Writer {
+    std::uint64_t handle = 0;  // DDS instance handle of the matched publication
+    std::array<std::uint8_t, 16> guid{};
+    msgs::OfferedQos offered;
+  };
+  std::vector<Writer> writers_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -192,7 +194,7 @@ class Recorder {
   };
   struct Topic {
     Subscription subscription;
-    std::uint16_t channel;
+    std::uint16_t channel;  // 0 until the first sample: its writer's QoS goes into the channel
     std::uint32_t received;
     Gaps gaps;
     // Per writer, the newest source timestamp recorded. A sample not newer than that is one

@@ -86,6 +86,11 @@ mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t 
 
 mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec,
                                       std::string_view ns) {
+  return add_topic(writer, spec, ns, msgs::offered_qos(spec));
+}
+
+mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
+                                      const msgs::OfferedQos& offered) {
   Result<std::string> schema = msgs::ros2msg_schema(spec.type);
   if (!schema) return mcap::Status::Error(mcap::StatusCode::InvalidArgument, schema.error().message);
   const std::string& text = schema.value();
@@ -93,7 +98,7 @@ mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpe
                                      {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
   if (!schema_id.ok()) return schema_id.status();
   return writer.add_channel(schema_id.value(), msgs::topic_name(spec, ns), "cdr",
-                            {{"offered_qos_profiles", msgs::offered_qos_yaml(spec)}});
+                            {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}});
 }
 
 bool parse_compression(std::string_view name, mcap::Compression& out) {

@@ -80,14 +80,23 @@ std::string dds_type_name(std::string_view ros_type) {
   return full.substr(0, a) + "::" + full.substr(a + 1, b - a - 1) + "::dds_::" + full.substr(b + 1) + "_";
 }
 
-std::string offered_qos_yaml(const TopicSpec& spec) {
-  // rosbag2's encoding (yaml-cpp dump of a one-element sequence, format version >= 9);
-  // "infinite" durations are RMW_DURATION_INFINITE = {9223372036 s, 854775807 ns}.
+OfferedQos offered_qos(const TopicSpec& spec, std::int32_t keep_last) {
+  OfferedQos q;
+  q.transient_local = spec.transient_local;
+  q.keep_all = !spec.transient_local && keep_last <= 0;
+  q.depth = spec.transient_local ? 1 : q.keep_all ? 0 : keep_last;
+  return q;
+}
+
+std::string offered_qos_yaml(const OfferedQos& qos) {
+  // rosbag2's encoding (yaml-cpp dump of a one-element sequence, format version >= 9: policies by
+  // name); "infinite" durations are RMW_DURATION_INFINITE = {9223372036 s, 854775807 ns}. A keep-all
+  // writer has no depth: 0, as rclcpp's KeepAll leaves it.
   const char* infinite = "\n    sec: 9223372036\n    nsec: 854775807";
-  std::string y = "- history: keep_last\n  depth: ";
-  y += spec.transient_local ? "1" : "100";
+  std::string y = qos.keep_all ? "- history: keep_all\n  depth: 0"
+                               : "- history: keep_last\n  depth: " + std::to_string(qos.depth);
   y += "\n  reliability: reliable\n  durability: ";
-  y += spec.transient_local ? "transient_local" : "volatile";
+  y += qos.transient_local ? "transient_local" : "volatile";
   y += std::string("\n  deadline:") + infinite + "\n  lifespan:" + infinite + "\n  liveliness: automatic" +
        "\n  liveliness_lease_duration:" + infinite + "\n  avoid_ros_namespace_conventions: false";
   return y;

@@ -43,8 +43,18 @@ std::string topic_name(const TopicSpec& spec, std::string_view ns);
 // DDS names per ROS 2 conventions: "rt/rbsim/body_states", "rbsim_msgs::msg::dds_::BodyStates_".
 std::string dds_topic_name(std::string_view ros_topic);
 std::string dds_type_name(std::string_view ros_type);
-// The YAML rosbag2 stores in a channel's "offered_qos_profiles" metadata for this topic.
-std::string offered_qos_yaml(const TopicSpec& spec);
+// What a writer of a topic offers (reliability is always reliable).
+struct OfferedQos {
+  bool transient_local = false;  // late joiners get the last sample (the scene description)
+  bool keep_all = false;         // keep all (wait for slow readers) instead of keep last
+  std::int32_t depth = 1;        // keep-last depth
+};
+// What rbsim's node and replay offer: the scene description transient local, keep last 1;
+// per-step topics keep all, or keep last `keep_last` when it is positive (the writer then never
+// waits, and a reader that falls more than `keep_last` samples behind loses the oldest).
+OfferedQos offered_qos(const TopicSpec& spec, std::int32_t keep_last = 0);
+// The YAML rosbag2 stores in a channel's "offered_qos_profiles" metadata for one publisher.
+std::string offered_qos_yaml(const OfferedQos& qos);
 
 // ---------------------------------------------------------------------------------------------
 // Definitions and schemas
