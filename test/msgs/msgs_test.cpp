@@ -67,6 +67,52 @@ TEST(Ros2msgSchema, EveryTopicTypeResolves) {
   }
 }
 
+TEST(ParseMsgFields, ReadsArraysNestedTypesAndSkipsConstants) {
+  using rbsim::msgs::MsgField;
+  const auto fields = rbsim::msgs::parse_msg_fields("pkg/msg/T", R"(# a comment line
+int32 LIMIT=3
+string NAME = "x"   # a constant with spaces
+float64 x   # trailing comment
+uint8[4] fixed
+string<=8[] names
+Header header
+other_pkg/Thing[<=2] things
+Local[] locals
+)");
+  ASSERT_TRUE(fields.ok()) << fields.error().message;
+  const std::vector<MsgField>& f = fields.value();
+  ASSERT_EQ(f.size(), 6u);
+  EXPECT_EQ(f[0].name, "x");
+  ASSERT_TRUE(f[0].primitive.has_value());
+  EXPECT_EQ(f[0].primitive->kind, Scalar::Kind::Float);
+  EXPECT_EQ(f[0].primitive->size, 8);
+  EXPECT_EQ(f[1].array, MsgField::Array::Fixed);
+  EXPECT_EQ(f[1].fixed_size, 4u);
+  EXPECT_EQ(f[2].array, MsgField::Array::Sequence);
+  EXPECT_EQ(f[2].primitive->size, 0) << "a bounded string is a string";
+  EXPECT_EQ(f[3].type, "std_msgs/msg/Header");
+  EXPECT_FALSE(f[3].primitive.has_value());
+  EXPECT_EQ(f[4].type, "other_pkg/msg/Thing");
+  EXPECT_EQ(f[4].array, MsgField::Array::Sequence);
+  EXPECT_EQ(f[5].type, "pkg/msg/Local");
+
+  // rosidl's member for an empty message
+  const auto empty = rbsim::msgs::parse_msg_fields("pkg/msg/Empty", "# nothing\n");
+  ASSERT_TRUE(empty.ok());
+  ASSERT_EQ(empty.value().size(), 1u);
+  EXPECT_EQ(empty.value()[0].name, "structure_needs_at_least_one_member");
+  EXPECT_EQ(empty.value()[0].primitive->size, 1);
+
+  for (const char* bad : {"float64", "uint8[3x] a", "uint8[-1] a", "uint8[99999999999] a", "uint8[3 a",
+                          "wstring w"}) {
+    const auto r = rbsim::msgs::parse_msg_fields("pkg/msg/Bad", bad);
+    EXPECT_FALSE(r.ok()) << bad;
+    if (!r.ok()) {
+      EXPECT_TRUE(r.error().message.starts_with("pkg/msg/Bad: ")) << r.error().message;
+    }
+  }
+}
+
 // Hand-encoded: header 00 01 00 00, sec = 1 (int32), nanosec = 500000000 = 0x1DCD6500 (uint32).
 TEST(EncoderClock, MatchesHandEncodedCdr) {
   rbsim::Scene scene = spring_wind_scene();

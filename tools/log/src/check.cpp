@@ -31,43 +31,7 @@ namespace rbsim::log {
 
 namespace {
 
-struct PrimitiveInfo {
-  std::string_view name;
-  msgs::Scalar::Kind kind;
-  std::uint8_t size;  // 0: string
-};
-constexpr PrimitiveInfo kPrimitiveKinds[] = {
-    {"bool", msgs::Scalar::Kind::Bool, 1},     {"byte", msgs::Scalar::Kind::UInt, 1},
-    {"char", msgs::Scalar::Kind::UInt, 1},     {"int8", msgs::Scalar::Kind::Int, 1},
-    {"uint8", msgs::Scalar::Kind::UInt, 1},    {"int16", msgs::Scalar::Kind::Int, 2},
-    {"uint16", msgs::Scalar::Kind::UInt, 2},   {"int32", msgs::Scalar::Kind::Int, 4},
-    {"uint32", msgs::Scalar::Kind::UInt, 4},   {"int64", msgs::Scalar::Kind::Int, 8},
-    {"uint64", msgs::Scalar::Kind::UInt, 8},   {"float32", msgs::Scalar::Kind::Float, 4},
-    {"float64", msgs::Scalar::Kind::Float, 8}, {"string", msgs::Scalar::Kind::String, 0},
-};
-
-bool primitive_kind(std::string_view t, msgs::Scalar::Kind& kind, std::uint8_t& size) {
-  if (t.starts_with("string<=")) t = "string";
-  for (const PrimitiveInfo& p : kPrimitiveKinds) {
-    if (p.name == t) {
-      kind = p.kind;
-      size = p.size;
-      return true;
-    }
-  }
-  return false;
-}
-
 using msgs::canonical_type;
-
-struct RawField {
-  std::string name, type;  // type: primitive name or canonical nested type
-  bool primitive = false;
-  msgs::Scalar::Kind kind = msgs::Scalar::Kind::Float;
-  std::uint8_t size = 0;
-  Layout::Field::Array array = Layout::Field::Array::None;
-  std::uint32_t fixed = 0;
-};
 
 // Bytes a run of fixed-size fields takes from offset `at` (relative to the data start).
 std::uint64_t flat_bytes(const std::vector<Layout::Field>& fields, std::uint64_t at) {
@@ -140,15 +104,17 @@ class LayoutBuilder {
   Result<std::vector<Layout::Field>> expand(const std::string& type, const std::string& prefix, int depth,
                                             std::vector<FieldGroup>& groups) {
     if (depth > 64) return Error{"types nest deeper than 64"};
-    Result<std::vector<RawField>> raw = parse(type);
+    const auto section = sections_.find(type);
+    if (section == sections_.end()) return Error{"schema has no definition for " + type};
+    Result<std::vector<msgs::MsgField>> raw = msgs::parse_msg_fields(type, section->second);
     if (!raw) return raw.error();
     std::vector<Layout::Field> out;
-    for (const RawField& rf : raw.value()) {
+    for (const msgs::MsgField& rf : raw.value()) {
       if (groups.size() > 100000) return Error{"schema expands to more than 100000 fields"};
       Layout::Field f;
       f.name = rf.name;
       f.array = rf.array;
-      f.fixed = rf.fixed;
+      f.fixed = rf.fixed_size;
       const std::string path = prefix.empty() ? rf.name : prefix + "." + rf.name;
       if (f.array == Layout::Field::Array::Sequence) {
         f.length_group = static_cast<std::uint32_t>(groups.size());
@@ -157,10 +123,10 @@ class LayoutBuilder {
       const std::string element = f.array == Layout::Field::Array::None ? path : path + "[]";
       if (rf.primitive) {
         f.primitive = true;
-        f.kind = rf.kind;
-        f.size = rf.size;
+        f.kind = rf.primitive->kind;
+        f.size = rf.primitive->size;
         f.group = static_cast<std::uint32_t>(groups.size());
-        groups.push_back({element, rf.kind});
+        groups.push_back({element, f.kind});
       } else {
         auto children = expand(rf.type, element, depth + 1, groups);
         if (!children) return children.error();
@@ -173,57 +139,6 @@ class LayoutBuilder {
   }
 
  private:
-  Result<std::vector<RawField>> parse(const std::string& name) {
-    const auto it = sections_.find(name);
-    if (it == sections_.end()) return Error{"schema has no definition for " + name};
-    const std::string package = name.substr(0, name.find('/'));
-    std::vector<RawField> fields;
-    std::istringstream def(it->second);
-    std::string text;
-    while (std::getline(def, text)) {
-      if (const auto hash = text.find('#'); hash != std::string::npos) text.resize(hash);
-      std::istringstream words(text);
-      std::string type, field;
-      if (!(words >> type)) continue;
-      if (!(words >> field)) return Error{name + ": field without a name: " + type};
-      if (field.find('=') != std::string::npos) continue;  // constant
-      std::string rest;
-      if (words >> rest && rest.starts_with('=')) continue;
-      RawField f;
-      f.name = field;
-      if (const auto bracket = type.find('['); bracket != std::string::npos) {
-        if (type.back() != ']') return Error{name + ": bad array type in " + text};
-        const std::string inside = type.substr(bracket + 1, type.size() - bracket - 2);
-        type.resize(bracket);
-        if (inside.empty() || inside.starts_with("<=")) {
-          f.array = Layout::Field::Array::Sequence;
-        } else {
-          char* end = nullptr;
-          const unsigned long n = std::strtoul(inside.c_str(), &end, 10);
-          if (end == inside.c_str() || *end != '\0' || n > UINT32_MAX)
-            return Error{name + ": bad array size in " + text};
-          f.array = Layout::Field::Array::Fixed;
-          f.fixed = static_cast<std::uint32_t>(n);
-        }
-      }
-      if (type == "wstring") return Error{name + ": wstring fields are not supported"};
-      f.primitive = primitive_kind(type, f.kind, f.size);
-      f.type = f.primitive ? type : canonical_type(type, package);
-      fields.push_back(std::move(f));
-    }
-    // rosidl gives a message without fields one uint8 member (as the decoder does).
-    if (fields.empty()) {
-      RawField f;
-      f.name = "structure_needs_at_least_one_member";
-      f.primitive = true;
-      f.kind = msgs::Scalar::Kind::UInt;
-      f.size = 1;
-      f.type = "uint8";
-      fields.push_back(std::move(f));
-    }
-    return fields;
-  }
-
   std::map<std::string, std::string> sections_;
 };
 

@@ -74,7 +74,8 @@ class Layout {
     bool primitive = false;
     msgs::Scalar::Kind kind = msgs::Scalar::Kind::Float;
     std::uint8_t size = 0;  // primitives: bytes on the wire (0: string)
-    enum class Array : std::uint8_t { None, Fixed, Sequence } array = Array::None;
+    using Array = msgs::MsgField::Array;
+    Array array = Array::None;
     std::uint32_t fixed = 0;
     std::uint32_t group = 0;         // primitives: the group of every element
     std::uint32_t length_group = 0;  // sequences: the group of the length

@@ -1,4 +1,6 @@
 // Parsing ros2msg schemas and decoding CDR by them.
+#include <cctype>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <sstream>
@@ -217,60 +219,83 @@ std::map<std::string, std::string> schema_sections(std::string_view root, std::s
   return sections;
 }
 
+std::optional<PrimitiveType> primitive_type(std::string_view type) {
+  const int i = primitive_index(type);
+  if (i < 0) return std::nullopt;
+  return PrimitiveType{kPrimitives[i].kind, kPrimitives[i].size};
+}
+
+Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::string_view text) {
+  const std::string name(type);
+  const std::string package = name.substr(0, name.find('/'));
+  std::vector<MsgField> fields;
+  std::istringstream def{std::string(text)};
+  std::string line;
+  while (std::getline(def, line)) {
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream words(line);
+    std::string field_type, field;
+    if (!(words >> field_type)) continue;
+    if (!(words >> field)) return Error{name + ": field without a name: " + field_type};
+    if (field.find('=') != std::string::npos) continue;  // constant "int32 X=3"
+    std::string rest;
+    if (words >> rest && rest.starts_with('=')) continue;  // constant "int32 X = 3"
+    MsgField f;
+    f.name = field;
+    if (const auto bracket = field_type.find('['); bracket != std::string::npos) {
+      if (field_type.back() != ']') return Error{name + ": bad array type in " + line};
+      const std::string inside = field_type.substr(bracket + 1, field_type.size() - bracket - 2);
+      field_type.resize(bracket);
+      if (inside.empty() || inside.starts_with("<=")) {
+        f.array = MsgField::Array::Sequence;
+      } else {
+        char* end = nullptr;
+        const unsigned long n = std::strtoul(inside.c_str(), &end, 10);
+        if (!std::isdigit(static_cast<unsigned char>(inside[0])) || *end != '\0' || n > UINT32_MAX)
+          return Error{name + ": bad array size in " + line};
+        f.array = MsgField::Array::Fixed;
+        f.fixed_size = static_cast<std::uint32_t>(n);
+      }
+    }
+    if (field_type == "wstring") return Error{name + ": wstring fields are not supported"};
+    f.primitive = primitive_type(field_type);
+    f.type = f.primitive ? field_type : canonical_type(field_type, package);
+    fields.push_back(std::move(f));
+  }
+  // rosidl gives a message without fields one uint8 member, so every element has a size.
+  if (fields.empty()) {
+    fields.push_back(MsgField{"structure_needs_at_least_one_member", "uint8", primitive_type("uint8")});
+  }
+  return fields;
+}
+
 Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string_view schema) {
   const std::string root_name = canonical_type(root, "");
   const std::map<std::string, std::string> sections = schema_sections(root_name, schema);
 
   MessageDecoder d;
   std::map<std::string, std::size_t> index;
-  std::vector<std::string> pending{root_name};
   index[root_name] = 0;
   d.types_.push_back(Type{root_name, {}});
   for (std::size_t t = 0; t < d.types_.size(); ++t) {
     const std::string name = d.types_[t].name;
     const auto it = sections.find(name);
     if (it == sections.end()) return Error{"schema has no definition for " + name};
-    const std::string package = name.substr(0, name.find('/'));
-    std::istringstream def(it->second);
-    std::string text;
-    while (std::getline(def, text)) {
-      if (const auto hash = text.find('#'); hash != std::string::npos) text.resize(hash);
-      std::istringstream words(text);
-      std::string type, field;
-      if (!(words >> type)) continue;
-      if (!(words >> field)) return Error{name + ": field without a name: " + type};
-      if (field.find('=') != std::string::npos) continue;  // constant
-      std::string rest;
-      if (words >> rest && rest.starts_with('=')) continue;  // "int32 X = 3"
+    auto parsed = parse_msg_fields(name, it->second);
+    if (!parsed) return parsed.error();
+    for (MsgField& m : parsed.value()) {
       Field f;
-      f.name = field;
-      if (const auto bracket = type.find('['); bracket != std::string::npos) {
-        const std::string inside = type.substr(bracket + 1, type.size() - bracket - 2);
-        type.resize(bracket);
-        if (inside.empty() || inside.starts_with("<=")) {
-          f.array = Field::Array::Sequence;
-        } else {
-          f.array = Field::Array::Fixed;
-          try {
-            f.fixed_size = static_cast<std::uint32_t>(std::stoul(inside));
-          } catch (...) {
-            return Error{name + ": bad array size in " + text};
-          }
-        }
-      }
-      f.primitive = primitive_index(type);
-      if (type == "wstring") return Error{name + ": wstring fields are not supported"};
-      if (f.primitive < 0) {
-        const std::string nested = canonical_type(type, package);
-        auto [pos, fresh] = index.try_emplace(nested, d.types_.size());
-        if (fresh) d.types_.push_back(Type{nested, {}});
+      f.name = std::move(m.name);
+      f.array = m.array;
+      f.fixed_size = m.fixed_size;
+      f.primitive = m.primitive ? primitive_index(m.type) : -1;
+      if (!m.primitive) {
+        auto [pos, fresh] = index.try_emplace(m.type, d.types_.size());
+        if (fresh) d.types_.push_back(Type{m.type, {}});
         f.nested = pos->second;
       }
       d.types_[t].fields.push_back(std::move(f));
     }
-    // rosidl gives a message without fields one uint8 member, so every element has a size.
-    if (d.types_[t].fields.empty())
-      d.types_[t].fields.push_back(Field{"structure_needs_at_least_one_member", 4});
   }
   return d;
 }

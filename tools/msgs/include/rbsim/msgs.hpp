@@ -160,6 +160,26 @@ std::string canonical_type(std::string_view type, std::string_view package);
 // A rosbag2-style schema split into its definitions, keyed by canonical type (`root` first).
 std::map<std::string, std::string> schema_sections(std::string_view root, std::string_view schema);
 
+// A primitive .msg type: its scalar kind and CDR size in bytes (0: string; "string<=N" is one).
+struct PrimitiveType {
+  Scalar::Kind kind = Scalar::Kind::UInt;
+  std::uint8_t size = 0;
+};
+std::optional<PrimitiveType> primitive_type(std::string_view type);
+
+// One field of a .msg definition.
+struct MsgField {
+  std::string name;
+  std::string type;                        // a primitive's name, or the canonical nested type
+  std::optional<PrimitiveType> primitive;  // set for primitives
+  enum class Array : std::uint8_t { None, Fixed, Sequence } array = Array::None;
+  std::uint32_t fixed_size = 0;  // Array::Fixed
+};
+// The fields of the .msg text of `type` ("pkg/msg/Name"; bare nested names resolve in its package),
+// constants and comments skipped. A message without fields gets rosidl's one uint8 member.
+// Fails on a malformed line, a bad array bound or a wstring.
+Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::string_view text);
+
 class MessageDecoder {
  public:
   // `type` names the root ("rbsim_msgs/msg/BodyStates"); `schema` is its ros2msg text with its
@@ -183,7 +203,8 @@ struct MessageDecoder::Field {
   std::string name;
   int primitive = -1;      // index into the primitive table, or -1 for a nested type
   std::size_t nested = 0;  // index into types_ when primitive < 0
-  enum class Array : std::uint8_t { None, Fixed, Sequence } array = Array::None;
+  using Array = MsgField::Array;
+  Array array = Array::None;
   std::uint32_t fixed_size = 0;
 };
 struct MessageDecoder::Type {
