@@ -103,8 +103,8 @@ Local[] locals
   EXPECT_EQ(empty.value()[0].name, "structure_needs_at_least_one_member");
   EXPECT_EQ(empty.value()[0].primitive->size, 1);
 
-  for (const char* bad : {"float64", "uint8[3x] a", "uint8[-1] a", "uint8[99999999999] a", "uint8[3 a",
-                          "wstring w"}) {
+  for (const char* bad :
+       {"float64", "uint8[3x] a", "uint8[-1] a", "uint8[99999999999] a", "uint8[3 a", "wstring w"}) {
     const auto r = rbsim::msgs::parse_msg_fields("pkg/msg/Bad", bad);
     EXPECT_FALSE(r.ok()) << bad;
     if (!r.ok()) {
