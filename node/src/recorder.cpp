@@ -94,6 +94,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   const dds_return_t n = dds_waitset_wait(waitset_, triggered, 16, timeout_ns);
   if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
   bool any = false;
+  // A chunk compressed while no message came in reaches the file now, not at the next message.
+  if (auto st = writer_.write_compressed_chunk(); !st.ok()) return Error{options_.path + ": " + st.message};
   Received sample;
   for (Topic& t : topics_) {
     while (t.subscription.take(sample)) {

@@ -115,6 +115,10 @@ struct Writer::Impl {
     return s;
   }
 
+  Status write_compressed_chunk() {
+    return worker && worker->pending() && worker->finished() ? finish_pending() : Status::Ok();
+  }
+
   // Writes the chunk the worker holds, once compressed (waiting for it if need be).
   Status finish_pending() {
     if (!worker || !worker->pending()) return Status::Ok();
@@ -346,9 +350,7 @@ Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, T
   meta.end_time = meta.has_messages ? std::max(meta.end_time, log_time) : log_time;
   meta.has_messages = true;
   // A compressed chunk goes to the file as soon as it is ready, not only when the next one is full.
-  if (w.worker && w.worker->pending() && w.worker->finished()) {
-    if (Status s = w.finish_pending(); !s.ok()) return s;
-  }
+  if (Status s = w.write_compressed_chunk(); !s.ok()) return s;
   if (w.chunk.size() >= w.options.chunk_size) return w.flush_chunk();
   return Status::Ok();
 }
@@ -394,6 +396,11 @@ Status Writer::flush_chunk() {
   if (Status s = impl_->check_open(); !s.ok()) return s;
   if (Status s = impl_->flush_chunk(); !s.ok()) return s;
   return impl_->finish_pending();
+}
+
+Status Writer::write_compressed_chunk() {
+  if (Status s = impl_->check_open(); !s.ok()) return s;
+  return impl_->write_compressed_chunk();
 }
 
 Status Writer::close() {

@@ -297,6 +297,9 @@ class Writer {
   Status add_metadata(std::string_view name, const KeyValueMap& metadata);
   // Writes the pending chunk now (a recorder may call this periodically to bound loss).
   Status flush_chunk();
+  // With background_compression: writes a chunk whose compression has finished, without waiting
+  // (write_message does this too; a writer that may sit idle calls it so the chunk reaches the file).
+  Status write_compressed_chunk();
   // Writes the last chunk, DataEnd, summary, summary offsets, Footer and magic.
   Status close();
 
