@@ -70,7 +70,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   // every other reader exists by the time the node starts publishing.
   std::stable_partition(wanted.begin(), wanted.end(),
                         [](const msgs::TopicSpec* s) { return s->id != msgs::TopicId::BodyStates; });
-  if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size));
+  if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size,
+                                                                  options.compression_level));
       !st.ok()) {
     return Error{options.path + ": " + st.message};
   }

@@ -122,6 +122,40 @@ TEST(ExportCli, RecordEveryThreeExportsExactlyTheRecordedSteps) {
   EXPECT_EQ(lines_of(energy).size(), 1u + 101u);
 }
 
+// --compression-level changes the chunk bytes, never the messages; a level the codec has no use
+// for is a one-line error before anything is written.
+TEST(RecordCli, CompressionLevelChangesBytesNotMessages) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/cantilever.xml");
+  const auto record = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"run", scene, "-q", "--steps", "400", "--record", (dir / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return rbsim(args);
+  };
+  ASSERT_EQ(record("default.mcap", {}).exit_code, 0);
+  for (const std::vector<std::string>& extra :
+       std::vector<std::vector<std::string>>{{"--compression-level", "19"},
+                                             {"--compression-level", "-5"},
+                                             {"--compression", "lz4", "--compression-level", "9"}}) {
+    const std::string name = "level" + extra.back() + ".mcap";
+    Outcome o = record(name, extra);
+    ASSERT_EQ(o.exit_code, 0) << describe(o);
+    EXPECT_NE(read_text(dir / name), read_text(dir / "default.mcap")) << extra.back();
+    Outcome check = rbsim({"check", (dir / name).string(), (dir / "default.mcap").string()});
+    EXPECT_EQ(check.exit_code, 0) << describe(check);
+  }
+  for (const std::vector<std::string>& bad :
+       std::vector<std::vector<std::string>>{{"--compression-level", "23"},
+                                             {"--compression", "lz4", "--compression-level", "13"},
+                                             {"--compression", "none", "--compression-level", "1"}}) {
+    Outcome o = record("bad.mcap", bad);
+    EXPECT_EQ(o.exit_code, 1) << describe(o);
+    EXPECT_NE(o.err.find("rbsim run: error: --compression-level: "), std::string::npos) << o.err;
+    EXPECT_EQ(lines_of(o.err).size(), 1u) << o.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.mcap"));
+  }
+}
+
 TEST(ExportCli, ErrorsAreOneLine) {
   TempDir dir;
   Outcome run = rbsim({"run", source_path("scenes/chain.xml"), "-q", "--steps", "20", "--record",

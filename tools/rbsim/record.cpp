@@ -28,6 +28,9 @@ int fail(const std::string& m) {
 int record_command(RecordArgs a) {
   if (!log::parse_compression(a.compression, a.rec.compression))
     return fail("unknown compression " + a.compression);
+  if (const std::string bad = log::check_compression_level(a.rec.compression, a.rec.compression_level);
+      !bad.empty())
+    return fail("--compression-level: " + bad);
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
   // error, leaving a recoverable file, instead of SIGXFSZ killing it.
   std::signal(SIGXFSZ, SIG_IGN);
@@ -99,9 +102,13 @@ Subcommand add_record_command(CLI::App& parent) {
   app->add_option("--compression", a->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
+  app->add_option("--compression-level", a->rec.compression_level,
+                  "zstd -50..22 or lz4 0..12; 0: zstd 1, the MCAP C++ library's default")
+      ->default_str("0");
   app->add_option(
          "--chunk-size", a->rec.chunk_size,
-         "Uncompressed bytes per MCAP chunk: a killed recorder loses at most the chunk it was filling")
+         "Uncompressed bytes per MCAP chunk: a killed recorder loses at most the chunk it was filling and "
+         "the one being compressed")
       ->check(CLI::Range(std::uint64_t{1024}, std::uint64_t{1} << 30))
       ->default_str("1048576");
   app->add_flag("-q,--quiet", a->quiet, "Only errors");

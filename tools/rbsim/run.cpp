@@ -21,6 +21,7 @@ struct RunOptions {
   std::string csv, energy_csv, fosssim_out, record;
   std::int64_t record_every = 1;
   std::string compression = "zstd";
+  int compression_level = 0;
   std::string ns = "rbsim";
   std::string frames, size = "1280x720";
   double fps = 24.0;
@@ -58,6 +59,10 @@ int run(const RunOptions& o) {
     ro.ns = o.ns;
     if (!log::parse_compression(o.compression, ro.compression))
       return fail("unknown compression " + o.compression);
+    if (const std::string bad = log::check_compression_level(ro.compression, o.compression_level);
+        !bad.empty())
+      return fail("--compression-level: " + bad);
+    ro.compression_level = o.compression_level;
     sinks.push_back(log::make_mcap_sink(o.record, ro));
   }
   if (!o.frames.empty()) {
@@ -148,6 +153,10 @@ Subcommand add_run_command(CLI::App& parent) {
   app->add_option("--compression", o->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
+  app->add_option("--compression-level", o->compression_level,
+                  "zstd -50..22 or lz4 0..12 (higher: smaller and slower); 0: zstd 1, the MCAP C++ "
+                  "library's default")
+      ->default_str("0");
   app->add_option("--namespace", o->ns, "ROS namespace of the recorded topics (/<namespace>/body_states ...)")
       ->default_str("rbsim");
   app->add_option("--frames", o->frames,

@@ -161,6 +161,7 @@ struct RecorderOptions {
   std::string ns = "rbsim";
   std::vector<std::string> topics;  // names ("body_states" or "/rbsim/body_states"); empty: all
   mcap::Compression compression = mcap::Compression::Zstd;
+  int compression_level = 0;  // 0: the codec's default
   std::uint64_t chunk_size = 1 << 20;
   std::uint64_t max_messages = 0;  // 0: no limit
 };

@@ -26,7 +26,9 @@ class McapSink final : public Sink {
 
   Status begin(const Scene& scene, const World& world) override {
     encoder_ = std::make_unique<msgs::Encoder>(scene);
-    if (auto st = writer_.open(path_, writer_options(options_.compression, options_.chunk_size)); !st.ok()) {
+    if (auto st = writer_.open(
+            path_, writer_options(options_.compression, options_.chunk_size, options_.compression_level));
+        !st.ok()) {
       return fail(path_, st);
     }
     for (msgs::TopicId id : options_.topics) {
@@ -73,11 +75,13 @@ class McapSink final : public Sink {
 
 }  // namespace
 
-mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size) {
+mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size,
+                                   int compression_level) {
   mcap::WriterOptions o;
   o.profile = "ros2";
   o.library = "rbsim 0.1.0";
   o.compression = compression;
+  o.compression_level = compression_level;
   o.chunk_size = chunk_size;
   // Recordings compress beside the simulation or DDS reception that feeds them (same bytes).
   o.background_compression = true;
@@ -106,6 +110,23 @@ bool parse_compression(std::string_view name, mcap::Compression& out) {
   if (name == "lz4") return out = mcap::Compression::Lz4, true;
   if (name == "none") return out = mcap::Compression::None, true;
   return false;
+}
+
+std::string check_compression_level(mcap::Compression compression, int level) {
+  const auto range = [level](int lo, int hi, const char* codec) -> std::string {
+    if (level >= lo && level <= hi) return {};
+    return "compression level " + std::to_string(level) + " is outside " + codec + "'s " +
+           std::to_string(lo) + ".." + std::to_string(hi);
+  };
+  switch (compression) {
+    case mcap::Compression::Zstd:
+      return range(-50, 22, "zstd");
+    case mcap::Compression::Lz4:
+      return range(0, 12, "lz4");
+    case mcap::Compression::None:
+      return level == 0 ? std::string() : "a compression level needs --compression zstd or lz4";
+  }
+  return "unknown compression";
 }
 
 std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options) {

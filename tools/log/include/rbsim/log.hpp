@@ -15,6 +15,7 @@ namespace rbsim::log {
 
 struct RecordOptions {
   mcap::Compression compression = mcap::Compression::Zstd;
+  int compression_level = 0;           // 0: the codec's default (check_compression_level)
   std::uint64_t chunk_size = 1 << 20;  // uncompressed bytes per chunk
   std::int64_t every = 1;              // record every k-th step (step 0 always)
   std::string ns = "rbsim";            // ROS namespace of the topics
@@ -31,10 +32,14 @@ mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpe
                                       const msgs::OfferedQos& offered);
 mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns);
 // The writer options of every rbsim log (profile "ros2", library "rbsim <version>").
-mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size = 1 << 20);
+mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size = 1 << 20,
+                                   int compression_level = 0);
 
 // Parses "zstd", "lz4", "none".
 bool parse_compression(std::string_view name, mcap::Compression& out);
+// Empty when `level` suits the codec: zstd -50..22 (negative: faster, larger), lz4 0..12 (frame
+// compression levels; 3 and up are LZ4-HC), none 0 only. Otherwise what is wrong.
+std::string check_compression_level(mcap::Compression compression, int level);
 
 }  // namespace rbsim::log
 
