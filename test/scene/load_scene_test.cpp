@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -298,6 +300,12 @@ TEST(StepsFor, CeilingOfDurationOverDtInDoublePrecision) {
   EXPECT_EQ(steps_for(1.0, 0.001), 1000);
   EXPECT_EQ(steps_for(0.0, 0.01), 0);
   EXPECT_EQ(steps_for(0.015, 0.01), 2);
+  constexpr auto kMax = std::numeric_limits<std::int64_t>::max();
+  EXPECT_EQ(steps_for(4.9e101, 0.01), kMax);  // the fuzzer's: no int64 holds it
+  EXPECT_EQ(steps_for(9.3e18, 1.0), kMax);
+  EXPECT_EQ(steps_for(1.0, 0.0), kMax);  // +inf
+  EXPECT_EQ(steps_for(std::nan(""), 0.01), 0);
+  EXPECT_EQ(steps_for(9.0e15, 1.0), 9'000'000'000'000'000);
   Scene s;
   s.duration = 0.07;
   s.world.dt = 0.01;

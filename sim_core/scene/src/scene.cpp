@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -19,7 +20,11 @@ namespace rbsim {
 
 std::int64_t steps_for(double duration, double dt) {
   const double n = std::ceil(duration / dt);
-  return n <= 0.0 ? 0 : static_cast<std::int64_t>(n);
+  if (!(n > 0.0)) return 0;  // also NaN
+  // A duration of 1e100 s is a valid scene that runs until stopped: more steps than int64 holds
+  // saturate (converting such a double to an integer is undefined; the fuzzer found it).
+  constexpr double kMax = 9223372036854774784.0;  // the largest double below 2^63
+  return n >= kMax ? std::numeric_limits<std::int64_t>::max() : static_cast<std::int64_t>(n);
 }
 
 std::int64_t Scene::step_count() const {

@@ -39,7 +39,8 @@ struct Scene {
   std::int64_t step_count() const;
 };
 
-// Number of steps of size dt that cover a duration (see Scene::step_count).
+// Number of steps of size dt that cover a duration (see Scene::step_count); 0 for a duration <= 0
+// (or NaN), INT64_MAX when the count does not fit.
 std::int64_t steps_for(double duration, double dt);
 
 // Loads and validates a scene file. On failure the error message is one line:
