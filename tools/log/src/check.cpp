@@ -921,10 +921,7 @@ class Comparer {
         }
         if (!(va == vb || (va != va && vb != vb)) && !c.differs_float(st, va, vb) &&
             first_bad == UINT64_MAX) {
-          bad_a.kind = bad_b.kind = Kind::Float;
-          bad_a.f = va;
-          bad_b.f = vb;
-          first_bad = index;
+          mark(float_scalar(va), float_scalar(vb));
         }
         ++index;
         return;
@@ -935,6 +932,12 @@ class Comparer {
       const Scalar sa = load(x, size, kind), sb = load(y, size, kind);
       if (!c.differs(st, sa, sb) && first_bad == UINT64_MAX) mark(sa, sb);
       ++index;
+    }
+    static Scalar float_scalar(double v) {
+      Scalar s;
+      s.kind = Kind::Float;
+      s.f = v;
+      return s;
     }
     void mark(const Scalar& run_value, const Scalar& golden_value) {
       first_bad = index;

@@ -33,7 +33,7 @@ class Compressor {
 class ChunkWorker {
  public:
   ChunkWorker(Compression compression, int level, bool crc);
-  ~ChunkWorker();  // abandons a job still running and joins
+  ~ChunkWorker();  // drops a job the thread has not started, lets a started one end, and joins
   ChunkWorker(const ChunkWorker&) = delete;
   ChunkWorker& operator=(const ChunkWorker&) = delete;
 
