@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "rbsim/builders.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/dds.hpp"
 
 namespace {
 

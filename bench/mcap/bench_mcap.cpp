@@ -8,7 +8,7 @@
 //                               schema-driven decoder `rbsim log check/export` use), checking the
 //                               decoded body count
 //   BM_ReadTyped/<codec>/N      the same with the typed msgs::decode_body_states instead
-//   BM_Check/<codec>/N          rbsim check (log::check_logs) of such a file against a copy
+//   BM_Check/<codec>/N          rbsim check (check::check_logs) of such a file against a copy
 //   BM_CheckDiffers/<codec>/N   ... against a file whose every message differs (all values compared)
 //   BM_Record/<variant>         one `rbsim run`-equivalent run of builders::grid(1000, true) for
 //                               RBSIM_BENCH_RECORD_STEPS steps (default 2000): World::step,
@@ -42,11 +42,12 @@
 #include <vector>
 
 #include "rbsim/builders.hpp"
+#include "rbsim/check.hpp"
 #include "rbsim/core.hpp"
 #include "rbsim/io.hpp"
-#include "rbsim/log.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/record.hpp"
 #include "rbsim/scene.hpp"
 
 namespace {
@@ -275,7 +276,7 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
   set_throughput(state, bytes, count);
 }
 
-// rbsim check (log::check_logs) of a file against a copy, what a CI gate on a golden made by the
+// rbsim check (check::check_logs) of a file against a copy, what a CI gate on a golden made by the
 // same binary does (identical messages take the byte-equal path), or, `differ`, against a file
 // whose every message is a snapshot later: every value is decoded, compared and tabulated (and
 // the check reports the divergence). Bytes: one file's message data.
@@ -289,7 +290,7 @@ void bm_check(benchmark::State& state, Codec codec, bool differ) {
   const std::uint64_t bytes = write_file(state, run, codec, snaps, encoder, count, buf);
   if (bytes == 0 || write_file(state, golden, codec, snaps, encoder, count, buf, differ ? 1 : 0) == 0) return;
   for (auto _ : state) {
-    auto report = log::check_logs(run, golden);
+    auto report = check::check_logs(run, golden);
     if (!report) {
       state.SkipWithError(report.error().message.c_str());
       break;

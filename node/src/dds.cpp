@@ -8,7 +8,7 @@
 #include <cstring>
 
 #include "raw_serdata.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/dds.hpp"
 #include "topics.hpp"
 
 namespace rbsim::node {

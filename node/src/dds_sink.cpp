@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "clock.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/dds_sink.hpp"
 
 namespace rbsim::node {
 

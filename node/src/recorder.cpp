@@ -5,8 +5,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "rbsim/log.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/record.hpp"
+#include "rbsim/recorder.hpp"
 
 namespace rbsim::node {
 

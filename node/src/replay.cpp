@@ -7,7 +7,8 @@
 #include <set>
 
 #include "clock.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/mcap.hpp"
+#include "rbsim/replay.hpp"
 
 namespace rbsim::node {
 

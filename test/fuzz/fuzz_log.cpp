@@ -9,7 +9,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "rbsim/log.hpp"
+#include "rbsim/check.hpp"
+#include "rbsim/mcap_tools.hpp"
 
 namespace {
 std::string temp_path(const char* what) {
@@ -27,17 +28,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size > 0 && std::fwrite(data, 1, size, f) != size) __builtin_trap();
   std::fclose(f);
 
-  rbsim::log::CheckOptions options;
-  (void)rbsim::log::check_logs(in, in, options);
+  rbsim::check::CheckOptions options;
+  (void)rbsim::check::check_logs(in, in, options);
   options.compare_log_time = false;
   options.rtol = 1e-9;
   if (golden != nullptr && *golden != '\0') {
-    (void)rbsim::log::check_logs(in, golden, options);
-    (void)rbsim::log::check_logs(golden, in, options);
+    (void)rbsim::check::check_logs(in, golden, options);
+    (void)rbsim::check::check_logs(golden, in, options);
   }
-  (void)rbsim::log::info(in);
-  (void)rbsim::log::doctor(in);
-  (void)rbsim::log::recover(in, out);
+  (void)rbsim::mcap_tools::info(in);
+  (void)rbsim::mcap_tools::doctor(in);
+  (void)rbsim::mcap_tools::recover(in, out);
   std::remove(out.c_str());
   return 0;
 }

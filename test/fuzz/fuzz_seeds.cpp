@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "rbsim/log.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/record.hpp"
 #include "rbsim/scene.hpp"
 
 namespace {
@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     }
     for (const char* name : {"none", "lz4", "zstd"}) {
       rbsim::log::RecordOptions options;
-      if (!rbsim::log::parse_compression(name, options.compression)) return fail(name);
+      if (!rbsim::mcap::parse_compression(name, options.compression)) return fail(name);
       options.chunk_size = 4096;  // several chunks in a small file
       auto w = rbsim::World::create(scene.value().world);
       auto sink = rbsim::log::make_mcap_sink((out / "log" / (stem + "-" + name + ".mcap")).string(), options);

@@ -12,7 +12,9 @@
 #include <set>
 #include <sstream>
 
-#include "rbsim/log.hpp"
+#include "rbsim/check.hpp"
+#include "rbsim/golden.hpp"
+#include "rbsim/record.hpp"
 #include "rbsim/subprocess.hpp"
 
 namespace {
@@ -90,7 +92,7 @@ fs::path golden_path(const std::string& name) {
   return kGoldens / (name + ".mcap");
 }
 
-std::string to_string(const log::GoldenVerification& v) {
+std::string to_string(const check::GoldenVerification& v) {
   std::string s = "rule " + v.rule + "\n";
   for (const std::string& line : v.lines) s += "  " + line + "\n";
   return s;
@@ -105,7 +107,7 @@ TEST_P(GoldenScene, RerunMatchesGolden) {
   const fs::path golden = golden_path(GetParam());
   ASSERT_TRUE(fs::exists(golden)) << "no golden for " << scene_path(GetParam()) << ": run scripts/golden "
                                   << scene_path(GetParam());
-  Result<std::int64_t> every = log::read_record_every(golden.string());
+  Result<std::int64_t> every = check::read_record_every(golden.string());
   ASSERT_TRUE(every) << every.error().message;
   TempDir tmp;
   const fs::path run = tmp / "run.mcap";
@@ -119,16 +121,16 @@ TEST_P(GoldenScene, RerunMatchesGolden) {
 TEST_P(GoldenScene, GoldenIsVerified) {
   const fs::path golden = golden_path(GetParam());
   ASSERT_TRUE(fs::exists(golden)) << "no golden for " << scene_path(GetParam());
-  log::GoldenVerifyOptions options;
+  check::GoldenVerifyOptions options;
   options.fosssim_dir = kFosssim.string();
-  Result<log::GoldenVerification> v =
-      log::verify_golden(scene_path(GetParam()).string(), golden.string(), options);
+  Result<check::GoldenVerification> v =
+      check::verify_golden(scene_path(GetParam()).string(), golden.string(), options);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_TRUE(v->passed) << to_string(v.value());
   // Every golden is re-integrated independently; against the FOSSSim reference when there is one,
   // else, for conservative symplectic scenes, checked for energy conservation.
-  const log::FosssimMatch match =
-      log::find_fosssim_reference(scene_path(GetParam()).string(), kFosssim.string());
+  const check::FosssimMatch match =
+      check::find_fosssim_reference(scene_path(GetParam()).string(), kFosssim.string());
   Result<Scene> scene = load_scene(scene_path(GetParam()).string());
   ASSERT_TRUE(scene) << scene.error().message;
   const bool conservative = scene->world.integrator == Integrator::SymplecticEuler &&
@@ -182,7 +184,7 @@ const fs::path kChainGolden = kGoldens / "chain.mcap";
 constexpr const char* kChainEvery = "200";  // chain's golden: --record-every 200 (checked below)
 
 TEST(Check, ChainGoldenIsRecordedEvery200Steps) {
-  Result<std::int64_t> every = log::read_record_every(kChainGolden.string());
+  Result<std::int64_t> every = check::read_record_every(kChainGolden.string());
   ASSERT_TRUE(every) << every.error().message;
   EXPECT_EQ(std::to_string(every.value()), kChainEvery);
 }
@@ -421,7 +423,7 @@ TEST(CheckLibrary, TruncatedAndFlippedBytesAreErrors) {
   std::size_t n = 0;
   auto expect_error = [&](const std::string& what) {
     ++n;
-    Result<log::CheckReport> r = log::check_logs(base.string(), bad.string());
+    Result<check::CheckReport> r = check::check_logs(base.string(), bad.string());
     EXPECT_FALSE(r.ok()) << what << ": "
                          << (r ? (r->passed() ? "match" : "divergence " + r->first->line()) : "");
   };
@@ -456,7 +458,7 @@ TEST(CheckLibrary, ConformanceFilesMatchTheirOtherLayouts) {
     for (const fs::path& f : layouts) {
       ++files;
       for (const fs::path& golden : {f, layouts.front()}) {
-        Result<log::CheckReport> r = log::check_logs(f.string(), golden.string());
+        Result<check::CheckReport> r = check::check_logs(f.string(), golden.string());
         ASSERT_TRUE(r) << f << " vs " << golden << ": " << r.error().message;
         EXPECT_TRUE(r->passed()) << f << " vs " << golden << ": " << r->first->line();
       }
@@ -509,12 +511,12 @@ std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs
 
 TEST(CheckLibrary, FieldMaximaMatchAnIndependentDecode) {
   const Pair tiny("1.000000001");
-  Result<log::CheckReport> r = log::check_logs(tiny.other.string(), tiny.base.string());
+  Result<check::CheckReport> r = check::check_logs(tiny.other.string(), tiny.base.string());
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_FALSE(r->passed());
   const auto expected = independent_max(tiny.other, tiny.base);
   std::size_t checked = 0, nonzero = 0;
-  for (const log::FieldStats& f : r->fields) {
+  for (const check::FieldStats& f : r->fields) {
     if (f.kind != "float") continue;
     const auto it = expected.find(f.topic + " " + f.field);
     ASSERT_NE(it, expected.end()) << f.topic << " " << f.field;
@@ -537,9 +539,9 @@ TEST(Verify, WrongPhysicsFailsVerification) {
   const fs::path scene = edited(tmp.path(), kChain, "fy=\"-1.0\"", "fy=\"-1.05\"");
   const fs::path log_path = tmp / "chain.mcap";
   record(scene, log_path, {"--record-every", kChainEvery});
-  log::GoldenVerifyOptions options;
+  check::GoldenVerifyOptions options;
   options.fosssim_dir = kFosssim.string();
-  Result<log::GoldenVerification> v = log::verify_golden(kChain.string(), log_path.string(), options);
+  Result<check::GoldenVerification> v = check::verify_golden(kChain.string(), log_path.string(), options);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_FALSE(v->passed) << to_string(v.value());
   auto line = [&](const std::string& prefix) {
@@ -553,7 +555,7 @@ TEST(Verify, WrongPhysicsFailsVerification) {
   EXPECT_TRUE(line("FAIL energy conservation")) << to_string(v.value());
   EXPECT_GT(v->energy_error, 10 * v->energy_bound);
   // The same recording is a fine golden of the scene it was made from.
-  v = log::verify_golden(scene.string(), log_path.string(), options);
+  v = check::verify_golden(scene.string(), log_path.string(), options);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_TRUE(v->passed) << to_string(v.value());
   EXPECT_LT(v->energy_error, v->energy_bound);
@@ -575,12 +577,12 @@ TEST(Verify, WrongWindFailsTheIndependentIntegration) {
   const fs::path scene = edited(tmp.path(), original, text.substr(at, end - at), stronger.str());
   const fs::path log_path = tmp / "windy.mcap";
   record(scene, log_path, {"--record-every", "10"});
-  Result<log::GoldenVerification> v = log::verify_golden(original.string(), log_path.string());
+  Result<check::GoldenVerification> v = check::verify_golden(original.string(), log_path.string());
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_FALSE(v->passed) << to_string(v.value());
   EXPECT_TRUE(contains(to_string(v.value()), "PASS energy terms")) << to_string(v.value());
   EXPECT_TRUE(contains(to_string(v.value()), "FAIL independent integration")) << to_string(v.value());
-  v = log::verify_golden(scene.string(), log_path.string());
+  v = check::verify_golden(scene.string(), log_path.string());
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_TRUE(v->passed) << to_string(v.value());
   EXPECT_EQ(v->rule, "independent-integration");
@@ -589,8 +591,8 @@ TEST(Verify, WrongWindFailsTheIndependentIntegration) {
 TEST(Verify, ErrorsOnBadInput) {
   TempDir tmp;
   write_text(tmp / "empty.mcap", "");
-  EXPECT_FALSE(log::verify_golden(kChain.string(), (tmp / "empty.mcap").string()).ok());
-  EXPECT_FALSE(log::verify_golden((tmp / "missing.xml").string(), kChainGolden.string()).ok());
+  EXPECT_FALSE(check::verify_golden(kChain.string(), (tmp / "empty.mcap").string()).ok());
+  EXPECT_FALSE(check::verify_golden((tmp / "missing.xml").string(), kChainGolden.string()).ok());
   const Outcome o = rbsim({"check", "--verify-golden", kChain.string(), (tmp / "empty.mcap").string()});
   EXPECT_EQ(o.exit_code, 2) << o;
 }

@@ -1,4 +1,4 @@
-// log::doctor at library level: a clean recording, then one planted problem per test (with the
+// mcap_tools::doctor at library level: a clean recording, then one planted problem per test (with the
 // file's CRCs recomputed, so the planted problem is the one reported), hostile inputs, and the
 // official conformance files.
 #include <gtest/gtest.h>
@@ -14,14 +14,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool has_finding(const log::DoctorReport& r, const std::string& needle, bool error = true) {
+bool has_finding(const mcap_tools::DoctorReport& r, const std::string& needle, bool error = true) {
   for (const auto& f : r.findings) {
     if (f.error == error && f.text.find(needle) != std::string::npos) return true;
   }
   return false;
 }
 
-std::string dump(const log::DoctorReport& r) {
+std::string dump(const mcap_tools::DoctorReport& r) {
   std::string s = std::to_string(r.errors) + " errors, " + std::to_string(r.warnings) + " warnings\n";
   for (const auto& f : r.findings) s += (f.error ? "error: " : "warning: ") + f.text + "\n";
   return s;
@@ -37,12 +37,12 @@ class DoctorTest : public ::testing::Test {
     records_ = top_level_records(bytes_);
   }
   // Applies `patch` to a copy of the good file (CRCs recomputed) and runs the doctor on it.
-  log::DoctorReport doctor_patched(const std::function<void(mcap::Bytes&)>& patch, bool fix = true) {
+  mcap_tools::DoctorReport doctor_patched(const std::function<void(mcap::Bytes&)>& patch, bool fix = true) {
     mcap::Bytes b = bytes_;
     patch(b);
     if (fix) fix_crcs(b);
     write_bytes(dir_ / "patched.mcap", b);
-    return log::doctor((dir_ / "patched.mcap").string());
+    return mcap_tools::doctor((dir_ / "patched.mcap").string());
   }
   template <class T>
   void patch_record(mcap::Bytes& b, mcap::Opcode opcode, std::size_t nth,
@@ -60,7 +60,7 @@ class DoctorTest : public ::testing::Test {
 };
 
 TEST_F(DoctorTest, GoodRecordingIsClean) {
-  const auto r = log::doctor(good_.string());
+  const auto r = mcap_tools::doctor(good_.string());
   EXPECT_TRUE(r.ok()) << dump(r);
   EXPECT_EQ(r.errors, 0u) << dump(r);
   EXPECT_EQ(r.warnings, 0u) << dump(r);
@@ -101,7 +101,7 @@ TEST_F(DoctorTest, FlippedByteInAnUncompressedChunkIsAChunkCrcError) {
   b[chunk.offset + chunk.length - 3] ^= 0x01;  // the last message's payload
   fix_crcs(b);                                 // only the chunk CRC can notice
   write_bytes(raw, b);
-  const auto r = log::doctor(raw.string());
+  const auto r = mcap_tools::doctor(raw.string());
   EXPECT_TRUE(has_finding(r, "invalid CRC")) << dump(r);
   EXPECT_FALSE(has_finding(r, "data section CRC")) << dump(r);
 }
@@ -254,7 +254,7 @@ TEST(DoctorCrafted, UnknownSchemaAndChannelReferences) {
   b.insert(b.end(), std::begin(mcap::kMagic), std::end(mcap::kMagic));
   TempDir dir;
   write_bytes(dir / "x.mcap", b);
-  const auto r = log::doctor((dir / "x.mcap").string());
+  const auto r = mcap_tools::doctor((dir / "x.mcap").string());
   EXPECT_TRUE(has_finding(r, "Encountered Channel (1) with unknown Schema (7)")) << dump(r);
   EXPECT_TRUE(has_finding(r, "Message record for channel: 9")) << dump(r);
   EXPECT_TRUE(has_finding(r, "less than the previous message record time")) << dump(r);
@@ -270,12 +270,12 @@ TEST(DoctorCrafted, OutOfOrderMessagesInChunksAreWarningsUnlessStrict) {
   ASSERT_TRUE(w.close().ok());
   TempDir dir;
   write_bytes(dir / "x.mcap", w.buffer());
-  auto r = log::doctor((dir / "x.mcap").string());
+  auto r = mcap_tools::doctor((dir / "x.mcap").string());
   EXPECT_EQ(r.errors, 0u) << dump(r);
   EXPECT_TRUE(has_finding(r, "is less than the latest log time", false)) << dump(r);
-  log::DoctorOptions strict;
+  mcap_tools::DoctorOptions strict;
   strict.strict_message_order = true;
-  r = log::doctor((dir / "x.mcap").string(), strict);
+  r = mcap_tools::doctor((dir / "x.mcap").string(), strict);
   EXPECT_TRUE(has_finding(r, "is less than the latest log time", true)) << dump(r);
 }
 
@@ -284,18 +284,18 @@ TEST_F(DoctorTest, TruncatedEmptyAndForeignFiles) {
                             bytes_.size() / 3, bytes_.size() - 40, bytes_.size() - 9, bytes_.size() - 1}) {
     mcap::Bytes b(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(cut));
     write_bytes(dir_ / "cut.mcap", b);
-    const auto r = log::doctor((dir_ / "cut.mcap").string());
+    const auto r = mcap_tools::doctor((dir_ / "cut.mcap").string());
     EXPECT_FALSE(r.ok()) << "cut at " << cut;
     const std::string first = r.first_error();
     EXPECT_TRUE(first.find("truncated") != std::string::npos || first.find("empty file") != std::string::npos)
         << "cut at " << cut << ": " << first;
   }
   write_text(dir_ / "text.mcap", "name,value\n1,2\n");
-  auto r = log::doctor((dir_ / "text.mcap").string());
+  auto r = mcap_tools::doctor((dir_ / "text.mcap").string());
   EXPECT_EQ(r.first_error(), "not an MCAP file: the leading magic bytes are wrong");
-  r = log::doctor((dir_ / "missing.mcap").string());
+  r = mcap_tools::doctor((dir_ / "missing.mcap").string());
   EXPECT_NE(r.first_error().find("cannot open"), std::string::npos) << r.first_error();
-  r = log::doctor(dir_.path().string());
+  r = mcap_tools::doctor(dir_.path().string());
   EXPECT_NE(r.first_error().find("directory"), std::string::npos) << r.first_error();
 }
 
@@ -319,16 +319,16 @@ TEST(DoctorHostile, EveryFlipAndEveryTruncationOfASmallFileIsAnError) {
   TempDir dir;
   const fs::path path = dir / "f.mcap";
   write_bytes(path, good);
-  ASSERT_EQ(log::doctor(path.string()).errors, 0u) << dump(log::doctor(path.string()));
+  ASSERT_EQ(mcap_tools::doctor(path.string()).errors, 0u) << dump(mcap_tools::doctor(path.string()));
   for (std::size_t i = 0; i < good.size(); ++i) {
     mcap::Bytes b = good;
     b[i] ^= 0x04;
     write_bytes(path, b);
-    EXPECT_FALSE(log::doctor(path.string()).ok()) << "flip at byte " << i;
+    EXPECT_FALSE(mcap_tools::doctor(path.string()).ok()) << "flip at byte " << i;
   }
   for (std::size_t n = 0; n < good.size(); ++n) {
     write_bytes(path, mcap::Bytes(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(n)));
-    EXPECT_FALSE(log::doctor(path.string()).ok()) << "cut at " << n;
+    EXPECT_FALSE(mcap_tools::doctor(path.string()).ok()) << "cut at " << n;
   }
 }
 
@@ -346,7 +346,7 @@ TEST(DoctorConformance, NoFalseErrorsOnTheOfficialFiles) {
   for (const auto& entry : fs::recursive_directory_iterator(data_path("mcap-conformance"))) {
     if (entry.path().extension() != ".mcap") continue;
     ++files;
-    const auto r = log::doctor(entry.path().string());
+    const auto r = mcap_tools::doctor(entry.path().string());
     for (const auto& f : r.findings) {
       if (f.error) {
         EXPECT_TRUE(std::regex_match(f.text, go_parity)) << entry.path().filename() << ": " << f.text;

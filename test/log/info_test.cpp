@@ -1,4 +1,4 @@
-// log::info at library level: from the summary, from a scan, and refusing damaged files.
+// mcap_tools::info at library level: from the summary, from a scan, and refusing damaged files.
 #include <gtest/gtest.h>
 
 #include "log_test_util.hpp"
@@ -14,9 +14,9 @@ TEST(Info, RecordingFromItsSummary) {
   RecordSpec spec;
   spec.chunk_size = 64 * 1024;
   ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), dir / "r.mcap", 100, spec));
-  const auto info = log::info((dir / "r.mcap").string());
+  const auto info = mcap_tools::info((dir / "r.mcap").string());
   ASSERT_TRUE(info.ok()) << info.error().message;
-  const log::LogInfo& i = info.value();
+  const mcap_tools::LogInfo& i = info.value();
   EXPECT_FALSE(i.scanned);
   EXPECT_EQ(i.header.profile, "ros2");
   EXPECT_EQ(i.header.library, "rbsim 0.1.0");
@@ -35,7 +35,7 @@ TEST(Info, RecordingFromItsSummary) {
   EXPECT_EQ(i.channels[1].schema_encoding, "ros2msg");
   EXPECT_EQ(i.channels[1].messages, 101u);
   EXPECT_EQ(i.channels[0].messages, 1u);
-  const std::string text = log::format_info(i);
+  const std::string text = mcap_tools::format_info(i);
   for (const char* needle :
        {"library:     rbsim 0.1.0", "profile:     ros2", "messages:    607", "duration:    0.100000000 s",
         "start:       0.000000000 s", "end:         0.100000000 s", "zstd: [", "/rbsim/energy",
@@ -65,9 +65,9 @@ TEST(Info, FileWithoutSummaryIsScanned) {
   ASSERT_TRUE(w.close().ok());
   TempDir dir;
   write_bytes(dir / "x.mcap", w.buffer());
-  const auto info = log::info((dir / "x.mcap").string());
+  const auto info = mcap_tools::info((dir / "x.mcap").string());
   ASSERT_TRUE(info.ok()) << info.error().message;
-  const log::LogInfo& i = info.value();
+  const mcap_tools::LogInfo& i = info.value();
   EXPECT_TRUE(i.scanned);
   EXPECT_EQ(i.messages, 30u);
   EXPECT_EQ(i.start, 1'000'000'000u);
@@ -82,7 +82,7 @@ TEST(Info, FileWithoutSummaryIsScanned) {
   EXPECT_GT(i.chunks, 3u);
   EXPECT_EQ(i.attachment_count, 1u);
   EXPECT_EQ(i.metadata_count, 1u);
-  const std::string text = log::format_info(i);
+  const std::string text = mcap_tools::format_info(i);
   EXPECT_NE(text.find("scan of the whole file"), std::string::npos) << text;
   EXPECT_NE(text.find("<no schema>"), std::string::npos) << text;
   EXPECT_NE(text.find("notes.txt"), std::string::npos) << text;
@@ -95,7 +95,7 @@ TEST(Info, DamagedFilesAreErrors) {
   const fs::path bad = dir / "bad.mcap";
   auto expect_error = [&](const mcap::Bytes& b, const std::string& needle) {
     write_bytes(bad, b);
-    const auto info = log::info(bad.string());
+    const auto info = mcap_tools::info(bad.string());
     ASSERT_FALSE(info.ok());
     EXPECT_NE(info.error().message.find(needle), std::string::npos) << info.error().message;
   };
@@ -106,7 +106,7 @@ TEST(Info, DamagedFilesAreErrors) {
     mcap::Bytes b = good;
     b[at] ^= 0x01;
     write_bytes(bad, b);
-    EXPECT_FALSE(log::info(bad.string()).ok()) << "flip at " << at;
+    EXPECT_FALSE(mcap_tools::info(bad.string()).ok()) << "flip at " << at;
   }
 }
 

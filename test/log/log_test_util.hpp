@@ -7,8 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "rbsim/log.hpp"
+#include "rbsim/check.hpp"
+#include "rbsim/export.hpp"
+#include "rbsim/golden.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_tools.hpp"
+#include "rbsim/record.hpp"
 
 namespace rbsim::test {
 

@@ -1,4 +1,4 @@
-// log::recover at library level: truncation at many offsets keeps exactly the messages of the
+// mcap_tools::recover at library level: truncation at many offsets keeps exactly the messages of the
 // complete chunks (counted independently, from the original's chunk and message indexes), and
 // the output is a clean, indexed file holding those messages unchanged.
 #include <gtest/gtest.h>
@@ -52,7 +52,7 @@ class RecoverTest : public ::testing::Test {
   }
 
   void check_recovered(std::uint64_t kept) {
-    const auto doc = log::doctor(recovered_.string());
+    const auto doc = mcap_tools::doctor(recovered_.string());
     EXPECT_EQ(doc.errors, 0u) << doc.first_error();
     EXPECT_EQ(doc.warnings, 0u);
     const auto got = all_messages(recovered_);
@@ -76,7 +76,7 @@ class RecoverTest : public ::testing::Test {
 };
 
 TEST_F(RecoverTest, IntactInputIsCopiedWhole) {
-  const auto r = log::recover(original_.string(), recovered_.string());
+  const auto r = mcap_tools::recover(original_.string(), recovered_.string());
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_TRUE(r.value().input_intact);
   EXPECT_EQ(r.value().messages, messages_.size());
@@ -101,7 +101,7 @@ TEST_F(RecoverTest, TruncatedAtManyOffsetsKeepsExactlyTheCompleteChunks) {
     SCOPED_TRACE("cut at " + std::to_string(cut) + " of " + std::to_string(bytes_.size()));
     write_bytes(cut_, mcap::Bytes(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(cut)));
     fs::remove(recovered_);
-    const auto r = log::recover(cut_.string(), recovered_.string());
+    const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
     if (cut < header_end_) {
       ASSERT_FALSE(r.ok());
       EXPECT_FALSE(fs::exists(recovered_));
@@ -126,13 +126,13 @@ TEST_F(RecoverTest, CorruptChunkIsSkippedAndTheRestKept) {
     mcap::Bytes b = bytes_;
     b[(chunks_[k].start + chunks_[k].end) / 2] ^= 0x20;
     write_bytes(cut_, b);
-    const auto r = log::recover(cut_.string(), recovered_.string());
+    const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_FALSE(r.value().input_intact);
     EXPECT_EQ(r.value().corrupt_chunks, 1u);
     EXPECT_EQ(r.value().messages, messages_.size() - chunks_[k].messages);
     EXPECT_EQ(r.value().dropped_messages, 0u);  // channels lost with chunk 0 come back from the summary
-    const auto doc = log::doctor(recovered_.string());
+    const auto doc = mcap_tools::doctor(recovered_.string());
     EXPECT_EQ(doc.errors, 0u) << doc.first_error();
   }
 }
@@ -143,26 +143,26 @@ TEST_F(RecoverTest, ZeroFilledTailStopsReadingThere) {
   mcap::Bytes b(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(c.end + 10));
   b.resize(b.size() + 1'000'000, 0);
   write_bytes(cut_, b);
-  const auto r = log::recover(cut_.string(), recovered_.string());
+  const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_FALSE(r.value().input_intact);
   EXPECT_NE(r.value().problem.find("opcode 0x00"), std::string::npos) << r.value().problem;
   EXPECT_EQ(r.value().messages, expected(c.end).first);
   ASSERT_NO_FATAL_FAILURE(check_recovered(expected(c.end).first));
-  const auto doc = log::doctor(cut_.string());
+  const auto doc = mcap_tools::doctor(cut_.string());
   EXPECT_EQ(doc.errors, 1u);
   EXPECT_NE(doc.first_error().find("zero-filled"), std::string::npos) << doc.first_error();
 }
 
 TEST_F(RecoverTest, RefusesToOverwriteItsInput) {
   const auto size = fs::file_size(original_);
-  auto r = log::recover(original_.string(), original_.string());
+  auto r = mcap_tools::recover(original_.string(), original_.string());
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("must not be the input"), std::string::npos) << r.error().message;
   fs::create_symlink(original_, dir_ / "link.mcap");
-  r = log::recover(original_.string(), (dir_ / "link.mcap").string());
+  r = mcap_tools::recover(original_.string(), (dir_ / "link.mcap").string());
   ASSERT_FALSE(r.ok());
-  r = log::recover(original_.string(), (dir_.path() / "." / "original.mcap").string());
+  r = mcap_tools::recover(original_.string(), (dir_.path() / "." / "original.mcap").string());
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(fs::file_size(original_), size);
   EXPECT_EQ(read_bytes(original_), bytes_);
@@ -171,12 +171,12 @@ TEST_F(RecoverTest, RefusesToOverwriteItsInput) {
 TEST_F(RecoverTest, NothingWrittenForUnreadableInput) {
   for (const mcap::Bytes& b : {mcap::Bytes{}, mcap::Bytes{'h', 'e', 'l', 'l', 'o'}, mcap::Bytes(4096, 0)}) {
     write_bytes(cut_, b);
-    const auto r = log::recover(cut_.string(), recovered_.string());
+    const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
     EXPECT_FALSE(r.ok());
     EXPECT_FALSE(fs::exists(recovered_));
   }
-  EXPECT_FALSE(log::recover((dir_ / "missing.mcap").string(), recovered_.string()).ok());
-  EXPECT_FALSE(log::recover(original_.string(), (dir_ / "no-such-dir" / "x.mcap").string()).ok());
+  EXPECT_FALSE(mcap_tools::recover((dir_ / "missing.mcap").string(), recovered_.string()).ok());
+  EXPECT_FALSE(mcap_tools::recover(original_.string(), (dir_ / "no-such-dir" / "x.mcap").string()).ok());
   for (const auto& e : fs::directory_iterator(dir_.path())) {
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
         << "temporary left behind: " << e.path();
@@ -193,7 +193,7 @@ TEST_F(RecoverTest, RecoveredRecordingExportsItsCompleteSteps) {
   bytes_ = read_bytes(original_);
   write_bytes(
       cut_, mcap::Bytes(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(bytes_.size() * 2 / 3)));
-  ASSERT_TRUE(log::recover(cut_.string(), recovered_.string()).ok());
+  ASSERT_TRUE(mcap_tools::recover(cut_.string(), recovered_.string()).ok());
   log::ExportOptions eo;
   eo.csv = (dir_ / "x.csv").string();
   eo.energy_csv = (dir_ / "x_energy.csv").string();

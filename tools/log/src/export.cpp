@@ -16,8 +16,10 @@
 //    recorded potential and total associate differently, so they are not used).
 #include <charconv>
 
-#include "rbsim/log.hpp"
-#include "tools_util.hpp"
+#include "rbsim/export.hpp"
+#include "rbsim/io.hpp"
+#include "rbsim/mcap_tools.hpp"
+#include "rbsim/msgs.hpp"
 
 namespace rbsim::log {
 
@@ -123,15 +125,11 @@ class Exporter {
     if (options_.csv.empty() && options_.energy_csv.empty()) {
       return Error{"nothing to export: give --csv and/or --energy-csv"};
     }
-    {
-      detail::FileBytes f;
-      if (std::string e = f.open(path_); !e.empty()) return Error{path_ + ": " + e};
-      if (f.size() == 0) return Error{path_ + ": empty file (0 bytes): not an MCAP file"};
-    }
+    if (std::string e = mcap_tools::unreadable(path_); !e.empty()) return Error{path_ + ": " + e};
     mcap::IndexedReader reader;
-    if (mcap::Status s = reader.open(path_); !s.ok()) return Error{path_ + ": " + detail::read_error(s)};
+    if (mcap::Status s = reader.open(path_); !s.ok()) return Error{path_ + ": " + mcap_tools::read_error(s)};
     if (mcap::Status s = reader.verify_data_section_crc(); !s.ok()) {
-      return Error{path_ + ": " + detail::read_error(s)};
+      return Error{path_ + ": " + mcap_tools::read_error(s)};
     }
     // Channels known up front (the summary repeats them): check the topics before reading.
     mcap::ReadMessagesOptions ro;
@@ -161,7 +159,7 @@ class Exporter {
       failure = message(e);
       return static_cast<bool>(failure);
     });
-    if (!read.ok()) return Error{path_ + ": " + detail::read_error(read)};
+    if (!read.ok()) return Error{path_ + ": " + mcap_tools::read_error(read)};
     if (!failure) return failure.error();
     if (Status st = require_topics(); !st) return st.error();
     if (current_) {
@@ -228,7 +226,7 @@ class Exporter {
     const auto& data = e.message.data;
     const std::span<const std::byte> cdr(reinterpret_cast<const std::byte*>(data.data()), data.size());
     const msgs::MessageDecoder& decoder = decoders_.at(e.message.channel_id);
-    const std::string where = "message at log time " + detail::seconds(e.message.log_time) + " s on " +
+    const std::string where = "message at log time " + mcap_tools::seconds(e.message.log_time) + " s on " +
                               (e.channel != nullptr ? e.channel->topic : std::string("?"));
     if (Status st = decoder.decode(cdr, scalars_); !st) return fail(where + ": " + st.error().message);
     switch (role->second) {

@@ -1,7 +1,7 @@
 // Recording a run to MCAP.
 #include <array>
 
-#include "rbsim/log.hpp"
+#include "rbsim/record.hpp"
 
 namespace rbsim::log {
 
@@ -103,30 +103,6 @@ mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpe
   if (!schema_id.ok()) return schema_id.status();
   return writer.add_channel(schema_id.value(), msgs::topic_name(spec, ns), "cdr",
                             {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}});
-}
-
-bool parse_compression(std::string_view name, mcap::Compression& out) {
-  if (name == "zstd") return out = mcap::Compression::Zstd, true;
-  if (name == "lz4") return out = mcap::Compression::Lz4, true;
-  if (name == "none") return out = mcap::Compression::None, true;
-  return false;
-}
-
-std::string check_compression_level(mcap::Compression compression, int level) {
-  const auto range = [level](int lo, int hi, const char* codec) -> std::string {
-    if (level >= lo && level <= hi) return {};
-    return "compression level " + std::to_string(level) + " is outside " + codec + "'s " +
-           std::to_string(lo) + ".." + std::to_string(hi);
-  };
-  switch (compression) {
-    case mcap::Compression::Zstd:
-      return range(-50, 22, "zstd");
-    case mcap::Compression::Lz4:
-      return range(0, 12, "lz4");
-    case mcap::Compression::None:
-      return level == 0 ? std::string() : "a compression level needs --compression zstd or lz4";
-  }
-  return "unknown compression";
 }
 
 std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options) {

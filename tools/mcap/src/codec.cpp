@@ -246,4 +246,28 @@ Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
   return Status::Ok();
 }
 
+bool parse_compression(std::string_view name, Compression& out) {
+  if (name == "zstd") return out = Compression::Zstd, true;
+  if (name == "lz4") return out = Compression::Lz4, true;
+  if (name == "none") return out = Compression::None, true;
+  return false;
+}
+
+std::string check_compression_level(Compression compression, int level) {
+  const auto range = [level](int lo, int hi, const char* codec) -> std::string {
+    if (level >= lo && level <= hi) return {};
+    return "compression level " + std::to_string(level) + " is outside " + codec + "'s " +
+           std::to_string(lo) + ".." + std::to_string(hi);
+  };
+  switch (compression) {
+    case Compression::Zstd:
+      return range(-50, 22, "zstd");
+    case Compression::Lz4:
+      return range(0, 12, "lz4");
+    case Compression::None:
+      return level == 0 ? std::string() : "a compression level needs --compression zstd or lz4";
+  }
+  return "unknown compression";
+}
+
 }  // namespace rbsim::mcap

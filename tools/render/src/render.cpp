@@ -11,7 +11,8 @@
 #include <fstream>
 
 #include "process.hpp"
-#include "rbsim/log.hpp"
+
+#include "rbsim/mcap.hpp"
 #include "rbsim/render.hpp"
 
 extern char** environ;

@@ -237,6 +237,11 @@ std::uint32_t crc32(ByteView data, std::uint32_t crc = 0);
 
 enum class Compression : std::uint8_t { None, Lz4, Zstd };
 std::string_view compression_name(Compression compression);  // "", "lz4", "zstd"
+// Parses a codec's command-line name: "zstd", "lz4", "none".
+bool parse_compression(std::string_view name, Compression& out);
+// Empty when `level` suits the codec: zstd -50..22 (negative: faster, larger), lz4 0..12 (frame
+// compression levels; 3 and up are LZ4-HC), none 0 only. Otherwise what is wrong.
+std::string check_compression_level(Compression compression, int level);
 
 // Decompresses chunk.records into `out`, checking the size against uncompressed_size and, when
 // verify_crc and the chunk has one, the CRC. Never allocates much beyond the real output.

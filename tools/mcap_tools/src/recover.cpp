@@ -12,10 +12,10 @@
 #include <filesystem>
 #include <optional>
 
-#include "rbsim/log.hpp"
+#include "rbsim/mcap_tools.hpp"
 #include "tools_util.hpp"
 
-namespace rbsim::log {
+namespace rbsim::mcap_tools {
 
 namespace {
 
@@ -210,12 +210,12 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   mcap::StreamOptions so;
   so.descend_into_chunks = false;  // chunks are decompressed and checked here, one by one
   so.verify_crcs = true;           // data section, attachment and summary CRCs
-  if (mcap::Status s = reader.open(in, so); !s.ok()) return Error{in + ": " + detail::read_error(s)};
+  if (mcap::Status s = reader.open(in, so); !s.ok()) return Error{in + ": " + read_error(s)};
 
   mcap::RecordEntry entry;
   if (!reader.next(entry) || !std::holds_alternative<mcap::Header>(entry.record)) {
     const mcap::Status& s = reader.status();
-    return Error{in + ": " + (s.ok() ? std::string("no Header record") : detail::read_error(s)) +
+    return Error{in + ": " + (s.ok() ? std::string("no Header record") : read_error(s)) +
                  "; nothing to recover, nothing written"};
   }
   const mcap::Header header = std::get<mcap::Header>(entry.record);
@@ -226,7 +226,10 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     mcap::IndexedReader summary;
     if (summary.open(in).ok() && summary.indexed()) rec.set_fallback(summary.schemas(), summary.channels());
   }
-  mcap::WriterOptions wo = writer_options(options.compression, options.chunk_size);
+  mcap::WriterOptions wo;
+  wo.compression = options.compression;
+  wo.chunk_size = options.chunk_size;
+  wo.background_compression = true;
   wo.profile = header.profile;
   wo.library = header.library;
   if (mcap::Status s = rec.writer().open(temp, wo); !s.ok()) return Error{out + ": " + s.message};
@@ -300,4 +303,4 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   return report;
 }
 
-}  // namespace rbsim::log
+}  // namespace rbsim::mcap_tools

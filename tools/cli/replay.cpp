@@ -4,7 +4,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/replay.hpp"
 
 namespace rbsim::cli {
 

@@ -12,10 +12,10 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "rbsim/log.hpp"
+#include "rbsim/mcap_tools.hpp"
 #include "tools_util.hpp"
 
-namespace rbsim::log {
+namespace rbsim::mcap_tools {
 
 using detail::opcode_name;
 
@@ -910,4 +910,4 @@ DoctorReport doctor(const std::string& path, const DoctorOptions& options) {
   return Doctor(options).run(path);
 }
 
-}  // namespace rbsim::log
+}  // namespace rbsim::mcap_tools

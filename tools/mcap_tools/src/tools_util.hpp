@@ -9,7 +9,7 @@
 
 #include "rbsim/mcap.hpp"
 
-namespace rbsim::log::detail {
+namespace rbsim::mcap_tools::detail {
 
 // Bounded random access to a file: every read is checked against the size found at open.
 class FileBytes {
@@ -38,10 +38,4 @@ inline std::uint64_t le64(const std::uint8_t* p) {
 // "Chunk", "Message", ... for an opcode; "opcode 0x42" for unknown ones.
 std::string opcode_name(std::uint8_t opcode);
 
-// "1.500000000" seconds for a nanosecond timestamp.
-std::string seconds(std::uint64_t ns);
-
-// Hints appended to read errors so users know which tool helps.
-std::string read_error(const mcap::Status& status);
-
-}  // namespace rbsim::log::detail
+}  // namespace rbsim::mcap_tools::detail

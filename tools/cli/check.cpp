@@ -5,7 +5,9 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "rbsim/log.hpp"
+#include "rbsim/check.hpp"
+#include "rbsim/golden.hpp"
+#include "rbsim/scene.hpp"
 
 namespace rbsim::cli {
 
@@ -13,7 +15,7 @@ namespace {
 
 struct CheckArgs {
   std::vector<std::string> files;  // RUN GOLDEN, or SCENE GOLDEN with --verify-golden
-  log::CheckOptions options;
+  check::CheckOptions options;
   bool all_fields = false;
   bool verify_golden = false;
   std::string fosssim_dir;
@@ -33,11 +35,11 @@ std::string g(double v, const char* format = "%.3g") {
   return buf;
 }
 
-void print_table(const log::CheckReport& r, bool all_fields) {
+void print_table(const check::CheckReport& r, bool all_fields) {
   std::size_t topic_w = 5, field_w = 5;
   std::size_t identical = 0;
-  std::vector<const log::FieldStats*> rows;
-  for (const log::FieldStats& f : r.fields) {
+  std::vector<const check::FieldStats*> rows;
+  for (const check::FieldStats& f : r.fields) {
     if (!all_fields && f.max_abs == 0.0 && f.over == 0) {
       ++identical;
       continue;
@@ -51,7 +53,7 @@ void print_table(const log::CheckReport& r, bool all_fields) {
     std::printf("  %-*s  %-*s  %-6s  %10s  %10s  %10s  %12s  %10s\n", static_cast<int>(topic_w), "topic",
                 static_cast<int>(field_w), "field", "kind", "values", "max |diff|", "max rel", "at",
                 "over tol");
-    for (const log::FieldStats* f : rows) {
+    for (const check::FieldStats* f : rows) {
       const std::string at =
           f->max_abs == 0.0 ? "-" : (f->has_step ? "step " : "msg ") + std::to_string(f->step_at_max);
       std::printf("  %-*s  %-*s  %-6s  %10llu  %10s  %10s  %12s  %10llu\n", static_cast<int>(topic_w),
@@ -70,10 +72,10 @@ int compare(const CheckArgs& a) {
   const std::string& run = a.files[0];
   const std::string& golden = a.files[1];
   const auto start = std::chrono::steady_clock::now();
-  Result<log::CheckReport> result = log::check_logs(run, golden, a.options);
+  Result<check::CheckReport> result = check::check_logs(run, golden, a.options);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!result) return fail(result.error().message);
-  const log::CheckReport& r = result.value();
+  const check::CheckReport& r = result.value();
   std::printf("rbsim check: %s vs golden %s (atol %s, rtol %s): %s\n", run.c_str(), golden.c_str(),
               g(a.options.atol, "%g").c_str(), g(a.options.rtol, "%g").c_str(),
               r.passed() ? "MATCH" : "DIVERGED");
@@ -95,11 +97,11 @@ int compare(const CheckArgs& a) {
 int verify(const CheckArgs& a) {
   const std::string& scene = a.files[0];
   const std::string& golden = a.files[1];
-  log::GoldenVerifyOptions o;
+  check::GoldenVerifyOptions o;
   o.fosssim_dir = a.fosssim_dir;
-  Result<log::GoldenVerification> result = log::verify_golden(scene, golden, o);
+  Result<check::GoldenVerification> result = check::verify_golden(scene, golden, o);
   if (!result) return fail(result.error().message);
-  const log::GoldenVerification& v = result.value();
+  const check::GoldenVerification& v = result.value();
   std::printf("rbsim check --verify-golden %s %s: rule %s\n", scene.c_str(), golden.c_str(),
               v.rule.empty() ? "(none applies)" : v.rule.c_str());
   for (const std::string& line : v.lines) std::printf("  %s\n", line.c_str());
@@ -110,7 +112,7 @@ int verify(const CheckArgs& a) {
 int golden_every(const CheckArgs& a) {
   Result<Scene> scene = load_scene(a.golden_every);
   if (!scene) return fail(scene.error().message);
-  std::printf("%lld\n", static_cast<long long>(log::golden_record_every(scene->step_count())));
+  std::printf("%lld\n", static_cast<long long>(check::golden_record_every(scene->step_count())));
   return kMatch;
 }
 

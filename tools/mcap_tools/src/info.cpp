@@ -3,15 +3,15 @@
 #include <cmath>
 #include <cstdio>
 
-#include "rbsim/log.hpp"
+#include "rbsim/mcap_tools.hpp"
 #include "tools_util.hpp"
 
-namespace rbsim::log {
+namespace rbsim::mcap_tools {
 
 namespace {
 
 Error fail(const mcap::Status& s) {
-  return Error{detail::read_error(s)};
+  return Error{read_error(s)};
 }
 
 CompressionStats& stats_for(std::vector<CompressionStats>& v, const std::string& name) {
@@ -175,9 +175,9 @@ std::string format_info(const LogInfo& info) {
   const std::uint64_t span = info.end >= info.start ? info.end - info.start : 0;
   const double duration = static_cast<double>(span) / 1e9;
   if (info.messages > 0) {
-    line("duration:", detail::seconds(span) + " s");
-    line("start:", detail::seconds(info.start) + " s");
-    line("end:", detail::seconds(info.end) + " s");
+    line("duration:", seconds(span) + " s");
+    line("start:", seconds(info.start) + " s");
+    line("end:", seconds(info.end) + " s");
   }
   line("chunks:", std::to_string(info.chunks));
   if (!info.compression.empty()) {
@@ -248,4 +248,4 @@ std::string format_info(const LogInfo& info) {
   return out;
 }
 
-}  // namespace rbsim::log
+}  // namespace rbsim::mcap_tools

@@ -21,10 +21,11 @@
 #include <sstream>
 #include <thread>
 
-#include "check_layout.hpp"
-#include "rbsim/log.hpp"
+#include "layout.hpp"
+#include "rbsim/check.hpp"
+#include "rbsim/mcap.hpp"
 
-namespace rbsim::log {
+namespace rbsim::check {
 
 // ---------------------------------------------------------------------------------------------
 // Layout: the schema parsed by msgs::MessageDecoder's rules, expanded into field groups.
@@ -1288,4 +1289,4 @@ Result<CheckReport> check_logs(const std::string& run_path, const std::string& g
   return c.compare();
 }
 
-}  // namespace rbsim::log
+}  // namespace rbsim::check

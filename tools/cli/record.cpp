@@ -6,8 +6,8 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
-#include "rbsim/log.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/record.hpp"
+#include "rbsim/recorder.hpp"
 
 namespace rbsim::cli {
 
@@ -26,9 +26,9 @@ int fail(const std::string& m) {
 }
 
 int record_command(RecordArgs a) {
-  if (!log::parse_compression(a.compression, a.rec.compression))
+  if (!mcap::parse_compression(a.compression, a.rec.compression))
     return fail("unknown compression " + a.compression);
-  if (const std::string bad = log::check_compression_level(a.rec.compression, a.rec.compression_level);
+  if (const std::string bad = mcap::check_compression_level(a.rec.compression, a.rec.compression_level);
       !bad.empty())
     return fail("--compression-level: " + bad);
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an

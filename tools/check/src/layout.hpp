@@ -11,7 +11,7 @@
 
 #include "rbsim/msgs.hpp"
 
-namespace rbsim::log {
+namespace rbsim::check {
 
 struct FieldGroup {
   std::string path;
@@ -95,4 +95,4 @@ class Layout {
   bool has_step_ = false;
 };
 
-}  // namespace rbsim::log
+}  // namespace rbsim::check

@@ -1,11 +1,14 @@
 #include "tools_util.hpp"
 
+#include "rbsim/mcap_tools.hpp"
+
 #include <sys/stat.h>
 
 #include <cerrno>
 #include <cstring>
 
-namespace rbsim::log::detail {
+namespace rbsim::mcap_tools {
+namespace detail {
 
 std::string FileBytes::open(const std::string& path) {
   struct stat st {};
@@ -38,11 +41,20 @@ std::string opcode_name(std::uint8_t opcode) {
   return buf;
 }
 
+}  // namespace detail
+
 std::string seconds(std::uint64_t ns) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%llu.%09llu", static_cast<unsigned long long>(ns / 1'000'000'000),
                 static_cast<unsigned long long>(ns % 1'000'000'000));
   return buf;
+}
+
+std::string unreadable(const std::string& path) {
+  detail::FileBytes f;
+  if (std::string e = f.open(path); !e.empty()) return e;
+  if (f.size() == 0) return "empty file (0 bytes): not an MCAP file";
+  return {};
 }
 
 std::string read_error(const mcap::Status& status) {
@@ -59,4 +71,4 @@ std::string read_error(const mcap::Status& status) {
   }
 }
 
-}  // namespace rbsim::log::detail
+}  // namespace rbsim::mcap_tools

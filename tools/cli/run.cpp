@@ -7,7 +7,7 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/io.hpp"
-#include "rbsim/log.hpp"
+#include "rbsim/record.hpp"
 #include "rbsim/render.hpp"
 
 namespace rbsim::cli {
@@ -57,9 +57,9 @@ int run(const RunOptions& o) {
     log::RecordOptions ro;
     ro.every = o.record_every;
     ro.ns = o.ns;
-    if (!log::parse_compression(o.compression, ro.compression))
+    if (!mcap::parse_compression(o.compression, ro.compression))
       return fail("unknown compression " + o.compression);
-    if (const std::string bad = log::check_compression_level(ro.compression, o.compression_level);
+    if (const std::string bad = mcap::check_compression_level(ro.compression, o.compression_level);
         !bad.empty())
       return fail("--compression-level: " + bad);
     ro.compression_level = o.compression_level;

@@ -3,7 +3,8 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "rbsim/log.hpp"
+#include "rbsim/export.hpp"
+#include "rbsim/mcap_tools.hpp"
 
 namespace rbsim::cli {
 
@@ -23,18 +24,18 @@ int fail(const char* command, const std::string& message) {
 }
 
 int info_command(const LogOptions& o) {
-  auto info = log::info(o.file);
+  auto info = mcap_tools::info(o.file);
   if (!info) return fail("info", o.file + ": " + info.error().message);
-  std::fputs(log::format_info(info.value()).c_str(), stdout);
+  std::fputs(mcap_tools::format_info(info.value()).c_str(), stdout);
   return 0;
 }
 
 int doctor_command(const LogOptions& o) {
-  log::DoctorOptions options;
+  mcap_tools::DoctorOptions options;
   options.strict_message_order = o.strict_message_order;
   std::printf("Examining %s\n", o.file.c_str());
-  const log::DoctorReport report = log::doctor(o.file, options);
-  for (const log::DoctorFinding& f : report.findings) {
+  const mcap_tools::DoctorReport report = mcap_tools::doctor(o.file, options);
+  for (const mcap_tools::DoctorFinding& f : report.findings) {
     std::printf("%s: %s\n", f.error ? "error" : "warning", f.text.c_str());
   }
   std::printf("%llu errors, %llu warnings\n", static_cast<unsigned long long>(report.errors),
@@ -50,13 +51,13 @@ int doctor_command(const LogOptions& o) {
 }
 
 int recover_command(const LogOptions& o) {
-  log::RecoverOptions options;
-  if (!log::parse_compression(o.compression, options.compression)) {
+  mcap_tools::RecoverOptions options;
+  if (!mcap::parse_compression(o.compression, options.compression)) {
     return fail("recover", "unknown compression " + o.compression);
   }
-  auto report = log::recover(o.file, o.out, options);
+  auto report = mcap_tools::recover(o.file, o.out, options);
   if (!report) return fail("recover", report.error().message);
-  const log::RecoverReport& r = report.value();
+  const mcap_tools::RecoverReport& r = report.value();
   if (!o.quiet) std::fputs(r.summary().c_str(), stdout);
   std::fflush(stdout);
   if (!r.input_intact) {

@@ -10,10 +10,12 @@
 #include <map>
 #include <sstream>
 
-#include "check_layout.hpp"
-#include "rbsim/log.hpp"
+#include "layout.hpp"
+#include "rbsim/golden.hpp"
+#include "rbsim/io.hpp"
+#include "rbsim/mcap.hpp"
 
-namespace rbsim::log {
+namespace rbsim::check {
 
 namespace fs = std::filesystem;
 
@@ -886,4 +888,4 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   return v;
 }
 
-}  // namespace rbsim::log
+}  // namespace rbsim::check

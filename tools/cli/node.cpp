@@ -5,7 +5,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
-#include "rbsim/node.hpp"
+#include "rbsim/dds_sink.hpp"
 
 namespace rbsim::cli {
 

@@ -1,0 +1,50 @@
+// The node: a Sink that publishes every topic of a step over DDS (rbsim node).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rbsim/dds.hpp"
+#include "rbsim/io.hpp"
+
+namespace rbsim::node {
+
+struct NodeOptions {
+  std::uint32_t domain = 0;
+  std::string ns = "rbsim";
+  double rate = 1.0;               // real-time factor; 0: as fast as possible
+  std::int64_t publish_every = 1;  // publish every k-th step
+  std::int32_t keep_last = 0;      // per-step writers keep last N instead of keep all (0)
+};
+// Publishes the scene description at begin() and the per-step topics on every k-th step,
+// pacing steps to wall time by `rate`.
+class DdsSink final : public Sink {
+ public:
+  static Result<std::unique_ptr<DdsSink>> create(const Participant& participant, const NodeOptions& options);
+  Status begin(const Scene& scene, const World& world) override;
+  Status write(const World& world) override;
+  // Waits (bounded) until subscribers acknowledged everything, so nothing in flight is lost
+  // when the node exits.
+  Status finish() override;
+  // Waits until `count` subscriptions match the body-state topic; false when `stop` turned true.
+  bool wait_for_subscribers(std::int32_t count, bool (*stop)());
+  // Restarts the pacing clock (e.g. when --loop starts the scene again).
+  void restart_clock();
+  std::uint64_t published() const { return published_; }
+
+ private:
+  DdsSink() = default;
+  Status publish(msgs::TopicId id, const World& world);
+  NodeOptions options_;
+  std::vector<std::optional<Publisher>> publishers_;  // by TopicId
+  std::unique_ptr<msgs::Encoder> encoder_;
+  msgs::Bytes buffer_;
+  std::int64_t start_ns_ = 0;  // monotonic clock at the paced step
+  std::int64_t start_step_ = 0;
+  std::uint64_t published_ = 0;
+};
+
+}  // namespace rbsim::node

@@ -1,0 +1,85 @@
+// rbsim record: DDS topics into an MCAP recording.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rbsim/dds.hpp"
+#include "rbsim/mcap.hpp"
+
+namespace rbsim::node {
+
+// The recorder: subscribes to rbsim topics and writes the exact CDR payloads to MCAP (rosbag2
+// layout), log_time = receive time, publish_time = the sample's source timestamp (both ns since
+// the Unix epoch). Chunks are flushed as they fill, so a killed recorder leaves a file
+// `rbsim log recover` repairs.
+//
+// Lost messages are what DDS reports lost or rejected plus the gaps the recorder sees in the
+// steps of each per-step topic: every per-step message carries its simulated time (header stamp,
+// or the clock), the scene description gives dt, so each message names its step; the node
+// publishes every k-th step, so within one run of the scene (a --loop restarts it) the steps
+// received on a topic are first, first + k, ..., last, and the ones missing from that sequence
+// were lost, e.g. while a link was down for longer than the DDS lease and the reader was
+// dropped (messages that DDS itself never reports). k is the smallest step difference seen.
+
+struct RecorderOptions {
+  std::string path;
+  std::string ns = "rbsim";
+  std::vector<std::string> topics;  // names ("body_states" or "/rbsim/body_states"); empty: all
+  mcap::Compression compression = mcap::Compression::Zstd;
+  int compression_level = 0;  // 0: the codec's default
+  std::uint64_t chunk_size = 1 << 20;
+  std::uint64_t max_messages = 0;  // 0: no limit
+};
+
+class Recorder {
+ public:
+  static Result<std::unique_ptr<Recorder>> create(const Participant& participant,
+                                                  const RecorderOptions& options);
+  ~Recorder();
+  // Waits up to `timeout_ns` for data and records everything available; true if anything came.
+  Result<bool> poll(std::int64_t timeout_ns);
+  [[nodiscard]] Status close();  // finishes a valid, indexed file
+  std::uint64_t received() const { return received_; }
+  struct TopicCount {
+    std::string topic;
+    std::uint64_t received = 0, lost = 0;  // lost: reported by DDS plus gaps in the steps
+    std::uint64_t duplicates = 0;          // samples delivered again, not recorded twice
+  };
+  std::vector<TopicCount> counts() const;
+
+ private:
+  Recorder() = default;
+  // Steps received on one per-step topic since the scene (re)started, as simulated times in ns
+  // (converted with dt once the scene description is known).
+  struct Gaps {
+    std::int64_t first = -1, last = -1, stride = 0;  // ns; stride: smallest difference seen
+    std::uint64_t count = 0;                         // messages in this run of the scene
+    std::uint64_t lost_before = 0;                   // in earlier runs (--loop)
+    void add(std::int64_t stamp_ns, double dt);
+    std::uint64_t lost(double dt) const;
+  };
+  struct Topic {
+    Subscription subscription;
+    std::uint16_t channel;  // 0 until the first sample: its writer's QoS goes into the channel
+    std::uint32_t received;
+    Gaps gaps;
+    // Per writer, the newest source timestamp recorded. A sample not newer than that is one
+    // delivered again: after a reconnection DDS can resend what a reader already had (seen when
+    // a link came back after the lease expired), and a log must hold each message once.
+    std::vector<std::pair<std::array<std::uint8_t, 16>, std::int64_t>> newest{};
+    std::uint64_t duplicates = 0;
+  };
+  RecorderOptions options_;
+  mcap::Writer writer_;
+  std::int32_t waitset_ = 0;
+  std::vector<Topic> topics_;
+  std::uint64_t received_ = 0;
+  double dt_ = 0.0;  // from the scene description; 0 until it arrives
+};
+
+}  // namespace rbsim::node

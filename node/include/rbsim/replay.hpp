@@ -1,0 +1,71 @@
+// rbsim replay: a recording republished over DDS.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rbsim/dds.hpp"
+
+namespace rbsim::node {
+
+// The replay: an MCAP recording (rbsim run --record or rbsim record) republished over DDS with
+// its recorded timing. Every channel whose schema names one of our types (msgs::topics()) and
+// whose messages are CDR gets a publisher with that topic's QoS; messages go out in log-time
+// order, paced by their log-time differences divided by `rate`.
+
+struct ReplayOptions {
+  std::string path;
+  double rate = 1.0;  // real-time factor on log time; 0: as fast as possible
+  std::vector<std::string>
+      topics;  // recorded names ("/rbsim/body_states") or suffixes ("body_states"); empty: all
+  double start_offset =
+      0.0;             // seconds of log time skipped at the start (the scene description is still sent)
+  bool clock = false;  // publish rosgraph_msgs/Clock on /clock with each message's log time
+                       // (recorded /clock messages are then not replayed)
+  std::optional<std::string> ns;  // republish under /<ns>/<name> instead of the recorded names
+  std::int32_t keep_last = 0;     // per-step writers keep last N instead of keep all (0)
+};
+
+class Replay {
+ public:
+  // Opens the recording and creates the publishers. Errors: unreadable or non-MCAP input, no rbsim
+  // topics in the log, --topics names the log does not have.
+  static Result<std::unique_ptr<Replay>> open(const Participant& participant, const ReplayOptions& options);
+  ~Replay();
+
+  struct Output {
+    std::string
+        recorded;       // channel topic in the log ("/rbsim/body_states"), empty for the synthesized /clock
+    std::string topic;  // topic published
+    std::uint64_t messages = 0;  // messages of the channel in the log (0 when unknown)
+  };
+  const std::vector<Output>& outputs() const { return outputs_; }
+  std::uint64_t first_log_time() const { return first_log_time_; }
+  std::uint64_t last_log_time() const { return last_log_time_; }
+
+  // Waits until `count` subscriptions match the body-state publisher (or, without body states,
+  // the first one); false when `stop` turned true.
+  bool wait_for_subscribers(std::int32_t count, bool (*stop)());
+  // Plays the log once from the start offset; Ok(false) when `stop` turned true on the way.
+  Result<bool> play(bool (*stop)());
+  // Waits (bounded) until the subscribers acknowledged everything published, so nothing in
+  // flight is lost when the replay exits.
+  [[nodiscard]] Status finish(double timeout_s = 30.0);
+  std::uint64_t published() const { return published_; }
+  // Channels left out (not CDR, or a definition that differs from this build's).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  Replay() = default;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::vector<Output> outputs_;
+  std::vector<std::string> warnings_;
+  std::uint64_t first_log_time_ = 0, last_log_time_ = 0;
+  std::uint64_t published_ = 0;
+};
+
+}  // namespace rbsim::node

@@ -1,0 +1,67 @@
+// rbsim check: two recordings compared message by message and field by field (src/check.cpp).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rbsim/core.hpp"
+
+namespace rbsim::check {
+
+struct CheckOptions {
+  double atol = 0.0;  // a float field matches when |actual - expected| <= atol + rtol * |expected|
+  double rtol = 0.0;  // (both 0: bit-exact, right for goldens made by the same binary)
+  std::vector<std::string> topics;          // compare only these topics (empty: every topic)
+  std::vector<std::string> exclude_topics;  // never compare these
+  // Log times differ between a live recording (receive time) and `rbsim run --record` (simulated
+  // time) of the same run; payloads do not.
+  bool compare_log_time = true;
+};
+
+// Where two recordings first differ. `field` is the full path ("bodies[3].x"), or for a message-
+// or topic-level difference a description in parentheses ("(message missing from the run)").
+struct Divergence {
+  std::string topic;
+  bool has_step = false;  // true: `step` is the message's step field; false: message index
+  std::uint64_t step = 0;
+  std::string field;
+  std::string expected, actual, difference;  // golden value, run value, actual - expected
+  bool topic_level = false;                  // the topic itself differs (not one message)
+  std::string line() const;                  // "topic /rbsim/body_states, step 200, field ..."
+};
+
+// Per topic, per field with array indices collapsed ("bodies[].x"): the largest difference.
+struct FieldStats {
+  std::string topic, field;
+  std::string kind;          // "float", "int", "uint", "bool", "string", "length", "bytes", "time"
+  std::uint64_t values = 0;  // values compared
+  std::uint64_t over = 0;    // values outside the tolerance (or unequal, for exact kinds)
+  double max_abs = 0.0;      // max |actual - expected| (1 for an unequal string/bool/bytes)
+  double max_rel = 0.0;      // max |actual - expected| / |expected| (inf when expected is 0)
+  bool has_step = false;
+  std::uint64_t step_at_max = 0;  // step (or message index) of max_abs
+};
+
+struct CheckReport {
+  std::optional<Divergence> first;                // none: the recordings match
+  std::uint64_t diverging_values = 0;             // values outside the tolerance
+  std::uint64_t diverging_messages = 0;           // messages with such a value, plus missing and extra ones
+  std::vector<std::string> topic_problems;        // topic-level differences (only in one file, schema)
+  std::vector<FieldStats> fields;                 // topics by name, then fields in message order
+  std::vector<std::string> topics;                // topics compared
+  std::uint64_t messages = 0;                     // message pairs compared
+  std::uint64_t run_bytes = 0, golden_bytes = 0;  // uncompressed message data read
+  bool passed() const { return !first.has_value(); }
+};
+
+// Compares a recording with a golden one. Messages pair up per topic in file order (rbsim writes
+// every topic in log-time order); a missing or extra message, a topic in only one file, a
+// different schema, log time or any field value outside the tolerance is a divergence. Integers,
+// strings, bools and sequence lengths compare exactly. An Error means the inputs could not be
+// read (not MCAP, truncated, corrupted, bad CDR): a different outcome from a divergence.
+Result<CheckReport> check_logs(const std::string& run_path, const std::string& golden_path,
+                               const CheckOptions& options = {});
+
+}  // namespace rbsim::check

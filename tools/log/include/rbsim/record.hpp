@@ -1,0 +1,39 @@
+// Recording a run: the MCAP sink and the conventions every rbsim recording follows, the rosbag2
+// layout (profile "ros2", "ros2msg" schemas, "cdr" messages, "offered_qos_profiles" channel
+// metadata), so Foxglove and `ros2 bag` open them.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rbsim/io.hpp"
+#include "rbsim/mcap.hpp"
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::log {
+
+struct RecordOptions {
+  mcap::Compression compression = mcap::Compression::Zstd;
+  int compression_level = 0;           // 0: the codec's default (check_compression_level)
+  std::uint64_t chunk_size = 1 << 20;  // uncompressed bytes per chunk
+  std::int64_t every = 1;              // record every k-th step (step 0 always)
+  std::string ns = "rbsim";            // ROS namespace of the topics
+  std::vector<msgs::TopicId> topics;   // empty: every topic
+};
+
+// A Sink that records a run: the scene description once at step 0, then every per-step topic.
+// log_time = publish_time = simulated time in ns, so a recording is deterministic.
+std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options = {});
+
+// Adds the schema and channel of `spec` to a writer in the rosbag2 layout; returns the channel id.
+// The channel's offered_qos_profiles say `offered` (by default what rbsim's node offers).
+mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
+                                      const msgs::OfferedQos& offered);
+mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns);
+// The writer options of every rbsim log (profile "ros2", library "rbsim <version>").
+mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size = 1 << 20,
+                                   int compression_level = 0);
+
+}  // namespace rbsim::log
