@@ -1,0 +1,84 @@
+// The rbsim command line's usage errors: every one exits 2 with one line that starts with the
+// command ("rbsim check: error: ..."), unknown commands are named, and `rbsim help` works.
+#include <gtest/gtest.h>
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "rbsim/subprocess.hpp"
+
+namespace rbsim {
+namespace {
+
+using test::rbsim;
+
+struct UsageCase {
+  std::vector<std::string> args;
+  std::string first_line;  // how stderr must start
+  std::string mentions;    // and something it must say
+};
+
+void PrintTo(const UsageCase& c, std::ostream* os) {
+  *os << "rbsim";
+  for (const std::string& a : c.args) *os << ' ' << a;
+}
+
+class Usage : public ::testing::TestWithParam<UsageCase> {};
+
+TEST_P(Usage, ExitsTwoWithTheCommandAndTheProblem) {
+  const UsageCase& c = GetParam();
+  const test::Outcome o = rbsim(c.args);
+  EXPECT_EQ(o.exit_code, 2) << o;
+  ASSERT_FALSE(o.err_lines().empty()) << o;
+  EXPECT_EQ(o.err_lines()[0].rfind(c.first_line, 0), 0u) << o;
+  EXPECT_NE(o.err.find(c.mentions), std::string::npos) << o;
+  EXPECT_LT(o.err.size(), 400u) << "a usage error is a line or two: " << o;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cli, Usage,
+    ::testing::Values(
+        UsageCase{{}, "rbsim: error: no command given", "run, grade"},
+        UsageCase{{"frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "run, grade"},
+        UsageCase{{"help", "frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "--help"},
+        UsageCase{{"log", "frob"}, "rbsim log: error: unknown command 'frob'", "info, doctor, recover, export"},
+        UsageCase{{"check", "a.mcap", "b.mcap", "--atol", "abc"}, "rbsim check: error:", "--atol"},
+        UsageCase{{"check", "x", "y", "z"}, "rbsim check: error:", "rbsim check --help"},
+        UsageCase{{"run", "scene.xml", "--steps", "-1"}, "rbsim run: error:", "--steps"},
+        UsageCase{{"run", "scene.xml", "--no-such-flag"}, "rbsim run: error:", "--no-such-flag"},
+        UsageCase{{"log", "info"}, "rbsim log info: error:", "file"}));
+
+TEST(Help, HelpCommandShowsTheCommandsHelp) {
+  const test::Outcome o = rbsim({"help", "log", "recover"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_NE(o.out.find("Usage: rbsim log recover"), std::string::npos) << o;
+  EXPECT_NE(o.out.find("Exit status"), std::string::npos) << o;
+}
+
+// Every command states its exit codes in its --help.
+TEST(Help, EveryCommandStatesItsExitStatus) {
+  for (const std::vector<std::string>& command :
+       std::vector<std::vector<std::string>>{{},
+                                             {"run"},
+                                             {"grade"},
+                                             {"render"},
+                                             {"plot"},
+                                             {"node"},
+                                             {"record"},
+                                             {"replay"},
+                                             {"check"},
+                                             {"log", "info"},
+                                             {"log", "doctor"},
+                                             {"log", "recover"},
+                                             {"log", "export"}}) {
+    std::vector<std::string> args = command;
+    args.push_back("--help");
+    const test::Outcome o = rbsim(args);
+    EXPECT_EQ(o.exit_code, 0) << o;
+    EXPECT_NE(o.out.find("Exit status"), std::string::npos) << "rbsim " << testing::PrintToString(command) << o;
+  }
+}
+
+}  // namespace
+}  // namespace rbsim
