@@ -42,7 +42,8 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{}, "rbsim: error: no command given", "run, grade"},
         UsageCase{{"frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "run, grade"},
         UsageCase{{"help", "frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "--help"},
-        UsageCase{{"log", "frob"}, "rbsim log: error: unknown command 'frob'", "info, doctor, recover, export"},
+        UsageCase{
+            {"log", "frob"}, "rbsim log: error: unknown command 'frob'", "info, doctor, recover, export"},
         UsageCase{{"check", "a.mcap", "b.mcap", "--atol", "abc"}, "rbsim check: error:", "--atol"},
         UsageCase{{"check", "x", "y", "z"}, "rbsim check: error:", "rbsim check --help"},
         UsageCase{{"run", "scene.xml", "--steps", "-1"}, "rbsim run: error:", "--steps"},
@@ -58,25 +59,25 @@ TEST(Help, HelpCommandShowsTheCommandsHelp) {
 
 // Every command states its exit codes in its --help.
 TEST(Help, EveryCommandStatesItsExitStatus) {
-  for (const std::vector<std::string>& command :
-       std::vector<std::vector<std::string>>{{},
-                                             {"run"},
-                                             {"grade"},
-                                             {"render"},
-                                             {"plot"},
-                                             {"node"},
-                                             {"record"},
-                                             {"replay"},
-                                             {"check"},
-                                             {"log", "info"},
-                                             {"log", "doctor"},
-                                             {"log", "recover"},
-                                             {"log", "export"}}) {
+  for (const std::vector<std::string>& command : std::vector<std::vector<std::string>>{{},
+                                                                                       {"run"},
+                                                                                       {"grade"},
+                                                                                       {"render"},
+                                                                                       {"plot"},
+                                                                                       {"node"},
+                                                                                       {"record"},
+                                                                                       {"replay"},
+                                                                                       {"check"},
+                                                                                       {"log", "info"},
+                                                                                       {"log", "doctor"},
+                                                                                       {"log", "recover"},
+                                                                                       {"log", "export"}}) {
     std::vector<std::string> args = command;
     args.push_back("--help");
     const test::Outcome o = rbsim(args);
     EXPECT_EQ(o.exit_code, 0) << o;
-    EXPECT_NE(o.out.find("Exit status"), std::string::npos) << "rbsim " << testing::PrintToString(command) << o;
+    EXPECT_NE(o.out.find("Exit status"), std::string::npos)
+        << "rbsim " << testing::PrintToString(command) << o;
   }
 }
 

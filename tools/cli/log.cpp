@@ -60,10 +60,12 @@ int recover_command(const LogOptions& o) {
   const mcap_tools::RecoverReport& r = report.value();
   if (!o.quiet) std::fputs(r.summary().c_str(), stdout);
   std::fflush(stdout);
-  if (!r.input_intact) {
-    return fail("recover", o.file + ": " + r.problem + "; wrote " + o.out + " with the " +
-                               std::to_string(r.messages) + " complete messages (chunks lost: " +
-                               std::to_string(r.incomplete_chunks + r.corrupt_chunks) + ")");
+  if (!r.input_intact) {  // as `mcap recover`: a written output is a success, the damage a warning
+    std::fprintf(
+        stderr,
+        "rbsim log recover: warning: %s: %s; wrote %s with the %llu complete messages (chunks lost: %llu)\n",
+        o.file.c_str(), r.problem.c_str(), o.out.c_str(), static_cast<unsigned long long>(r.messages),
+        static_cast<unsigned long long>(r.incomplete_chunks + r.corrupt_chunks));
   }
   return 0;
 }
@@ -131,9 +133,9 @@ Subcommand add_log_command(CLI::App& parent) {
       "with "
       "its messages; every complete chunk is kept, with the same schema and channel ids, profile and "
       "library.\n"
-      "Exit status: 0 the input was intact (OUT is a copy); 1 the input was damaged (OUT holds every "
-      "complete "
-      "message, the reason is on stderr) or nothing could be recovered (no OUT written).");
+      "Exit status: 0 OUT written (a copy of an intact input, or every complete message of a damaged one, "
+      "with a warning on stderr saying what was lost), 1 nothing could be recovered (no complete message; "
+      "no OUT written) or an error.");
 
   CLI::App* exp = app->add_subcommand(
       "export", "Write the CSV files 'rbsim run --csv / --energy-csv' write, from a recording of the run");

@@ -210,12 +210,13 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   mcap::StreamOptions so;
   so.descend_into_chunks = false;  // chunks are decompressed and checked here, one by one
   so.verify_crcs = true;           // data section, attachment and summary CRCs
-  if (mcap::Status s = reader.open(in, so); !s.ok()) return Error{in + ": " + read_error(s)};
+  if (mcap::Status s = reader.open(in, so); !s.ok())
+    return Error{in + ": " + s.message + "; nothing written"};
 
   mcap::RecordEntry entry;
   if (!reader.next(entry) || !std::holds_alternative<mcap::Header>(entry.record)) {
     const mcap::Status& s = reader.status();
-    return Error{in + ": " + (s.ok() ? std::string("no Header record") : read_error(s)) +
+    return Error{in + ": " + (s.ok() ? std::string("no Header record") : s.message) +
                  "; nothing to recover, nothing written"};
   }
   const mcap::Header header = std::get<mcap::Header>(entry.record);
@@ -285,6 +286,12 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     report.problem = std::to_string(report.corrupt_chunks) + " corrupt chunks";
   }
 
+  // A damaged input with nothing complete in it gives no output (an empty recording would only
+  // pass the damage on under a new name).
+  if (!report.input_intact && report.messages == 0 && report.attachments == 0 && report.metadata == 0) {
+    return abandon("nothing to recover from " + in + " (" + report.problem +
+                   "): it holds no complete message; nothing written");
+  }
   if (mcap::Status s = rec.writer().close(); !s.ok()) {
     std::remove(temp.c_str());
     return Error{out + ": " + s.message};
