@@ -25,8 +25,9 @@ dds_qos_t* make_qos(const QosSpec& q, bool reader) {
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(30));
   dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   // Per-step topics keep all: with keep-last, a writer drops samples a slow reader has not yet
-  // acknowledged once `depth` newer ones exist (measured: 700 of 12,000 lost to a recorder of a
-  // 1,000-body scene); keep-all makes the node wait instead. A reader keeps all it is sent.
+  // acknowledged once `depth` newer ones exist, so a recorder that falls behind loses steps;
+  // keep-all makes the node wait instead (scripts/soak reports losses). A reader keeps all it is
+  // sent.
   if (!q.transient_local && (reader || q.keep_all)) {
     dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
   } else {

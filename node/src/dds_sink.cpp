@@ -1,5 +1,6 @@
 // The node's output: every topic of a step published over DDS, paced to wall time.
 #include <cmath>
+#include <string>
 
 #include "clock.hpp"
 #include "rbsim/dds_sink.hpp"
@@ -7,9 +8,11 @@
 namespace rbsim::node {
 
 Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant, const NodeOptions& options) {
+  if (options.publish_every < 1) {
+    return Error{"publish every " + std::to_string(options.publish_every) + " steps: must be at least 1"};
+  }
   std::unique_ptr<DdsSink> sink(new DdsSink());
   sink->options_ = options;
-  if (sink->options_.publish_every < 1) sink->options_.publish_every = 1;
   sink->publishers_.resize(msgs::kTopicCount);
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns),

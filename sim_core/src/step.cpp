@@ -102,7 +102,7 @@ void World::accumulate_springs() {
   }
 }
 
-// d/dt (X, theta, V, omega) = (V, omega, F / M, tau / I)  (spec 3.4).
+// d/dt (X, theta, V, omega) = (V, omega, F / M, tau / I)  (docs/rigid-body-milestone.md 3.4).
 void World::integrate() {
   const std::int32_t n = body_count();
   const double h = dt_;

@@ -1,4 +1,4 @@
-// Wind (spec 4.8) in closed form.
+// Wind (docs/rigid-body-milestone.md 4.8) in closed form.
 //
 // The spec samples each hull edge i (from vertex a to the next, clockwise) at P points
 // p_k = a + s_k e, s_k = (k + 1/2) / P, and applies at each

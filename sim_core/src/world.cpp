@@ -98,7 +98,7 @@ Result<World> World::create(const WorldDef& def) {
   std::vector<Vec2> local;
   for (std::size_t b = 0; b < n; ++b) {
     const BodyDef& body = def.bodies[b];
-    // M = sum m_i;  X = sum m_i r_i / M;  I = sum m_i |r_i - X|^2  (spec 3.1, 3.3.2)
+    // M = sum m_i;  X = sum m_i r_i / M;  I = sum m_i |r_i - X|^2  (docs/rigid-body-milestone.md 3.1, 3.3.2)
     double m = 0.0;
     Vec2 mx(0.0, 0.0);
     for (std::size_t v = 0; v < body.hull.size(); ++v) {

@@ -1,4 +1,5 @@
-// Total mass, centre of mass and moment of inertia of known shapes (spec 3.1, 3.3.2, 4.1).
+// Total mass, centre of mass and moment of inertia of known shapes
+// (docs/rigid-body-milestone.md 3.1, 3.3.2, 4.1).
 #include <gtest/gtest.h>
 
 #include <cmath>

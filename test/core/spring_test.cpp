@@ -127,7 +127,7 @@ TEST(WorldSpringState, EndpointsLengthAndPotential) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Zero-length springs (spec 4.7 note; spring_force_on_i in step.cpp):
+// Zero-length springs (docs/rigid-body-milestone.md 4.7 note; spring_force_on_i in step.cpp):
 //   l0 = 0:           F = k (rj - ri), zero when the ends meet, never 0/0;
 //   l0 > 0 and l = 0: no force (direction undefined), potential k l0^2 / 2 still counted.
 WorldDef body_on_zero_spring(double l0, Vec2 body_at, Vec2 fixed_at, Vec2 anchor = {0.0, 0.0}) {

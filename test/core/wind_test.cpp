@@ -1,4 +1,5 @@
-// Wind (spec 4.8): the closed form against the spec's sample sum, and its physical behaviour.
+// Wind (docs/rigid-body-milestone.md 4.8): the closed form against the spec's sample sum, and its physical
+// behaviour.
 #include <gtest/gtest.h>
 
 #include <array>

@@ -1,7 +1,7 @@
 // Rebuilds an MCAP conformance input from its expected-output JSON, byte for byte, following
 // foxglove's generator (tests/conformance/scripts/generate-inputs.ts with @mcap/core's
-// McapRecordBuilder and ChunkBuilder). The shared copy of the suite holds Git LFS pointers instead
-// of the binaries; rebuilding and checking the pointer's SHA-256 recovers the official files.
+// McapRecordBuilder and ChunkBuilder). The MCAP repository keeps the suite's .mcap files as Git LFS pointers
+// instead of the binaries; rebuilding and checking the pointer's SHA-256 recovers the official files.
 #pragma once
 
 #include <nlohmann/json.hpp>

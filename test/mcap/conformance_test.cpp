@@ -3,8 +3,8 @@
 // place of each Chunk, no Chunk/MessageIndex entries). The indexed form is derived from it the way
 // foxglove's IndexedReadTestRunner does (tests/conformance/scripts/run-tests/runners/TestRunner.ts).
 //
-// The .mcap files were rebuilt from their JSON (conformance_gen.cpp) because the shared copy holds
-// Git LFS pointers; SHA256SUMS keeps the pointers' oids, and OfficialBytes proves each file is the
+// The .mcap files were rebuilt from their JSON (conformance_gen.cpp) because the MCAP repository keeps
+// them as Git LFS pointers; SHA256SUMS keeps the pointers' oids, and OfficialBytes proves each file is the
 // official one.
 #include <gtest/gtest.h>
 

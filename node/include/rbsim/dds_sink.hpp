@@ -16,7 +16,7 @@ struct NodeOptions {
   std::uint32_t domain = 0;
   std::string ns = "rbsim";
   double rate = 1.0;               // real-time factor; 0: as fast as possible
-  std::int64_t publish_every = 1;  // publish every k-th step
+  std::int64_t publish_every = 1;  // publish every k-th step; create() refuses < 1
   std::int32_t keep_last = 0;      // per-step writers keep last N instead of keep all (0)
 };
 // Publishes the scene description at begin() and the per-step topics on every k-th step,

@@ -112,7 +112,7 @@ struct BodyState {
   double omega = 0.0;
 };
 
-// The graded per-body quantities (spec section 4).
+// The graded per-body quantities (docs/rigid-body-milestone.md section 4).
 struct BodyQuantities {
   Vec2 momentum{0.0, 0.0};  // P = M V
   double l_point = 0.0;     // M (X x V)

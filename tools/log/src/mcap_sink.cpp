@@ -1,5 +1,6 @@
 // Recording a run to MCAP.
 #include <array>
+#include <string>
 
 #include "rbsim/record.hpp"
 
@@ -21,10 +22,12 @@ class McapSink final : public Sink {
     if (options_.topics.empty()) {
       for (const auto& t : msgs::topics()) options_.topics.push_back(t.id);
     }
-    if (options_.every < 1) options_.every = 1;
   }
 
   Status begin(const Scene& scene, const World& world) override {
+    if (options_.every < 1) {
+      return Error{path_ + ": record every " + std::to_string(options_.every) + " steps: must be at least 1"};
+    }
     encoder_ = std::make_unique<msgs::Encoder>(scene);
     if (auto st = writer_.open(
             path_, writer_options(options_.compression, options_.chunk_size, options_.compression_level));

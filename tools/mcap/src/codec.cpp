@@ -32,9 +32,8 @@ Status Compressor::compress(ByteView in, Bytes& out) {
     case Compression::Zstd: {
       if (impl_->zstd == nullptr) return Status::Error(StatusCode::IoError, "out of memory for zstd context");
       out.resize(ZSTD_compressBound(in.size()));
-      // Level 0 is the MCAP C++ library's default for zstd chunks, 1. zstd's own default, 3, took
-      // 1.4x the time on a 1,000-body recording for chunks 30% smaller (and was no smaller on the
-      // goldens).
+      // Level 0 is the MCAP C++ library's default for zstd chunks, 1 (zstd's own default is 3).
+      // scripts/bench-mcap prints what levels 3 and -3 cost and save against it.
       const int level = impl_->level == 0 ? 1 : impl_->level;
       const std::size_t n =
           ZSTD_compressCCtx(impl_->zstd, out.data(), out.size(), in.data(), in.size(), level);

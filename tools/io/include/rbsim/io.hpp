@@ -53,7 +53,7 @@ class Sink {
 std::unique_ptr<Sink> make_csv_sink(std::string path);
 // One row per step: step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L (scene totals).
 std::unique_ptr<Sink> make_energy_csv_sink(std::string path);
-// The FOSSSim reference binary format (see ../shared/fosssim/README.md).
+// The FOSSSim reference binary format (see test/data/fosssim/README.md).
 std::unique_ptr<Sink> make_fosssim_sink(std::string path);
 
 // Appends the shortest decimal that reads back as exactly `v`.

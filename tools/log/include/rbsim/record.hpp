@@ -18,7 +18,7 @@ struct RecordOptions {
   mcap::Compression compression = mcap::Compression::Zstd;
   int compression_level = 0;           // 0: the codec's default (check_compression_level)
   std::uint64_t chunk_size = 1 << 20;  // uncompressed bytes per chunk
-  std::int64_t every = 1;              // record every k-th step (step 0 always)
+  std::int64_t every = 1;              // record every k-th step (step 0 always); begin() refuses < 1
   std::string ns = "rbsim";            // ROS namespace of the topics
   std::vector<msgs::TopicId> topics;   // empty: every topic
 };
