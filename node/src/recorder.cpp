@@ -82,6 +82,7 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
     if (!sub) return sub.error();
     dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
     r->topics_.push_back(Topic{std::move(sub.value()), 0, 0, Gaps{}});
+    if (spec->id == msgs::TopicId::Scene) r->scene_pending_ = true;
   }
   return r;
 }
@@ -112,30 +113,61 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       } else {
         newest->second = sample.source_time_ns;
       }
-      if (t.channel == 0) {  // like rosbag2: the channel says what the (first) publisher offers
-        auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
-        if (!channel.ok()) return Error{options_.path + ": " + channel.status().message};
-        t.channel = channel.value();
-      }
       const std::uint64_t now = wall_ns();
-      const std::uint64_t source =
-          sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : now;
-      if (auto st = writer_.write_message(t.channel, t.received, now, source, view(sample.cdr)); !st.ok()) {
-        return Error{options_.path + ": " + st.message};
-      }
-      ++t.received;
-      ++received_;
-      const msgs::TopicId id = t.subscription.spec().id;
-      if (id == msgs::TopicId::Scene) {
-        if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0)
-          dt_ = scene.value().dt;
-      } else if (const auto stamp = msgs::decode_stamp(id, sample.cdr)) {
-        t.gaps.add(static_cast<std::int64_t>(stamp->sec) * 1'000'000'000 + stamp->nanosec, dt_);
+      const bool is_scene = t.subscription.spec().id == msgs::TopicId::Scene;
+      if (scene_pending_ && !is_scene) {
+        held_.push_back({static_cast<std::size_t>(&t - topics_.data()), std::move(sample), now});
+        ++received_;
+      } else {
+        if (is_scene && scene_pending_) {
+          scene_pending_ = false;
+          const std::uint64_t log_time = held_.empty() ? now : std::min(now, held_.front().log_time);
+          if (Status st = write(t, sample, log_time); !st) return st.error();
+          ++received_;
+          if (Status st = release_held(); !st) return st.error();
+        } else {
+          if (Status st = write(t, sample, now); !st) return st.error();
+          ++received_;
+        }
       }
       if (options_.max_messages > 0 && received_ >= options_.max_messages) return any;
     }
   }
+  // No scene description after kHoldNs: stop waiting for it (the readers find it wherever it is).
+  if (scene_pending_ && !held_.empty() && wall_ns() - held_.front().log_time > kHoldNs) {
+    scene_pending_ = false;
+    if (Status st = release_held(); !st) return st.error();
+  }
   return any;
+}
+
+Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time) {
+  if (t.channel == 0) {  // like rosbag2: the channel says what the (first) publisher offers
+    auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
+    if (!channel.ok()) return Error{options_.path + ": " + channel.status().message};
+    t.channel = channel.value();
+  }
+  const std::uint64_t source =
+      sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : log_time;
+  if (auto st = writer_.write_message(t.channel, t.received, log_time, source, view(sample.cdr)); !st.ok()) {
+    return Error{options_.path + ": " + st.message};
+  }
+  ++t.received;
+  const msgs::TopicId id = t.subscription.spec().id;
+  if (id == msgs::TopicId::Scene) {
+    if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
+  } else if (const auto stamp = msgs::decode_stamp(id, sample.cdr)) {
+    t.gaps.add(static_cast<std::int64_t>(stamp->sec) * 1'000'000'000 + stamp->nanosec, dt_);
+  }
+  return Ok{};
+}
+
+Status Recorder::release_held() {
+  for (Held& h : held_) {
+    if (Status st = write(topics_[h.topic], h.sample, h.log_time); !st) return st;
+  }
+  held_.clear();
+  return Ok{};
 }
 
 std::vector<Recorder::TopicCount> Recorder::counts() const {
@@ -148,6 +180,7 @@ std::vector<Recorder::TopicCount> Recorder::counts() const {
 }
 
 Status Recorder::close() {
+  if (Status st = release_held(); !st) return st;
   if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.message};
   return Ok{};
 }

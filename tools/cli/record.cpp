@@ -6,6 +6,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/outputs.hpp"
 #include "rbsim/record.hpp"
 #include "rbsim/recorder.hpp"
 
@@ -18,6 +19,7 @@ struct RecordArgs {
   std::optional<double> duration;
   std::string compression = "zstd";
   bool quiet = false;
+  bool overwrite = false;
 };
 
 int fail(const std::string& m) {
@@ -34,6 +36,7 @@ int record_command(RecordArgs a) {
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
   // error, leaving a recoverable file, instead of SIGXFSZ killing it.
   std::signal(SIGXFSZ, SIG_IGN);
+  if (Status st = check_outputs({{a.rec.path, "OUT"}}, {}, a.overwrite); !st) return fail(st.error().message);
   auto participant = node::Participant::create(a.domain);
   if (!participant) return fail(participant.error().message);
   auto recorder = node::Recorder::create(participant.value(), a.rec);
@@ -80,6 +83,11 @@ int record_command(RecordArgs a) {
                  static_cast<unsigned long long>(lost), a.rec.path.c_str());
   }
   if (failure) return fail(*failure + " (the file was finished up to that point)");
+  if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
+    std::remove(a.rec.path.c_str());
+    return fail("nothing received on domain " + std::to_string(a.domain) + " under /" + a.rec.ns +
+                "; nothing written (is a node running with the same domain and namespace?)");
+  }
   return 0;
 }
 }  // namespace
@@ -112,12 +120,17 @@ Subcommand add_record_command(CLI::App& parent) {
       ->check(CLI::Range(std::uint64_t{1024}, std::uint64_t{1} << 30))
       ->default_str("1048576");
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
+  app->add_flag("--overwrite", a->overwrite,
+                "Replace OUT if it exists (by default an existing OUT is refused)");
   app->footer(
       "Writes the exact CDR payloads received: log_time = receive time, publish_time = the sample's source "
       "timestamp (ns since the Unix epoch). Ctrl-C or SIGTERM finishes a valid, indexed file and exits 0; a "
       "killed recorder leaves a file that 'rbsim log recover' repairs. Reports received and lost counts: "
       "lost "
-      "is what DDS reports plus the steps missing from each per-step topic's sequence.");
+      "is what DDS reports plus the steps missing from each per-step topic's sequence. The scene description "
+      "is written first, whatever order discovery delivers the topics in.\n"
+      "Exit status: 0 recorded (stopped by Ctrl-C/SIGTERM, --duration or --max-messages), 1 error or nothing "
+      "received (no file left), 2 usage error.");
   return {app, [a] { return record_command(*a); }};
 }
 

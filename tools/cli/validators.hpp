@@ -26,7 +26,11 @@ inline CLI::Validator at_least(double min, bool strict) {
       },
       std::string(strict ? "> " : ">= ") + bound);
 }
-inline CLI::Validator non_negative() { return at_least(0, false); }
-inline CLI::Validator positive() { return at_least(0, true); }
+inline CLI::Validator non_negative() {
+  return at_least(0, false);
+}
+inline CLI::Validator positive() {
+  return at_least(0, true);
+}
 
 }  // namespace rbsim::cli

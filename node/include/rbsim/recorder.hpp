@@ -80,6 +80,21 @@ class Recorder {
   std::vector<Topic> topics_;
   std::uint64_t received_ = 0;
   double dt_ = 0.0;  // from the scene description; 0 until it arrives
+
+  // The scene description is written first, whatever order discovery delivers the topics in:
+  // per-step samples that arrive before it are held (at most kHoldNs of wall time), then written
+  // after it. Its log time is then that of the first held sample, so the file stays in log-time
+  // order.
+  static constexpr std::uint64_t kHoldNs = 3'000'000'000;
+  struct Held {
+    std::size_t topic;
+    Received sample;
+    std::uint64_t log_time;
+  };
+  bool scene_pending_ = false;  // the scene topic is recorded and nothing came on it yet
+  std::vector<Held> held_;
+  [[nodiscard]] Status write(Topic& topic, const Received& sample, std::uint64_t log_time);
+  [[nodiscard]] Status release_held();
 };
 
 }  // namespace rbsim::node
