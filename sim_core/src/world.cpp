@@ -204,6 +204,16 @@ Energy World::energy() const {
   return e;
 }
 
+SceneTotals World::totals() const {
+  SceneTotals t;
+  for (std::int32_t b = 0; b < body_count(); ++b) {
+    const BodyQuantities q = quantities(BodyId{b});
+    t.momentum += q.momentum;
+    t.angular += q.l_point + q.l_spin;
+  }
+  return t;
+}
+
 std::optional<World::NonFinite> World::find_nonfinite() const {
   // v * 0 is 0 for every finite v and NaN for inf or NaN, so one branch-free pass per group
   // decides whether the exact search is needed. Derived quantities (T = M |V|^2 / 2, U, ...) can

@@ -328,5 +328,34 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
   EXPECT_EQ(all.exit_code, 0) << describe(all);
 }
 
+// Every command that simulates a scene runs it through the same driver: a divergence is one
+// message, whichever command meets it (run and node add what their outputs hold).
+TEST(RbsimRun, RenderAndPlotReportADivergenceAsRunDoes) {
+  TempDir dir;
+  std::string text = read_text(kScenes + "/springtests/test00ee.xml");
+  const std::string k = "k=\"";
+  for (std::size_t at = text.find(k); at != std::string::npos; at = text.find(k, at + 1)) {
+    text.replace(at + k.size(), text.find('"', at + k.size()) - (at + k.size()), "1e9");
+  }
+  test::write_text(dir / "stiff.xml", text);
+  const test::Outcome run = rbsim({"run", (dir / "stiff.xml").string(), "-q"});
+  ASSERT_EQ(run.exit_code, 1) << describe(run);
+  const std::string prefix = "rbsim run: error: ";
+  ASSERT_EQ(run.err.rfind(prefix, 0), 0u) << run.err;
+  const auto end = run.err.find(". Outputs hold steps");
+  ASSERT_NE(end, std::string::npos) << run.err;
+  const std::string message = run.err.substr(prefix.size(), end - prefix.size());
+  EXPECT_NE(message.find("is not finite: the simulation diverged"), std::string::npos) << message;
+
+  const test::Outcome render =
+      rbsim({"render", (dir / "stiff.xml").string(), "--out", (dir / "frames").string(), "--size", "64x48"});
+  EXPECT_EQ(render.exit_code, 1) << describe(render);
+  EXPECT_EQ(render.err, "rbsim render: error: " + message + "\n");
+  const test::Outcome plot = rbsim({"plot", (dir / "stiff.xml").string(), "--out", (dir / "p.png").string()});
+  EXPECT_EQ(plot.exit_code, 1) << describe(plot);
+  EXPECT_EQ(plot.err, "rbsim plot: error: " + message + "\n");
+  EXPECT_FALSE(fs::exists(dir / "p.png"));
+}
+
 }  // namespace
 }  // namespace rbsim

@@ -80,12 +80,4 @@ void Progress::finish() {
   enabled_ = false;
 }
 
-std::string describe_divergence(std::int64_t step, std::int32_t body, const char* quantity) {
-  const std::string where = body >= 0 ? "body " + std::to_string(body) + " " : "";
-  return "step " + std::to_string(step) + ": " + where + quantity +
-         " is not finite: the simulation diverged (try a smaller dt or symplectic-euler; --allow-nonfinite "
-         "keeps "
-         "going)";
-}
-
 }  // namespace rbsim::cli

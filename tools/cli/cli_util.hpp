@@ -37,8 +37,4 @@ class Progress {
 
 std::string format_seconds(double seconds);
 
-// "step N: body b x is not finite: the simulation diverged (try a smaller dt ...)" for the first
-// non-finite value World::find_nonfinite() found after step N.
-std::string describe_divergence(std::int64_t step, std::int32_t body, const char* quantity);
-
 }  // namespace rbsim::cli

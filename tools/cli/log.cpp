@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_tools.hpp"
 
@@ -140,10 +141,8 @@ Subcommand add_log_command(CLI::App& parent) {
   CLI::App* exp = app->add_subcommand(
       "export", "Write the CSV files 'rbsim run --csv / --energy-csv' write, from a recording of the run");
   exp->add_option("file", o->file, "MCAP file recorded by rbsim run --record")->required();
-  exp->add_option("--csv", o->csv,
-                  "Per-body CSV: step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin");
-  exp->add_option("--energy-csv", o->energy_csv,
-                  "Scene-wide CSV: step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L");
+  exp->add_option("--csv", o->csv, std::string("Per-body CSV: ") + kBodyCsvColumns);
+  exp->add_option("--energy-csv", o->energy_csv, std::string("Scene-wide CSV: ") + kEnergyCsvColumns);
   exp->add_option("--namespace", o->ns,
                   "ROS namespace of the recording's topics (default: the only one in the file)");
   exp->add_flag("-q,--quiet", o->quiet, "No closing summary line");

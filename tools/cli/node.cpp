@@ -6,6 +6,7 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/dds_sink.hpp"
+#include "rbsim/run.hpp"
 
 namespace rbsim::cli {
 
@@ -48,28 +49,30 @@ int node_command(const NodeArgs& a) {
     if (!a.quiet) std::fprintf(stderr, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
     if (!sink.value()->wait_for_subscribers(a.wait_for, stop_requested)) return 128 + stop_signal();
   }
-  std::int64_t total_steps = 0;
   const auto start = std::chrono::steady_clock::now();
+  Result<Driver> created = Driver::create(scene);
+  if (!created) return fail(created.error().message);
+  Driver& driver = created.value();
+  driver.add(*sink.value());
+  DriverOptions options;
+  options.steps = steps;
+  options.allow_nonfinite = a.allow_nonfinite;
+  options.stop = stop_requested;
   do {
-    Result<World> created = World::create(scene.world);
-    if (!created) return fail(created.error().message);
-    World& world = created.value();
-    if (Status st = sink.value()->begin(scene, world); !st) return fail(st.error().message);
-    while (world.step_index() < steps && !stop_requested()) {
-      world.step();
-      ++total_steps;
-      if (const auto bad = a.allow_nonfinite ? std::nullopt : world.find_nonfinite()) {
-        // Subscribers still get every step before it (bounded wait for their acknowledgements).
-        const Status flushed = sink.value()->finish();
-        return fail(describe_divergence(world.step_index(), bad->body.index, bad->quantity) +
-                    ". Published steps up to " + std::to_string(world.step_index() - 1) +
-                    (flushed ? "." : " (" + flushed.error().message + ")."));
-      }
-      if (Status st = sink.value()->write(world); !st) return fail(st.error().message);
+    if (Status st = driver.begin(); !st) return fail(st.error().message);
+    const Result<PassEnd> end = driver.run(options);
+    if (!end) return fail(end.error().message);
+    if (end.value() == PassEnd::Diverged) {
+      // Subscribers still get every step before it (bounded wait for their acknowledgements).
+      const Status flushed = driver.finish();
+      return fail(describe_divergence(driver.divergence()) + ". Published steps up to " +
+                  std::to_string(driver.world().step_index() - 1) +
+                  (flushed ? "." : " (" + flushed.error().message + ")."));
     }
   } while (a.loop && !stop_requested());
-  if (Status st = sink.value()->finish(); !st) return fail(st.error().message);
+  if (Status st = driver.finish(); !st) return fail(st.error().message);
   if (!a.quiet) {
+    const std::int64_t total_steps = driver.steps_done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published\n",
                  stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),

@@ -6,9 +6,11 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/csv.hpp"
 #include "rbsim/io.hpp"
 #include "rbsim/record.hpp"
 #include "rbsim/render.hpp"
+#include "rbsim/run.hpp"
 
 namespace rbsim::cli {
 
@@ -45,9 +47,9 @@ int run(const RunOptions& o) {
   if (o.duration) steps = steps_for(*o.duration, scene.world.dt);
   if (o.steps) steps = *o.steps;
 
-  Result<World> created = World::create(scene.world);
+  Result<Driver> created = Driver::create(scene);
   if (!created) return fail(scene.path + ": " + created.error().message);
-  World& world = created.value();
+  Driver& driver = created.value();
 
   std::vector<std::unique_ptr<Sink>> sinks;
   if (!o.csv.empty()) sinks.push_back(make_csv_sink(o.csv));
@@ -72,36 +74,29 @@ int run(const RunOptions& o) {
     if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
     sinks.push_back(render::make_frame_sink(o.frames, width, height, o.fps));
   }
-  for (auto& sink : sinks) {
-    if (Status st = sink->begin(scene, world); !st) return fail(st.error().message);
-  }
+  for (auto& sink : sinks) driver.add(*sink);
+  if (Status st = driver.begin(); !st) return fail(st.error().message);
 
   install_stop_handlers();
   Progress progress(steps, o.progress == "always"  ? Progress::Mode::Always
                            : o.progress == "never" ? Progress::Mode::Never
                                                    : Progress::Mode::Auto);
+  DriverOptions options;
+  options.steps = steps;
+  options.allow_nonfinite = o.allow_nonfinite;
+  options.stop = stop_requested;
+  options.progress = [&progress](std::int64_t step) { progress.update(step); };
   const auto start = std::chrono::steady_clock::now();
-  std::optional<std::string> failure;
-  while (world.step_index() < steps && !stop_requested()) {
-    world.step();
-    if (!o.allow_nonfinite) {
-      if (const auto bad = world.find_nonfinite()) {
-        failure = describe_divergence(world.step_index(), bad->body.index, bad->quantity) +
-                  ". Outputs hold steps 0.." + std::to_string(world.step_index() - 1) + ".";
-        break;
-      }
-    }
-    for (auto& sink : sinks) {
-      if (Status st = sink->write(world); !st) return fail(st.error().message);
-    }
-    progress.update(world.step_index());
-  }
+  const Result<PassEnd> end = driver.run(options);
+  if (!end) return fail(end.error().message);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.finish();
-  for (auto& sink : sinks) {
-    if (Status st = sink->finish(); !st) return fail(st.error().message);
+  if (Status st = driver.finish(); !st) return fail(st.error().message);
+  const World& world = driver.world();
+  if (end.value() == PassEnd::Diverged) {
+    return fail(describe_divergence(driver.divergence()) + ". Outputs hold steps 0.." +
+                std::to_string(world.step_index() - 1) + ".");
   }
-  if (failure) return fail(*failure);
 
   const std::int64_t done = world.step_index();
   if (!o.quiet) {
@@ -136,11 +131,10 @@ Subcommand add_run_command(CLI::App& parent) {
       ->check(CLI::NonNegativeNumber)
       ->excludes(steps);
   app->add_option("--csv", o->csv,
-                  "Per-body CSV, one row per body per step from step 0: "
-                  "step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin "
-                  "(shortest round-trip decimals: values read back bit-exact)");
+                  std::string("Per-body CSV, one row per body per step from step 0: ") + kBodyCsvColumns +
+                      " (shortest round-trip decimals: values read back bit-exact)");
   app->add_option("--energy-csv", o->energy_csv,
-                  "Scene-wide CSV, one row per step: step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L");
+                  std::string("Scene-wide CSV, one row per step: ") + kEnergyCsvColumns);
   app->add_option("--fosssim-out", o->fosssim_out,
                   "FOSSSim reference binary output (raw little-endian doubles), comparable byte for byte "
                   "with the reference solver's");

@@ -139,6 +139,13 @@ struct Energy {
   double total() const { return potential() + kinetic(); }
 };
 
+// Scene-wide sums of the per-body quantities: P = sum of M V, L = sum of (L_point + L_spin), both
+// about the world origin.
+struct SceneTotals {
+  Vec2 momentum{0.0, 0.0};
+  double angular = 0.0;
+};
+
 namespace detail {
 // The wind force and torque on a hull are linear in the body-frame relative wind u and in
 // omega; these are their coefficients, summed over the edges once per shape (src/wind.cpp).
@@ -192,6 +199,9 @@ class World {
   // U = gravity + springs, as graded by the reference.
   double potential_energy() const { return energy().potential(); }
   Energy energy() const;
+  // Summed in body order from zero, so every output that carries them (energy CSV, EnergyTerms,
+  // plots) holds the same bits.
+  SceneTotals totals() const;
 
   // Raw state arrays for adapters that copy whole columns.
   std::span<const double> x() const { return x_; }

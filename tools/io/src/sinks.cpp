@@ -1,113 +1,55 @@
 // CSV and FOSSSim-binary outputs of a run.
 #include <bit>
-#include <charconv>
 #include <cstring>
 
+#include "rbsim/csv.hpp"
 #include "rbsim/io.hpp"
 
 namespace rbsim {
 
-void append_double(std::string& out, double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
-  out.append(buf, ec == std::errc() ? end : buf);
-}
-
 namespace {
 
-void append_int(std::string& out, std::int64_t v) {
-  char buf[24];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, ec == std::errc() ? end : buf);
-}
-
-// Text sinks build rows in a reused string and hand it to the file in large writes.
-class TextSink : public Sink {
+// The CSV sinks: one CsvWriter, rows appended after every step.
+class CsvSink : public Sink {
  public:
-  explicit TextSink(std::string path) : path_(std::move(path)) {}
+  CsvSink(std::string path, const char* columns) : path_(std::move(path)), columns_(columns) {}
   Status begin(const Scene&, const World& world) override {
-    if (Status st = file_.open(path_); !st) return st;
-    buffer_.reserve(kFlushAt + 4096);
-    buffer_ = header();
-    buffer_ += '\n';
+    if (Status st = csv_.open(path_, columns_); !st) return st;
     return write(world);
   }
   Status write(const World& world) override {
-    rows(world);
-    if (buffer_.size() >= kFlushAt) return flush();
-    return Ok{};
+    rows(world, csv_.rows());
+    return csv_.flush_if_full();
   }
-  Status finish() override {
-    if (Status st = flush(); !st) return st;
-    return file_.commit();
-  }
-
- protected:
-  virtual std::string header() const = 0;
-  virtual void rows(const World& world) = 0;
-  std::string buffer_;
+  Status finish() override { return csv_.commit(); }
 
  private:
-  static constexpr std::size_t kFlushAt = 1 << 20;
-  Status flush() {
-    Status st = file_.write(buffer_.data(), buffer_.size());
-    buffer_.clear();
-    return st;
-  }
+  virtual void rows(const World& world, std::string& out) const = 0;
   std::string path_;
-  AtomicFile file_;
+  const char* columns_;
+  CsvWriter csv_;
 };
 
-class CsvSink final : public TextSink {
+class BodyCsvSink final : public CsvSink {
  public:
-  using TextSink::TextSink;
+  explicit BodyCsvSink(std::string path) : CsvSink(std::move(path), kBodyCsvColumns) {}
 
  private:
-  std::string header() const override {
-    return "step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin";
-  }
-  void rows(const World& world) override {
+  void rows(const World& world, std::string& out) const override {
     const double t = world.time();
     for (std::int32_t b = 0; b < world.body_count(); ++b) {
-      const BodyState s = world.state(BodyId{b});
-      const BodyQuantities q = world.quantities(BodyId{b});
-      append_int(buffer_, world.step_index());
-      buffer_ += ',';
-      append_double(buffer_, t);
-      buffer_ += ',';
-      append_int(buffer_, b);
-      for (double v : {s.position.x(), s.position.y(), s.theta, s.velocity.x(), s.velocity.y(), s.omega,
-                       q.momentum.x(), q.momentum.y(), q.l_point, q.l_spin, q.t_point, q.t_spin}) {
-        buffer_ += ',';
-        append_double(buffer_, v);
-      }
-      buffer_ += '\n';
+      append_body_row(out, world.step_index(), t, b, world.state(BodyId{b}), world.quantities(BodyId{b}));
     }
   }
 };
 
-class EnergyCsvSink final : public TextSink {
+class EnergyCsvSink final : public CsvSink {
  public:
-  using TextSink::TextSink;
+  explicit EnergyCsvSink(std::string path) : CsvSink(std::move(path), kEnergyCsvColumns) {}
 
  private:
-  std::string header() const override { return "step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L"; }
-  void rows(const World& world) override {
-    const Energy e = world.energy();
-    Vec2 p(0.0, 0.0);
-    double l = 0.0;
-    for (std::int32_t b = 0; b < world.body_count(); ++b) {
-      const BodyQuantities q = world.quantities(BodyId{b});
-      p += q.momentum;
-      l += q.l_point + q.l_spin;
-    }
-    append_int(buffer_, world.step_index());
-    for (double v : {world.time(), e.potential(), e.t_point, e.t_spin, e.kinetic(), e.total(), e.u_gravity,
-                     e.u_spring, p.x(), p.y(), l}) {
-      buffer_ += ',';
-      append_double(buffer_, v);
-    }
-    buffer_ += '\n';
+  void rows(const World& world, std::string& out) const override {
+    append_energy_row(out, world.step_index(), world.time(), world.energy(), world.totals());
   }
 };
 
@@ -172,7 +114,7 @@ class FosssimSink final : public Sink {
 }  // namespace
 
 std::unique_ptr<Sink> make_csv_sink(std::string path) {
-  return std::make_unique<CsvSink>(std::move(path));
+  return std::make_unique<BodyCsvSink>(std::move(path));
 }
 std::unique_ptr<Sink> make_energy_csv_sink(std::string path) {
   return std::make_unique<EnergyCsvSink>(std::move(path));

@@ -14,10 +14,8 @@
 //    World::energy()'s expression (the build never contracts to FMA: -ffp-contract=off);
 //  - U = U_gravity + U_spring, T = T_point + T_spin, E = U + T: Energy's own formulas (the
 //    recorded potential and total associate differently, so they are not used).
-#include <charconv>
-
 #include "rbsim/export.hpp"
-#include "rbsim/io.hpp"
+#include "rbsim/csv.hpp"
 #include "rbsim/mcap_tools.hpp"
 #include "rbsim/msgs.hpp"
 
@@ -81,42 +79,6 @@ constexpr std::string_view kTypes[] = {"rbsim_msgs/msg/SceneDescription", "rbsim
 constexpr msgs::TopicId kTopicIds[] = {msgs::TopicId::Scene, msgs::TopicId::BodyStates,
                                        msgs::TopicId::Energy};
 
-void append_int(std::string& out, std::int64_t v) {
-  char buf[24];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, ec == std::errc() ? end : buf);
-}
-
-class CsvOut {
- public:
-  Status open(const std::string& path, const char* header) {
-    if (path.empty()) return Ok{};
-    active_ = true;
-    if (Status st = file_.open(path); !st) return st;
-    buffer_ = header;
-    buffer_ += '\n';
-    return Ok{};
-  }
-  bool active() const { return active_; }
-  std::string& buffer() { return buffer_; }
-  Status maybe_flush() { return buffer_.size() >= (1u << 20) ? flush() : Status(Ok{}); }
-  Status commit() {
-    if (!active_) return Ok{};
-    if (Status st = flush(); !st) return st;
-    return file_.commit();
-  }
-
- private:
-  Status flush() {
-    Status st = file_.write(buffer_.data(), buffer_.size());
-    buffer_.clear();
-    return st;
-  }
-  bool active_ = false;
-  AtomicFile file_;
-  std::string buffer_;
-};
-
 class Exporter {
  public:
   Exporter(std::string path, const ExportOptions& options) : path_(std::move(path)), options_(options) {}
@@ -144,15 +106,11 @@ class Exporter {
         if (!topic.empty()) ro.topics.push_back(topic);
       }
     }
-    if (Status st =
-            csv_.open(options_.csv, "step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin");
-        !st) {
-      return st.error();
+    if (!options_.csv.empty()) {
+      if (Status st = csv_.open(options_.csv, kBodyCsvColumns); !st) return st.error();
     }
-    if (Status st =
-            energy_.open(options_.energy_csv, "step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L");
-        !st) {
-      return st.error();
+    if (!options_.energy_csv.empty()) {
+      if (Status st = energy_.open(options_.energy_csv, kEnergyCsvColumns); !st) return st.error();
     }
     Status failure = Ok{};
     mcap::Status read = reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
@@ -354,7 +312,7 @@ class Exporter {
     const std::string at = "step " + std::to_string(d.step);
     if (!scene_) return fail(at + ": no SceneDescription message before it");
     const SceneData& s = *scene_;
-    const bool need_states = csv_.active() || (energy_.active() && s.gravity.size() > 1);
+    const bool need_states = csv_.is_open() || (energy_.is_open() && s.gravity.size() > 1);
     if ((need_states && !d.have_states) || !d.have_energy) {
       report_.warnings.push_back(at + ": no " + std::string(d.have_energy ? "BodyStates" : "EnergyTerms") +
                                  " message (recording cut short?): step skipped");
@@ -369,27 +327,17 @@ class Exporter {
     }
     const auto step = static_cast<std::int64_t>(d.step);
     const double t = static_cast<double>(step) * s.dt;  // World::time()
-    if (csv_.active()) {
-      std::string& out = csv_.buffer();
+    if (csv_.is_open()) {
       for (std::size_t b = 0; b < n; ++b) {
-        append_int(out, step);
-        out += ',';
-        append_double(out, t);
-        out += ',';
-        append_int(out, static_cast<std::int64_t>(b));
-        for (int k = 0; k < 6; ++k) {
-          out += ',';
-          append_double(out, d.states[6 * b + k]);
-        }
-        for (int k = 0; k < 6; ++k) {
-          out += ',';
-          append_double(out, d.quantities[6 * b + k]);
-        }
-        out += '\n';
+        const double* v = &d.states[6 * b];
+        const double* q = &d.quantities[6 * b];
+        const BodyState state{{v[0], v[1]}, v[2], {v[3], v[4]}, v[5]};
+        const BodyQuantities quantities{{q[0], q[1]}, q[2], q[3], q[4], q[5]};
+        append_body_row(csv_.rows(), step, t, static_cast<std::int32_t>(b), state, quantities);
       }
-      if (Status st = csv_.maybe_flush(); !st) return st;
+      if (Status st = csv_.flush_if_full(); !st) return st;
     }
-    if (energy_.active()) {
+    if (energy_.is_open()) {
       double u_gravity = 0.0;
       if (s.gravity.size() == 1) {
         u_gravity = d.gravity_u[0];
@@ -407,15 +355,8 @@ class Exporter {
       e.u_spring = u_spring;
       e.t_point = d.t_point;
       e.t_spin = d.t_spin;
-      std::string& out = energy_.buffer();
-      append_int(out, step);
-      for (double v : {t, e.potential(), e.t_point, e.t_spin, e.kinetic(), e.total(), e.u_gravity, e.u_spring,
-                       d.px, d.py, d.l}) {
-        out += ',';
-        append_double(out, v);
-      }
-      out += '\n';
-      if (Status st = energy_.maybe_flush(); !st) return st;
+      append_energy_row(energy_.rows(), step, t, e, SceneTotals{{d.px, d.py}, d.l});
+      if (Status st = energy_.flush_if_full(); !st) return st;
     }
     if (report_.steps == 0) report_.first_step = d.step;
     report_.last_step = d.step;
@@ -434,7 +375,7 @@ class Exporter {
   std::optional<SceneData> scene_;
   std::optional<StepData> current_;
   std::optional<std::uint64_t> last_step_;
-  CsvOut csv_, energy_;
+  CsvWriter csv_, energy_;
 };
 
 }  // namespace

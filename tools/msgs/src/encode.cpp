@@ -132,8 +132,7 @@ void Encoder::energy(const World& world, Bytes& out) const {
   CdrWriter w(out);
   w.header(sim_time(world), kFrame);
   w.u64(static_cast<std::uint64_t>(world.step_index()));
-  Vec2 momentum(0.0, 0.0);
-  double angular = 0.0, t_point = 0.0, t_spin = 0.0;
+  double t_point = 0.0, t_spin = 0.0;
   w.sequence_length(static_cast<std::size_t>(world.body_count()));
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     const BodyQuantities q = world.quantities(BodyId{b});
@@ -143,8 +142,6 @@ void Encoder::energy(const World& world, Bytes& out) const {
     w.f64(q.l_spin);
     w.f64(q.t_point);
     w.f64(q.t_spin);
-    momentum += q.momentum;
-    angular += q.l_point + q.l_spin;
     t_point += q.t_point;
     t_spin += q.t_spin;
   }
@@ -169,8 +166,9 @@ void Encoder::energy(const World& world, Bytes& out) const {
     w.f64(u);
     potential += u;
   }
-  vector2(w, momentum);
-  w.f64(angular);
+  const SceneTotals totals = world.totals();
+  vector2(w, totals.momentum);
+  w.f64(totals.angular);
   w.f64(potential);
   w.f64(t_point);
   w.f64(t_spin);

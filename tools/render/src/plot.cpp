@@ -1,4 +1,5 @@
 // Energy and momentum over time, drawn by gnuplot.
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include "process.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/render.hpp"
+#include "rbsim/run.hpp"
 
 namespace rbsim::render {
 
@@ -18,33 +20,47 @@ struct Sample {
   double t, t_point, t_spin, u, e, px, py, l;
 };
 
+// Samples of step 0, every `every`-th step and step `last`: at most about 8000 in all.
+class SampleSink final : public Sink {
+ public:
+  explicit SampleSink(std::int64_t last) : last_(last), every_(std::max<std::int64_t>(1, last / 4000)) {}
+  Status begin(const Scene&, const World& world) override {
+    samples_.clear();
+    samples_.reserve(static_cast<std::size_t>(last_ / every_ + 2));
+    return write(world);
+  }
+  Status write(const World& w) override {
+    if (w.step_index() % every_ == 0 || w.step_index() == last_) {
+      const Energy e = w.energy();
+      const SceneTotals totals = w.totals();
+      samples_.push_back({w.time(), e.t_point, e.t_spin, e.potential(), e.total(), totals.momentum.x(),
+                          totals.momentum.y(), totals.angular});
+    }
+    return Ok{};
+  }
+  Status finish() override { return Ok{}; }
+  std::vector<Sample>& samples() { return samples_; }
+
+ private:
+  std::int64_t last_, every_;
+  std::vector<Sample> samples_;
+};
+
 Result<std::vector<Sample>> samples_from_scene(const std::string& path, std::optional<double> duration) {
   Result<Scene> scene = load_scene(path);
   if (!scene) return scene.error();
-  Result<World> created = World::create(scene->world);
-  if (!created) return created.error();
-  World& w = created.value();
-  const std::int64_t steps = steps_for(duration.value_or(scene->duration), w.dt());
-  const std::int64_t every = std::max<std::int64_t>(1, steps / 4000);
-  std::vector<Sample> out;
-  while (true) {
-    if (w.step_index() % every == 0 || w.step_index() == steps) {
-      const Energy e = w.energy();
-      Vec2 p(0.0, 0.0);
-      double l = 0.0;
-      for (std::int32_t b = 0; b < w.body_count(); ++b) {
-        const BodyQuantities q = w.quantities(BodyId{b});
-        p += q.momentum;
-        l += q.l_point + q.l_spin;
-      }
-      out.push_back({w.time(), e.t_point, e.t_spin, e.potential(), e.total(), p.x(), p.y(), l});
-    }
-    if (w.step_index() >= steps) break;
-    w.step();
-    if (w.find_nonfinite())
-      return Error{path + ": the simulation diverged at step " + std::to_string(w.step_index())};
-  }
-  return out;
+  Result<Driver> driver = Driver::create(scene.value());
+  if (!driver) return driver.error();
+  DriverOptions options;
+  options.steps = steps_for(duration.value_or(scene->duration), driver->world().dt());
+  SampleSink sink(options.steps);
+  driver->add(sink);
+  if (Status st = driver->begin(); !st) return st.error();
+  const Result<PassEnd> end = driver->run(options);
+  if (!end) return end.error();
+  if (end.value() == PassEnd::Diverged) return Error{describe_divergence(driver->divergence())};
+  if (Status st = driver->finish(); !st) return st.error();
+  return std::move(sink.samples());
 }
 
 // The totals at the end of rbsim_msgs/msg/EnergyTerms, found by name in the file's schema.

@@ -14,6 +14,7 @@
 
 #include "rbsim/mcap.hpp"
 #include "rbsim/render.hpp"
+#include "rbsim/run.hpp"
 
 extern char** environ;
 
@@ -67,13 +68,15 @@ void poses_of(const World& world, std::vector<Pose>& out) {
     out[b] = {world.x()[b], world.y()[b], world.theta()[b]};
 }
 
+// Frames of [0, duration) as the run goes; an infinite duration leaves the length to the run
+// (rbsim run --steps / --duration).
 class FrameSink final : public Sink {
  public:
-  FrameSink(std::string dir, int width, int height, double fps)
-      : frames_(std::move(dir), width, height, fps) {}
+  FrameSink(std::string dir, int width, int height, double fps, double duration = INFINITY)
+      : frames_(std::move(dir), width, height, fps), duration_(duration) {}
   Status begin(const Scene& scene, const World& world) override {
     stage_ = stage_of(scene, world);
-    stage_.duration = INFINITY;  // a run decides its own length (--steps / --duration)
+    stage_.duration = duration_;
     if (Status st = frames_.open(); !st) return st;
     return write(world);
   }
@@ -82,9 +85,11 @@ class FrameSink final : public Sink {
     return frames_.offer(stage_, world.step_index(), world.dt(), poses_);
   }
   Status finish() override { return Ok{}; }
+  std::int64_t frames() const { return frames_.frames(); }
 
  private:
   FrameWriter frames_;
+  double duration_;
   Stage stage_;
   std::vector<Pose> poses_;
 };
@@ -183,25 +188,20 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
   }
   Result<Scene> scene = load_scene(input);
   if (!scene) return scene.error();
-  Result<World> created = World::create(scene->world);
-  if (!created) return created.error();
-  World& world = created.value();
-  Stage stage = stage_of(scene.value(), world);
-  if (o.duration) stage.duration = *o.duration;
-  if (Status st = frames.open(); !st) return st.error();
-  const std::int64_t frames_wanted = frame_count(stage.duration, o.fps);
-  const std::int64_t last_step = frame_step(frames_wanted - 1, o.fps, world.dt());
-  while (true) {
-    poses_of(world, poses);
-    if (Status st = frames.offer(stage, world.step_index(), world.dt(), poses); !st) return st.error();
-    if (world.step_index() >= last_step) break;
-    world.step();
-    if (const auto bad = world.find_nonfinite()) {
-      return Error{"step " + std::to_string(world.step_index()) + ": " + bad->quantity +
-                   " is not finite: the simulation diverged"};
-    }
-  }
-  return frames.frames();
+  Result<Driver> driver = Driver::create(scene.value());
+  if (!driver) return driver.error();
+  const double duration = o.duration.value_or(scene->duration);
+  FrameSink sink(o.out_dir, o.width, o.height, o.fps, duration);
+  driver->add(sink);
+  if (Status st = driver->begin(); !st) return st.error();
+  DriverOptions options;
+  options.steps =
+      frame_step(frame_count(duration, o.fps) - 1, o.fps, driver->world().dt());  // the last frame's
+  const Result<PassEnd> end = driver->run(options);
+  if (!end) return end.error();
+  if (end.value() == PassEnd::Diverged) return Error{describe_divergence(driver->divergence())};
+  if (Status st = driver->finish(); !st) return st.error();
+  return sink.frames();
 }
 
 Status make_movie(const std::string& frames_dir, double fps, const std::string& mp4) {

@@ -48,16 +48,13 @@ class Sink {
   [[nodiscard]] virtual Status finish() = 0;
 };
 
-// One row per body per step: step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin
-// with every value printed in shortest round-trip form (reads back bit-exact).
+// One row per body per step, columns kBodyCsvColumns (rbsim/csv.hpp), every value printed in
+// shortest round-trip form (reads back bit-exact).
 std::unique_ptr<Sink> make_csv_sink(std::string path);
-// One row per step: step,t,U,T_point,T_spin,T,E,U_gravity,U_spring,px,py,L (scene totals).
+// One row per step, columns kEnergyCsvColumns: energies and scene totals.
 std::unique_ptr<Sink> make_energy_csv_sink(std::string path);
 // The FOSSSim reference binary format (see test/data/fosssim/README.md).
 std::unique_ptr<Sink> make_fosssim_sink(std::string path);
-
-// Appends the shortest decimal that reads back as exactly `v`.
-void append_double(std::string& out, double v);
 
 // ---------------------------------------------------------------------------------------------
 // FOSSSim reference output: raw little-endian doubles, per step the state then the quantities.

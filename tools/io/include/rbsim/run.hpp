@@ -1,0 +1,77 @@
+// The run driver: a scene stepped in a World whose state fans out to sinks after every step.
+// rbsim run, node, render and plot all simulate through it, so they stop, report progress and
+// report a divergence the same way, and any Sink works under any of them.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rbsim/core.hpp"
+#include "rbsim/io.hpp"
+#include "rbsim/scene.hpp"
+
+namespace rbsim {
+
+// The first non-finite value World::find_nonfinite() found, after step `step`.
+struct Divergence {
+  std::int64_t step = 0;
+  std::int32_t body = -1;  // -1 for a scene-wide quantity
+  const char* quantity = "";
+};
+// "step N: body b x is not finite: the simulation diverged (try a smaller dt ...)": the one
+// message every command gives; a command may append what its outputs hold.
+std::string describe_divergence(const Divergence& divergence);
+
+struct DriverOptions {
+  std::int64_t steps = 0;        // a pass runs from step 0 to step `steps`
+  bool allow_nonfinite = false;  // keep stepping and writing through inf/NaN
+  // Polled before every step; true ends the pass early (PassEnd::Stopped, not an error). Must be
+  // safe to call from the step loop (e.g. read a flag a signal handler raised).
+  bool (*stop)() = nullptr;
+  // Called after every step's writes with the step index; must not block.
+  std::function<void(std::int64_t)> progress;
+};
+
+enum class PassEnd { Done, Stopped, Diverged };
+
+// Drives passes over one scene: begin() then run() for each pass (rbsim node --loop makes
+// several), finish() once at the end. The step loop itself does not allocate; sinks may.
+class Driver {
+ public:
+  // Makes the World of `scene` (the error is World::create's). The scene, and the sinks added,
+  // must outlive the driver.
+  static Result<Driver> create(const Scene& scene);
+
+  // Sinks get begin/write/finish in the order added.
+  void add(Sink& sink) { sinks_.push_back(&sink); }
+
+  // Starts a pass at step 0: a new World (the first pass uses the one create() made), then
+  // begin() on every sink. The first sink error is returned.
+  [[nodiscard]] Status begin();
+  // Steps until options.steps, a stop request or a divergence; after every step the state is
+  // checked (unless allow_nonfinite), written to every sink and reported to progress. A diverged
+  // step is not written. A sink error ends the pass at once and is returned: the sinks are then
+  // not finished (their unfinished outputs are discarded when they are destroyed).
+  [[nodiscard]] Result<PassEnd> run(const DriverOptions& options);
+  // finish() on every sink in order, stopping at the first error. Also after a stop or a
+  // divergence: every output then holds the steps written so far.
+  [[nodiscard]] Status finish();
+
+  const World& world() const { return *world_; }
+  std::int64_t steps_done() const { return steps_done_; }       // over all passes
+  const Divergence& divergence() const { return divergence_; }  // after PassEnd::Diverged
+
+ private:
+  Driver(const Scene& scene, World world);
+  const Scene* scene_;
+  std::optional<World> world_;
+  bool fresh_ = true;  // world_ is at step 0 and no pass has begun with it
+  std::vector<Sink*> sinks_;
+  std::int64_t steps_done_ = 0;
+  Divergence divergence_;
+};
+
+}  // namespace rbsim

@@ -1,0 +1,61 @@
+// The run driver shared by rbsim run, node, render and plot.
+#include "rbsim/run.hpp"
+
+namespace rbsim {
+
+std::string describe_divergence(const Divergence& d) {
+  const std::string where = d.body >= 0 ? "body " + std::to_string(d.body) + " " : "";
+  return "step " + std::to_string(d.step) + ": " + where + d.quantity +
+         " is not finite: the simulation diverged (try a smaller dt or symplectic-euler; --allow-nonfinite "
+         "keeps going)";
+}
+
+Driver::Driver(const Scene& scene, World world) : scene_(&scene), world_(std::move(world)) {}
+
+Result<Driver> Driver::create(const Scene& scene) {
+  Result<World> created = World::create(scene.world);
+  if (!created) return created.error();
+  return Driver(scene, std::move(created.value()));
+}
+
+Status Driver::begin() {
+  if (!fresh_) {
+    Result<World> created = World::create(scene_->world);
+    if (!created) return created.error();
+    world_.emplace(std::move(created.value()));
+  }
+  fresh_ = false;
+  for (Sink* sink : sinks_) {
+    if (Status st = sink->begin(*scene_, *world_); !st) return st;
+  }
+  return Ok{};
+}
+
+Result<PassEnd> Driver::run(const DriverOptions& options) {
+  World& world = *world_;
+  while (world.step_index() < options.steps) {
+    if (options.stop != nullptr && options.stop()) return PassEnd::Stopped;
+    world.step();
+    ++steps_done_;
+    if (!options.allow_nonfinite) {
+      if (const auto bad = world.find_nonfinite()) {
+        divergence_ = {world.step_index(), bad->body.index, bad->quantity};
+        return PassEnd::Diverged;
+      }
+    }
+    for (Sink* sink : sinks_) {
+      if (Status st = sink->write(world); !st) return st.error();
+    }
+    if (options.progress) options.progress(world.step_index());
+  }
+  return PassEnd::Done;
+}
+
+Status Driver::finish() {
+  for (Sink* sink : sinks_) {
+    if (Status st = sink->finish(); !st) return st;
+  }
+  return Ok{};
+}
+
+}  // namespace rbsim
