@@ -3,9 +3,13 @@
 #include <dds/ddsi/ddsi_serdata.h>
 #include <dds/ddsi/ddsi_sertype.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 
 #include "raw_serdata.hpp"
 #include "rbsim/dds.hpp"
@@ -65,28 +69,33 @@ std::string_view loopback_config() {
 }
 
 Result<Participant> Participant::create(std::uint32_t domain) {
-  if (domain > kMaxDomainId) {
-    return Error{"domain id " + std::to_string(domain) + " out of range [0, " + std::to_string(kMaxDomainId) +
-                 "]"};
+  const RosEnvironment env = RosEnvironment::from_process();
+  auto settings = resolve_dds_settings(
+      env, domain == kDomainFromEnvironment ? std::nullopt : std::optional<std::uint32_t>(domain), getpid());
+  if (!settings) return settings.error();
+  const DdsSettings& s = settings.value();
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "rbsim: warning: %s\n", w.c_str());
+  if (s.config) {
+    // dds_create_domain fails harmlessly when the domain already exists in this process.
+    const dds_entity_t d = dds_create_domain(s.domain, s.config->c_str());
+    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) {
+      return dds_error("cannot create DDS " + s.describe(), d);
+    }
   }
-  const char* uri = std::getenv("CYCLONEDDS_URI");
-  if (uri == nullptr || *uri == '\0') {
-    // No configuration given: rbsim's loopback one. dds_create_domain fails harmlessly when the
-    // domain already exists in this process.
-    const std::string config(loopback_config());
-    const dds_entity_t d = dds_create_domain(domain, config.c_str());
-    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) return dds_error("cannot create DDS domain", d);
-  }
-  const dds_entity_t p = dds_create_participant(domain, nullptr, nullptr);
+  // Otherwise Cyclone configures the domain itself: from CYCLONEDDS_URI, or its defaults.
+  const dds_entity_t p = dds_create_participant(s.domain, nullptr, nullptr);
   if (p < 0) {
-    std::string hint =
-        uri != nullptr && *uri != '\0' ? std::string(" (check CYCLONEDDS_URI=") + uri + ")" : "";
-    return dds_error("cannot create a DDS participant on domain " + std::to_string(domain) + hint, p);
+    const std::string where =
+        s.from_cyclonedds_uri
+            ? "domain " + std::to_string(s.domain) + " (check CYCLONEDDS_URI=" + *env.cyclonedds_uri + ")"
+            : s.describe();
+    return dds_error("cannot create a DDS participant on " + where, p);
   }
-  return Participant(p, domain);
+  return Participant(p, s.domain, s.describe());
 }
 
-Participant::Participant(Participant&& o) noexcept : handle_(o.handle_), domain_(o.domain_) {
+Participant::Participant(Participant&& o) noexcept
+    : handle_(o.handle_), domain_(o.domain_), description_(std::move(o.description_)) {
   o.handle_ = 0;
 }
 Participant::~Participant() {

@@ -8,7 +8,8 @@ between two network namespaces the test creates).
 Every case uses its own DDS domain id (one of 200..232 no other running case holds: a flock
 registry in the temp directory) and its own ROS namespace (e2e_<case>_<pid>), so parallel runs,
 also from other build trees, do not cross. rbsim
-processes run with CYCLONEDDS_URI removed (the compiled-in loopback configuration) unless a case
+processes run with CYCLONEDDS_URI and ROS 2's ROS_DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE,
+ROS_STATIC_PEERS and ROS_LOCALHOST_ONLY removed (the compiled-in loopback configuration) unless a case
 sets it to node/config/cyclonedds-loopback.xml or, in the netns case, to a configuration bound to
 the veth addresses inside the namespaces. Every wait is bounded in time; every process started
 is killed at the end (and, through PR_SET_PDEATHSIG, if this driver dies); namespaces are
@@ -178,7 +179,9 @@ class Ctx:
     def env(self, uri=None):
         env = dict(os.environ)
         env.pop("CYCLONEDDS_URI", None)  # the compiled-in loopback configuration
-        env.pop("ROS_DOMAIN_ID", None)
+        # rbsim honours ROS 2's variables: none of a developer's settings (SUBNET...) gets in.
+        for name in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY"):
+            env.pop(name, None)
         if uri:
             env["CYCLONEDDS_URI"] = uri
         return env
@@ -1053,6 +1056,87 @@ def case_netns_link_flap(ctx):
     return 0
 
 
+def case_ros_env(ctx):
+    """ROS 2's environment variables, on loopback only: ROS_DOMAIN_ID alone puts a node and a
+    recorder on the same domain (the recorder gets everything), --domain wins over it, a recorder
+    on domain 0 or with ROS_AUTOMATIC_DISCOVERY_RANGE=OFF gets nothing; invalid values are
+    one-line errors naming the variable."""
+    scene = ctx.scene("cantilever.xml")
+    every = 10
+    run = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--record", run, "--record-every", every, "--namespace", ctx.ns)
+    want = Log(run)
+    steps = max(step_of(p) for p in want.by_suffix()["body_states"])
+    expected = 1 + 6 * (steps // every + 1)
+    d = str(ctx.domain)
+    on_d = dict(ctx.env(), ROS_DOMAIN_ID=d)
+    # No --domain: ROS_DOMAIN_ID decides.
+    rec_env = ctx.rb("record-env", "record", ctx.path("env.mcap"), "--namespace", ctx.ns,
+                     "--max-messages", expected, "--duration", 60, env=on_d)
+    # --domain wins over ROS_DOMAIN_ID; LOCALHOST with a static peer on this host.
+    rec_flag = ctx.rb("record-flag", "record", ctx.path("flag.mcap"), "--domain", d, "--namespace", ctx.ns,
+                      "--max-messages", expected, "--duration", 60,
+                      env=dict(ctx.env(), ROS_DOMAIN_ID="0", ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+                               ROS_STATIC_PEERS="localhost"))
+    # Must see nothing: domain 0 (nothing set), and the node's domain with discovery OFF.
+    rec_zero = ctx.rb("record-zero", "record", ctx.path("zero.mcap"), "--namespace", ctx.ns, "--duration", 60)
+    rec_off = ctx.rb("record-off", "record", ctx.path("off.mcap"), "--namespace", ctx.ns, "--duration", 60,
+                     env=dict(on_d, ROS_AUTOMATIC_DISCOVERY_RANGE="OFF"))
+    for p in (rec_env, rec_flag, rec_zero, rec_off):
+        p.wait_for_text("rbsim record: recording", 20, stream="stderr")
+    node = ctx.rb("node-env", "node", scene, "--namespace", ctx.ns, "--rate", 0, "--publish-every", every,
+                  "--wait-for-subscribers", 2, env=on_d)
+    exited_ok(ctx, node, 70)
+    exited_ok(ctx, rec_env, 70)
+    exited_ok(ctx, rec_flag, 70)
+    time.sleep(1.0)  # what the others would have received by now had they matched
+    for p in (rec_zero, rec_off):
+        p.signal(signal.SIGINT)
+        p.wait(30)
+    ctx.check(f"on domain {d}," in node.stderr(), f"the node does not say it runs on domain {d}:\n{node.stderr()}")
+    ctx.check(f"on domain {d} (LOCALHOST)" in rec_env.stderr(),
+              f"record-env does not say domain {d} (LOCALHOST):\n{rec_env.stderr()}")
+    ctx.check(f"on domain {d} (LOCALHOST, static peers localhost)" in rec_flag.stderr(),
+              f"record-flag does not say domain {d} with its static peer:\n{rec_flag.stderr()}")
+    ctx.check("on domain 0 (LOCALHOST)" in rec_zero.stderr(), f"record-zero is not on domain 0:\n{rec_zero.stderr()}")
+    ctx.check(f"on domain {d} (OFF)" in rec_off.stderr(), f"record-off is not OFF:\n{rec_off.stderr()}")
+    for p, name in ((rec_env, "env.mcap"), (rec_flag, "flag.mcap")):
+        ctx.check(counts_line(p) == (expected, 0),
+                  f"{p.name} reports {counts_line(p)} (received, lost), want ({expected}, 0)\n{p.output()}")
+        same_payloads(ctx, Log(ctx.path(name)), want, f"{name} vs rbsim run --record")
+    for p, name in ((rec_zero, "zero.mcap"), (rec_off, "off.mcap")):
+        got = counts_line(p)
+        if got is None and os.path.exists(ctx.path(name)):
+            got = (len(Log(ctx.path(name)).messages), 0)
+        ctx.check(got in (None, (0, 0)), f"{p.name} received {got} (received, lost), want nothing\n{p.output()}")
+        # A recorder that received nothing says so, exits 1 and leaves no file.
+        ctx.check(p.rc == 1 and "nothing received" in p.stderr() and not os.path.exists(ctx.path(name)),
+                  f"{p.name}: want exit 1, 'nothing received' and no {name}\n{p.output()}")
+
+    # Invalid values: an error exit and one line naming the variable, before any DDS traffic.
+    x = ctx.path("run.mcap")
+    bad = [
+        ("record", ("record", ctx.path("bad1.mcap")), {"ROS_DOMAIN_ID": "abc"},
+         "ROS_DOMAIN_ID='abc' is not a DDS domain id"),
+        ("node", ("node", scene), {"ROS_DOMAIN_ID": "233"}, "ROS_DOMAIN_ID='233': domain id 233 out of range"),
+        ("replay", ("replay", x), {"ROS_AUTOMATIC_DISCOVERY_RANGE": "EVERYWHERE"},
+         "ROS_AUTOMATIC_DISCOVERY_RANGE='EVERYWHERE' is not a discovery range"),
+        ("node", ("node", scene, "--domain", d), {"ROS_LOCALHOST_ONLY": "yes"}, "ROS_LOCALHOST_ONLY='yes'"),
+        ("record", ("record", ctx.path("bad2.mcap"), "--domain", d), {"ROS_STATIC_PEERS": "a b"},
+         "ROS_STATIC_PEERS: 'a b' is not a host name"),
+    ]
+    for i, (cmd, args, extra, text) in enumerate(bad):
+        rc, out, err = ctx.rbrun(f"bad-env-{i}", *args, env=dict(ctx.env(), **extra), ok=False, timeout=30)
+        lines = err.strip().splitlines()
+        ctx.check(rc == 1, f"{extra}: exit {rc}, want 1\n{out}{err}")
+        ctx.check(len(lines) == 1 and lines[0].startswith(f"rbsim {cmd}: error: ") and text in lines[0],
+                  f"{extra}: want one line 'rbsim {cmd}: error: ...{text}...', got:\n{err}")
+    # --domain wins over an invalid ROS_DOMAIN_ID too (rcl reads it only when no domain is given).
+    rc, out, err = ctx.rbrun("domain-wins", "replay", x, "--domain", d, "--rate", 0, "-q",
+                             env=dict(ctx.env(), ROS_DOMAIN_ID="abc"), ok=False, timeout=30)
+    ctx.check(rc == 0, f"replay --domain {d} with ROS_DOMAIN_ID=abc: exit {rc}\n{out}{err}")
+
+
 # --- bad input and faults --------------------------------------------------------------------
 
 
@@ -1265,6 +1349,7 @@ CASES = {
     "netns": case_netns,
     "netns_link_flap": case_netns_link_flap,
     "bad_input": case_bad_input,
+    "ros_env": case_ros_env,
     "record_disk_full": case_record_disk_full,
     "record_sigkill": case_record_sigkill,
     "soak": case_soak,

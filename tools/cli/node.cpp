@@ -95,7 +95,7 @@ Subcommand add_node_command(CLI::App& parent) {
   app->add_option("--publish-every", a->node.publish_every, "Publish every k-th step")
       ->check(CLI::PositiveNumber)
       ->default_str("1");
-  app->add_option("--domain", a->node.domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
+  add_domain_option(app, a->node.domain);
   app->add_option("--namespace", a->node.ns, "ROS namespace: topics are /<namespace>/<name>")
       ->default_str("rbsim");
   app->add_option("--duration", a->duration, "Simulated seconds per run (default: the scene's)")

@@ -6,6 +6,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/dds.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/record.hpp"
 #include "rbsim/recorder.hpp"
@@ -15,7 +16,7 @@ namespace rbsim::cli {
 namespace {
 struct RecordArgs {
   node::RecorderOptions rec;
-  std::uint32_t domain = 0;
+  std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   std::optional<double> duration;
   std::string compression = "zstd";
   bool quiet = false;
@@ -43,9 +44,9 @@ int record_command(RecordArgs a) {
   if (!recorder) return fail(recorder.error().message);
   install_stop_handlers();
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim record: recording %s topics under /%s on domain %u to %s (Ctrl-C to stop)\n",
-                 a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(), a.domain,
-                 a.rec.path.c_str());
+    std::fprintf(stderr, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",
+                 a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(),
+                 participant.value().description().c_str(), a.rec.path.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = a.duration ? start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -85,7 +86,7 @@ int record_command(RecordArgs a) {
   if (failure) return fail(*failure + " (the file was finished up to that point)");
   if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
     std::remove(a.rec.path.c_str());
-    return fail("nothing received on domain " + std::to_string(a.domain) + " under /" + a.rec.ns +
+    return fail("nothing received on " + participant.value().description() + " under /" + a.rec.ns +
                 "; nothing written (is a node running with the same domain and namespace?)");
   }
   return 0;
@@ -102,7 +103,7 @@ Subcommand add_record_command(CLI::App& parent) {
          "Topics to record, comma-separated or repeated (body_states or /rbsim/body_states); default all")
       ->delimiter(',')
       ->allow_extra_args(false);
-  app->add_option("--domain", a->domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
+  add_domain_option(app, a->domain);
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")->default_str("rbsim");
   app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")
       ->check(CLI::PositiveNumber);
@@ -132,6 +133,36 @@ Subcommand add_record_command(CLI::App& parent) {
       "Exit status: 0 recorded (stopped by Ctrl-C/SIGTERM, --duration or --max-messages), 1 error or nothing "
       "received (no file left), 2 usage error.");
   return {app, [a] { return record_command(*a); }};
+}
+
+namespace {
+constexpr const char* kDdsEnvironmentHelp =
+    "DDS environment, as for ROS 2 with rmw_cyclonedds_cpp: ROS_DOMAIN_ID is the domain when --domain is "
+    "not given (else 0). ROS_AUTOMATIC_DISCOVERY_RANGE: LOCALHOST (default: rbsim's loopback "
+    "configuration, 127.0.0.1 only, no multicast), SUBNET (Cyclone's network interface, multicast), "
+    "OFF (no other process) or SYSTEM_DEFAULT (Cyclone's defaults). ROS_STATIC_PEERS=host;host adds "
+    "unicast discovery peers (LOCALHOST, SUBNET). ROS_LOCALHOST_ONLY=1 (deprecated) means LOCALHOST and "
+    "wins over both. CYCLONEDDS_URI, when set, configures everything but the domain id. An invalid value "
+    "is an error naming the variable.";
+}  // namespace
+
+CLI::Option* add_domain_option(CLI::App* app, std::uint32_t& domain) {
+  auto from_env = node::domain_from_environment(node::RosEnvironment::from_process());
+  std::string shown = "0";
+  if (!from_env) {
+    domain = node::kDomainFromEnvironment;
+    shown = "invalid ROS_DOMAIN_ID";
+  } else if (from_env.value()) {
+    domain = *from_env.value();
+    shown = std::to_string(domain) + ", from ROS_DOMAIN_ID";
+  } else {
+    domain = 0;
+  }
+  app->footer([] { return std::string(kDdsEnvironmentHelp); });  // printed before the command's own footer
+  return app
+      ->add_option("--domain", domain,
+                   "DDS domain id 0..232; wins over ROS_DOMAIN_ID (DDS environment below)")
+      ->default_str(shown);
 }
 
 }  // namespace rbsim::cli

@@ -4,6 +4,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/dds.hpp"
 #include "rbsim/replay.hpp"
 
 namespace rbsim::cli {
@@ -12,7 +13,7 @@ namespace {
 struct ReplayArgs {
   node::ReplayOptions replay;
   std::string ns;
-  std::uint32_t domain = 0;
+  std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   bool loop = false;
   std::int32_t wait_for = 0;
   bool quiet = false;
@@ -37,8 +38,8 @@ int replay_command(ReplayArgs a) {
     const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
     char rate[32] = "as fast as possible";
     if (a.replay.rate > 0) std::snprintf(rate, sizeof rate, "%gx", a.replay.rate);
-    std::fprintf(stderr, "rbsim replay: %s (%s of log time) on domain %u, rate %s%s:\n",
-                 a.replay.path.c_str(), format_seconds(span).c_str(), a.domain, rate,
+    std::fprintf(stderr, "rbsim replay: %s (%s of log time) on %s, rate %s%s:\n", a.replay.path.c_str(),
+                 format_seconds(span).c_str(), participant.value().description().c_str(), rate,
                  a.loop ? ", looping" : "");
     for (const auto& o : replay.outputs()) {
       if (o.recorded.empty()) {
@@ -102,7 +103,7 @@ Subcommand add_replay_command(CLI::App& parent) {
       "--clock", a->replay.clock,
       "Publish rosgraph_msgs/Clock on /clock carrying the log time of each message replayed (recorded "
       "/clock messages are then left out)");
-  app->add_option("--domain", a->domain, "DDS domain id (ROS_DOMAIN_ID), 0..232")->default_str("0");
+  add_domain_option(app, a->domain);
   app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names");
   app->add_option("--wait-for-subscribers", a->wait_for,
                   "Wait until N subscribers match the body states first")
@@ -118,7 +119,7 @@ Subcommand add_replay_command(CLI::App& parent) {
       "EnergyTerms, geometry_msgs/PoseArray, visualization_msgs/MarkerArray, rosgraph_msgs/Clock) is "
       "republished byte for byte with the node's QoS (the scene description transient local), in log-time "
       "order. "
-      "DDS configuration as for 'rbsim node'. Ctrl-C stops cleanly (exit 0).");
+      "Ctrl-C stops cleanly (exit 0).");
   return {app, [a] { return replay_command(*a); }};
 }
 

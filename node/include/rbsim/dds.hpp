@@ -10,32 +10,41 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rbsim/core.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/ros_env.hpp"
 
 namespace rbsim::node {
 
-// Domain ids that map onto valid UDP ports with the default port mapping.
-inline constexpr std::uint32_t kMaxDomainId = 232;
+// Participant::create's domain argument for "ROS_DOMAIN_ID, else 0".
+inline constexpr std::uint32_t kDomainFromEnvironment = UINT32_MAX;
 
-// A DDS participant. Without CYCLONEDDS_URI in the environment the domain runs on rbsim's
-// loopback configuration (127.0.0.1 only, no multicast, ParticipantIndex auto); with it, on
-// whatever that configuration says.
+// A DDS participant, configured by ROS 2's environment variables (rbsim/ros_env.hpp): by default
+// (ROS_AUTOMATIC_DISCOVERY_RANGE unset or LOCALHOST, no ROS_STATIC_PEERS) the domain runs on
+// rbsim's loopback configuration (127.0.0.1 only, no multicast, ParticipantIndex auto); with
+// CYCLONEDDS_URI set, on whatever that configuration says. Warnings about variables that are
+// ignored go to stderr.
 class Participant {
  public:
-  static Result<Participant> create(std::uint32_t domain);
+  // `domain`: the explicit id (--domain), or kDomainFromEnvironment.
+  static Result<Participant> create(std::uint32_t domain = kDomainFromEnvironment);
   Participant(Participant&& other) noexcept;
   Participant& operator=(Participant&&) = delete;
   ~Participant();
   std::int32_t handle() const { return handle_; }
   std::uint32_t domain() const { return domain_; }
+  // How it was configured, e.g. "domain 7 (LOCALHOST)" (DdsSettings::describe).
+  const std::string& description() const { return description_; }
 
  private:
-  Participant(std::int32_t handle, std::uint32_t domain) : handle_(handle), domain_(domain) {}
+  Participant(std::int32_t handle, std::uint32_t domain, std::string description)
+      : handle_(handle), domain_(domain), description_(std::move(description)) {}
   std::int32_t handle_ = 0;
   std::uint32_t domain_ = 0;
+  std::string description_;
 };
 
 // The loopback configuration compiled into rbsim (node/config/cyclonedds-loopback.xml).

@@ -13,7 +13,7 @@
 namespace rbsim::node {
 
 struct NodeOptions {
-  std::uint32_t domain = 0;
+  std::uint32_t domain = kDomainFromEnvironment;  // ROS_DOMAIN_ID, else 0 (Participant::create)
   std::string ns = "rbsim";
   double rate = 1.0;               // real-time factor; 0: as fast as possible
   std::int64_t publish_every = 1;  // publish every k-th step; create() refuses < 1
