@@ -25,8 +25,8 @@ Result<std::uint32_t> parse_domain(std::string_view text) {
   }
   const auto id = static_cast<std::uint32_t>(std::stoul(std::string(text)));
   if (id > kMaxDomainId) {
-    return Error{bad + ": domain id " + std::to_string(id) + " out of range [0, " + std::to_string(kMaxDomainId) +
-                 "]"};
+    return Error{bad + ": domain id " + std::to_string(id) + " out of range [0, " +
+                 std::to_string(kMaxDomainId) + "]"};
   }
   return id;
 }
@@ -70,8 +70,7 @@ bool is_loopback_peer(std::string_view peer) {
          host.starts_with("::1");
 }
 
-constexpr std::string_view kHead =
-    R"(<CycloneDDS xmlns="https://cdds.io/config"><Domain Id="any">)";
+constexpr std::string_view kHead = R"(<CycloneDDS xmlns="https://cdds.io/config"><Domain Id="any">)";
 constexpr std::string_view kTail = "</Domain></CycloneDDS>";
 constexpr std::string_view kLoopbackInterface =
     R"(<Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces>)";
@@ -90,10 +89,14 @@ std::string peers_xml(const std::vector<std::string>& peers) {
 
 std::string_view to_string(DiscoveryRange range) {
   switch (range) {
-    case DiscoveryRange::Localhost: return "LOCALHOST";
-    case DiscoveryRange::Subnet: return "SUBNET";
-    case DiscoveryRange::Off: return "OFF";
-    case DiscoveryRange::SystemDefault: return "SYSTEM_DEFAULT";
+    case DiscoveryRange::Localhost:
+      return "LOCALHOST";
+    case DiscoveryRange::Subnet:
+      return "SUBNET";
+    case DiscoveryRange::Off:
+      return "OFF";
+    case DiscoveryRange::SystemDefault:
+      return "SYSTEM_DEFAULT";
   }
   return "?";
 }
@@ -125,8 +128,8 @@ Result<std::optional<std::uint32_t>> domain_from_environment(const RosEnvironmen
   return std::optional<std::uint32_t>(id.value());
 }
 
-Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env, std::optional<std::uint32_t> explicit_domain,
-                                         std::int64_t pid) {
+Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
+                                         std::optional<std::uint32_t> explicit_domain, std::int64_t pid) {
   DdsSettings s;
   // The domain: --domain, else ROS_DOMAIN_ID, else 0 (rcl_get_default_domain_id).
   if (explicit_domain) {
@@ -178,7 +181,8 @@ Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env, std::optiona
   if (localhost_only) {
     if (!empty(env.ros_automatic_discovery_range) || !peers.value().empty()) {
       s.warnings.emplace_back(
-          "ROS_LOCALHOST_ONLY=1 (deprecated) wins: ROS_AUTOMATIC_DISCOVERY_RANGE and ROS_STATIC_PEERS are ignored");
+          "ROS_LOCALHOST_ONLY=1 (deprecated) wins: ROS_AUTOMATIC_DISCOVERY_RANGE and ROS_STATIC_PEERS are "
+          "ignored");
     }
     range = DiscoveryRange::Localhost;
     peers.value().clear();
@@ -190,7 +194,8 @@ Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env, std::optiona
     s.from_cyclonedds_uri = true;
     if (!empty(env.ros_automatic_discovery_range) || !peers.value().empty() || localhost_only) {
       s.warnings.emplace_back(
-          "CYCLONEDDS_URI is set: it configures discovery, so ROS_AUTOMATIC_DISCOVERY_RANGE, ROS_STATIC_PEERS "
+          "CYCLONEDDS_URI is set: it configures discovery, so ROS_AUTOMATIC_DISCOVERY_RANGE, "
+          "ROS_STATIC_PEERS "
           "and ROS_LOCALHOST_ONLY are ignored");
     }
     return s;
@@ -220,7 +225,8 @@ Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env, std::optiona
       // Cyclone's interface selection and multicast; unicast discovery to the static peers too.
       s.static_peers = peers.value();
       s.config = std::string(kHead) + "<Discovery>" + std::string(kIndexAndLease) +
-                 (peers.value().empty() ? "" : peers_xml(peers.value())) + "</Discovery>" + std::string(kTail);
+                 (peers.value().empty() ? "" : peers_xml(peers.value())) + "</Discovery>" +
+                 std::string(kTail);
       break;
     case DiscoveryRange::Off:
       // No discovery beyond this process: no multicast, no peers, no participant index, and a

@@ -126,8 +126,9 @@ TEST(RosEnv, StaticPeers) {
   ASSERT_TRUE(s.config);
   EXPECT_TRUE(has(*s.config, R"(<NetworkInterface address="127.0.0.1"/>)")) << *s.config;
   EXPECT_TRUE(has(*s.config, "<AllowMulticast>false</AllowMulticast>")) << *s.config;
-  EXPECT_TRUE(has(*s.config,
-                  R"(<Peers><Peer Address="127.0.0.1"/><Peer Address="127.0.0.2"/><Peer Address="localhost"/></Peers>)"))
+  EXPECT_TRUE(has(
+      *s.config,
+      R"(<Peers><Peer Address="127.0.0.1"/><Peer Address="127.0.0.2"/><Peer Address="localhost"/></Peers>)"))
       << *s.config;
   EXPECT_EQ(s.describe(), "domain 0 (LOCALHOST, static peers 127.0.0.2;localhost)");
 

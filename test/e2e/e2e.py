@@ -424,6 +424,12 @@ def live_recording(ctx, scene, every, out, tag, env=None, steps_total=None):
     exited_ok(ctx, rec, 90)
     ctx.check(counts_line(rec) == (expected, 0),
               f"recorder reports {counts_line(rec)} (received, lost), want ({expected}, 0)\n{rec.output()}")
+    # The latched scene description comes first, in the file and in log time, whatever order
+    # discovery delivered the topics in (tools that read the recording rely on it).
+    first_in_file = read_stream_messages(out)[0][0]
+    first_in_time = Log(out).messages[0][0]
+    ctx.check(first_in_file.endswith("/scene") and first_in_time.endswith("/scene"),
+              f"{out}: first message on {first_in_file} (file order), {first_in_time} (log time), want the scene")
     return expected
 
 

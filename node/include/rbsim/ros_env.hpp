@@ -50,8 +50,8 @@ struct DdsSettings {
 // unknown ROS_AUTOMATIC_DISCOVERY_RANGE, a ROS_LOCALHOST_ONLY other than 0 or 1, a
 // ROS_STATIC_PEERS entry that is not a host name or address. `pid` names the discovery tag of
 // the OFF range (as rmw_cyclonedds_cpp: only this process can match it).
-Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env, std::optional<std::uint32_t> explicit_domain,
-                                         std::int64_t pid);
+Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
+                                         std::optional<std::uint32_t> explicit_domain, std::int64_t pid);
 
 // ROS_DOMAIN_ID alone: nullopt when unset or empty.
 Result<std::optional<std::uint32_t>> domain_from_environment(const RosEnvironment& env);

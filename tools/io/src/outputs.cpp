@@ -50,7 +50,8 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
       if (!o.folder) return fail("folder " + parent.string() + " does not exist");
       continue;  // a frame folder is created with its parents
     }
-    if (::access(parent.c_str(), W_OK | X_OK) != 0) return fail("folder " + parent.string() + " is not writable");
+    if (::access(parent.c_str(), W_OK | X_OK) != 0)
+      return fail("folder " + parent.string() + " is not writable");
   }
   return Ok{};
 }

@@ -11,8 +11,8 @@
 namespace rbsim {
 
 struct OutputPath {
-  std::string path;    // empty: the output is not wanted (skipped)
-  std::string option;  // how the user named it, for messages ("--csv")
+  std::string path;     // empty: the output is not wanted (skipped)
+  std::string option;   // how the user named it, for messages ("--csv")
   bool folder = false;  // a folder of files (frames): may exist; must not be a file
 };
 
@@ -20,8 +20,8 @@ struct OutputPath {
 // folder (or, for a folder output, not a file), no two outputs are the same file, none is one of
 // `inputs` (never, even with `overwrite`), and a file output does not exist yet unless
 // `overwrite`. The Error names the option, the path and the rule.
-[[nodiscard]] Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs,
-                                   bool overwrite);
+[[nodiscard]] Status check_outputs(const std::vector<OutputPath>& outputs,
+                                   const std::vector<std::string>& inputs, bool overwrite);
 
 // Whether two paths name the same file (existing or not: compared by canonical path).
 bool same_file(const std::string& a, const std::string& b);
