@@ -43,8 +43,8 @@ TEST(RecordCli, NothingReceivedIsAnErrorAndLeavesNoFile) {
 
 TEST(RecordCli, OutputInAMissingFolderIsRefusedBeforeStarting) {
   test::TempDir dir;
-  const test::Outcome o =
-      rbsim({"record", (dir / "no" / "such" / "out.mcap").string(), "--domain", kQuietDomain, "--duration", "5"});
+  const test::Outcome o = rbsim(
+      {"record", (dir / "no" / "such" / "out.mcap").string(), "--domain", kQuietDomain, "--duration", "5"});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_NE(o.err.find("does not exist"), std::string::npos) << o;
   EXPECT_EQ(o.err.find("recording"), std::string::npos) << "refused before DDS started: " << o;

@@ -49,7 +49,7 @@ Subcommand add_grade_command(CLI::App& parent) {
   app->footer(
       "Passes when the largest per-step state difference is < 1e-8, their sum < 1e-6, and every quantity "
       "(M, X, I, P, L_point, L_spin, T_point, T_spin, U) is within 1e-8.\n"
-      "Exit status: 0 pass, 1 fail, 2 error.");
+      "Exit status: 0 pass, 1 fail, 2 error or usage error.");
   return {app, [a] { return grade_command(*a); }};
 }
 

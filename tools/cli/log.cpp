@@ -106,7 +106,7 @@ Subcommand add_log_command(CLI::App& parent) {
   info->add_option("file", o->file, "MCAP file")->required();
   info->footer(
       "Reads the summary section (or scans a file that has none, and says so) and checks the data section "
-      "CRC.\nExit status: 0 success, 1 error (unreadable, truncated or corrupted file).");
+      "CRC.\nExit status: 0 success, 1 error (unreadable, truncated or corrupted file), 2 usage error.");
 
   CLI::App* doctor = app->add_subcommand(
       "doctor",
@@ -117,7 +117,7 @@ Subcommand add_log_command(CLI::App& parent) {
                    "Messages out of log-time order are errors (by default warnings)");
   doctor->footer(
       "Prints 'Examining FILE', then one line per problem ('error: ...' or 'warning: ...').\n"
-      "Exit status: 0 no errors (warnings allowed), 1 any error.");
+      "Exit status: 0 no errors (warnings allowed), 1 any error, 2 usage error.");
 
   CLI::App* recover = app->add_subcommand(
       "recover",
@@ -136,7 +136,7 @@ Subcommand add_log_command(CLI::App& parent) {
       "library.\n"
       "Exit status: 0 OUT written (a copy of an intact input, or every complete message of a damaged one, "
       "with a warning on stderr saying what was lost), 1 nothing could be recovered (no complete message; "
-      "no OUT written) or an error.");
+      "no OUT written) or an error, 2 usage error.");
 
   CLI::App* exp = app->add_subcommand(
       "export", "Write the CSV files 'rbsim run --csv / --energy-csv' write, from a recording of the run");
@@ -148,7 +148,7 @@ Subcommand add_log_command(CLI::App& parent) {
   exp->add_flag("-q,--quiet", o->quiet, "No closing summary line");
   exp->footer(
       "Byte for byte what rbsim run wrote for the recorded steps (all of them, or every k-th with "
-      "--record-every k).\nExit status: 0 success, 1 error.");
+      "--record-every k).\nExit status: 0 success, 1 error, 2 usage error.");
 
   return {app, [o, info, doctor, recover, exp]() -> int {
             if (info->parsed()) return info_command(*o);

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "rbsim/dds_sink.hpp"
 #include "rbsim/run.hpp"
+#include "validators.hpp"
 
 namespace rbsim::cli {
 
@@ -90,16 +91,16 @@ Subcommand add_node_command(CLI::App& parent) {
   app->add_option("scene", a->scene, "FOSSSim XML scene file")->required();
   app->add_option("--rate", a->node.rate,
                   "Real-time factor (2 = twice as fast as real time; 0 = as fast as possible)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative())
       ->default_str("1");
   app->add_option("--publish-every", a->node.publish_every, "Publish every k-th step")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->default_str("1");
   add_domain_option(app, a->node.domain);
   app->add_option("--namespace", a->node.ns, "ROS namespace: topics are /<namespace>/<name>")
       ->default_str("rbsim");
   app->add_option("--duration", a->duration, "Simulated seconds per run (default: the scene's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   app->add_flag("--loop", a->loop, "Start the scene again when it ends, until Ctrl-C");
   app->add_flag(
       "--allow-nonfinite", a->allow_nonfinite,
@@ -107,11 +108,11 @@ Subcommand add_node_command(CLI::App& parent) {
       "the step, body and quantity)");
   app->add_option("--wait-for-subscribers", a->wait_for,
                   "Wait until N subscribers match the body states first")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   app->add_option("--keep-last", a->node.keep_last,
                   "Per-step writers keep the last N samples instead of all: the node never waits for a slow "
                   "subscriber, which may then lose samples (ROS 2's default profile is keep last 10)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   app->add_flag("-q,--quiet", a->quiet, "No start and end lines");
   app->footer(
       "Topics (DDS name rt/<namespace>/<name>, type pkg::msg::dds_::Name_, CDR): scene "
@@ -122,10 +123,8 @@ Subcommand add_node_command(CLI::App& parent) {
       "(rosgraph_msgs/Clock), all reliable, volatile, keep all: a slow subscriber slows the node down rather "
       "than "
       "losing samples (--keep-last N trades that for a node that never waits).\n"
-      "DDS: without CYCLONEDDS_URI the node uses rbsim's loopback configuration (127.0.0.1 only, no "
-      "multicast); set "
-      "CYCLONEDDS_URI to a Cyclone DDS configuration to go onto a real network.\n"
-      "Ctrl-C stops cleanly (exit 0).");
+      "Exit status: 0 done, or stopped by Ctrl-C/SIGTERM (cleanly); 1 error (bad scene, DDS failure, "
+      "divergence); 2 usage error.");
   return {app, [a] { return node_command(*a); }};
 }
 

@@ -10,6 +10,7 @@
 #include "rbsim/outputs.hpp"
 #include "rbsim/record.hpp"
 #include "rbsim/recorder.hpp"
+#include "validators.hpp"
 
 namespace rbsim::cli {
 
@@ -105,8 +106,7 @@ Subcommand add_record_command(CLI::App& parent) {
       ->allow_extra_args(false);
   add_domain_option(app, a->domain);
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")->default_str("rbsim");
-  app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")
-      ->check(CLI::PositiveNumber);
+  app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")->check(positive());
   app->add_option("--max-messages", a->rec.max_messages, "Stop after this many messages");
   app->add_option("--compression", a->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "rbsim/render.hpp"
+#include "validators.hpp"
 
 namespace rbsim::cli {
 
@@ -69,12 +70,14 @@ Subcommand add_render_command(CLI::App& parent) {
   app->add_option("--fps", a->fps, "Frames per simulated second")->default_str("24");
   app->add_option("--size", a->size, "Frame size WxH in pixels")->default_str("1280x720");
   app->add_option("--duration", a->duration, "Simulated seconds to draw (default: the scene's duration)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   app->add_option("--mp4", a->mp4, "Also assemble the frames into an H.264 (yuv420p) movie with ffmpeg");
   app->footer(
       "Frame k shows time k / fps (the first step at or after it); duration x fps frames in all. Bodies are "
       "filled hulls grown by their radius r in their scene colours, springs are lines in theirs (fixed ends "
-      "ringed), on the scene's background, framed by its viewport (or fitted to the bodies).");
+      "ringed), on the scene's background, framed by its viewport (or fitted to the bodies).\n"
+      "Exit status: 0 success, 1 error (bad input, divergence, unwritable output, ffmpeg failure), 2 usage "
+      "error.");
   return {app, [a] { return render_command(*a); }};
 }
 
@@ -87,7 +90,10 @@ Subcommand add_plot_command(CLI::App& parent) {
   app->add_option("--out", a->out, "PNG file to write")->required();
   app->add_option("--size", a->size, "Image size WxH in pixels")->default_str("1200x900");
   app->add_option("--duration", a->duration, "Simulated seconds (scenes only; default: the scene's duration)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
+  app->footer(
+      "Exit status: 0 success, 1 error (bad input, divergence, unwritable output, gnuplot failure), 2 usage "
+      "error.");
   return {app, [a] { return plot_command(*a); }};
 }
 

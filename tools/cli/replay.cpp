@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/replay.hpp"
+#include "validators.hpp"
 
 namespace rbsim::cli {
 
@@ -87,7 +88,7 @@ Subcommand add_replay_command(CLI::App& parent) {
   app->add_option("in", a->replay.path, "MCAP recording (rbsim run --record or rbsim record)")->required();
   app->add_option("--rate", a->replay.rate,
                   "Real-time factor on the recorded log times (2 = twice as fast; 0 = as fast as possible)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative())
       ->default_str("1");
   app->add_flag("--loop", a->loop, "Start again at the end, until Ctrl-C");
   app->add_option("--topics", a->replay.topics,
@@ -98,7 +99,7 @@ Subcommand add_replay_command(CLI::App& parent) {
   app->add_option(
          "--start-offset", a->replay.start_offset,
          "Skip this many seconds of log time at the start (the scene description is still published first)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   app->add_flag(
       "--clock", a->replay.clock,
       "Publish rosgraph_msgs/Clock on /clock carrying the log time of each message replayed (recorded "
@@ -107,19 +108,21 @@ Subcommand add_replay_command(CLI::App& parent) {
   app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names");
   app->add_option("--wait-for-subscribers", a->wait_for,
                   "Wait until N subscribers match the body states first")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   app->add_option(
          "--keep-last", a->replay.keep_last,
          "Per-step writers keep the last N samples instead of all (the replay never waits for a slow "
          "subscriber, which may then lose samples)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
   app->footer(
       "Every channel whose schema is an rbsim type (rbsim_msgs/SceneDescription, BodyStates, SpringStates, "
       "EnergyTerms, geometry_msgs/PoseArray, visualization_msgs/MarkerArray, rosgraph_msgs/Clock) is "
       "republished byte for byte with the node's QoS (the scene description transient local), in log-time "
       "order. "
-      "Ctrl-C stops cleanly (exit 0).");
+      "Ctrl-C stops cleanly.\n"
+      "Exit status: 0 done or stopped by Ctrl-C/SIGTERM, 1 error (unreadable recording, no rbsim topics, DDS "
+      "failure), 2 usage error.");
   return {app, [a] { return replay_command(*a); }};
 }
 

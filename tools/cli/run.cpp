@@ -11,6 +11,7 @@
 #include "rbsim/record.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
+#include "validators.hpp"
 
 namespace rbsim::cli {
 
@@ -125,10 +126,10 @@ Subcommand add_run_command(CLI::App& parent) {
       ->required();  // the loader reports a missing file (exit 1)
   auto* steps =
       app->add_option("--steps", o->steps, "Number of steps to run (overrides the scene's duration)")
-          ->check(CLI::NonNegativeNumber);
+          ->check(non_negative());
   app->add_option("--duration", o->duration,
                   "Simulated seconds to run: ceil(T / dt) steps (overrides the scene)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative())
       ->excludes(steps);
   app->add_option("--csv", o->csv,
                   std::string("Per-body CSV, one row per body per step from step 0: ") + kBodyCsvColumns +
@@ -143,7 +144,7 @@ Subcommand add_run_command(CLI::App& parent) {
       "Record every topic (scene description once, then body states, spring states, energy terms, "
       "PoseArray, MarkerArray and /clock per step) to an MCAP file in the rosbag2 layout");
   app->add_option("--record-every", o->record_every, "Record every k-th step (step 0 always)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   app->add_option("--compression", o->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
@@ -168,7 +169,8 @@ Subcommand add_run_command(CLI::App& parent) {
   app->footer(
       "Outputs are written to a temporary file and renamed into place when complete. Ctrl-C stops the run "
       "cleanly: outputs then hold every step done so far, and the exit status is 130.\n"
-      "Exit status: 0 success, 1 error (bad scene, I/O failure, divergence), 130 interrupted.");
+      "Exit status: 0 success, 1 error (bad scene, I/O failure, divergence), 2 usage error, 130 "
+      "interrupted.");
   return {app, [o] { return run(*o); }};
 }
 
