@@ -131,9 +131,42 @@ struct BodyStatesMessage {
   };
   std::vector<Body> bodies;
 };
+struct SpringStatesMessage {
+  Time stamp;
+  std::uint64_t step = 0;
+  struct Spring {
+    std::int32_t id = 0;
+    Vec2 end_i{0.0, 0.0}, end_j{0.0, 0.0};  // world endpoints
+    double length = 0.0, rest_length = 0.0, potential = 0.0;
+  };
+  std::vector<Spring> springs;
+};
+struct EnergyTermsMessage {
+  Time stamp;
+  std::uint64_t step = 0;
+  struct Body {
+    std::int32_t id = 0;
+    Vec2 momentum{0.0, 0.0};
+    double l_point = 0.0, l_spin = 0.0, t_point = 0.0, t_spin = 0.0;
+  };
+  std::vector<Body> bodies;
+  // ForcePotential.kind: each gravity field (index among the fields), then each spring.
+  enum class ForceKind : std::uint8_t { Gravity = 0, Spring = 1 };
+  struct Force {
+    std::uint8_t kind = 0;  // a ForceKind; other values are carried as recorded
+    std::int32_t index = 0;
+    double potential = 0.0;
+  };
+  std::vector<Force> forces;
+  Vec2 momentum{0.0, 0.0};  // totals over bodies
+  double angular_momentum = 0.0, potential = 0.0, kinetic_point = 0.0, kinetic_spin = 0.0, total = 0.0;
+};
 Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
-// Reuses `out`'s storage: decoding a stream of messages does not allocate once warmed up.
+// These reuse `out`'s storage: decoding a stream of messages does not allocate once warmed up.
+// They fail on truncated or malformed data (a sequence longer than the bytes left included).
 [[nodiscard]] Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out);
+[[nodiscard]] Status decode_spring_states(std::span<const std::byte> cdr, SpringStatesMessage& out);
+[[nodiscard]] Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out);
 // The simulated time a per-step message carries: its header stamp, a Clock's clock, a
 // MarkerArray's first marker's stamp. nullopt for the scene description, an empty MarkerArray or
 // bytes too short to hold it.
