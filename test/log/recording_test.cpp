@@ -27,7 +27,7 @@ struct Planned {
 // given, under namespace `ns`; every message carries the world's state at its step.
 void write_recording(const fs::path& out, const std::vector<Planned>& plan, const std::string& ns = "rbsim",
                      const std::vector<TopicId>& topics = {TopicId::Scene, TopicId::BodyStates,
-                                                          TopicId::SpringStates, TopicId::Energy}) {
+                                                           TopicId::SpringStates, TopicId::Energy}) {
   Result<Scene> scene = load_scene(source_path("scenes/cantilever.xml"));
   ASSERT_TRUE(scene.ok()) << scene.error().message;
   std::int64_t last = 0;

@@ -62,7 +62,8 @@ std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader
     if (channel.message_encoding != "cdr") {
       c.problem = "message encoding \"" + channel.message_encoding + "\", not cdr";
     } else if (!ours || schema->second.encoding != "ros2msg" ||
-               std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) != ours.value()) {
+               std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) !=
+                   ours.value()) {
       c.problem = "its " + type + " schema differs from this build's (recorded by another version?)";
     }
     out.push_back(std::move(c));
@@ -100,7 +101,8 @@ struct Recording::Impl {
         return fail("several " + std::string(c.spec->type) + " topics (" + topic + ", " + c.channel->topic +
                     "): choose one recording with --namespace");
       }
-      if (!c.problem.empty()) return fail("topic " + c.channel->topic + ": " + c.problem + ": cannot read it");
+      if (!c.problem.empty())
+        return fail("topic " + c.channel->topic + ": " + c.problem + ": cannot read it");
       topic = c.channel->topic;
       route.emplace(c.channel->id, id);
       if (i >= 0) present[static_cast<std::size_t>(i)] = true;
@@ -183,7 +185,8 @@ struct Recording::Impl {
     if (!decoded) return fail(where(e) + ": " + decoded.error().message);
     if (last[i] && step <= *last[i]) {
       const std::string type(msgs::topic(kPerStep[i]).type);
-      if (step == *last[i]) return fail(where(e) + ": step " + std::to_string(step) + " has two " + type + " messages");
+      if (step == *last[i])
+        return fail(where(e) + ": step " + std::to_string(step) + " has two " + type + " messages");
       return fail(where(e) + ": step " + std::to_string(step) + " after step " + std::to_string(*last[i]) +
                   " (steps must increase: a recording of several runs?)");
     }
@@ -225,7 +228,8 @@ struct Recording::Impl {
                   ", the scene description " + std::to_string(want));
     };
     if (s.has[kStates]) {
-      if (Status st = count(msgs::TopicId::BodyStates, "bodies", s.states.bodies.size(), bodies); !st) return st;
+      if (Status st = count(msgs::TopicId::BodyStates, "bodies", s.states.bodies.size(), bodies); !st)
+        return st;
     }
     if (s.has[kSprings]) {
       if (Status st = count(msgs::TopicId::SpringStates, "springs", s.springs.springs.size(), springs); !st)
@@ -239,7 +243,8 @@ struct Recording::Impl {
       }
       if (Status st = count(msgs::TopicId::Energy, "gravity potentials", gravity, scene->gravity.size()); !st)
         return st;
-      if (Status st = count(msgs::TopicId::Energy, "spring potentials", s.energy.forces.size() - gravity, springs);
+      if (Status st =
+              count(msgs::TopicId::Energy, "spring potentials", s.energy.forces.size() - gravity, springs);
           !st)
         return st;
     }
@@ -291,7 +296,8 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
   if (std::string e = mcap_tools::unreadable(path); !e.empty()) return im.fail(e);
   if (mcap::Status s = im.reader.open(path); !s.ok()) return im.fail(mcap_tools::read_error(s));
   if (options.verify_crc) {
-    if (mcap::Status s = im.reader.verify_data_section_crc(); !s.ok()) return im.fail(mcap_tools::read_error(s));
+    if (mcap::Status s = im.reader.verify_data_section_crc(); !s.ok())
+      return im.fail(mcap_tools::read_error(s));
   }
   // A file whose summary lists no channels of ours defines them in its data section: read it once
   // to learn them.
@@ -310,9 +316,13 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
   return r;
 }
 
-const std::string& Recording::path() const { return impl_->path; }
+const std::string& Recording::path() const {
+  return impl_->path;
+}
 
-const msgs::SceneMessage* Recording::scene() const { return impl_->scene ? &*impl_->scene : nullptr; }
+const msgs::SceneMessage* Recording::scene() const {
+  return impl_->scene ? &*impl_->scene : nullptr;
+}
 
 const std::string& Recording::topic(msgs::TopicId id) const {
   return impl_->topics[static_cast<std::size_t>(id)];

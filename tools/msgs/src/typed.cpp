@@ -204,6 +204,24 @@ Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& o
   return Ok{};
 }
 
+Status decode_poses(std::span<const std::byte> cdr, PosesMessage& out) {
+  Reader r(cdr);
+  out.stamp = r.time();
+  r.skip_string();  // frame_id
+  out.poses.resize(r.length(56));
+  for (auto& p : out.poses) {
+    p.x = r.get<double>();
+    p.y = r.get<double>();
+    p.z = r.get<double>();
+    p.qx = r.get<double>();
+    p.qy = r.get<double>();
+    p.qz = r.get<double>();
+    p.qw = r.get<double>();
+  }
+  if (!r.ok()) return bad("PoseArray");
+  return Ok{};
+}
+
 std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr) {
   if (id == TopicId::Scene) return std::nullopt;
   Reader r(cdr);

@@ -161,12 +161,22 @@ struct EnergyTermsMessage {
   Vec2 momentum{0.0, 0.0};  // totals over bodies
   double angular_momentum = 0.0, potential = 0.0, kinetic_point = 0.0, kinetic_spin = 0.0, total = 0.0;
 };
+// geometry_msgs/msg/PoseArray, as rbsim publishes it (one pose per body, in body order).
+struct PosesMessage {
+  Time stamp;
+  struct Pose {
+    double x = 0.0, y = 0.0, z = 0.0;               // position
+    double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;  // orientation quaternion
+  };
+  std::vector<Pose> poses;
+};
 Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
 // These reuse `out`'s storage: decoding a stream of messages does not allocate once warmed up.
 // They fail on truncated or malformed data (a sequence longer than the bytes left included).
 [[nodiscard]] Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out);
 [[nodiscard]] Status decode_spring_states(std::span<const std::byte> cdr, SpringStatesMessage& out);
 [[nodiscard]] Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out);
+[[nodiscard]] Status decode_poses(std::span<const std::byte> cdr, PosesMessage& out);
 // The simulated time a per-step message carries: its header stamp, a Clock's clock, a
 // MarkerArray's first marker's stamp. nullopt for the scene description, an empty MarkerArray or
 // bytes too short to hold it.
