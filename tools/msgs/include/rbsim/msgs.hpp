@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <optional>
 #include <span>
@@ -197,6 +198,39 @@ struct Scalar {
   bool operator==(const Scalar&) const = default;
   std::string to_string() const;
 };
+
+// The scalar of kind `kind` held in the `size` (1, 2, 4 or 8) little-endian bytes at `p`: float32
+// widened, signed integers sign-extended, bool 0 or 1. The one primitive loader of every CDR walker
+// (MessageDecoder, rbsim check's comparer); inline, as it runs once per value.
+inline Scalar load_scalar(const std::byte* p, std::uint8_t size, Scalar::Kind kind) {
+  Scalar s;
+  s.kind = kind;
+  switch (kind) {
+    case Scalar::Kind::Float:
+      if (size == 4) {
+        float f;
+        std::memcpy(&f, p, 4);
+        s.f = f;
+      } else {
+        std::memcpy(&s.f, p, 8);
+      }
+      break;
+    case Scalar::Kind::Int: {
+      std::uint64_t u = 0;
+      std::memcpy(&u, p, size);
+      const unsigned shift = 64u - 8u * size;  // sign-extend
+      s.i = static_cast<std::int64_t>(u << shift) >> shift;
+      break;
+    }
+    case Scalar::Kind::Bool:
+      s.i = *p != std::byte{0};
+      break;
+    default:
+      std::memcpy(&s.u, p, size);
+      break;
+  }
+  return s;
+}
 
 // "pkg/Name" or bare "Name" (in `package`) -> "pkg/msg/Name"; bare "Header" is std_msgs'.
 std::string canonical_type(std::string_view type, std::string_view package);
