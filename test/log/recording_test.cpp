@@ -24,10 +24,12 @@ struct Planned {
 };
 
 // Runs scenes/cantilever.xml (gravity and springs) and writes the planned messages, in the order
-// given, under namespace `ns`; every message carries the world's state at its step.
+// given, under namespace `ns`; every message carries the world's state at its step. Without
+// `summary_channels` the summary repeats no Schema or Channel record.
 void write_recording(const fs::path& out, const std::vector<Planned>& plan, const std::string& ns = "rbsim",
                      const std::vector<TopicId>& topics = {TopicId::Scene, TopicId::BodyStates,
-                                                           TopicId::SpringStates, TopicId::Energy}) {
+                                                           TopicId::SpringStates, TopicId::Energy},
+                     bool summary_channels = true) {
   Result<Scene> scene = load_scene(source_path("scenes/cantilever.xml"));
   ASSERT_TRUE(scene.ok()) << scene.error().message;
   std::int64_t last = 0;
@@ -45,7 +47,9 @@ void write_recording(const fs::path& out, const std::vector<Planned>& plan, cons
     }
   }
   mcap::Writer writer;
-  ASSERT_TRUE(writer.open(out.string(), log::writer_options(mcap::Compression::None)).ok());
+  mcap::WriterOptions wo = log::writer_options(mcap::Compression::None);
+  wo.repeat_schemas = wo.repeat_channels = summary_channels;
+  ASSERT_TRUE(writer.open(out.string(), wo).ok());
   std::map<TopicId, std::uint16_t> channel;
   for (TopicId id : topics) {
     auto c = log::add_topic(writer, msgs::topic(id), ns);
@@ -147,6 +151,27 @@ TEST(Recording, OpenFindsASceneDescriptionRecordedAfterTheFirstBodyStates) {
     EXPECT_EQ(seen[k].step, k);
     EXPECT_TRUE(seen[k].states && seen[k].springs && seen[k].energy) << k;
   }
+}
+
+TEST(Recording, OpenLearnsChannelsTheSummaryDoesNotList) {
+  TempDir dir;
+  const fs::path file = dir / "no-summary-channels.mcap";
+  write_recording(file,
+                  {{TopicId::BodyStates, 0, 10},
+                   {TopicId::SpringStates, 0, 11},
+                   {TopicId::Energy, 0, 12},
+                   {TopicId::Scene, 0, 13},
+                   {TopicId::BodyStates, 1, 20},
+                   {TopicId::SpringStates, 1, 21},
+                   {TopicId::Energy, 1, 22}},
+                  "rbsim", {TopicId::Scene, TopicId::BodyStates, TopicId::SpringStates, TopicId::Energy},
+                  /*summary_channels=*/false);
+  auto opened = log::Recording::open(file.string(), {});
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  ASSERT_NE(opened.value()->scene(), nullptr);
+  const auto seen = read_all(*opened.value());
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_TRUE(seen[1].states && seen[1].springs && seen[1].energy);
 }
 
 TEST(Recording, OpenWithoutASceneDescriptionIsAClearError) {

@@ -101,8 +101,10 @@ struct Recording::Impl {
         return fail("several " + std::string(c.spec->type) + " topics (" + topic + ", " + c.channel->topic +
                     "): choose one recording with --namespace");
       }
-      if (!c.problem.empty())
+      if (!c.problem.empty()) {
+        if (id == msgs::TopicId::Scene && !options.require_scene) continue;
         return fail("topic " + c.channel->topic + ": " + c.problem + ": cannot read it");
+      }
       topic = c.channel->topic;
       route.emplace(c.channel->id, id);
       if (i >= 0) present[static_cast<std::size_t>(i)] = true;
@@ -299,9 +301,9 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
     if (mcap::Status s = im.reader.verify_data_section_crc(); !s.ok())
       return im.fail(mcap_tools::read_error(s));
   }
-  // A file whose summary lists no channels of ours defines them in its data section: read it once
-  // to learn them.
-  if (recorded_channels(im.reader).empty()) {
+  // A file whose summary lists no channels defines them in its data section: read it once to
+  // learn them.
+  if (im.reader.channels().empty()) {
     const mcap::Status s = im.reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
     if (!s.ok()) return im.fail(mcap_tools::read_error(s));
   }

@@ -52,8 +52,10 @@ struct RecordingOptions {
   std::vector<msgs::TopicId> read;
   // Per-step topics that must be in the file (a channel of the type, in the namespace).
   std::vector<msgs::TopicId> require;
-  bool require_scene = true;  // false: a recording without a scene description is read too
-  bool verify_crc = false;    // check the data section CRC on open (reads the whole file once)
+  // false: a recording without a scene description (or with one this build cannot decode) is
+  // read too, and scene() is null.
+  bool require_scene = true;
+  bool verify_crc = false;  // check the data section CRC on open (reads the whole file once)
 };
 
 // One recorded step. A message pointer is null when the topic is not read, not recorded, or has
@@ -84,7 +86,7 @@ class Recording {
   Recording& operator=(const Recording&) = delete;
 
   const std::string& path() const;
-  // The scene description; null only when the file has none and require_scene was false.
+  // The scene description; null only when require_scene was false and the file has none.
   const msgs::SceneMessage* scene() const;
   // The topic name read for `id` ("/rbsim/body_states"); empty when the file has none.
   const std::string& topic(msgs::TopicId id) const;
@@ -94,8 +96,9 @@ class Recording {
   // on once every read topic has either delivered it or moved past it, so messages are held back
   // only as long as the topics' log times interleave. Fails (naming the file, the topic and the
   // message's log time) on a malformed message, a step that does not increase on its topic (a
-  // repeat included), or a message that does not match the scene description. Once warm, a
-  // recording read in step order does not allocate.
+  // repeat included), or a message that does not match the scene description. Decoding and
+  // joining reuse their storage: once warm, they do not allocate for a recording whose topics
+  // interleave no more than they did so far.
   [[nodiscard]] Status read_steps(const std::function<Status(const RecordedStep&)>& on_step);
 
  private:
