@@ -318,13 +318,6 @@ Result<Layout> Layout::create(std::string_view type, std::string_view schema) {
   return layout;
 }
 
-int Layout::find(std::string_view path) const {
-  for (std::size_t i = 0; i < groups_.size(); ++i) {
-    if (groups_[i].path == path) return static_cast<int>(i);
-  }
-  return -1;
-}
-
 bool Layout::map(std::span<const msgs::Scalar> s, Plan& plan) const {
   plan.group.clear();
   plan.lengths.clear();
