@@ -8,6 +8,7 @@
 
 #include "clock.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/recording.hpp"
 #include "rbsim/replay.hpp"
 
 namespace rbsim::node {
@@ -23,15 +24,6 @@ bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
     if (now >= deadline_ns) return true;
     sleep_until(std::min(deadline_ns, now + kSlice));
   }
-}
-
-// rosbag2 writes "pkg/msg/Name"; older tools "pkg/Name".
-const msgs::TopicSpec* spec_for_type(std::string_view type) {
-  const std::string t = msgs::canonical_type(type, "");
-  for (const msgs::TopicSpec& spec : msgs::topics()) {
-    if (spec.type == t) return &spec;
-  }
-  return nullptr;
 }
 
 std::string last_component(std::string_view topic) {
@@ -81,31 +73,18 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     return Error{"cannot read " + path + ": " + st.message + hint};
   }
 
-  // Channels that carry one of our types as CDR, by id (file order).
+  // Channels that carry one of our types as CDR (found by type), by id (file order).
   struct Candidate {
     const mcap::Channel* channel;
     const msgs::TopicSpec* spec;
   };
   std::vector<Candidate> candidates;
-  for (const auto& [id, channel] : im.reader.channels()) {
-    const auto schema_it = im.reader.schemas().find(channel.schema_id);
-    if (schema_it == im.reader.schemas().end()) continue;
-    const msgs::TopicSpec* spec = spec_for_type(schema_it->second.name);
-    if (spec == nullptr) continue;
-    if (channel.message_encoding != "cdr") {
-      r->warnings_.push_back("skipping " + channel.topic + ": message encoding \"" +
-                             channel.message_encoding + "\", not cdr");
+  for (const log::RecordedChannel& c : log::recorded_channels(im.reader)) {
+    if (!c.problem.empty()) {
+      r->warnings_.push_back("skipping " + c.channel->topic + ": " + c.problem);
       continue;
     }
-    Result<std::string> ours = msgs::ros2msg_schema(spec->type);
-    const mcap::Bytes& theirs = schema_it->second.data;
-    if (!ours ||
-        std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) != ours.value()) {
-      r->warnings_.push_back("skipping " + channel.topic + ": its " + std::string(spec->type) +
-                             " definition differs from this build's");
-      continue;
-    }
-    candidates.push_back({&channel, spec});
+    candidates.push_back({c.channel, c.spec});
   }
   if (candidates.empty()) {
     std::string why = "none of its channels carries an rbsim message type as CDR";

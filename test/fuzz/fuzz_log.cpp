@@ -1,6 +1,7 @@
 // libFuzzer target: the input handling of `rbsim check` and the other log tools. The input is
 // written to a file (the tools take paths) and given to check (against itself and against a
-// golden log), info, doctor and recover. Each must end with a report or an error, never crash.
+// golden log), info, doctor, recover and the recording reader (every step of every topic). Each
+// must end with a report or an error, never crash.
 #include <unistd.h>
 
 #include <cstddef>
@@ -11,6 +12,7 @@
 
 #include "rbsim/check.hpp"
 #include "rbsim/mcap_tools.hpp"
+#include "rbsim/recording.hpp"
 
 namespace {
 std::string temp_path(const char* what) {
@@ -39,6 +41,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)rbsim::mcap_tools::info(in);
   (void)rbsim::mcap_tools::doctor(in);
   (void)rbsim::mcap_tools::recover(in, out);
+  rbsim::log::RecordingOptions ro;
+  ro.require_scene = false;
+  if (auto recording = rbsim::log::Recording::open(in, ro); recording.ok()) {
+    (void)recording.value()->read_steps(
+        [](const rbsim::log::RecordedStep&) -> rbsim::Status { return rbsim::Ok{}; });
+  }
   std::remove(out.c_str());
   return 0;
 }

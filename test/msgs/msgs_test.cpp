@@ -296,6 +296,86 @@ TEST(DecodeBodyStates, RoundTripsAndRejectsTruncation) {
   }
 }
 
+// The typed decoders of the other per-step messages read what the schema-driven decoder reads,
+// value by value in field order, and refuse truncated bytes.
+TEST(DecodeTyped, SpringStatesEnergyTermsAndPosesAgreeWithTheSchemaDecoder) {
+  rbsim::Scene scene = spring_wind_scene();
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  for (int i = 0; i < 17; ++i) w->step();
+  const rbsim::msgs::Encoder encoder(scene);
+  auto number = [](const Scalar& s) {
+    switch (s.kind) {
+      case Scalar::Kind::Float:
+        return s.f;
+      case Scalar::Kind::Int:
+      case Scalar::Kind::Bool:
+        return static_cast<double>(s.i);
+      default:
+        return static_cast<double>(s.u);
+    }
+  };
+  // The schema decoder's numbers (strings skipped) against the typed message's, flattened.
+  auto expect_same = [&](TopicId id, const rbsim::msgs::Bytes& cdr, const std::vector<double>& typed) {
+    std::vector<Scalar> scalars;
+    ASSERT_TRUE(decoder_for(id).decode(cdr, scalars).ok());
+    std::vector<double> want;
+    for (const Scalar& s : scalars) {
+      if (s.kind != Scalar::Kind::String) want.push_back(number(s));
+    }
+    EXPECT_EQ(typed, want) << rbsim::msgs::topic(id).suffix;
+  };
+  rbsim::msgs::Bytes out;
+  encoder.spring_states(w.value(), out);
+  rbsim::msgs::SpringStatesMessage springs;
+  ASSERT_TRUE(rbsim::msgs::decode_spring_states(out, springs).ok());
+  EXPECT_EQ(springs.step, 17u);
+  ASSERT_FALSE(springs.springs.empty());
+  {
+    std::vector<double> v = {double(springs.stamp.sec), double(springs.stamp.nanosec), double(springs.step),
+                             double(springs.springs.size())};
+    for (const auto& x : springs.springs) {
+      v.insert(v.end(), {double(x.id), x.end_i.x(), x.end_i.y(), x.end_j.x(), x.end_j.y(), x.length,
+                         x.rest_length, x.potential});
+    }
+    expect_same(TopicId::SpringStates, out, v);
+  }
+  for (std::size_t n = 0; n < out.size() - 3; ++n)
+    EXPECT_FALSE(rbsim::msgs::decode_spring_states(std::span(out).first(n), springs).ok()) << n;
+
+  encoder.energy(w.value(), out);
+  rbsim::msgs::EnergyTermsMessage energy;
+  ASSERT_TRUE(rbsim::msgs::decode_energy_terms(out, energy).ok());
+  EXPECT_DOUBLE_EQ(energy.total, w->energy().total());  // summed in another order than Energy::total()
+  {
+    std::vector<double> v = {double(energy.stamp.sec), double(energy.stamp.nanosec), double(energy.step),
+                             double(energy.bodies.size())};
+    for (const auto& b : energy.bodies)
+      v.insert(v.end(),
+               {double(b.id), b.momentum.x(), b.momentum.y(), b.l_point, b.l_spin, b.t_point, b.t_spin});
+    v.push_back(double(energy.forces.size()));
+    for (const auto& f : energy.forces) v.insert(v.end(), {double(f.kind), double(f.index), f.potential});
+    v.insert(v.end(), {energy.momentum.x(), energy.momentum.y(), energy.angular_momentum, energy.potential,
+                       energy.kinetic_point, energy.kinetic_spin, energy.total});
+    expect_same(TopicId::Energy, out, v);
+  }
+  for (std::size_t n = 0; n < out.size() - 3; ++n)
+    EXPECT_FALSE(rbsim::msgs::decode_energy_terms(std::span(out).first(n), energy).ok()) << n;
+
+  encoder.poses(w.value(), out);
+  rbsim::msgs::PosesMessage poses;
+  ASSERT_TRUE(rbsim::msgs::decode_poses(out, poses).ok());
+  ASSERT_EQ(poses.poses.size(), 3u);
+  {
+    std::vector<double> v = {double(poses.stamp.sec), double(poses.stamp.nanosec),
+                             double(poses.poses.size())};
+    for (const auto& p : poses.poses) v.insert(v.end(), {p.x, p.y, p.z, p.qx, p.qy, p.qz, p.qw});
+    expect_same(TopicId::Poses, out, v);
+  }
+  for (std::size_t n = 0; n < out.size() - 3; ++n)
+    EXPECT_FALSE(rbsim::msgs::decode_poses(std::span(out).first(n), poses).ok()) << n;
+}
+
 // Every per-step message names its simulated time (what the recorder counts gaps by); the scene
 // description and bytes too short to hold a stamp give none.
 TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {

@@ -222,7 +222,7 @@ TEST(RenderCli, BadInputGivesAClearErrorAndNonzeroExit) {
     ASSERT_TRUE(w.close().ok());
   }
   EXPECT_EQ(run({RBSIM_BINARY, "render", noscene, "--out", (dir / "g").string()}, &err), 1);
-  EXPECT_NE(err.find("body states before any scene description"), std::string::npos) << err;
+  EXPECT_NE(err.find(noscene + ": no scene description recorded"), std::string::npos) << err;
   // not a scene, not a log
   const fs::path junk = dir / "junk.bin";
   std::ofstream(junk) << "definitely not a scene";

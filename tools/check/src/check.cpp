@@ -318,13 +318,6 @@ Result<Layout> Layout::create(std::string_view type, std::string_view schema) {
   return layout;
 }
 
-int Layout::find(std::string_view path) const {
-  for (std::size_t i = 0; i < groups_.size(); ++i) {
-    if (groups_[i].path == path) return static_cast<int>(i);
-  }
-  return -1;
-}
-
 bool Layout::map(std::span<const msgs::Scalar> s, Plan& plan) const {
   plan.group.clear();
   plan.lengths.clear();
@@ -876,33 +869,7 @@ class Comparer {
       return v;
     }
     static Scalar load(const std::byte* p, std::uint8_t size, Kind kind) {
-      Scalar s;
-      s.kind = kind;
-      switch (kind) {
-        case Kind::Float:
-          if (size == 4) {
-            float f;
-            std::memcpy(&f, p, 4);
-            s.f = f;
-          } else {
-            std::memcpy(&s.f, p, 8);
-          }
-          break;
-        case Kind::Int: {
-          std::uint64_t u = 0;
-          std::memcpy(&u, p, size);
-          const unsigned shift = 64u - 8u * size;
-          s.i = static_cast<std::int64_t>(u << shift) >> shift;
-          break;
-        }
-        case Kind::Bool:
-          s.i = *p != std::byte{0};
-          break;
-        default:
-          std::memcpy(&s.u, p, size);
-          break;
-      }
-      return s;
+      return msgs::load_scalar(p, size, kind);
     }
     // One value pair at x (run) and y (golden).
     void value(const std::byte* x, const std::byte* y, std::uint8_t size, Kind kind, std::uint32_t group) {

@@ -10,10 +10,10 @@
 #include <map>
 #include <sstream>
 
-#include "layout.hpp"
 #include "rbsim/golden.hpp"
 #include "rbsim/io.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/recording.hpp"
 
 namespace rbsim::check {
 
@@ -21,14 +21,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using msgs::Scalar;
-using Kind = Scalar::Kind;
+std::string type_of(msgs::TopicId id) {
+  return std::string(msgs::topic(id).type);
+}
 
-constexpr std::string_view kSceneType = "rbsim_msgs/msg/SceneDescription";
-constexpr std::string_view kBodyStatesType = "rbsim_msgs/msg/BodyStates";
-constexpr std::string_view kSpringStatesType = "rbsim_msgs/msg/SpringStates";
-constexpr std::string_view kEnergyType = "rbsim_msgs/msg/EnergyTerms";
-constexpr std::string_view kPosesType = "geometry_msgs/msg/PoseArray";
+// `get` of every element of `items`, as doubles.
+template <class T, class Get>
+std::vector<double> field(const std::vector<T>& items, Get get) {
+  std::vector<double> out;
+  out.reserve(items.size());
+  for (const T& item : items) out.push_back(static_cast<double>(get(item)));
+  return out;
+}
 
 std::string g17(double v) {
   char buf[40];
@@ -41,117 +45,92 @@ std::string g3(double v) {
   return buf;
 }
 
-double number(const Scalar& s) {
-  switch (s.kind) {
-    case Kind::Float:
-      return s.f;
-    case Kind::Int:
-    case Kind::Bool:
-      return static_cast<double>(s.i);
-    case Kind::UInt:
-    case Kind::Length:
-      return static_cast<double>(s.u);
-    case Kind::String:
-      return std::nan("");
-  }
-  return std::nan("");
-}
-
-// Every message of one topic of a log, decoded.
-struct TopicLog {
-  std::string topic, type;
-  std::optional<msgs::MessageDecoder> decoder;
-  std::optional<Layout> layout;
-  struct Msg {
-    mcap::Timestamp log_time = 0;
-    mcap::Bytes data;  // the scalars' strings point into it
-    std::vector<Scalar> scalars;
-    Plan plan;
-  };
-  std::vector<Msg> messages;
-
-  // The values of field group `path` ("bodies[].x") in message m, in order.
-  std::vector<const Scalar*> values(std::size_t m, std::string_view path) const {
-    std::vector<const Scalar*> out;
-    const int g = layout->find(path);
-    if (g < 0) return out;
-    const Msg& msg = messages[m];
-    for (std::size_t i = 0; i < msg.scalars.size(); ++i) {
-      if (msg.plan.group[i] == static_cast<std::uint32_t>(g)) out.push_back(&msg.scalars[i]);
-    }
-    return out;
-  }
-  std::vector<double> numbers(std::size_t m, std::string_view path) const {
-    std::vector<double> out;
-    for (const Scalar* s : values(m, path)) out.push_back(number(*s));
-    return out;
-  }
-  double one(std::size_t m, std::string_view path) const {
-    const auto v = values(m, path);
-    return v.empty() ? std::nan("") : number(*v.front());
-  }
-  std::string text(std::size_t m, std::string_view path) const {
-    const auto v = values(m, path);
-    return v.empty() || v.front()->kind != Kind::String ? std::string() : std::string(v.front()->s);
-  }
-  std::uint64_t step(std::size_t m) const {
-    const Msg& msg = messages[m];
-    if (msg.plan.step < 0) return UINT64_MAX;
-    const Scalar& s = msg.scalars[static_cast<std::size_t>(msg.plan.step)];
-    return s.kind == Kind::Int ? static_cast<std::uint64_t>(s.i) : s.u;
+// A golden log read whole (goldens are small), typed: the scene description and the per-step
+// topics through the recording reader (topics found by type), the poses and the scene
+// description's count and log time from one pass over those two topics.
+template <class M>
+struct TopicMessages {
+  std::string topic;
+  std::vector<M> messages;
+  std::vector<mcap::Timestamp> log_time;
+  void add(const M& m, mcap::Timestamp t) {
+    messages.push_back(m);
+    log_time.push_back(t);
   }
 };
+struct GoldenLog {
+  std::optional<msgs::SceneMessage> scene;
+  std::uint64_t scene_messages = 0;
+  mcap::Timestamp scene_log_time = 0;  // of the first
+  TopicMessages<msgs::BodyStatesMessage> states;
+  TopicMessages<msgs::SpringStatesMessage> springs;
+  TopicMessages<msgs::EnergyTermsMessage> energy;
+  TopicMessages<msgs::PosesMessage> poses;
+};
 
-// A golden log read whole (goldens are small), topics keyed by message type.
-Result<std::map<std::string, TopicLog>> read_log(const std::string& path) {
+Result<GoldenLog> read_log(const std::string& path) {
+  log::RecordingOptions ro;
+  ro.require_scene = false;  // a missing topic is a failed check, not an unreadable file
+  ro.verify_crc = true;
+  auto recording = log::Recording::open(path, ro);
+  if (!recording) return recording.error();
+  log::Recording& r = *recording.value();
+  GoldenLog g;
+  if (r.scene() != nullptr) g.scene = *r.scene();
+  g.states.topic = r.topic(msgs::TopicId::BodyStates);
+  g.springs.topic = r.topic(msgs::TopicId::SpringStates);
+  g.energy.topic = r.topic(msgs::TopicId::Energy);
+  if (Status st = r.read_steps([&](const log::RecordedStep& s) -> Status {
+        if (s.body_states != nullptr) g.states.add(*s.body_states, s.log_time.body_states);
+        if (s.spring_states != nullptr) g.springs.add(*s.spring_states, s.log_time.spring_states);
+        if (s.energy != nullptr) g.energy.add(*s.energy, s.log_time.energy);
+        return Ok{};
+      });
+      !st) {
+    return st.error();
+  }
+
   mcap::IndexedReader reader;
   if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
-  if (auto st = reader.verify_data_section_crc(); !st.ok()) return Error{path + ": " + st.message};
-  std::map<std::string, TopicLog> topics;
-  std::optional<Error> failure;
-  auto st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
-    if (e.channel == nullptr || e.schema == nullptr || e.schema->encoding != "ros2msg" ||
-        e.channel->message_encoding != "cdr") {
-      return true;  // not one of ours: ignored
-    }
-    TopicLog& t = topics[e.schema->name];
-    if (t.topic.empty()) {
-      t.topic = e.channel->topic;
-      t.type = e.schema->name;
-      const std::string_view text(reinterpret_cast<const char*>(e.schema->data.data()),
-                                  e.schema->data.size());
-      auto decoder = msgs::MessageDecoder::create(t.type, text);
-      auto layout = Layout::create(t.type, text);
-      if (!decoder || !layout) {
-        failure = Error{path + ": schema " + t.type + ": " +
-                        (!decoder ? decoder.error().message : layout.error().message)};
-        return false;
+  std::map<std::uint16_t, msgs::TopicId> route;
+  for (const log::RecordedChannel& c : log::recorded_channels(reader)) {
+    if (c.spec->id == msgs::TopicId::Scene && c.channel->topic == r.topic(msgs::TopicId::Scene)) {
+      route.emplace(c.channel->id, msgs::TopicId::Scene);
+    } else if (c.spec->id == msgs::TopicId::Poses && c.problem.empty()) {
+      if (!g.poses.topic.empty() && g.poses.topic != c.channel->topic) {
+        return Error{path + ": two topics carry " + std::string(c.spec->type) + ": " + g.poses.topic +
+                     " and " + c.channel->topic};
       }
-      t.decoder = std::move(decoder.value());
-      t.layout = std::move(layout.value());
-    } else if (t.topic != e.channel->topic) {
-      failure = Error{path + ": two topics carry " + t.type + ": " + t.topic + " and " + e.channel->topic};
+      g.poses.topic = c.channel->topic;
+      route.emplace(c.channel->id, msgs::TopicId::Poses);
+    }
+  }
+  mcap::ReadMessagesOptions o;
+  for (const std::string& t : {r.topic(msgs::TopicId::Scene), g.poses.topic}) {
+    if (!t.empty()) o.topics.push_back(t);
+  }
+  if (o.topics.empty()) return g;
+  std::optional<Error> failure;
+  msgs::PosesMessage poses;
+  auto st = reader.read_messages(o, [&](const mcap::MessageEntry& e) {
+    const auto it = route.find(e.message.channel_id);
+    if (it == route.end()) return true;
+    if (it->second == msgs::TopicId::Scene) {
+      if (g.scene_messages++ == 0) g.scene_log_time = e.message.log_time;
+      return true;
+    }
+    if (Status d = msgs::decode_poses(std::as_bytes(std::span<const std::uint8_t>(e.message.data)), poses);
+        !d) {
+      failure = Error{path + ": " + g.poses.topic + " message " + std::to_string(g.poses.messages.size()) +
+                      ": " + d.error().message};
       return false;
     }
-    TopicLog::Msg m;
-    m.log_time = e.message.log_time;
-    m.data = e.message.data;
-    if (Status d = t.decoder->decode(std::as_bytes(std::span<const std::uint8_t>(m.data)), m.scalars); !d) {
-      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) + ": " +
-                      d.error().message};
-      return false;
-    }
-    if (!t.layout->map(m.scalars, m.plan)) {
-      failure = Error{path + ": " + t.topic + " message " + std::to_string(t.messages.size()) +
-                      " does not fit its schema"};
-      return false;
-    }
-    t.messages.push_back(std::move(m));
+    g.poses.add(poses, e.message.log_time);
     return true;
   });
   if (!st.ok()) return Error{path + ": " + st.message};
   if (failure) return *failure;
-  return topics;
+  return g;
 }
 
 // The largest deviation of a set of comparisons, and the first one outside its tolerance.
@@ -451,12 +430,10 @@ FosssimMatch find_fosssim_reference(const std::string& scene_path, const std::st
 Result<std::int64_t> read_record_every(const std::string& golden_path) {
   auto log = read_log(golden_path);
   if (!log) return log.error();
-  const auto it = log->find(std::string(kBodyStatesType));
-  if (it == log->end() || it->second.messages.empty())
-    return Error{golden_path + ": no body states recorded"};
-  const TopicLog& t = it->second;
-  if (t.messages.size() < 2) return std::int64_t{1};
-  return static_cast<std::int64_t>(t.step(1) - t.step(0));
+  const auto& t = log->states.messages;
+  if (t.empty()) return Error{golden_path + ": no body states recorded"};
+  if (t.size() < 2) return std::int64_t{1};
+  return static_cast<std::int64_t>(t[1].step - t[0].step);
 }
 
 Result<GoldenVerification> verify_golden(const std::string& scene_path, const std::string& golden_path,
@@ -466,7 +443,7 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   const Scene& scene = loaded.value();
   auto log_result = read_log(golden_path);
   if (!log_result) return log_result.error();
-  const std::map<std::string, TopicLog>& topics = log_result.value();
+  const GoldenLog& golden = log_result.value();
 
   GoldenVerification v;
   Report r{v};
@@ -475,22 +452,19 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   const double dt = scene.world.dt;
   v.steps = scene.step_count();
 
-  auto topic = [&](std::string_view type) -> const TopicLog* {
-    const auto it = topics.find(std::string(type));
-    return it == topics.end() || it->second.messages.empty() ? nullptr : &it->second;
-  };
-  const TopicLog* desc = topic(kSceneType);
-  const TopicLog* states = topic(kBodyStatesType);
-  const TopicLog* springs = topic(kSpringStatesType);
-  const TopicLog* energy = topic(kEnergyType);
-  const TopicLog* poses = topic(kPosesType);
-  for (auto [t, type] : {std::pair{desc, kSceneType},
-                         {states, kBodyStatesType},
-                         {springs, kSpringStatesType},
-                         {energy, kEnergyType}}) {
-    if (t == nullptr) r.line(false, "recording: no " + std::string(type) + " messages");
+  using msgs::TopicId;
+  for (auto [missing, id] : {std::pair{!golden.scene, TopicId::Scene},
+                             {golden.states.messages.empty(), TopicId::BodyStates},
+                             {golden.springs.messages.empty(), TopicId::SpringStates},
+                             {golden.energy.messages.empty(), TopicId::Energy}}) {
+    if (missing) r.line(false, "recording: no " + type_of(id) + " messages");
   }
   if (r.failed) return v;
+  const msgs::SceneMessage& desc = *golden.scene;
+  const auto& states = golden.states;
+  const auto& springs = golden.springs;
+  const auto& energy = golden.energy;
+  const bool poses = !golden.poses.messages.empty();
 
   // 1. The recorded scene description against the scene file.
   {
@@ -501,20 +475,27 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     auto rel = [&](double got, double want, const std::string& what) {
       tally.add(got, want, 1e-12 * std::max(1.0, std::fabs(want)), [&] { return what; });
     };
-    if (desc->messages.size() != 1 || desc->messages[0].log_time != 0) {
+    if (golden.scene_messages != 1 || golden.scene_log_time != 0) {
       tally.fail("expected one scene description at log time 0, found " +
-                 std::to_string(desc->messages.size()));
+                 std::to_string(golden.scene_messages));
     }
-    if (desc->text(0, "integrator") != to_string(scene.world.integrator)) {
-      tally.fail("integrator '" + desc->text(0, "integrator") + "', scene " +
-                 to_string(scene.world.integrator));
+    if (desc.integrator != to_string(scene.world.integrator)) {
+      tally.fail("integrator '" + desc.integrator + "', scene " + to_string(scene.world.integrator));
     }
-    exact(desc->one(0, "dt"), dt, "dt");
-    exact(desc->one(0, "duration"), scene.duration, "duration");
-    exact(desc->one(0, "step_count"), static_cast<double>(v.steps), "step_count");
-    const auto mass = desc->numbers(0, "bodies[].mass"), inertia = desc->numbers(0, "bodies[].inertia");
-    const auto hull_n = desc->numbers(0, "bodies[].hull.length");
-    const auto hx = desc->numbers(0, "bodies[].hull[].x"), hy = desc->numbers(0, "bodies[].hull[].y");
+    exact(desc.dt, dt, "dt");
+    exact(desc.duration, scene.duration, "duration");
+    exact(static_cast<double>(desc.step_count), static_cast<double>(v.steps), "step_count");
+    using Body = msgs::SceneMessage::Body;
+    const auto mass = field(desc.bodies, [](const Body& b) { return b.mass; });
+    const auto inertia = field(desc.bodies, [](const Body& b) { return b.inertia; });
+    const auto hull_n = field(desc.bodies, [](const Body& b) { return b.hull.size(); });
+    std::vector<double> hx, hy;
+    for (const Body& b : desc.bodies) {
+      for (const Vec2& p : b.hull) {
+        hx.push_back(p.x());
+        hy.push_back(p.y());
+      }
+    }
     exact(static_cast<double>(mass.size()), static_cast<double>(bodies), "body count");
     std::size_t h = 0;
     for (std::size_t b = 0; b < std::min(bodies, mass.size()); ++b) {
@@ -528,10 +509,15 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         rel(hy[h], want.y(), id + " hull vertex " + std::to_string(k) + " y");
       }
     }
-    const auto bi = desc->numbers(0, "springs[].body_i"), bj = desc->numbers(0, "springs[].body_j");
-    const auto aix = desc->numbers(0, "springs[].anchor_i.x"), aiy = desc->numbers(0, "springs[].anchor_i.y");
-    const auto ajx = desc->numbers(0, "springs[].anchor_j.x"), ajy = desc->numbers(0, "springs[].anchor_j.y");
-    const auto k = desc->numbers(0, "springs[].stiffness"), l0 = desc->numbers(0, "springs[].rest_length");
+    const auto& ds = desc.springs;
+    const auto bi = field(ds, [](const SpringDef& d) { return d.body_i; });
+    const auto bj = field(ds, [](const SpringDef& d) { return d.body_j; });
+    const auto aix = field(ds, [](const SpringDef& d) { return d.anchor_i.x(); });
+    const auto aiy = field(ds, [](const SpringDef& d) { return d.anchor_i.y(); });
+    const auto ajx = field(ds, [](const SpringDef& d) { return d.anchor_j.x(); });
+    const auto ajy = field(ds, [](const SpringDef& d) { return d.anchor_j.y(); });
+    const auto k = field(ds, [](const SpringDef& d) { return d.stiffness; });
+    const auto l0 = field(ds, [](const SpringDef& d) { return d.rest_length; });
     exact(static_cast<double>(k.size()), static_cast<double>(model.springs.size()), "spring count");
     for (std::size_t s = 0; s < std::min(k.size(), model.springs.size()); ++s) {
       const SpringDef& sp = model.springs[s];
@@ -545,15 +531,17 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       exact(k[s], sp.stiffness, id + " stiffness");
       exact(l0[s], sp.rest_length, id + " rest_length");
     }
-    const auto gx = desc->numbers(0, "gravity[].acceleration.x"),
-               gy = desc->numbers(0, "gravity[].acceleration.y");
+    const auto gx = field(desc.gravity, [](const GravityDef& d) { return d.acceleration.x(); });
+    const auto gy = field(desc.gravity, [](const GravityDef& d) { return d.acceleration.y(); });
     exact(static_cast<double>(gx.size()), static_cast<double>(model.gravity.size()), "gravity count");
     for (std::size_t g = 0; g < std::min(gx.size(), model.gravity.size()); ++g) {
       exact(gx[g], model.gravity[g].acceleration.x(), "gravity " + std::to_string(g) + " x");
       exact(gy[g], model.gravity[g].acceleration.y(), "gravity " + std::to_string(g) + " y");
     }
-    const auto beta = desc->numbers(0, "winds[].beta"), wx = desc->numbers(0, "winds[].velocity.x");
-    const auto wy = desc->numbers(0, "winds[].velocity.y"), ppe = desc->numbers(0, "winds[].points_per_edge");
+    const auto beta = field(desc.winds, [](const WindDef& d) { return d.beta; });
+    const auto wx = field(desc.winds, [](const WindDef& d) { return d.velocity.x(); });
+    const auto wy = field(desc.winds, [](const WindDef& d) { return d.velocity.y(); });
+    const auto ppe = field(desc.winds, [](const WindDef& d) { return d.points_per_edge; });
     exact(static_cast<double>(beta.size()), static_cast<double>(scene.world.winds.size()), "wind count");
     for (std::size_t w = 0; w < std::min(beta.size(), scene.world.winds.size()); ++w) {
       const WindDef& wd = scene.world.winds[w];
@@ -580,20 +568,22 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
 
   // 2. The recording: steps 0, K, 2K, ... up to the end of the run, stamped t = step * dt, the
   //    same steps on every per-step topic, the initial state from the scene.
-  std::vector<State> state(states->messages.size());
-  std::vector<std::uint64_t> steps(states->messages.size());
+  std::vector<State> state(states.messages.size());
+  std::vector<std::uint64_t> steps(states.messages.size());
   {
     Tally tally;
-    for (std::size_t m = 0; m < states->messages.size(); ++m) {
-      steps[m] = states->step(m);
+    using Body = msgs::BodyStatesMessage::Body;
+    for (std::size_t m = 0; m < states.messages.size(); ++m) {
+      const msgs::BodyStatesMessage& msg = states.messages[m];
+      steps[m] = msg.step;
       State& s = state[m];
-      s.x = states->numbers(m, "bodies[].x");
-      s.y = states->numbers(m, "bodies[].y");
-      s.theta = states->numbers(m, "bodies[].theta");
-      s.vx = states->numbers(m, "bodies[].vx");
-      s.vy = states->numbers(m, "bodies[].vy");
-      s.omega = states->numbers(m, "bodies[].omega");
-      const auto ids = states->numbers(m, "bodies[].id");
+      s.x = field(msg.bodies, [](const Body& b) { return b.state.position.x(); });
+      s.y = field(msg.bodies, [](const Body& b) { return b.state.position.y(); });
+      s.theta = field(msg.bodies, [](const Body& b) { return b.state.theta; });
+      s.vx = field(msg.bodies, [](const Body& b) { return b.state.velocity.x(); });
+      s.vy = field(msg.bodies, [](const Body& b) { return b.state.velocity.y(); });
+      s.omega = field(msg.bodies, [](const Body& b) { return b.state.omega; });
+      const auto ids = field(msg.bodies, [](const Body& b) { return b.id; });
       if (s.x.size() != bodies || s.omega.size() != bodies || ids.size() != bodies) {
         tally.fail("step message " + std::to_string(m) + " holds " + std::to_string(s.x.size()) + " bodies");
         state.resize(m);
@@ -616,9 +606,9 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         break;
       }
       const std::uint64_t ns = stamp_ns(steps[m], dt);
-      tally.add(static_cast<double>(states->messages[m].log_time), static_cast<double>(ns), 0.0,
+      tally.add(static_cast<double>(states.log_time[m]), static_cast<double>(ns), 0.0,
                 [&] { return "step " + std::to_string(steps[m]) + " log time"; });
-      const double sec = states->one(m, "header.stamp.sec"), nsec = states->one(m, "header.stamp.nanosec");
+      const double sec = states.messages[m].stamp.sec, nsec = states.messages[m].stamp.nanosec;
       tally.add(sec * 1e9 + nsec, static_cast<double>(ns), 0.0,
                 [&] { return "step " + std::to_string(steps[m]) + " header stamp"; });
     }
@@ -628,20 +618,31 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       tally.fail("the recording ends at step " + std::to_string(steps.back()) + ", the scene runs " +
                  std::to_string(v.steps) + " steps");
     }
-    for (const TopicLog* t : {springs, energy, poses}) {
-      if (t == nullptr) continue;
-      if (t->messages.size() != states->messages.size()) {
-        tally.fail(t->topic + " has " + std::to_string(t->messages.size()) + " messages, " + states->topic +
-                   " " + std::to_string(states->messages.size()));
+    // The other per-step topics: their topic, log times and steps (none for poses).
+    struct Other {
+      const std::string& topic;
+      const std::vector<mcap::Timestamp>& log_time;
+      std::vector<std::uint64_t> steps;
+    };
+    std::vector<Other> others = {
+        {springs.topic, springs.log_time, {}},
+        {energy.topic, energy.log_time, {}},
+    };
+    for (const auto& msg : springs.messages) others[0].steps.push_back(msg.step);
+    for (const auto& msg : energy.messages) others[1].steps.push_back(msg.step);
+    if (poses) others.push_back({golden.poses.topic, golden.poses.log_time, {}});
+    for (const Other& t : others) {
+      if (t.log_time.size() != states.messages.size()) {
+        tally.fail(t.topic + " has " + std::to_string(t.log_time.size()) + " messages, " + states.topic +
+                   " " + std::to_string(states.messages.size()));
         continue;
       }
       for (std::size_t m = 0; m < steps.size(); ++m) {
-        tally.add(static_cast<double>(t->messages[m].log_time),
-                  static_cast<double>(states->messages[m].log_time), 0.0,
-                  [&] { return t->topic + " message " + std::to_string(m) + " log time"; });
-        if (t->layout->has_step()) {
-          tally.add(static_cast<double>(t->step(m)), static_cast<double>(steps[m]), 0.0,
-                    [&] { return t->topic + " message " + std::to_string(m) + " step"; });
+        tally.add(static_cast<double>(t.log_time[m]), static_cast<double>(states.log_time[m]), 0.0,
+                  [&] { return t.topic + " message " + std::to_string(m) + " log time"; });
+        if (!t.steps.empty()) {
+          tally.add(static_cast<double>(t.steps[m]), static_cast<double>(steps[m]), 0.0,
+                    [&] { return t.topic + " message " + std::to_string(m) + " step"; });
         }
       }
     }
@@ -679,9 +680,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
           return at + " " + what + (i == SIZE_MAX ? std::string() : " [" + std::to_string(i) + "]");
         });
       };
-      auto each = [&](Tally& tally, const TopicLog* t_log, const char* path,
+      auto each = [&](Tally& tally, const std::vector<double>& got, const char* path,
                       const std::vector<double>& want) {
-        const auto got = t_log->numbers(m, path);
         if (got.size() != want.size()) {
           tally.fail(at + " " + path + ": " + std::to_string(got.size()) + " values, expected " +
                      std::to_string(want.size()));
@@ -689,20 +689,23 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         }
         for (std::size_t i = 0; i < got.size(); ++i) near(tally, got[i], want[i], path, i);
       };
-      each(e, energy, "bodies[].momentum.x", t.px);
-      each(e, energy, "bodies[].momentum.y", t.py);
-      each(e, energy, "bodies[].l_point", t.l_point);
-      each(e, energy, "bodies[].l_spin", t.l_spin);
-      each(e, energy, "bodies[].t_point", t.t_point);
-      each(e, energy, "bodies[].t_spin", t.t_spin);
-      each(e, energy, "forces[].potential", t.force_potential);
-      near(e, energy->one(m, "momentum.x"), t.momentum_x, "momentum.x");
-      near(e, energy->one(m, "momentum.y"), t.momentum_y, "momentum.y");
-      near(e, energy->one(m, "angular_momentum"), t.angular, "angular_momentum");
-      near(e, energy->one(m, "potential"), t.potential, "potential");
-      near(e, energy->one(m, "kinetic_point"), t.kinetic_point, "kinetic_point");
-      near(e, energy->one(m, "kinetic_spin"), t.kinetic_spin, "kinetic_spin");
-      near(e, energy->one(m, "total"), t.total, "total");
+      using EBody = msgs::EnergyTermsMessage::Body;
+      const msgs::EnergyTermsMessage& en = energy.messages[m];
+      each(e, field(en.bodies, [](const EBody& b) { return b.momentum.x(); }), "bodies[].momentum.x", t.px);
+      each(e, field(en.bodies, [](const EBody& b) { return b.momentum.y(); }), "bodies[].momentum.y", t.py);
+      each(e, field(en.bodies, [](const EBody& b) { return b.l_point; }), "bodies[].l_point", t.l_point);
+      each(e, field(en.bodies, [](const EBody& b) { return b.l_spin; }), "bodies[].l_spin", t.l_spin);
+      each(e, field(en.bodies, [](const EBody& b) { return b.t_point; }), "bodies[].t_point", t.t_point);
+      each(e, field(en.bodies, [](const EBody& b) { return b.t_spin; }), "bodies[].t_spin", t.t_spin);
+      each(e, field(en.forces, [](const msgs::EnergyTermsMessage::Force& f) { return f.potential; }),
+           "forces[].potential", t.force_potential);
+      near(e, en.momentum.x(), t.momentum_x, "momentum.x");
+      near(e, en.momentum.y(), t.momentum_y, "momentum.y");
+      near(e, en.angular_momentum, t.angular, "angular_momentum");
+      near(e, en.potential, t.potential, "potential");
+      near(e, en.kinetic_point, t.kinetic_point, "kinetic_point");
+      near(e, en.kinetic_spin, t.kinetic_spin, "kinetic_spin");
+      near(e, en.total, t.total, "total");
       std::vector<double> ex, ey, fx, fy, len, rest, pot;
       for (std::size_t k = 0; k < t.springs.size(); ++k) {
         ex.push_back(t.springs[k].end_i.x());
@@ -713,23 +716,27 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         rest.push_back(model.springs[k].rest_length);
         pot.push_back(t.springs[k].potential);
       }
-      each(sp, springs, "springs[].end_i.x", ex);
-      each(sp, springs, "springs[].end_i.y", ey);
-      each(sp, springs, "springs[].end_j.x", fx);
-      each(sp, springs, "springs[].end_j.y", fy);
-      each(sp, springs, "springs[].length", len);
-      each(sp, springs, "springs[].rest_length", rest);
-      each(sp, springs, "springs[].potential", pot);
-      if (poses != nullptr) {
+      using SState = msgs::SpringStatesMessage::Spring;
+      const auto& ss = springs.messages[m].springs;
+      each(sp, field(ss, [](const SState& x) { return x.end_i.x(); }), "springs[].end_i.x", ex);
+      each(sp, field(ss, [](const SState& x) { return x.end_i.y(); }), "springs[].end_i.y", ey);
+      each(sp, field(ss, [](const SState& x) { return x.end_j.x(); }), "springs[].end_j.x", fx);
+      each(sp, field(ss, [](const SState& x) { return x.end_j.y(); }), "springs[].end_j.y", fy);
+      each(sp, field(ss, [](const SState& x) { return x.length; }), "springs[].length", len);
+      each(sp, field(ss, [](const SState& x) { return x.rest_length; }), "springs[].rest_length", rest);
+      each(sp, field(ss, [](const SState& x) { return x.potential; }), "springs[].potential", pot);
+      if (poses) {
+        using Pose = msgs::PosesMessage::Pose;
+        const auto& ps = golden.poses.messages[m].poses;
         std::vector<double> qz, qw;
         for (std::size_t b = 0; b < bodies; ++b) {
           qz.push_back(std::sin(0.5 * state[m].theta[b]));
           qw.push_back(std::cos(0.5 * state[m].theta[b]));
         }
-        each(po, poses, "poses[].position.x", state[m].x);
-        each(po, poses, "poses[].position.y", state[m].y);
-        each(po, poses, "poses[].orientation.z", qz);
-        each(po, poses, "poses[].orientation.w", qw);
+        each(po, field(ps, [](const Pose& p) { return p.x; }), "poses[].position.x", state[m].x);
+        each(po, field(ps, [](const Pose& p) { return p.y; }), "poses[].position.y", state[m].y);
+        each(po, field(ps, [](const Pose& p) { return p.qz; }), "poses[].orientation.z", qz);
+        each(po, field(ps, [](const Pose& p) { return p.qw; }), "poses[].orientation.w", qw);
       }
     }
     const std::string tol = " (tolerance " + g3(rtol) + " x max(1, |value|))";
@@ -739,8 +746,7 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
                e.summary());
     r.line(sp.ok(), "spring states: endpoints, lengths and potentials recomputed from the recorded poses" +
                         tol + ": " + sp.summary());
-    if (poses != nullptr)
-      r.line(po.ok(), "poses: positions and orientation quaternions" + tol + ": " + po.summary());
+    if (poses) r.line(po.ok(), "poses: positions and orientation quaternions" + tol + ": " + po.summary());
   }
 
   // 4. The dynamics, re-integrated independently: from each recorded state, K steps of the
@@ -795,10 +801,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     const FosssimLog& rl = ref.value();
     for (std::size_t b = 0; b < bodies; ++b) {
       const std::string id = "body " + std::to_string(b);
-      q.add(desc->numbers(0, "bodies[].mass")[b], rl.mass[b], options.quantity_tol,
-            [&] { return id + " M"; });
-      q.add(desc->numbers(0, "bodies[].inertia")[b], rl.inertia[b], options.quantity_tol,
-            [&] { return id + " I"; });
+      q.add(desc.bodies[b].mass, rl.mass[b], options.quantity_tol, [&] { return id + " M"; });
+      q.add(desc.bodies[b].inertia, rl.inertia[b], options.quantity_tol, [&] { return id + " I"; });
     }
     for (std::size_t m = 0; m < state.size(); ++m) {
       if (steps[m] >= rl.frames.size()) {
@@ -823,14 +827,15 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         st.add(s.omega[b], want.omega, tol, where("omega"));
         const BodyQuantities& wq = f.quantities[b];
         const double qt = options.quantity_tol;
-        q.add(energy->numbers(m, "bodies[].momentum.x")[b], wq.momentum.x(), qt, where("P.x"));
-        q.add(energy->numbers(m, "bodies[].momentum.y")[b], wq.momentum.y(), qt, where("P.y"));
-        q.add(energy->numbers(m, "bodies[].l_point")[b], wq.l_point, qt, where("L_point"));
-        q.add(energy->numbers(m, "bodies[].l_spin")[b], wq.l_spin, qt, where("L_spin"));
-        q.add(energy->numbers(m, "bodies[].t_point")[b], wq.t_point, qt, where("T_point"));
-        q.add(energy->numbers(m, "bodies[].t_spin")[b], wq.t_spin, qt, where("T_spin"));
+        const msgs::EnergyTermsMessage::Body& eb = energy.messages[m].bodies[b];
+        q.add(eb.momentum.x(), wq.momentum.x(), qt, where("P.x"));
+        q.add(eb.momentum.y(), wq.momentum.y(), qt, where("P.y"));
+        q.add(eb.l_point, wq.l_point, qt, where("L_point"));
+        q.add(eb.l_spin, wq.l_spin, qt, where("L_spin"));
+        q.add(eb.t_point, wq.t_point, qt, where("T_point"));
+        q.add(eb.t_spin, wq.t_spin, qt, where("T_spin"));
       }
-      q.add(energy->one(m, "potential"), f.potential, options.quantity_tol,
+      q.add(energy.messages[m].potential, f.potential, options.quantity_tol,
             [&] { return "step " + std::to_string(steps[m]) + " U"; });
     }
     r.line(st.ok(), "body states of the " + std::to_string(state.size()) +

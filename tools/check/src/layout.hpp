@@ -1,4 +1,4 @@
-// The field layout of a ros2msg schema, for the golden-log checks: every scalar that
+// The field layout of a ros2msg schema, for rbsim check's comparer: every scalar that
 // msgs::MessageDecoder produces for a message maps to a field group, its path with array indices
 // collapsed ("bodies[].x", "bodies.length"). The schema is parsed by the decoder's own rules.
 #pragma once
@@ -47,8 +47,6 @@ class Layout {
 
   const std::vector<FieldGroup>& groups() const { return groups_; }
   bool has_step() const { return has_step_; }
-  // The group id of `path`, or -1.
-  int find(std::string_view path) const;
   bool same_fields(const Layout& other) const { return groups_ == other.groups_; }
 
   // Fills `plan` for the scalars of one decoded message; false when they do not fit the schema.

@@ -92,32 +92,9 @@ class Walker {
       s.s = std::string_view(reinterpret_cast<const char*>(cdr_.data() + pos_), n - 1);
       pos_ += n;
     } else {
-      std::uint8_t raw[8] = {};
+      std::byte raw[8] = {};
       if (!read(p.size, raw)) return false;
-      switch (p.kind) {
-        case Scalar::Kind::Float:
-          if (p.size == 4) {
-            float v;
-            std::memcpy(&v, raw, 4);
-            s.f = v;
-          } else {
-            std::memcpy(&s.f, raw, 8);
-          }
-          break;
-        case Scalar::Kind::Int: {
-          std::uint64_t u = 0;
-          std::memcpy(&u, raw, p.size);
-          const unsigned shift = 64u - 8u * p.size;  // sign-extend
-          s.i = static_cast<std::int64_t>(u << shift) >> shift;
-          break;
-        }
-        case Scalar::Kind::Bool:
-          s.i = raw[0] != 0;
-          break;
-        default:
-          std::memcpy(&s.u, raw, p.size);
-          break;
-      }
+      s = load_scalar(raw, p.size, p.kind);
     }
     visit.scalar(s, false);
     return true;

@@ -37,6 +37,14 @@ class Reader {
     pos_ += n;
     return s;
   }
+  void skip_string() {
+    const auto n = get<std::uint32_t>();
+    if (!ok_ || n == 0 || n > d_.size() - pos_) {
+      ok_ = false;
+      return;
+    }
+    pos_ += n;
+  }
   // A sequence length, bounded by the bytes left (every element takes at least `min_size`).
   std::uint32_t length(std::size_t min_size) {
     const auto n = get<std::uint32_t>();
@@ -134,7 +142,7 @@ Result<SceneMessage> decode_scene(std::span<const std::byte> cdr) {
 Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out) {
   Reader r(cdr);
   out.stamp = r.time();
-  (void)r.string();
+  r.skip_string();  // frame_id
   out.step = r.get<std::uint64_t>();
   out.bodies.resize(r.length(52));
   for (auto& b : out.bodies) {
@@ -145,6 +153,72 @@ Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out
     b.state.omega = r.get<double>();
   }
   if (!r.ok()) return bad("BodyStates");
+  return Ok{};
+}
+
+Status decode_spring_states(std::span<const std::byte> cdr, SpringStatesMessage& out) {
+  Reader r(cdr);
+  out.stamp = r.time();
+  r.skip_string();  // frame_id
+  out.step = r.get<std::uint64_t>();
+  out.springs.resize(r.length(60));
+  for (auto& s : out.springs) {
+    s.id = r.get<std::int32_t>();
+    s.end_i = r.vec2();
+    s.end_j = r.vec2();
+    s.length = r.get<double>();
+    s.rest_length = r.get<double>();
+    s.potential = r.get<double>();
+  }
+  if (!r.ok()) return bad("SpringStates");
+  return Ok{};
+}
+
+Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out) {
+  Reader r(cdr);
+  out.stamp = r.time();
+  r.skip_string();  // frame_id
+  out.step = r.get<std::uint64_t>();
+  out.bodies.resize(r.length(52));
+  for (auto& b : out.bodies) {
+    b.id = r.get<std::int32_t>();
+    b.momentum = r.vec2();
+    b.l_point = r.get<double>();
+    b.l_spin = r.get<double>();
+    b.t_point = r.get<double>();
+    b.t_spin = r.get<double>();
+  }
+  out.forces.resize(r.length(13));
+  for (auto& f : out.forces) {
+    f.kind = r.get<std::uint8_t>();
+    f.index = r.get<std::int32_t>();
+    f.potential = r.get<double>();
+  }
+  out.momentum = r.vec2();
+  out.angular_momentum = r.get<double>();
+  out.potential = r.get<double>();
+  out.kinetic_point = r.get<double>();
+  out.kinetic_spin = r.get<double>();
+  out.total = r.get<double>();
+  if (!r.ok()) return bad("EnergyTerms");
+  return Ok{};
+}
+
+Status decode_poses(std::span<const std::byte> cdr, PosesMessage& out) {
+  Reader r(cdr);
+  out.stamp = r.time();
+  r.skip_string();  // frame_id
+  out.poses.resize(r.length(56));
+  for (auto& p : out.poses) {
+    p.x = r.get<double>();
+    p.y = r.get<double>();
+    p.z = r.get<double>();
+    p.qx = r.get<double>();
+    p.qy = r.get<double>();
+    p.qz = r.get<double>();
+    p.qw = r.get<double>();
+  }
+  if (!r.ok()) return bad("PoseArray");
   return Ok{};
 }
 

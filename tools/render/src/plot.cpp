@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "process.hpp"
-#include "rbsim/mcap.hpp"
+#include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
 
@@ -63,40 +63,27 @@ Result<std::vector<Sample>> samples_from_scene(const std::string& path, std::opt
   return std::move(sink.samples());
 }
 
-// The totals at the end of rbsim_msgs/msg/EnergyTerms, found by name in the file's schema.
+// The totals of every recorded rbsim_msgs/msg/EnergyTerms, at the time its header stamp says.
 Result<std::vector<Sample>> samples_from_log(const std::string& path) {
-  mcap::IndexedReader reader;
-  if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
+  log::RecordingOptions ro;
+  ro.read = {msgs::TopicId::Energy};
+  ro.require = {msgs::TopicId::Energy};
+  ro.require_scene = false;
+  auto recording = log::Recording::open(path, ro);
+  if (!recording) return recording.error();
   std::vector<Sample> out;
-  std::optional<msgs::MessageDecoder> decoder;
-  std::vector<msgs::Scalar> v;
-  std::string failure;
-  auto st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
-    if (e.schema == nullptr || e.schema->name != "rbsim_msgs/msg/EnergyTerms") return true;
-    const std::span<const std::byte> data(reinterpret_cast<const std::byte*>(e.message.data.data()),
-                                          e.message.data.size());
-    if (!decoder) {
-      auto d = msgs::MessageDecoder::create(
-          e.schema->name,
-          std::string_view(reinterpret_cast<const char*>(e.schema->data.data()), e.schema->data.size()));
-      if (!d) return failure = d.error().message, false;
-      decoder = std::move(d.value());
-    }
-    if (Status s = decoder->decode(data, v); !s || v.size() < 9) {
-      return failure = "bad EnergyTerms message", false;
-    }
-    const std::size_t n = v.size();
-    if (decoder->path(data, n - 7) != "momentum.x" || decoder->path(data, n - 1) != "total") {
-      return failure = "EnergyTerms schema is not the one this rbsim writes", false;
-    }
-    const double t = static_cast<double>(v[0].i) + 1e-9 * static_cast<double>(v[1].u);
-    out.push_back({t, v[n - 3].f, v[n - 2].f, v[n - 4].f, v[n - 1].f, v[n - 7].f, v[n - 6].f, v[n - 5].f});
-    return true;
+  Status st = recording.value()->read_steps([&](const log::RecordedStep& step) -> Status {
+    if (step.energy == nullptr) return Ok{};
+    const msgs::EnergyTermsMessage& e = *step.energy;
+    const double t = static_cast<double>(e.stamp.sec) + 1e-9 * static_cast<double>(e.stamp.nanosec);
+    out.push_back({t, e.kinetic_point, e.kinetic_spin, e.potential, e.total, e.momentum.x(), e.momentum.y(),
+                   e.angular_momentum});
+    return Ok{};
   });
-  if (!st.ok()) return Error{path + ": " + st.message};
-  if (!failure.empty()) return Error{path + ": " + failure};
+  if (!st) return st.error();
   if (out.empty())
-    return Error{path + ": the log has no energy terms (topic of type rbsim_msgs/msg/EnergyTerms)"};
+    return Error{path + ": no energy terms recorded (topic " +
+                 recording.value()->topic(msgs::TopicId::Energy) + ")"};
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include "process.hpp"
 
 #include "rbsim/mcap.hpp"
+#include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
 
@@ -94,45 +95,6 @@ class FrameSink final : public Sink {
   std::vector<Pose> poses_;
 };
 
-std::span<const std::byte> bytes_of(const mcap::Message& m) {
-  return {reinterpret_cast<const std::byte*>(m.data.data()), m.data.size()};
-}
-
-// Calls on_scene once, then on_states for each recorded body-state message in step order.
-Status read_recording(const std::string& path,
-                      const std::function<Status(const msgs::SceneMessage&)>& on_scene,
-                      const std::function<Status(const msgs::BodyStatesMessage&)>& on_states) {
-  mcap::IndexedReader reader;
-  if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
-  std::optional<msgs::SceneMessage> scene;
-  msgs::BodyStatesMessage states;
-  Status result = Ok{};
-  auto st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
-    if (e.schema == nullptr) return true;
-    if (e.schema->name == "rbsim_msgs/msg/SceneDescription" && !scene) {
-      auto decoded = msgs::decode_scene(bytes_of(e.message));
-      if (!decoded) return result = Error{path + ": " + decoded.error().message}, false;
-      scene = decoded.value();
-      if (Status s = on_scene(*scene); !s) return result = s, false;
-    } else if (e.schema->name == "rbsim_msgs/msg/BodyStates") {
-      if (!scene) return result = Error{path + ": body states before any scene description"}, false;
-      if (Status s = msgs::decode_body_states(bytes_of(e.message), states); !s) {
-        return result = Error{path + ": " + s.error().message}, false;
-      }
-      if (states.bodies.size() != scene->bodies.size()) {
-        return result = Error{path + ": body states do not match the scene description"}, false;
-      }
-      if (Status s = on_states(states); !s) return result = s, false;
-    }
-    return true;
-  });
-  if (!st.ok()) return Error{path + ": " + st.message};
-  if (!result) return result;
-  if (!scene)
-    return Error{path + ": the log has no scene description (topic of type rbsim_msgs/msg/SceneDescription)"};
-  return Ok{};
-}
-
 }  // namespace
 
 namespace detail {
@@ -169,20 +131,20 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
   FrameWriter frames(o.out_dir, o.width, o.height, o.fps);
   std::vector<Pose> poses;
   if (detail::is_mcap(input)) {
-    Stage stage;
-    Status st = read_recording(
-        input,
-        [&](const msgs::SceneMessage& m) {
-          stage = stage_of(m);
-          if (o.duration) stage.duration = *o.duration;
-          return frames.open();
-        },
-        [&](const msgs::BodyStatesMessage& m) {
-          poses.clear();
-          for (const auto& b : m.bodies)
-            poses.push_back({b.state.position.x(), b.state.position.y(), b.state.theta});
-          return frames.offer(stage, static_cast<std::int64_t>(m.step), stage.dt, poses);
-        });
+    log::RecordingOptions ro;
+    ro.read = {msgs::TopicId::BodyStates};
+    auto recording = log::Recording::open(input, ro);
+    if (!recording) return recording.error();
+    Stage stage = stage_of(*recording.value()->scene());
+    if (o.duration) stage.duration = *o.duration;
+    if (Status st = frames.open(); !st) return st.error();
+    Status st = recording.value()->read_steps([&](const log::RecordedStep& step) -> Status {
+      if (step.body_states == nullptr) return Ok{};
+      poses.clear();
+      for (const auto& b : step.body_states->bodies)
+        poses.push_back({b.state.position.x(), b.state.position.y(), b.state.theta});
+      return frames.offer(stage, static_cast<std::int64_t>(step.step), stage.dt, poses);
+    });
     if (!st) return st.error();
     return frames.frames();
   }

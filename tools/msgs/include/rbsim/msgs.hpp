@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <optional>
 #include <span>
@@ -131,9 +132,52 @@ struct BodyStatesMessage {
   };
   std::vector<Body> bodies;
 };
+struct SpringStatesMessage {
+  Time stamp;
+  std::uint64_t step = 0;
+  struct Spring {
+    std::int32_t id = 0;
+    Vec2 end_i{0.0, 0.0}, end_j{0.0, 0.0};  // world endpoints
+    double length = 0.0, rest_length = 0.0, potential = 0.0;
+  };
+  std::vector<Spring> springs;
+};
+struct EnergyTermsMessage {
+  Time stamp;
+  std::uint64_t step = 0;
+  struct Body {
+    std::int32_t id = 0;
+    Vec2 momentum{0.0, 0.0};
+    double l_point = 0.0, l_spin = 0.0, t_point = 0.0, t_spin = 0.0;
+  };
+  std::vector<Body> bodies;
+  // ForcePotential.kind: each gravity field (index among the fields), then each spring.
+  enum class ForceKind : std::uint8_t { Gravity = 0, Spring = 1 };
+  struct Force {
+    std::uint8_t kind = 0;  // a ForceKind; other values are carried as recorded
+    std::int32_t index = 0;
+    double potential = 0.0;
+  };
+  std::vector<Force> forces;
+  Vec2 momentum{0.0, 0.0};  // totals over bodies
+  double angular_momentum = 0.0, potential = 0.0, kinetic_point = 0.0, kinetic_spin = 0.0, total = 0.0;
+};
+// geometry_msgs/msg/PoseArray, as rbsim publishes it (one pose per body, in body order).
+struct PosesMessage {
+  Time stamp;
+  struct Pose {
+    double x = 0.0, y = 0.0, z = 0.0;               // position
+    double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;  // orientation quaternion
+  };
+  std::vector<Pose> poses;
+};
 Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
-// Reuses `out`'s storage: decoding a stream of messages does not allocate once warmed up.
+// These reuse `out`'s storage: decoding a stream of messages does not allocate once warmed up.
+// They fail on truncated or malformed data (a sequence longer than the bytes left included).
 [[nodiscard]] Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out);
+[[nodiscard]] Status decode_spring_states(std::span<const std::byte> cdr, SpringStatesMessage& out);
+[[nodiscard]] Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out);
+[[nodiscard]] Status decode_poses(std::span<const std::byte> cdr, PosesMessage& out);
 // The simulated time a per-step message carries: its header stamp, a Clock's clock, a
 // MarkerArray's first marker's stamp. nullopt for the scene description, an empty MarkerArray or
 // bytes too short to hold it.
@@ -154,6 +198,39 @@ struct Scalar {
   bool operator==(const Scalar&) const = default;
   std::string to_string() const;
 };
+
+// The scalar of kind `kind` held in the `size` (1, 2, 4 or 8) little-endian bytes at `p`: float32
+// widened, signed integers sign-extended, bool 0 or 1. The one primitive loader of every CDR walker
+// (MessageDecoder, rbsim check's comparer); inline, as it runs once per value.
+inline Scalar load_scalar(const std::byte* p, std::uint8_t size, Scalar::Kind kind) {
+  Scalar s;
+  s.kind = kind;
+  switch (kind) {
+    case Scalar::Kind::Float:
+      if (size == 4) {
+        float f;
+        std::memcpy(&f, p, 4);
+        s.f = f;
+      } else {
+        std::memcpy(&s.f, p, 8);
+      }
+      break;
+    case Scalar::Kind::Int: {
+      std::uint64_t u = 0;
+      std::memcpy(&u, p, size);
+      const unsigned shift = 64u - 8u * size;  // sign-extend
+      s.i = static_cast<std::int64_t>(u << shift) >> shift;
+      break;
+    }
+    case Scalar::Kind::Bool:
+      s.i = *p != std::byte{0};
+      break;
+    default:
+      std::memcpy(&s.u, p, size);
+      break;
+  }
+  return s;
+}
 
 // "pkg/Name" or bare "Name" (in `package`) -> "pkg/msg/Name"; bare "Header" is std_msgs'.
 std::string canonical_type(std::string_view type, std::string_view package);

@@ -1,0 +1,357 @@
+// The recording reader: topics by type, the scene description first, per-step messages joined by
+// their step.
+#include "rbsim/recording.hpp"
+
+#include <array>
+#include <map>
+#include <optional>
+
+#include "rbsim/mcap_tools.hpp"
+
+namespace rbsim::log {
+
+namespace {
+
+// The per-step topics the reader decodes, in RecordedStep's order.
+constexpr std::array<msgs::TopicId, 3> kPerStep = {msgs::TopicId::BodyStates, msgs::TopicId::SpringStates,
+                                                   msgs::TopicId::Energy};
+constexpr std::size_t kStates = 0, kSprings = 1, kEnergy = 2;
+
+int per_step_index(msgs::TopicId id) {
+  for (std::size_t i = 0; i < kPerStep.size(); ++i) {
+    if (kPerStep[i] == id) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::span<const std::byte> bytes_of(const mcap::Message& m) {
+  return {reinterpret_cast<const std::byte*>(m.data.data()), m.data.size()};
+}
+
+// The messages recorded for one step, as far as they have arrived.
+struct Slot {
+  std::uint64_t step = 0;
+  std::array<bool, kPerStep.size()> has{};
+  msgs::BodyStatesMessage states;
+  msgs::SpringStatesMessage springs;
+  msgs::EnergyTermsMessage energy;
+  RecordedStep::LogTimes log_time;
+};
+
+}  // namespace
+
+const msgs::TopicSpec* spec_for_type(std::string_view type) {
+  const std::string t = msgs::canonical_type(type, "");
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (spec.type == t) return &spec;
+  }
+  return nullptr;
+}
+
+std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader) {
+  std::vector<RecordedChannel> out;
+  for (const auto& [id, channel] : reader.channels()) {
+    const auto schema = reader.schemas().find(channel.schema_id);
+    if (schema == reader.schemas().end()) continue;
+    const msgs::TopicSpec* spec = spec_for_type(schema->second.name);
+    if (spec == nullptr) continue;
+    RecordedChannel c{&channel, spec, {}};
+    const std::string type(spec->type);
+    Result<std::string> ours = msgs::ros2msg_schema(type);
+    const mcap::Bytes& theirs = schema->second.data;
+    if (channel.message_encoding != "cdr") {
+      c.problem = "message encoding \"" + channel.message_encoding + "\", not cdr";
+    } else if (!ours || schema->second.encoding != "ros2msg" ||
+               std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) !=
+                   ours.value()) {
+      c.problem = "its " + type + " schema differs from this build's (recorded by another version?)";
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+struct Recording::Impl {
+  std::string path;
+  RecordingOptions options;
+  mcap::IndexedReader reader;
+  std::optional<msgs::SceneMessage> scene;
+  std::array<std::string, msgs::kTopicCount> topics;
+  std::map<std::uint16_t, msgs::TopicId> route;  // channel id -> the topic it carries
+  std::array<bool, kPerStep.size()> read{};      // decoded and joined
+  std::array<bool, kPerStep.size()> present{};   // read and in the file: a step waits for them
+
+  // Steps not passed on yet, by increasing step; spare slots keep their storage for reuse.
+  std::vector<std::unique_ptr<Slot>> pending, spare;
+  std::array<std::optional<std::uint64_t>, kPerStep.size()> last;  // last step seen per topic
+  msgs::BodyStatesMessage scratch_states;
+  msgs::SpringStatesMessage scratch_springs;
+  msgs::EnergyTermsMessage scratch_energy;
+
+  Error fail(const std::string& what) const { return Error{path + ": " + what}; }
+
+  Status classify() {
+    for (const RecordedChannel& c : recorded_channels(reader)) {
+      const msgs::TopicId id = c.spec->id;
+      const int i = per_step_index(id);
+      if (id != msgs::TopicId::Scene && (i < 0 || !read[static_cast<std::size_t>(i)])) continue;
+      if (!options.ns.empty() && c.channel->topic != msgs::topic_name(*c.spec, options.ns)) continue;
+      std::string& topic = topics[static_cast<std::size_t>(id)];
+      if (!topic.empty() && topic != c.channel->topic) {
+        return fail("several " + std::string(c.spec->type) + " topics (" + topic + ", " + c.channel->topic +
+                    "): choose one recording with --namespace");
+      }
+      if (!c.problem.empty()) {
+        if (id == msgs::TopicId::Scene && !options.require_scene) continue;
+        return fail("topic " + c.channel->topic + ": " + c.problem + ": cannot read it");
+      }
+      topic = c.channel->topic;
+      route.emplace(c.channel->id, id);
+      if (i >= 0) present[static_cast<std::size_t>(i)] = true;
+    }
+    return Ok{};
+  }
+
+  Error missing(msgs::TopicId id) const {
+    return fail("no " + std::string(msgs::topic(id).type) + " topic" +
+                (options.ns.empty() ? std::string() : " in namespace '" + options.ns + "'") +
+                " (recorded by rbsim run --record?)");
+  }
+
+  std::string where(const mcap::MessageEntry& e) const {
+    return "message at log time " + mcap_tools::seconds(e.message.log_time) + " s on " +
+           (e.channel != nullptr ? e.channel->topic : std::string("?"));
+  }
+
+  Status read_scene() {
+    const std::string& topic = topics[static_cast<std::size_t>(msgs::TopicId::Scene)];
+    if (topic.empty()) return Ok{};
+    mcap::ReadMessagesOptions ro;
+    ro.topics.push_back(topic);
+    Status failure = Ok{};
+    const mcap::Status st = reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+      const auto r = route.find(e.message.channel_id);
+      if (r == route.end() || r->second != msgs::TopicId::Scene) return true;
+      Result<msgs::SceneMessage> decoded = msgs::decode_scene(bytes_of(e.message));
+      if (!decoded) {
+        failure = fail(where(e) + ": " + decoded.error().message);
+        return false;
+      }
+      scene = std::move(decoded.value());
+      return false;  // published once (latched): a repeat carries the same constants
+    });
+    if (!st.ok()) return fail(mcap_tools::read_error(st));
+    if (!failure) return failure;
+    if (!scene && options.require_scene) {
+      return fail("no scene description recorded (topic " + topic + " of type " +
+                  std::string(msgs::topic(msgs::TopicId::Scene).type) + " has no messages)");
+    }
+    return Ok{};
+  }
+
+  Slot& slot_for(std::uint64_t step) {
+    std::size_t pos = pending.size();
+    while (pos > 0 && pending[pos - 1]->step > step) --pos;
+    if (pos > 0 && pending[pos - 1]->step == step) return *pending[pos - 1];
+    std::unique_ptr<Slot> s;
+    if (spare.empty()) {
+      s = std::make_unique<Slot>();
+    } else {
+      s = std::move(spare.back());
+      spare.pop_back();
+    }
+    s->step = step;
+    s->has = {};
+    s->log_time = {};
+    return **pending.insert(pending.begin() + static_cast<std::ptrdiff_t>(pos), std::move(s));
+  }
+
+  Status message(const mcap::MessageEntry& e, std::size_t i) {
+    const auto cdr = bytes_of(e.message);
+    Status decoded = Ok{};
+    std::uint64_t step = 0;
+    switch (i) {
+      case kStates:
+        decoded = msgs::decode_body_states(cdr, scratch_states);
+        step = scratch_states.step;
+        break;
+      case kSprings:
+        decoded = msgs::decode_spring_states(cdr, scratch_springs);
+        step = scratch_springs.step;
+        break;
+      default:
+        decoded = msgs::decode_energy_terms(cdr, scratch_energy);
+        step = scratch_energy.step;
+        break;
+    }
+    if (!decoded) return fail(where(e) + ": " + decoded.error().message);
+    if (last[i] && step <= *last[i]) {
+      const std::string type(msgs::topic(kPerStep[i]).type);
+      if (step == *last[i])
+        return fail(where(e) + ": step " + std::to_string(step) + " has two " + type + " messages");
+      return fail(where(e) + ": step " + std::to_string(step) + " after step " + std::to_string(*last[i]) +
+                  " (steps must increase: a recording of several runs?)");
+    }
+    last[i] = step;
+    Slot& s = slot_for(step);
+    s.has[i] = true;
+    switch (i) {
+      case kStates:
+        std::swap(s.states, scratch_states);
+        s.log_time.body_states = e.message.log_time;
+        break;
+      case kSprings:
+        std::swap(s.springs, scratch_springs);
+        s.log_time.spring_states = e.message.log_time;
+        break;
+      default:
+        std::swap(s.energy, scratch_energy);
+        s.log_time.energy = e.message.log_time;
+        break;
+    }
+    return Ok{};
+  }
+
+  // Whether every read topic has delivered the oldest pending step or moved past it.
+  bool ready(const Slot& s) const {
+    for (std::size_t i = 0; i < kPerStep.size(); ++i) {
+      if (present[i] && !s.has[i] && !(last[i] && *last[i] > s.step)) return false;
+    }
+    return true;
+  }
+
+  Status check(const Slot& s) const {
+    if (!scene) return Ok{};
+    const std::string at = "step " + std::to_string(s.step) + ": ";
+    const std::size_t bodies = scene->bodies.size(), springs = scene->springs.size();
+    const auto count = [&](msgs::TopicId id, const char* what, std::size_t got, std::size_t want) -> Status {
+      if (got == want) return Ok{};
+      return fail(at + topics[static_cast<std::size_t>(id)] + " has " + std::to_string(got) + " " + what +
+                  ", the scene description " + std::to_string(want));
+    };
+    if (s.has[kStates]) {
+      if (Status st = count(msgs::TopicId::BodyStates, "bodies", s.states.bodies.size(), bodies); !st)
+        return st;
+    }
+    if (s.has[kSprings]) {
+      if (Status st = count(msgs::TopicId::SpringStates, "springs", s.springs.springs.size(), springs); !st)
+        return st;
+    }
+    if (s.has[kEnergy]) {
+      if (Status st = count(msgs::TopicId::Energy, "bodies", s.energy.bodies.size(), bodies); !st) return st;
+      std::size_t gravity = 0;
+      for (const auto& f : s.energy.forces) {
+        if (f.kind == static_cast<std::uint8_t>(msgs::EnergyTermsMessage::ForceKind::Gravity)) ++gravity;
+      }
+      if (Status st = count(msgs::TopicId::Energy, "gravity potentials", gravity, scene->gravity.size()); !st)
+        return st;
+      if (Status st =
+              count(msgs::TopicId::Energy, "spring potentials", s.energy.forces.size() - gravity, springs);
+          !st)
+        return st;
+    }
+    return Ok{};
+  }
+
+  // Passes on the oldest pending steps that are ready (all of them when `all`).
+  Status drain(bool all, const std::function<Status(const RecordedStep&)>& on_step) {
+    std::size_t done = 0;
+    Status result = Ok{};
+    while (done < pending.size() && (all || ready(*pending[done]))) {
+      const Slot& s = *pending[done];
+      ++done;
+      if (result = check(s); !result) break;
+      RecordedStep step;
+      step.step = s.step;
+      if (s.has[kStates]) step.body_states = &s.states;
+      if (s.has[kSprings]) step.spring_states = &s.springs;
+      if (s.has[kEnergy]) step.energy = &s.energy;
+      step.log_time = s.log_time;
+      if (result = on_step(step); !result) break;
+    }
+    for (std::size_t k = 0; k < done; ++k) spare.push_back(std::move(pending[k]));
+    pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(done));
+    return result;
+  }
+};
+
+Recording::Recording() : impl_(std::make_unique<Impl>()) {}
+Recording::~Recording() = default;
+
+Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, const RecordingOptions& options) {
+  std::unique_ptr<Recording> r(new Recording());
+  Impl& im = *r->impl_;
+  im.path = path;
+  im.options = options;
+  for (msgs::TopicId id : options.read) {
+    const int i = per_step_index(id);
+    if (i < 0) return im.fail("cannot read " + std::string(msgs::topic(id).type) + " messages as steps");
+    im.read[static_cast<std::size_t>(i)] = true;
+  }
+  if (options.read.empty()) im.read.fill(true);
+  for (msgs::TopicId id : options.require) {
+    const int i = per_step_index(id);
+    if (i < 0 || !im.read[static_cast<std::size_t>(i)]) {
+      return im.fail("cannot require " + std::string(msgs::topic(id).type) + " without reading it");
+    }
+  }
+  if (std::string e = mcap_tools::unreadable(path); !e.empty()) return im.fail(e);
+  if (mcap::Status s = im.reader.open(path); !s.ok()) return im.fail(mcap_tools::read_error(s));
+  if (options.verify_crc) {
+    if (mcap::Status s = im.reader.verify_data_section_crc(); !s.ok())
+      return im.fail(mcap_tools::read_error(s));
+  }
+  // A file whose summary lists no channels defines them in its data section: read it once to
+  // learn them.
+  if (im.reader.channels().empty()) {
+    const mcap::Status s = im.reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
+    if (!s.ok()) return im.fail(mcap_tools::read_error(s));
+  }
+  if (Status st = im.classify(); !st) return st.error();
+  if (options.require_scene && im.topics[static_cast<std::size_t>(msgs::TopicId::Scene)].empty()) {
+    return im.missing(msgs::TopicId::Scene);
+  }
+  for (msgs::TopicId id : options.require) {
+    if (im.topics[static_cast<std::size_t>(id)].empty()) return im.missing(id);
+  }
+  if (Status st = im.read_scene(); !st) return st.error();
+  return r;
+}
+
+const std::string& Recording::path() const {
+  return impl_->path;
+}
+
+const msgs::SceneMessage* Recording::scene() const {
+  return impl_->scene ? &*impl_->scene : nullptr;
+}
+
+const std::string& Recording::topic(msgs::TopicId id) const {
+  return impl_->topics[static_cast<std::size_t>(id)];
+}
+
+Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& on_step) {
+  Impl& im = *impl_;
+  im.pending.clear();
+  im.last = {};
+  mcap::ReadMessagesOptions ro;
+  for (std::size_t i = 0; i < kPerStep.size(); ++i) {
+    if (im.present[i]) ro.topics.push_back(im.topics[static_cast<std::size_t>(kPerStep[i])]);
+  }
+  if (ro.topics.empty()) return Ok{};
+  Status failure = Ok{};
+  const mcap::Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+    const auto r = im.route.find(e.message.channel_id);
+    if (r == im.route.end()) return true;  // another channel of the same name
+    const int i = per_step_index(r->second);
+    if (i < 0) return true;
+    failure = im.message(e, static_cast<std::size_t>(i));
+    if (failure) failure = im.drain(false, on_step);
+    return static_cast<bool>(failure);
+  });
+  if (!st.ok()) return im.fail(mcap_tools::read_error(st));
+  if (!failure) return failure;
+  return im.drain(true, on_step);
+}
+
+}  // namespace rbsim::log
