@@ -102,13 +102,14 @@ TEST_F(RecoverTest, TruncatedAtManyOffsetsKeepsExactlyTheCompleteChunks) {
     write_bytes(cut_, mcap::Bytes(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(cut)));
     fs::remove(recovered_);
     const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
-    if (cut < header_end_) {
+    const auto [kept, inside] = expected(cut);
+    // Nothing complete to keep (cut inside the header or the first chunk): nothing written.
+    if (cut < header_end_ || kept == 0) {
       ASSERT_FALSE(r.ok());
       EXPECT_FALSE(fs::exists(recovered_));
       continue;
     }
     ASSERT_TRUE(r.ok()) << r.error().message;
-    const auto [kept, inside] = expected(cut);
     EXPECT_EQ(r.value().messages, kept);
     EXPECT_EQ(r.value().incomplete_chunks, inside ? 1u : 0u);
     EXPECT_EQ(r.value().input_intact, cut == bytes_.size());
