@@ -302,7 +302,9 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
   ASSERT_NE(at, std::string::npos) << o.err;
   const long bad_step = std::stol(o.err.substr(at + 5));
   EXPECT_GT(bad_step, 10);
-  EXPECT_NE(o.err.find("steps 0.." + std::to_string(bad_step - 1) + "."), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("steps 0.." + std::to_string(bad_step - 1) + " (--allow-nonfinite keeps going)."),
+            std::string::npos)
+      << o.err;
 
   const auto energy = lines_of(read_text(dir / "e.csv"));
   ASSERT_EQ(energy.size(), static_cast<std::size_t>(1 + bad_step));
@@ -355,6 +357,17 @@ TEST(RbsimRun, RenderAndPlotReportADivergenceAsRunDoes) {
   EXPECT_EQ(plot.exit_code, 1) << describe(plot);
   EXPECT_EQ(plot.err, "rbsim plot: error: " + message + "\n");
   EXPECT_FALSE(fs::exists(dir / "p.png"));
+
+  // The hint suggests the symplectic integrator only to a scene that does not use it already.
+  EXPECT_NE(message.find("or the symplectic-euler integrator"), std::string::npos) << message;
+  const std::string ee = "type=\"explicit-euler\"";
+  ASSERT_NE(text.find(ee), std::string::npos);
+  text.replace(text.find(ee), ee.size(), "type=\"symplectic-euler\"");
+  test::write_text(dir / "stiff-se.xml", text);
+  const test::Outcome se = rbsim({"run", (dir / "stiff-se.xml").string(), "-q"});
+  ASSERT_EQ(se.exit_code, 1) << describe(se);
+  EXPECT_NE(se.err.find("the simulation diverged (try a smaller dt)"), std::string::npos) << se.err;
+  EXPECT_EQ(se.err.find("symplectic"), std::string::npos) << se.err;
 }
 
 }  // namespace

@@ -68,7 +68,8 @@ int node_command(const NodeArgs& a) {
       const Status flushed = driver.finish();
       return fail(describe_divergence(driver.divergence()) + ". Published steps up to " +
                   std::to_string(driver.world().step_index() - 1) +
-                  (flushed ? "." : " (" + flushed.error().message + ")."));
+                  (flushed ? "" : " (" + flushed.error().message + ")") +
+                  " (--allow-nonfinite keeps going).");
     }
   } while (a.loop && !stop_requested());
   if (Status st = driver.finish(); !st) return fail(st.error().message);

@@ -96,7 +96,7 @@ int run(const RunOptions& o) {
   const World& world = driver.world();
   if (end.value() == PassEnd::Diverged) {
     return fail(describe_divergence(driver.divergence()) + ". Outputs hold steps 0.." +
-                std::to_string(world.step_index() - 1) + ".");
+                std::to_string(world.step_index() - 1) + " (--allow-nonfinite keeps going).");
   }
 
   const std::int64_t done = world.step_index();

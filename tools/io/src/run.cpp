@@ -6,8 +6,8 @@ namespace rbsim {
 std::string describe_divergence(const Divergence& d) {
   const std::string where = d.body >= 0 ? "body " + std::to_string(d.body) + " " : "";
   return "step " + std::to_string(d.step) + ": " + where + d.quantity +
-         " is not finite: the simulation diverged (try a smaller dt or symplectic-euler; --allow-nonfinite "
-         "keeps going)";
+         " is not finite: the simulation diverged (try a smaller dt" +
+         (d.integrator == Integrator::ExplicitEuler ? " or the symplectic-euler integrator)" : ")");
 }
 
 Driver::Driver(const Scene& scene, World world) : scene_(&scene), world_(std::move(world)) {}
@@ -39,7 +39,7 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
     ++steps_done_;
     if (!options.allow_nonfinite) {
       if (const auto bad = world.find_nonfinite()) {
-        divergence_ = {world.step_index(), bad->body.index, bad->quantity};
+        divergence_ = {world.step_index(), bad->body.index, bad->quantity, world.integrator()};
         return PassEnd::Diverged;
       }
     }

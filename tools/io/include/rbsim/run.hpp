@@ -20,9 +20,11 @@ struct Divergence {
   std::int64_t step = 0;
   std::int32_t body = -1;  // -1 for a scene-wide quantity
   const char* quantity = "";
+  Integrator integrator = Integrator::SymplecticEuler;  // the run's, for the hint
 };
 // "step N: body b x is not finite: the simulation diverged (try a smaller dt ...)": the one
-// message every command gives; a command may append what its outputs hold.
+// message every command gives (the symplectic integrator is suggested only to a run that does
+// not use it); a command may append what its outputs hold and its own options.
 std::string describe_divergence(const Divergence& divergence);
 
 struct DriverOptions {
