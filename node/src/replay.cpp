@@ -8,6 +8,7 @@
 
 #include "clock.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_tools.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/replay.hpp"
 
@@ -66,10 +67,13 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   Impl& im = *r->impl_;
   im.options = options;
   const std::string& path = options.path;
+  // An empty or unreadable file is said to be so (recover cannot help it).
+  if (const std::string bad = mcap_tools::unreadable(path); !bad.empty())
+    return Error{"cannot read " + path + ": " + bad};
   if (auto st = im.reader.open(path); !st.ok()) {
     std::string hint;
     if (st.code == mcap::StatusCode::Truncated)
-      hint = " (an unfinished recording: 'rbsim log recover' repairs it)";
+      hint = " (an unfinished recording: 'rbsim log recover' saves its complete messages, if it holds any)";
     return Error{"cannot read " + path + ": " + st.message + hint};
   }
 

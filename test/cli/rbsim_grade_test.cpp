@@ -40,7 +40,7 @@ TEST(RbsimGrade, PassesAgainstItsOwnFosssimOutput) {
   for (const char* name :
        {"/springtests/test02sym.xml", "/windtests/test03ee.xml", "/gravitytests/test01sym.xml"}) {
     const std::string scene = kScenes + name, ref = (dir / "ref.bin").string();
-    const test::Outcome run = rbsim({"run", scene, "-q", "--fosssim-out", ref});
+    const test::Outcome run = rbsim({"run", scene, "-q", "--overwrite", "--fosssim-out", ref});
     ASSERT_EQ(run.exit_code, 0) << describe(run);
     const test::Outcome g = rbsim({"grade", scene, ref});
     EXPECT_EQ(g.exit_code, 0) << name << "\n" << describe(g);

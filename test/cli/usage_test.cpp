@@ -48,7 +48,20 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{"check", "x", "y", "z"}, "rbsim check: error:", "rbsim check --help"},
         UsageCase{{"run", "scene.xml", "--steps", "-1"}, "rbsim run: error:", "--steps"},
         UsageCase{{"run", "scene.xml", "--no-such-flag"}, "rbsim run: error:", "--no-such-flag"},
-        UsageCase{{"log", "info"}, "rbsim log info: error:", "file"}));
+        UsageCase{{"log", "info"}, "rbsim log info: error:", "file"},
+        // Options of an output that was not asked for would be silently ignored.
+        UsageCase{{"run", "scene.xml", "--fps", "30"}, "rbsim run: error: --fps requires --frames", "--fps"},
+        UsageCase{{"run", "scene.xml", "--record-every", "3"},
+                  "rbsim run: error: --record-every requires --record",
+                  "--record"},
+        // Topic names follow ROS 2's rules.
+        UsageCase{{"run", "scene.xml", "--record", "x.mcap", "--namespace", "a b"},
+                  "rbsim run: error: --namespace",
+                  "is not a ROS 2 namespace"},
+        UsageCase{{"node", "scene.xml", "--namespace", "1robot"},
+                  "rbsim node: error: --namespace",
+                  "must not start with a digit"},
+        UsageCase{{"record", "x.mcap", "--namespace", "a//b"}, "rbsim record: error: --namespace", "//"}));
 
 TEST(Help, HelpCommandShowsTheCommandsHelp) {
   const test::Outcome o = rbsim({"help", "log", "recover"});

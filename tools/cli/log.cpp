@@ -6,6 +6,8 @@
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_tools.hpp"
+#include "rbsim/outputs.hpp"
+#include "validators.hpp"
 
 namespace rbsim::cli {
 
@@ -17,6 +19,7 @@ struct LogOptions {
   std::string compression = "zstd";
   std::string csv, energy_csv, ns;
   bool quiet = false;
+  bool overwrite = false;
 };
 
 int fail(const char* command, const std::string& message) {
@@ -53,6 +56,8 @@ int doctor_command(const LogOptions& o) {
 
 int recover_command(const LogOptions& o) {
   mcap_tools::RecoverOptions options;
+  if (Status st = check_outputs({{o.out, "OUT"}}, {o.file}, o.overwrite); !st)
+    return fail("recover", st.error().message);
   if (!mcap::parse_compression(o.compression, options.compression)) {
     return fail("recover", "unknown compression " + o.compression);
   }
@@ -73,6 +78,9 @@ int recover_command(const LogOptions& o) {
 
 int export_command(const LogOptions& o) {
   log::ExportOptions options;
+  if (Status st = check_outputs({{o.csv, "--csv"}, {o.energy_csv, "--energy-csv"}}, {o.file}, o.overwrite);
+      !st)
+    return fail("export", st.error().message);
   options.csv = o.csv;
   options.energy_csv = o.energy_csv;
   options.ns = o.ns;
@@ -129,6 +137,7 @@ Subcommand add_log_command(CLI::App& parent) {
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
   recover->add_flag("-q,--quiet", o->quiet, "No report on stdout");
+  recover->add_flag("--overwrite", o->overwrite, "Replace OUT if it exists (by default it is refused)");
   recover->footer(
       "Chunks are the unit of recovery: a chunk cut off by the end of the file (or failing its CRC) is lost "
       "with "
@@ -144,8 +153,11 @@ Subcommand add_log_command(CLI::App& parent) {
   exp->add_option("--csv", o->csv, std::string("Per-body CSV: ") + kBodyCsvColumns);
   exp->add_option("--energy-csv", o->energy_csv, std::string("Scene-wide CSV: ") + kEnergyCsvColumns);
   exp->add_option("--namespace", o->ns,
-                  "ROS namespace of the recording's topics (default: the only one in the file)");
+                  "ROS namespace of the recording's topics (default: the only one in the file)")
+      ->check(ros_namespace());
   exp->add_flag("-q,--quiet", o->quiet, "No closing summary line");
+  exp->add_flag("--overwrite", o->overwrite,
+                "Replace the CSV files if they exist (by default they are refused)");
   exp->footer(
       "Byte for byte what rbsim run wrote for the recorded steps (all of them, or every k-th with "
       "--record-every k).\nExit status: 0 success, 1 error, 2 usage error.");

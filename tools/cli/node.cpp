@@ -99,6 +99,7 @@ Subcommand add_node_command(CLI::App& parent) {
       ->default_str("1");
   add_domain_option(app, a->node.domain);
   app->add_option("--namespace", a->node.ns, "ROS namespace: topics are /<namespace>/<name>")
+      ->check(ros_namespace())
       ->default_str("rbsim");
   app->add_option("--duration", a->duration, "Simulated seconds per run (default: the scene's)")
       ->check(non_negative());

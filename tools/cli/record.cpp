@@ -105,7 +105,9 @@ Subcommand add_record_command(CLI::App& parent) {
       ->delimiter(',')
       ->allow_extra_args(false);
   add_domain_option(app, a->domain);
-  app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")->default_str("rbsim");
+  app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")
+      ->check(ros_namespace())
+      ->default_str("rbsim");
   app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")->check(positive());
   app->add_option("--max-messages", a->rec.max_messages, "Stop after this many messages");
   app->add_option("--compression", a->compression, "MCAP chunk compression")

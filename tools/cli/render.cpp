@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "rbsim/outputs.hpp"
 #include "rbsim/render.hpp"
 #include "validators.hpp"
 
@@ -42,6 +43,7 @@ int render_command(const RenderArgs& a) {
 struct PlotArgs {
   std::string input, out, size = "1200x900";
   std::optional<double> duration;
+  bool overwrite = false;
 };
 
 int plot_command(const PlotArgs& a) {
@@ -50,6 +52,17 @@ int plot_command(const PlotArgs& a) {
   o.duration = a.duration;
   if (!render::parse_size(a.size, o.width, o.height)) {
     std::fprintf(stderr, "rbsim plot: error: invalid --size \"%s\" (expected WxH)\n", a.size.c_str());
+    return 1;
+  }
+  if (a.duration && render::is_recording(a.input)) {  // a recording plots what it holds
+    std::fprintf(stderr,
+                 "rbsim plot: error: --duration applies to a scene, not to a recording (%s)\n"
+                 "Run 'rbsim plot --help' for usage.\n",
+                 a.input.c_str());
+    return 2;
+  }
+  if (Status st = check_outputs({{a.out, "--out"}}, {a.input}, a.overwrite); !st) {
+    std::fprintf(stderr, "rbsim plot: error: %s\n", st.error().message.c_str());
     return 1;
   }
   if (Status st = render::plot(a.input, o); !st) {
@@ -91,6 +104,7 @@ Subcommand add_plot_command(CLI::App& parent) {
   app->add_option("--size", a->size, "Image size WxH in pixels")->default_str("1200x900");
   app->add_option("--duration", a->duration, "Simulated seconds (scenes only; default: the scene's duration)")
       ->check(positive());
+  app->add_flag("--overwrite", a->overwrite, "Replace the PNG if it exists (by default it is refused)");
   app->footer(
       "Exit status: 0 success, 1 error (bad input, divergence, unwritable output, gnuplot failure), 2 usage "
       "error.");

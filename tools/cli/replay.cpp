@@ -105,7 +105,8 @@ Subcommand add_replay_command(CLI::App& parent) {
       "Publish rosgraph_msgs/Clock on /clock carrying the log time of each message replayed (recorded "
       "/clock messages are then left out)");
   add_domain_option(app, a->domain);
-  app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names");
+  app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names")
+      ->check(ros_namespace());
   app->add_option("--wait-for-subscribers", a->wait_for,
                   "Wait until N subscribers match the body states first")
       ->check(non_negative());

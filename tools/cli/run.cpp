@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/io.hpp"
+#include "rbsim/outputs.hpp"
 #include "rbsim/record.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
@@ -31,6 +32,7 @@ struct RunOptions {
   std::string progress = "auto";
   bool quiet = false;
   bool allow_nonfinite = false;
+  bool overwrite = false;
 };
 
 int fail(const std::string& message) {
@@ -47,6 +49,16 @@ int run(const RunOptions& o) {
   std::int64_t steps = scene.step_count();
   if (o.duration) steps = steps_for(*o.duration, scene.world.dt);
   if (o.steps) steps = *o.steps;
+
+  // Every output path is checked before step 0: a run never ends by throwing its result away.
+  if (Status st = check_outputs({{o.csv, "--csv"},
+                                 {o.energy_csv, "--energy-csv"},
+                                 {o.fosssim_out, "--fosssim-out"},
+                                 {o.record, "--record"},
+                                 {o.frames, "--frames", true}},
+                                {o.scene}, o.overwrite);
+      !st)
+    return fail(st.error().message);
 
   Result<Driver> created = Driver::create(scene);
   if (!created) return fail(scene.path + ": " + created.error().message);
@@ -139,25 +151,36 @@ Subcommand add_run_command(CLI::App& parent) {
   app->add_option("--fosssim-out", o->fosssim_out,
                   "FOSSSim reference binary output (raw little-endian doubles), comparable byte for byte "
                   "with the reference solver's");
-  app->add_option(
+  auto* record = app->add_option(
       "--record", o->record,
       "Record every topic (scene description once, then body states, spring states, energy terms, "
       "PoseArray, MarkerArray and /clock per step) to an MCAP file in the rosbag2 layout");
+  // Options of one output need that output: given alone they would be silently ignored.
   app->add_option("--record-every", o->record_every, "Record every k-th step (step 0 always)")
-      ->check(positive());
+      ->check(positive())
+      ->needs(record);
   app->add_option("--compression", o->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
-      ->default_str("zstd");
+      ->default_str("zstd")
+      ->needs(record);
   app->add_option("--compression-level", o->compression_level,
                   "zstd -50..22 or lz4 0..12 (higher: smaller and slower); 0: zstd 1, the MCAP C++ "
                   "library's default")
-      ->default_str("0");
+      ->default_str("0")
+      ->needs(record);
   app->add_option("--namespace", o->ns, "ROS namespace of the recorded topics (/<namespace>/body_states ...)")
-      ->default_str("rbsim");
-  app->add_option("--frames", o->frames,
-                  "Draw PNG frames into this folder during the run (see rbsim render)");
-  app->add_option("--fps", o->fps, "Frames per simulated second for --frames")->default_str("24");
-  app->add_option("--size", o->size, "Frame size WxH for --frames")->default_str("1280x720");
+      ->check(ros_namespace())
+      ->default_str("rbsim")
+      ->needs(record);
+  auto* frames = app->add_option("--frames", o->frames,
+                                 "Draw PNG frames into this folder during the run (see rbsim render)");
+  app->add_option("--fps", o->fps, "Frames per simulated second for --frames")
+      ->default_str("24")
+      ->needs(frames);
+  app->add_option("--size", o->size, "Frame size WxH for --frames")->default_str("1280x720")->needs(frames);
+  app->add_flag("--overwrite", o->overwrite,
+                "Replace output files that exist (by default an existing output is refused before the run "
+                "starts; the scene itself is never written over)");
   app->add_option("--progress", o->progress,
                   "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
       ->check(CLI::IsMember({"auto", "always", "never"}))
@@ -167,7 +190,9 @@ Subcommand add_run_command(CLI::App& parent) {
       "--allow-nonfinite", o->allow_nonfinite,
       "Keep going when the state becomes inf/NaN (by default the run stops at the first non-finite value)");
   app->footer(
-      "Outputs are written to a temporary file and renamed into place when complete. Ctrl-C stops the run "
+      "Every output path is checked before step 0 (its folder exists and is writable, it is not a folder, "
+      "not the scene, not another output, and it does not exist unless --overwrite). Outputs are written to "
+      "a temporary file and renamed into place when complete. Ctrl-C stops the run "
       "cleanly: outputs then hold every step done so far, and the exit status is 130.\n"
       "Exit status: 0 success, 1 error (bad scene, I/O failure, divergence), 2 usage error, 130 "
       "interrupted.");

@@ -136,4 +136,8 @@ Status plot(const std::string& input, const PlotOptions& o) {
   return Ok{};
 }
 
+bool is_recording(const std::string& path) {
+  return detail::is_mcap(path);
+}
+
 }  // namespace rbsim::render

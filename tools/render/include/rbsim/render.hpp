@@ -119,6 +119,9 @@ struct PlotOptions {
 };
 [[nodiscard]] Status plot(const std::string& input, const PlotOptions& options);
 
+// Whether `path` is an MCAP recording (starts with the MCAP magic) rather than a scene.
+bool is_recording(const std::string& path);
+
 // Parses "1280x720".
 bool parse_size(const std::string& text, int& width, int& height);
 
