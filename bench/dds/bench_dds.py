@@ -45,7 +45,7 @@ def main():
     # (a) node -> recorder
     live = os.path.join(work, "live.mcap")
     expected = 6 * (steps + 1) + 1
-    rec = subprocess.Popen([rbsim, "record", live, "--domain", domain, "--duration", "600", "--max-messages",
+    rec = subprocess.Popen([rbsim, "record", live, "--domain", domain, "--wall-duration", "600", "--max-messages",
                             str(expected)], stderr=subprocess.PIPE, text=True)
     time.sleep(0.5)
     t0 = time.monotonic()

@@ -36,10 +36,12 @@ TEST(RunOutputs, AnExistingOutputIsRefusedBeforeStepZeroUnlessOverwrite) {
   const test::Outcome o = rbsim({"run", f.scene.string(), "--steps", "100000000", "--csv", csv.string()},
                                 std::chrono::seconds(20));
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_NE(o.err.find("--csv " + csv.string() + ": exists (use --overwrite to replace it)"), std::string::npos)
+  EXPECT_NE(o.err.find("--csv " + csv.string() + ": exists (use --overwrite to replace it)"),
+            std::string::npos)
       << o;
   EXPECT_EQ(test::read_text(csv), "a good CSV\n");
-  const test::Outcome ok = rbsim({"run", f.scene.string(), "-q", "--steps", "3", "--csv", csv.string(), "--overwrite"});
+  const test::Outcome ok =
+      rbsim({"run", f.scene.string(), "-q", "--steps", "3", "--csv", csv.string(), "--overwrite"});
   EXPECT_EQ(ok.exit_code, 0) << ok;
   EXPECT_EQ(test::lines_of(test::read_text(csv)).size(), 1u + 4u * 2u);  // header, 2 bodies x steps 0..3
 }
@@ -83,7 +85,8 @@ TEST(PlotOutputs, RefusesAnExistingPngAndDurationOnARecording) {
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_NE(o.err.find("exists (use --overwrite"), std::string::npos) << o;
   EXPECT_EQ(test::read_text(png), "not yours");
-  const test::Outcome d = rbsim({"plot", f.log.string(), "--out", (f.dir / "p2.png").string(), "--duration", "1"});
+  const test::Outcome d =
+      rbsim({"plot", f.log.string(), "--out", (f.dir / "p2.png").string(), "--duration", "1"});
   EXPECT_EQ(d.exit_code, 2) << d;
   EXPECT_NE(d.err.find("--duration applies to a scene, not to a recording"), std::string::npos) << d;
 }

@@ -20,7 +20,8 @@ TEST(RecordCli, RefusesAnExistingOutputUnlessOverwrite) {
   test::TempDir dir;
   const fs::path precious = dir / "precious.mcap";
   test::write_text(precious, "a recording the user wants to keep");
-  const test::Outcome o = rbsim({"record", precious.string(), "--domain", kQuietDomain, "--duration", "0.2"});
+  const test::Outcome o =
+      rbsim({"record", precious.string(), "--domain", kQuietDomain, "--wall-duration", "0.2"});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_NE(o.err.find("exists (use --overwrite to replace it)"), std::string::npos) << o;
   EXPECT_EQ(test::read_text(precious), "a recording the user wants to keep");
@@ -29,7 +30,7 @@ TEST(RecordCli, RefusesAnExistingOutputUnlessOverwrite) {
 TEST(RecordCli, NothingReceivedIsAnErrorAndLeavesNoFile) {
   test::TempDir dir;
   const fs::path out = dir / "empty.mcap";
-  const test::Outcome o = rbsim({"record", out.string(), "--domain", kQuietDomain, "--duration", "0.5"});
+  const test::Outcome o = rbsim({"record", out.string(), "--domain", kQuietDomain, "--wall-duration", "0.5"});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_NE(o.err.find("nothing received on domain 229"), std::string::npos) << o;
   EXPECT_FALSE(fs::exists(out));
@@ -37,14 +38,14 @@ TEST(RecordCli, NothingReceivedIsAnErrorAndLeavesNoFile) {
   // nothing, so the old file is gone only because the user asked for it to be replaced.
   test::write_text(out, "old");
   const test::Outcome o2 =
-      rbsim({"record", out.string(), "--overwrite", "--domain", kQuietDomain, "--duration", "0.2"});
+      rbsim({"record", out.string(), "--overwrite", "--domain", kQuietDomain, "--wall-duration", "0.2"});
   EXPECT_EQ(o2.exit_code, 1) << o2;
 }
 
 TEST(RecordCli, OutputInAMissingFolderIsRefusedBeforeStarting) {
   test::TempDir dir;
-  const test::Outcome o = rbsim(
-      {"record", (dir / "no" / "such" / "out.mcap").string(), "--domain", kQuietDomain, "--duration", "5"});
+  const test::Outcome o = rbsim({"record", (dir / "no" / "such" / "out.mcap").string(), "--domain",
+                                 kQuietDomain, "--wall-duration", "5"});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_NE(o.err.find("does not exist"), std::string::npos) << o;
   EXPECT_EQ(o.err.find("recording"), std::string::npos) << "refused before DDS started: " << o;

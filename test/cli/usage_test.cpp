@@ -61,7 +61,10 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{"node", "scene.xml", "--namespace", "1robot"},
                   "rbsim node: error: --namespace",
                   "must not start with a digit"},
-        UsageCase{{"record", "x.mcap", "--namespace", "a//b"}, "rbsim record: error: --namespace", "//"}));
+        UsageCase{{"record", "x.mcap", "--namespace", "a//b"}, "rbsim record: error: --namespace", "//"},
+        // --duration is simulated time everywhere; a recorder's wall-clock limit has its own name.
+        UsageCase{
+            {"record", "x.mcap", "--duration", "3"}, "rbsim record: error: --duration", "--wall-duration"}));
 
 TEST(Help, HelpCommandShowsTheCommandsHelp) {
   const test::Outcome o = rbsim({"help", "log", "recover"});

@@ -417,7 +417,7 @@ def counts_line(proc):
 def live_recording(ctx, scene, every, out, tag, env=None, steps_total=None):
     """Recorder first, then the node (--rate 0, --wait-for-subscribers 1): the complete run."""
     expected = 1 + 6 * (steps_total // every + 1)
-    rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, "--max-messages", expected, "--duration", 90), env=env)
+    rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, "--max-messages", expected, "--wall-duration", 90), env=env)
     node = ctx.rb(f"node-{tag}", *node_args(ctx, scene, "--rate", 0, "--publish-every", every,
                                             "--wait-for-subscribers", 1), env=env)
     exited_ok(ctx, node, 90)
@@ -512,7 +512,7 @@ def case_replay_roundtrip(ctx):
     want = Log(x)
     n = len(want.messages)
     r1 = ctx.path("replayed.mcap")
-    rec = ctx.rb("record-replayed", *record_args(ctx, r1, "--max-messages", n, "--duration", 90))
+    rec = ctx.rb("record-replayed", *record_args(ctx, r1, "--max-messages", n, "--wall-duration", 90))
     rep = ctx.rb("replay-run", "replay", x, "--domain", ctx.domain, "--rate", 0, "--wait-for-subscribers", 1)
     exited_ok(ctx, rep, 90)
     exited_ok(ctx, rec, 90)
@@ -530,7 +530,7 @@ def case_replay_roundtrip(ctx):
     lv = Log(live)
     same_payloads(ctx, lv, want, "live recording vs rbsim run --record")
     l2 = ctx.path("live-replayed.mcap")
-    rec2 = ctx.rb("record-live-replayed", *record_args(ctx, l2, "--max-messages", len(lv.messages), "--duration", 90))
+    rec2 = ctx.rb("record-live-replayed", *record_args(ctx, l2, "--max-messages", len(lv.messages), "--wall-duration", 90))
     rep2 = ctx.rb("replay-live", "replay", live, "--domain", ctx.domain, "--rate", 0, "--wait-for-subscribers", 1)
     exited_ok(ctx, rep2, 90)
     exited_ok(ctx, rec2, 90)
@@ -556,7 +556,7 @@ def case_replay_options(ctx):
     def replay_into(tag, replay_extra, max_messages=None, ns=None, settle=1.0, rec_extra=()):
         out = ctx.path(f"{tag}.mcap")
         extra = ("--max-messages", max_messages) if max_messages else ()
-        rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, *extra, *rec_extra, "--duration", 60, ns=ns))
+        rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, *extra, *rec_extra, "--wall-duration", 60, ns=ns))
         rep = ctx.rb(f"replay-{tag}", "replay", x, "--domain", ctx.domain, "--wait-for-subscribers", 1,
                      *replay_extra)
         t = time.monotonic()
@@ -671,8 +671,8 @@ def case_subscribers_come_and_go(ctx):
         t = [m[2] for m in log.messages if m[0] == states]
         return max((b - a for a, b in zip(t, t[1:])), default=0) * 1e-9
 
-    # 1: a recorder that stops by itself (--duration).
-    rec = ctx.rb("record-1", *record_args(ctx, ctx.path("r1.mcap"), "--duration", 1.5))
+    # 1: a recorder that stops by itself (--wall-duration).
+    rec = ctx.rb("record-1", *record_args(ctx, ctx.path("r1.mcap"), "--wall-duration", 1.5))
     exited_ok(ctx, rec, 30)
     ctx.check(len(Log(ctx.path("r1.mcap")).payloads(states)) > 100, "recorder 1 got few body states in 1.5 s")
     alive("a recorder finished")
@@ -740,7 +740,7 @@ def case_subscribers_come_and_go(ctx):
 
     # 5: a newcomer after the SIGKILL gets the stream within the lease bound; then a clean stop.
     r5 = ctx.path("r5.mcap")
-    rec = ctx.rb("record-5", *record_args(ctx, r5, "--max-messages", 600, "--duration", 20))
+    rec = ctx.rb("record-5", *record_args(ctx, r5, "--max-messages", 600, "--wall-duration", 20))
     exited_ok(ctx, rec, 40)
     log5 = Log(r5)
     t5 = [m[2] for m in log5.messages if m[0] == states]
@@ -978,7 +978,7 @@ def case_netns(ctx):
         want = Log(run)
         n = len(want.messages)
         out = ctx.path("remote.mcap")
-        rec = net.rb("record-in-b", "b", *record_args(ctx, out, "--max-messages", n, "--duration", 90))
+        rec = net.rb("record-in-b", "b", *record_args(ctx, out, "--max-messages", n, "--wall-duration", 90))
         node = net.rb("node-in-a", "a", *node_args(ctx, scene, "--rate", 0, "--publish-every", every,
                                                    "--wait-for-subscribers", 1))
         exited_ok(ctx, node, 90, "node in namespace a")
@@ -1010,7 +1010,7 @@ def case_netns_link_flap(ctx):
                   "--namespace", ctx.ns)
         want = Log(run)
         out = ctx.path("remote.mcap")
-        rec = net.rb("record-in-b", "b", *record_args(ctx, out, "--duration", 120))
+        rec = net.rb("record-in-b", "b", *record_args(ctx, out, "--wall-duration", 120))
         node = net.rb("node-in-a", "a", *node_args(ctx, scene, "--rate", 1, "--publish-every", every,
                                                    "--duration", duration, "--wait-for-subscribers", 1))
         node.wait_for_text("rbsim node:", 30, stream="stderr")
@@ -1078,15 +1078,15 @@ def case_ros_env(ctx):
     on_d = dict(ctx.env(), ROS_DOMAIN_ID=d)
     # No --domain: ROS_DOMAIN_ID decides.
     rec_env = ctx.rb("record-env", "record", ctx.path("env.mcap"), "--namespace", ctx.ns,
-                     "--max-messages", expected, "--duration", 60, env=on_d)
+                     "--max-messages", expected, "--wall-duration", 60, env=on_d)
     # --domain wins over ROS_DOMAIN_ID; LOCALHOST with a static peer on this host.
     rec_flag = ctx.rb("record-flag", "record", ctx.path("flag.mcap"), "--domain", d, "--namespace", ctx.ns,
-                      "--max-messages", expected, "--duration", 60,
+                      "--max-messages", expected, "--wall-duration", 60,
                       env=dict(ctx.env(), ROS_DOMAIN_ID="0", ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                                ROS_STATIC_PEERS="localhost"))
     # Must see nothing: domain 0 (nothing set), and the node's domain with discovery OFF.
-    rec_zero = ctx.rb("record-zero", "record", ctx.path("zero.mcap"), "--namespace", ctx.ns, "--duration", 60)
-    rec_off = ctx.rb("record-off", "record", ctx.path("off.mcap"), "--namespace", ctx.ns, "--duration", 60,
+    rec_zero = ctx.rb("record-zero", "record", ctx.path("zero.mcap"), "--namespace", ctx.ns, "--wall-duration", 60)
+    rec_off = ctx.rb("record-off", "record", ctx.path("off.mcap"), "--namespace", ctx.ns, "--wall-duration", 60,
                      env=dict(on_d, ROS_AUTOMATIC_DISCOVERY_RANGE="OFF"))
     for p in (rec_env, rec_flag, rec_zero, rec_off):
         p.wait_for_text("rbsim record: recording", 20, stream="stderr")
@@ -1230,7 +1230,7 @@ def case_record_disk_full(ctx):
     node.wait_for_text("rbsim node:", 20, stream="stderr")
     out = ctx.path("full.mcap")
     limit = 3 * 1024 * 1024
-    rec = ctx.rb("record-limited", *record_args(ctx, out, "--compression", "none", "--duration", 60),
+    rec = ctx.rb("record-limited", *record_args(ctx, out, "--compression", "none", "--wall-duration", 60),
                  fsize_limit=limit)
     rc = rec.wait(60)
     ctx.check(rc != -signal.SIGXFSZ, "the recorder was killed by SIGXFSZ instead of stopping with an error")
@@ -1258,7 +1258,7 @@ def case_record_sigkill(ctx):
     node.wait_for_text("rbsim node:", 20, stream="stderr")
     for i in range(4):
         out = ctx.path(f"killed-{i}.mcap")
-        rec = ctx.rb(f"record-{i}", *record_args(ctx, out, "--chunk-size", 32768, "--duration", 60,
+        rec = ctx.rb(f"record-{i}", *record_args(ctx, out, "--chunk-size", 32768, "--wall-duration", 60,
                                                  "--compression", ("zstd", "lz4", "none")[i % 3]))
         # Kill once the file has grown past its header, at a random moment within 0.2 .. 3 s.
         deadline = time.monotonic() + 30
@@ -1300,7 +1300,7 @@ def case_soak(ctx):
     published = steps // every + 1
     expected = 1 + 6 * published
     live = ctx.path("live.mcap")
-    rec = ctx.rb("record", *record_args(ctx, live, "--duration", seconds + 120, "--max-messages", expected))
+    rec = ctx.rb("record", *record_args(ctx, live, "--wall-duration", seconds + 120, "--max-messages", expected))
     node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--publish-every", every, "--wait-for-subscribers", 1))
     node.wait_for_text("rbsim node:", 60, stream="stderr")
     t0 = time.monotonic()

@@ -1,4 +1,4 @@
-// rbsim record: DDS topics to MCAP until Ctrl-C, --duration or --max-messages.
+// rbsim record: DDS topics to MCAP until Ctrl-C, --wall-duration or --max-messages.
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -22,6 +22,7 @@ struct RecordArgs {
   std::string compression = "zstd";
   bool quiet = false;
   bool overwrite = false;
+  std::optional<double> wrong_duration;
 };
 
 int fail(const std::string& m) {
@@ -30,6 +31,12 @@ int fail(const std::string& m) {
 }
 
 int record_command(RecordArgs a) {
+  if (a.wrong_duration) {
+    std::fprintf(stderr,
+                 "rbsim record: error: --duration: a recorder runs in wall-clock time: use --wall-duration "
+                 "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.\n");
+    return 2;
+  }
   if (!mcap::parse_compression(a.compression, a.rec.compression))
     return fail("unknown compression " + a.compression);
   if (const std::string bad = mcap::check_compression_level(a.rec.compression, a.rec.compression_level);
@@ -55,7 +62,8 @@ int record_command(RecordArgs a) {
                                    : std::chrono::steady_clock::time_point::max();
   std::optional<std::string> failure;
   while (!stop_requested() && std::chrono::steady_clock::now() < deadline) {
-    auto polled = recorder.value()->poll(100'000'000);  // 100 ms: Ctrl-C and --duration are seen promptly
+    auto polled =
+        recorder.value()->poll(100'000'000);  // 100 ms: Ctrl-C and --wall-duration are seen promptly
     if (!polled) {
       failure = polled.error().message;
       break;
@@ -108,7 +116,14 @@ Subcommand add_record_command(CLI::App& parent) {
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")
       ->check(ros_namespace())
       ->default_str("rbsim");
-  app->add_option("--duration", a->duration, "Stop after this many seconds of wall time")->check(positive());
+  app->add_option(
+         "--wall-duration", a->duration,
+         "Stop after this many seconds of wall-clock time (elsewhere in rbsim --duration is simulated "
+         "time)")
+      ->check(positive());
+  // `--duration` means simulated seconds in every other command: here it would be wall time, so it
+  // is refused with a pointer rather than taken in another sense.
+  app->add_option("--duration", a->wrong_duration)->group("");
   app->add_option("--max-messages", a->rec.max_messages, "Stop after this many messages");
   app->add_option("--compression", a->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
@@ -132,7 +147,8 @@ Subcommand add_record_command(CLI::App& parent) {
       "lost "
       "is what DDS reports plus the steps missing from each per-step topic's sequence. The scene description "
       "is written first, whatever order discovery delivers the topics in.\n"
-      "Exit status: 0 recorded (stopped by Ctrl-C/SIGTERM, --duration or --max-messages), 1 error or nothing "
+      "Exit status: 0 recorded (stopped by Ctrl-C/SIGTERM, --wall-duration or --max-messages), 1 error or "
+      "nothing "
       "received (no file left), 2 usage error.");
   return {app, [a] { return record_command(*a); }};
 }
