@@ -73,6 +73,15 @@ TEST(Help, HelpCommandShowsTheCommandsHelp) {
   EXPECT_NE(o.out.find("Exit status"), std::string::npos) << o;
 }
 
+// Counts read as English: "1 body, 0 springs, 1 step".
+TEST(Summary, CountsAgreeWithTheirNouns) {
+  const test::Outcome o =
+      rbsim({"run", std::string(RBSIM_TEST_DATA_DIR) + "/fosssim/scenes/gravitytests/test00sym.xml",
+             "--steps", "1"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_NE(o.err.find(": 1 body, 0 springs, 1 step ("), std::string::npos) << o;
+}
+
 // Every command states its exit codes in its --help.
 TEST(Help, EveryCommandStatesItsExitStatus) {
   for (const std::vector<std::string>& command : std::vector<std::vector<std::string>>{{},

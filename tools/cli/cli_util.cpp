@@ -80,4 +80,8 @@ void Progress::finish() {
   enabled_ = false;
 }
 
+std::string count_of(std::int64_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
 }  // namespace rbsim::cli

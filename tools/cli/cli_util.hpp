@@ -37,4 +37,7 @@ class Progress {
 
 std::string format_seconds(double seconds);
 
+// "1 body", "2 bodies": a count with its noun in the right number.
+std::string count_of(std::int64_t n, const char* one, const char* many);
+
 }  // namespace rbsim::cli

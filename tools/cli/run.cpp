@@ -114,11 +114,11 @@ int run(const RunOptions& o) {
   const std::int64_t done = world.step_index();
   if (!o.quiet) {
     const double rate = wall > 0 ? static_cast<double>(done) / wall : 0.0;
-    std::fprintf(stderr,
-                 "rbsim run: %s: %d bodies, %d springs, %lld steps (%.6g s simulated) in %s: %.4g steps/s, "
-                 "%.4g body-steps/s\n",
-                 scene.name.c_str(), world.body_count(), world.spring_count(), static_cast<long long>(done),
-                 world.time(), format_seconds(wall).c_str(), rate, rate * world.body_count());
+    std::fprintf(
+        stderr, "rbsim run: %s: %s, %s, %s (%.6g s simulated) in %s: %.4g steps/s, %.4g body-steps/s\n",
+        scene.name.c_str(), count_of(world.body_count(), "body", "bodies").c_str(),
+        count_of(world.spring_count(), "spring", "springs").c_str(), count_of(done, "step", "steps").c_str(),
+        world.time(), format_seconds(wall).c_str(), rate, rate * world.body_count());
   }
   if (stop_requested()) {
     std::fprintf(stderr, "rbsim run: interrupted at step %lld of %lld; outputs hold steps 0..%lld\n",

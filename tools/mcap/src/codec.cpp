@@ -4,6 +4,7 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <cstdio>
 
 namespace rbsim::mcap {
 namespace detail {
@@ -238,8 +239,8 @@ Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
   if (verify_crc && chunk.uncompressed_crc != 0) {
     const std::uint32_t crc = crc32(out);
     if (crc != chunk.uncompressed_crc) {
-      return Status::Error(StatusCode::CrcMismatch, "chunk CRC mismatch: computed " + std::to_string(crc) +
-                                                        ", stored " + std::to_string(chunk.uncompressed_crc));
+      return Status::Error(StatusCode::CrcMismatch, "chunk CRC mismatch: computed " + crc_text(crc) +
+                                                        ", stored " + crc_text(chunk.uncompressed_crc));
     }
   }
   return Status::Ok();
@@ -267,6 +268,12 @@ std::string check_compression_level(Compression compression, int level) {
       return level == 0 ? std::string() : "a compression level needs --compression zstd or lz4";
   }
   return "unknown compression";
+}
+
+std::string crc_text(std::uint32_t crc) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08x", crc);
+  return buf;
 }
 
 }  // namespace rbsim::mcap

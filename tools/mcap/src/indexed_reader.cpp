@@ -126,9 +126,8 @@ struct IndexedReader::Impl {
       }
       const std::uint32_t crc = crc32(view);
       if (crc != footer.summary_crc) {
-        return Status::Error(StatusCode::CrcMismatch, "summary CRC mismatch: computed " +
-                                                          std::to_string(crc) + ", stored " +
-                                                          std::to_string(footer.summary_crc));
+        return Status::Error(StatusCode::CrcMismatch, "summary CRC mismatch: computed " + crc_text(crc) +
+                                                          ", stored " + crc_text(footer.summary_crc));
       }
     }
     if (footer.summary_start != 0) {

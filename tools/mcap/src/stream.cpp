@@ -44,8 +44,7 @@ Status check_attachment_crc(ByteView content, const Attachment& a) {
   const std::uint32_t crc = crc32(content.subspan(0, covered));
   if (crc == a.crc) return Status::Ok();
   return Status::Error(StatusCode::CrcMismatch, "attachment '" + a.name + "' CRC mismatch: computed " +
-                                                    std::to_string(crc) + ", stored " +
-                                                    std::to_string(a.crc));
+                                                    crc_text(crc) + ", stored " + crc_text(a.crc));
 }
 
 bool Streamer::fail(Status status) {
@@ -145,7 +144,7 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
       const std::uint32_t stored = std::get<DataEnd>(record).data_section_crc;
       if (options_.verify_crcs && stored != 0 && stored != data_crc) {
         return fail(Status::Error(StatusCode::CrcMismatch, "data section CRC mismatch: computed " +
-                                                               std::to_string(data_crc) + ", stored " +
+                                                               crc_text(data_crc) + ", stored " +
                                                                std::to_string(stored)));
       }
       seen_data_end_ = true;

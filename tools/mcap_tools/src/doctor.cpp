@@ -39,9 +39,7 @@ std::string cat(const A&... a) {
 }
 
 std::string hex32(std::uint32_t v) {
-  char buf[12];
-  std::snprintf(buf, sizeof buf, "%08x", v);
-  return buf;
+  return mcap::crc_text(v);
 }
 
 constexpr std::uint8_t op(mcap::Opcode o) {

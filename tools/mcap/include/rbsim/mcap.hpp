@@ -237,6 +237,8 @@ std::uint32_t crc32(ByteView data, std::uint32_t crc = 0);
 
 enum class Compression : std::uint8_t { None, Lz4, Zstd };
 std::string_view compression_name(Compression compression);  // "", "lz4", "zstd"
+// A CRC-32 as every rbsim tool prints one: "0x" and 8 lowercase hex digits.
+std::string crc_text(std::uint32_t crc);
 // Parses a codec's command-line name: "zstd", "lz4", "none".
 bool parse_compression(std::string_view name, Compression& out);
 // Empty when `level` suits the codec: zstd -50..22 (negative: faster, larger), lz4 0..12 (frame
