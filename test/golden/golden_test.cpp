@@ -359,13 +359,162 @@ TEST(Check, MissingAndExtraMessages) {
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_TRUE(contains(o.out,
                        "first divergence: topic /rbsim/body_states, step 100000: message missing from the "
-                       "run: the golden has 501 messages on this topic, the run 500"))
+                       "run: run lacks steps 100000 (1 message: the run ends at step 99800)"))
+      << o;
+  EXPECT_TRUE(contains(o.out,
+                       "steps in one file only: /rbsim/energy: run lacks steps 100000 (1 message: the run "
+                       "ends at step 99800)"))
       << o;
   o = rbsim({"check", kChainGolden.string(), shorter.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_TRUE(
-      contains(o.out, "first divergence: topic /rbsim/body_states, step 100000: extra message in the run"))
+      contains(o.out,
+               "first divergence: topic /rbsim/body_states, step 100000: extra message in the run: run "
+               "has extra steps 100000 (1 message: the run goes on past the golden's last step 99800)"))
       << o;
+}
+
+// Copies an MCAP file leaving out the first `n` messages of every topic but the scene description
+// (a recorder that joined late: the latched scene still reaches it).
+void copy_joined_late(const fs::path& in, const fs::path& out, std::size_t n) {
+  mcap::IndexedReader reader;
+  ASSERT_TRUE(reader.open(in.string()).ok());
+  mcap::Writer writer;
+  ASSERT_TRUE(writer.open(out.string(), log::writer_options(mcap::Compression::Zstd)).ok());
+  for (const auto& [id, schema] : reader.schemas()) ASSERT_TRUE(writer.add_schema(schema).ok());
+  for (const auto& [id, channel] : reader.channels()) ASSERT_TRUE(writer.add_channel(channel).ok());
+  std::map<std::string, std::size_t> seen;
+  const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+    if (e.channel->topic == "/rbsim/scene" || seen[e.channel->topic]++ >= n) {
+      EXPECT_TRUE(writer.write_message(e.message).ok());
+    }
+    return true;
+  });
+  ASSERT_TRUE(st.ok()) << st.message;
+  ASSERT_TRUE(writer.close().ok());
+}
+
+// A recording that joined late pairs up by simulated step: the leading steps are reported missing
+// per topic (not the first message's stamp as a field divergence).
+TEST(Check, LateJoiningRecordingReportsTheMissingLeadingSteps) {
+  TempDir tmp;
+  const fs::path late = tmp / "late.mcap";
+  copy_joined_late(kChainGolden, late, 100);  // steps 0, 200, ..., 19800 left out
+  Outcome o = rbsim({"check", late.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_FALSE(contains(o.out, "stamp")) << o;
+  EXPECT_TRUE(std::regex_search(
+      o.out, std::regex(R"(first divergence: topic /\S+, step 0: message missing from the run: run lacks )"
+                        R"(steps 0, 200, \.\.\., 19800 \(100 messages: recorder joined late\?\))")))
+      << o;
+  for (const char* topic :
+       {"/rbsim/body_states", "/rbsim/spring_states", "/rbsim/energy", "/rbsim/poses", "/rbsim/markers"}) {
+    EXPECT_TRUE(
+        contains(o.out, std::string("steps in one file only: ") + topic +
+                            ": run lacks steps 0, 200, ..., 19800 (100 messages: recorder joined late?)"))
+        << topic << "\n"
+        << o;
+  }
+  EXPECT_TRUE(contains(o.out, "fields identical")) << o;  // the 401 steps both have match
+  // The other way round: the run has steps before the golden's first.
+  o = rbsim({"check", kChainGolden.string(), late.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_FALSE(contains(o.out, "stamp")) << o;
+  EXPECT_TRUE(
+      contains(o.out,
+               "steps in one file only: /rbsim/body_states: run has extra steps 0, 200, ..., 19800 (100 "
+               "messages: the run starts before the golden's first step 20000)"))
+      << o;
+  // The library reports the same per topic, and pairs the 401 common steps.
+  Result<check::CheckReport> r = check::check_logs(late.string(), kChainGolden.string());
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->passed());
+  ASSERT_TRUE(r->first);
+  EXPECT_TRUE(r->first->has_step);
+  EXPECT_EQ(r->first->step, 0u);
+  EXPECT_GE(r->step_problems.size(), 5u);
+  EXPECT_EQ(r->diverging_values, 0u);
+  for (const check::FieldStats& f : r->fields) {
+    if (f.topic == "/rbsim/body_states" && f.field == "bodies[].x") {
+      EXPECT_EQ(f.values, 401u * 5u);
+      EXPECT_EQ(f.over, 0u);
+    }
+  }
+}
+
+// Another --record-every pairs the steps both recorded and names the stride as the cause.
+TEST(Check, AnotherRecordEveryNamesTheStride) {
+  TempDir tmp;
+  const fs::path run = tmp / "every100.mcap";
+  record(kChain, run, {"--record-every", "100"});
+  Outcome o = rbsim({"check", run.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_FALSE(contains(o.out, "stamp")) << o;
+  EXPECT_TRUE(
+      contains(o.out,
+               "steps in one file only: /rbsim/body_states: run has extra steps 100, 300, ..., 99900 (500 "
+               "messages: golden recorded every 200th step, run every 100th (--record-every))"))
+      << o;
+  EXPECT_TRUE(std::regex_search(
+      o.out,
+      std::regex(R"(first divergence: topic /\S+, step 100: extra message in the run: run has extra )"
+                 R"(steps 100, 300, \.\.\., 99900 \(500 messages: golden recorded every 200th step, run )"
+                 R"(every 100th \(--record-every\)\))")))
+      << o;
+  o = rbsim({"check", kChainGolden.string(), run.string()});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(
+      contains(o.out,
+               "steps in one file only: /rbsim/body_states: run lacks steps 100, 300, ..., 99900 (500 "
+               "messages: golden recorded every 100th step, run every 200th (--record-every))"))
+      << o;
+  // The 501 steps both recorded are identical.
+  Result<check::CheckReport> r = check::check_logs(run.string(), kChainGolden.string());
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->diverging_values, 0u);
+  EXPECT_EQ(r->diverging_messages, 500u * r->step_problems.size());
+}
+
+// The scene's file name (and its description) is metadata: reported apart, not a divergence
+// unless --strict-metadata.
+TEST(Check, SceneFileNameIsMetadataNotADivergence) {
+  TempDir tmp;
+  const fs::path scene = tmp / "mychain.xml";
+  fs::copy_file(kChain, scene);
+  const fs::path run = tmp / "run.mcap";
+  record(scene, run, {"--record-every", kChainEvery});
+  Outcome o = rbsim({"check", run.string(), kChainGolden.string()});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, ": MATCH")) << o;
+  EXPECT_FALSE(contains(o.out, "first divergence")) << o;
+  EXPECT_TRUE(contains(o.out, "metadata differs")) << o;
+  EXPECT_TRUE(contains(o.out, "  /rbsim/scene, field name: expected \"chain\", actual \"mychain\"")) << o;
+  EXPECT_TRUE(std::regex_search(o.out, std::regex(R"(all \d+ fields identical)")))
+      << o;  // no row for the name
+  EXPECT_FALSE(std::regex_search(o.out, std::regex(R"(/rbsim/scene +name +string)"))) << o;
+  Result<check::CheckReport> r = check::check_logs(run.string(), kChainGolden.string());
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->passed());
+  ASSERT_EQ(r->metadata.size(), 1u);
+  EXPECT_EQ(r->metadata[0].where, "/rbsim/scene, field name");
+  // --strict-metadata makes it a divergence.
+  o = rbsim({"check", run.string(), kChainGolden.string(), "--strict-metadata"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(
+      contains(o.out,
+               "first divergence: topic /rbsim/scene, message 0, field name: expected \"chain\", actual "
+               "\"mychain\", difference differs"))
+      << o;
+  // A physics difference in the scene description still fails without it.
+  fs::create_directories(tmp / "h");
+  const fs::path heavier = edited(tmp / "h", scene, "<rigidbodyvertex x=\"0\" y=\"0\" m=\"1\"/>",
+                                  "<rigidbodyvertex x=\"0\" y=\"0\" m=\"1.5\"/>");
+  const fs::path run2 = tmp / "run2.mcap";
+  record(heavier, run2, {"--record-every", kChainEvery});
+  o = rbsim({"check", run2.string(), kChainGolden.string(), "--topics", "/rbsim/scene"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_TRUE(contains(o.out, "first divergence: topic /rbsim/scene, message 0, field bodies[0].mass")) << o;
+  EXPECT_TRUE(contains(o.out, "field name: expected \"chain\", actual \"mychain\"")) << o;
 }
 
 TEST(Check, BadInputIsAnErrorWithExitStatus2) {

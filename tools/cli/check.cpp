@@ -81,14 +81,24 @@ int compare(const CheckArgs& a) {
               r.passed() ? "MATCH" : "DIVERGED");
   if (r.first) std::printf("first divergence: %s\n", r.first->line().c_str());
   for (const std::string& p : r.topic_problems) std::printf("topic difference: %s\n", p.c_str());
+  for (const std::string& p : r.step_problems) std::printf("steps in one file only: %s\n", p.c_str());
+  if (!r.metadata.empty()) {
+    std::printf("metadata differs (%s):\n",
+                a.options.strict_metadata ? "a divergence with --strict-metadata"
+                                          : "not physics, reported only; --strict-metadata fails on it");
+    for (const check::MetadataDifference& m : r.metadata) std::printf("  %s\n", m.line().c_str());
+  }
   print_table(r, a.all_fields);
   const double mb = static_cast<double>(r.run_bytes + r.golden_bytes) / 1e6;
   std::printf("%zu topics, %llu message pairs, %s MB of message data in %s s (%s MB/s)", r.topics.size(),
               static_cast<unsigned long long>(r.messages), g(mb).c_str(), g(wall).c_str(),
               g(wall > 0 ? mb / wall : 0.0).c_str());
-  if (!r.passed()) {
+  if (!r.passed() && (r.diverging_values > 0 || r.one_file_messages == 0)) {
     std::printf("; %llu values in %llu messages differ", static_cast<unsigned long long>(r.diverging_values),
-                static_cast<unsigned long long>(r.diverging_messages));
+                static_cast<unsigned long long>(r.diverging_messages - r.one_file_messages));
+  }
+  if (r.one_file_messages > 0) {
+    std::printf("; %llu messages in one file only", static_cast<unsigned long long>(r.one_file_messages));
   }
   std::printf("\n");
   return r.passed() ? kMatch : kDiverged;
@@ -151,6 +161,10 @@ Subcommand add_check_command(CLI::App& parent) {
       "--ignore-log-time", [a](std::int64_t) { a->options.compare_log_time = false; },
       "Compare payloads only, not log times (a live recording against rbsim run --record)");
   app->add_flag("--all-fields", a->all_fields, "List every field in the table, also the identical ones");
+  app->add_flag(
+      "--strict-metadata", a->options.strict_metadata,
+      "Make a metadata difference (the scene's name, description, viewport or background, the MCAP "
+      "header's profile or library) a divergence; by default it is reported apart and does not fail");
   app->add_flag("--verify-golden", a->verify_golden,
                 "Verify GOLDEN.mcap as a golden log of SCENE.xml, independently of the simulator: the scene "
                 "description, steps and every energy/spring/pose term recomputed, the dynamics re-integrated "
@@ -162,12 +176,15 @@ Subcommand add_check_command(CLI::App& parent) {
       "--golden-every", a->golden_every,
       "Print the --record-every K a golden of this scene is recorded with (about 500 steps) and exit");
   app->footer(
-      "Messages pair up per topic in order; a missing or extra message, a topic in only one file, a "
-      "different "
-      "schema or log time, or a value outside the tolerance is a divergence. Integers, strings, booleans and "
-      "array lengths compare exactly. Prints the first divergence (topic, step, field path, expected, "
-      "actual, "
-      "difference) and the largest difference per field.\n"
+      "Per-step messages (body and spring states, energy, poses, markers, clock) pair up per topic by "
+      "simulated step, round(stamp / dt) with each file's dt from its scene description; the scene "
+      "description (and messages of other types) pair up in order. A step or message in only one file, a "
+      "topic in only one file, a different schema or log time, or a physics value outside the tolerance is "
+      "a divergence; steps in one file only are listed per topic with their ranges and likely cause (a "
+      "recorder that joined late, another --record-every). Integers, strings, booleans and array lengths "
+      "compare exactly. Metadata (scene name, description, viewport, background; MCAP header profile and "
+      "library) is reported apart and does not fail without --strict-metadata. Prints the first divergence "
+      "(topic, step, field path, expected, actual, difference) and the largest difference per field.\n"
       "Exit status: 0 match (or golden verified), 1 divergence (or verification failed), 2 error "
       "(unreadable, "
       "truncated, corrupted or non-MCAP input, bad arguments).");

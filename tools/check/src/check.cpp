@@ -17,9 +17,12 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
+#include <utility>
 
 #include "layout.hpp"
 #include "rbsim/check.hpp"
@@ -394,6 +397,88 @@ struct Pending {
   mcap::Timestamp log_time = 0;
   std::uint64_t ordinal = 0;  // position among the file's messages
   std::uint64_t index = 0;    // position among the topic's messages
+  std::uint64_t step = 0;     // simulated step (topics aligned by step)
+};
+
+// "1,000"
+std::string grouped(std::uint64_t n) {
+  std::string digits = std::to_string(n), out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+// "2nd", "10th"
+std::string ordinal(std::uint64_t n) {
+  const std::uint64_t tens = n % 100, ones = n % 10;
+  const char* suffix = (tens >= 11 && tens <= 13) ? "th"
+                       : ones == 1                ? "st"
+                       : ones == 2                ? "nd"
+                       : ones == 3                ? "rd"
+                                                  : "th";
+  return std::to_string(n) + suffix;
+}
+
+// The steps a topic has in one file only, as arithmetic runs: "0..999", "5, 15, ..., 995".
+struct StepRuns {
+  struct Run {
+    std::uint64_t first = 0, last = 0, stride = 0, count = 0;
+  };
+  static constexpr std::size_t kMaxRuns = 6;
+  std::vector<Run> runs;
+  std::uint64_t count = 0, more_runs = 0;
+
+  void add(std::uint64_t step) {
+    ++count;
+    if (!runs.empty()) {
+      Run& r = runs.back();
+      if (step > r.last && (r.count == 1 || step - r.last == r.stride)) {
+        if (r.count == 1) r.stride = step - r.last;
+        r.last = step;
+        ++r.count;
+        return;
+      }
+    }
+    if (runs.size() < kMaxRuns) {
+      runs.push_back({step, step, 0, 1});
+    } else {
+      ++more_runs;
+    }
+  }
+  std::string text() const {
+    std::string out;
+    for (const Run& r : runs) {
+      if (!out.empty()) out += ", ";
+      if (r.count == 1) {
+        out += std::to_string(r.first);
+      } else if (r.stride == 1) {
+        out += std::to_string(r.first) + ".." + std::to_string(r.last);
+      } else if (r.count <= 3) {
+        for (std::uint64_t k = 0; k < r.count; ++k)
+          out += (k > 0 ? ", " : "") + std::to_string(r.first + k * r.stride);
+      } else {
+        out += std::to_string(r.first) + ", " + std::to_string(r.first + r.stride) + ", ..., " +
+               std::to_string(r.last);
+      }
+    }
+    if (more_runs > 0) out += " and more";
+    return out;
+  }
+};
+
+// The steps of one topic in one file: first, last, and the smallest step between two messages.
+struct StepTrack {
+  bool any = false;
+  std::uint64_t first = 0, last = 0, stride = 0, messages = 0;
+  void add(std::uint64_t step) {
+    if (any && step > last && (stride == 0 || step - last < stride)) stride = step - last;
+    if (!any) first = step;
+    any = true;
+    last = step;
+    ++messages;
+  }
 };
 
 struct Stat {
@@ -423,6 +508,15 @@ struct Topic {
   std::uint64_t count[2] = {0, 0};
   std::vector<std::uint64_t> identical_counts;  // values of byte-identical message pairs, per group
   bool diverged_message = false;                // scratch: current message pair has a difference
+  // Per-step topics of rbsim's types pair up by simulated step (both files have a dt).
+  std::optional<msgs::TopicId> step_id;
+  bool aligned = false;
+  StepTrack track[2];
+  StepRuns only[2];  // steps in this file only
+  // Metadata groups (the scene description's name, description, viewport, background).
+  bool has_meta = false;
+  std::vector<char> meta;
+  std::vector<char> meta_reported;
 };
 
 // Reads one file on its own thread (decompression and CRCs are most of the work), handing its
@@ -522,6 +616,8 @@ struct Side {
   bool summary_known = false;  // the summary lists every channel with messages
   std::uint64_t ordinal = 0, bytes = 0, consumed = 0;
   bool done = false;
+  double dt = 0.0;  // from the first scene description (0: none, messages pair by position)
+  mcap::Header header;
 };
 
 std::string with_path(const Side& s, const std::string& what) {
@@ -543,6 +639,20 @@ class Comparer {
     }
     for (int s : {kGolden, kRun}) {
       if (Status st = open(side_[s]); !st) return st.error();
+    }
+    const mcap::Header& hr = side_[kRun].header;
+    const mcap::Header& hg = side_[kGolden].header;
+    for (auto [what, run, golden] :
+         {std::tuple{"profile", &hr.profile, &hg.profile}, std::tuple{"library", &hr.library, &hg.library}}) {
+      if (*run == *golden) continue;
+      report_.metadata.push_back(
+          {std::string("MCAP header, ") + what, "\"" + *golden + "\"", "\"" + *run + "\""});
+      if (o_.strict_metadata) {
+        Divergence d;
+        d.topic_level = true;
+        d.field = "(" + report_.metadata.back().line() + ")";
+        consider(Key{0, problem_ordinal_++}, std::move(d));
+      }
     }
     while (!side_[kRun].done || !side_[kGolden].done) {
       int s = kGolden;
@@ -568,7 +678,9 @@ class Comparer {
     }
     mcap::IndexedReader index;
     if (auto st = index.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
+    s.header = index.header();
     for (const auto& [id, channel] : index.channels()) s.summary_topics.insert(channel.topic);
+    if (Status st = read_dt(s, index); !st) return st;
     // The summary's channels are known to be complete when every chunk's message index names
     // only channels it lists (rbsim writes indexes and repeats channels; other writers may not).
     s.summary_known = index.indexed();
@@ -580,6 +692,30 @@ class Comparer {
     }
     if (auto st = s.pump.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
     return Ok{};
+  }
+
+  // The time step of the file's first scene description: steps are round(stamp / dt).
+  static Status read_dt(Side& s, mcap::IndexedReader& index) {
+    std::vector<std::string> scene_topics;
+    for (const auto& [id, channel] : index.channels()) {
+      const auto schema = index.schemas().find(channel.schema_id);
+      if (schema != index.schemas().end() && is_type(schema->second.name, msgs::TopicId::Scene))
+        scene_topics.push_back(channel.topic);
+    }
+    if (scene_topics.empty()) return Ok{};
+    mcap::ReadMessagesOptions options;
+    options.topics = scene_topics;
+    const mcap::Status st = index.read_messages(options, [&](const mcap::MessageEntry& e) {
+      Result<msgs::SceneMessage> scene = msgs::decode_scene(cdr(e.message.data));
+      if (scene && std::isfinite(scene->dt) && scene->dt > 0.0) s.dt = scene->dt;
+      return false;
+    });
+    if (!st.ok()) return Error{with_path(s, describe(st))};
+    return Ok{};
+  }
+
+  static bool is_type(const std::string& schema_name, msgs::TopicId id) {
+    return canonical_type(schema_name, "") == canonical_type(msgs::topic(id).type, "");
   }
 
   static std::string describe(const mcap::Status& st) {
@@ -696,6 +832,29 @@ class Comparer {
       t.mode = Topic::Mode::Fields;
       t.stats.resize(t.layout->groups().size() + 1);
       t.time_stat = t.layout->groups().size();
+      for (const msgs::TopicSpec& spec : msgs::topics()) {
+        if (spec.per_step && is_type(g.schema_name, spec.id)) t.step_id = spec.id;
+      }
+      t.aligned = t.step_id.has_value() && side_[kRun].dt > 0.0 && side_[kGolden].dt > 0.0;
+      if (t.aligned) {
+        // Messages queued before the other file defined the topic get their steps now.
+        for (int si : {kRun, kGolden}) {
+          for (Pending& p : t.queue[si]) p.step = step_of_message(t, si, p.data);
+        }
+      }
+      if (is_type(g.schema_name, msgs::TopicId::Scene)) {
+        const auto& groups = t.layout->groups();
+        t.meta.assign(groups.size(), 0);
+        t.meta_reported.assign(groups.size(), 0);
+        for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+          const std::string& path = groups[gi].path;
+          if (path == "name" || path == "description" || path == "has_viewport" ||
+              path.starts_with("viewport_") || path.starts_with("background.")) {
+            t.meta[gi] = 1;
+            t.has_meta = true;
+          }
+        }
+      }
     } else {
       t.mode = Topic::Mode::Bytes;  // not ros2msg/CDR: the bytes must be equal
       t.stats.resize(2);
@@ -716,11 +875,89 @@ class Comparer {
     consider(Key{0, problem_ordinal_++}, std::move(d));
   }
 
-  void consider(Key key, Divergence d) {
+  // True when `d` became the first divergence.
+  bool consider(Key key, Divergence d) {
     if (!report_.first || key < first_key_) {
       first_key_ = key;
       report_.first = std::move(d);
+      first_only_.reset();
+      return true;
     }
+    return false;
+  }
+
+  // The simulated step of a per-step message: round(stamp / dt) with the file's own dt (a message
+  // without a stamp, an empty MarkerArray, follows the previous one).
+  std::uint64_t step_of_message(Topic& t, int si, const mcap::Bytes& data) {
+    StepTrack& tr = t.track[si];
+    std::uint64_t step = tr.any ? tr.last + std::max<std::uint64_t>(tr.stride, 1) : 0;
+    if (const auto stamp = msgs::decode_stamp(*t.step_id, cdr(data))) {
+      const double ns = static_cast<double>(stamp->sec) * 1e9 + static_cast<double>(stamp->nanosec);
+      const double k = std::round(ns / (side_[si].dt * 1e9));
+      step = !(k > 0.0) ? 0 : k >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(k);
+    }
+    tr.add(step);
+    return step;
+  }
+
+  // A message whose step the other file lacks.
+  void only(Topic& t, int si, const Pending& p) {
+    t.only[si].add(p.step);
+    ++report_.diverging_messages;
+    ++report_.one_file_messages;
+    Divergence d{
+        t.name, true, p.step, si == kGolden ? "(message missing from the run)" : "(extra message in the run)",
+        "",     "",   ""};
+    if (consider(Key{p.log_time, p.ordinal}, std::move(d))) {
+      first_only_ = std::pair{static_cast<std::size_t>(&t - topics_.data()), si};
+    }
+  }
+
+  // "run lacks steps 0..999 (1,000 messages: recorder joined late?)"
+  std::string only_summary(const Topic& t, int si) const {
+    const StepRuns& runs = t.only[si];
+    const StepTrack& r = t.track[kRun];
+    const StepTrack& g = t.track[kGolden];
+    std::string out = std::string(si == kGolden ? "run lacks steps " : "run has extra steps ") + runs.text() +
+                      " (" + grouped(runs.count) + (runs.count == 1 ? " message" : " messages");
+    std::vector<std::string> hints;
+    if (r.stride != 0 && g.stride != 0 && r.stride != g.stride) {
+      hints.push_back("golden recorded " +
+                      (g.stride == 1 ? "every step" : "every " + ordinal(g.stride) + " step") + ", run " +
+                      (r.stride == 1 ? "every step" : "every " + ordinal(r.stride)) + " (--record-every)");
+    } else if (!runs.runs.empty()) {
+      const StepTrack& mine = si == kGolden ? g : r;
+      const StepTrack& other = si == kGolden ? r : g;
+      const bool leading = runs.runs.front().first == mine.first && other.any && mine.first < other.first;
+      const bool trailing = runs.runs.back().last == mine.last && other.any && mine.last > other.last;
+      if (si == kGolden) {
+        if (leading) hints.push_back("recorder joined late?");
+        if (trailing) hints.push_back("the run ends at step " + std::to_string(other.last));
+        if (!other.any) hints.push_back("the run has none");
+        if (!leading && !trailing && other.any) hints.push_back("messages lost?");
+      } else {
+        if (leading)
+          hints.push_back("the run starts before the golden's first step " + std::to_string(other.first));
+        if (trailing)
+          hints.push_back("the run goes on past the golden's last step " + std::to_string(other.last));
+        if (!other.any) hints.push_back("the golden has none");
+      }
+    }
+    for (std::size_t i = 0; i < hints.size(); ++i) out += (i == 0 ? ": " : "; ") + hints[i];
+    return out + ")";
+  }
+
+  // A metadata value pair that differs: reported once per field; true when it does not count as
+  // a divergence (without strict_metadata).
+  bool metadata(Topic& t, std::uint32_t group, std::uint64_t index, const Scalar& run, const Scalar& golden,
+                std::span<const std::byte> golden_cdr) {
+    if (!t.meta[group]) return false;
+    if (!t.meta_reported[group]) {
+      t.meta_reported[group] = 1;
+      report_.metadata.push_back(
+          {t.name + ", field " + t.decoder[kGolden]->path(golden_cdr, index), text(golden), text(run)});
+    }
+    return !o_.strict_metadata;
   }
 
   // A file ends its topic while the other still has messages; or the other never had the topic.
@@ -745,6 +982,20 @@ class Comparer {
     if (other_lacks(t, si) || (t.ready && t.mode == Topic::Mode::Skip)) return Ok{};
     Pending p{std::move(m.data), m.log_time, ordinal, index};
     std::deque<Pending>& other = t.queue[1 - si];
+    if (t.aligned) {
+      // Pair by step: the other file's queued messages before this step are in that file only;
+      // a message whose step the other file has passed is in this file only.
+      p.step = step_of_message(t, si, p.data);
+      while (!other.empty() && other.front().step < p.step) {
+        only(t, 1 - si, other.front());
+        t.queued_bytes -= other.front().data.size();
+        other.pop_front();
+      }
+      if (!other.empty() && other.front().step > p.step) {
+        only(t, si, p);
+        return Ok{};
+      }
+    }
     if (!other.empty()) {
       Pending& q = other.front();
       Status st = si == kRun ? compare(t, p, q) : compare(t, q, p);
@@ -764,8 +1015,8 @@ class Comparer {
   // One message pair: `r` from the run, `g` from the golden.
   Status compare(Topic& t, const Pending& r, const Pending& g) {
     ++report_.messages;
-    last_has_step_ = false;
-    last_step_ = g.index;
+    last_has_step_ = t.aligned;
+    last_step_ = t.aligned ? g.step : g.index;
     t.diverged_message = false;
     const Key key{g.log_time, g.ordinal};
     if (t.mode == Topic::Mode::Bytes) {
@@ -887,8 +1138,9 @@ class Comparer {
           va = fa;
           vb = fb;
         }
-        if (!(va == vb || (va != va && vb != vb)) && !c.differs_float(st, va, vb) &&
-            first_bad == UINT64_MAX) {
+        if (!(va == vb || (va != va && vb != vb)) &&
+            !(t.has_meta && c.metadata(t, group, index, float_scalar(va), float_scalar(vb), b)) &&
+            !c.differs_float(st, va, vb) && first_bad == UINT64_MAX) {
           mark(float_scalar(va), float_scalar(vb));
         }
         ++index;
@@ -898,7 +1150,10 @@ class Comparer {
         return;
       }
       const Scalar sa = load(x, size, kind), sb = load(y, size, kind);
-      if (!c.differs(st, sa, sb) && first_bad == UINT64_MAX) mark(sa, sb);
+      if (!(t.has_meta && c.metadata(t, group, index, sa, sb, b)) && !c.differs(st, sa, sb) &&
+          first_bad == UINT64_MAX) {
+        mark(sa, sb);
+      }
       ++index;
     }
     static Scalar float_scalar(double v) {
@@ -961,7 +1216,10 @@ class Comparer {
               x.kind = y.kind = Kind::String;
               x.s = sa;
               y.s = sb;
-              if (!c.differs(st, x, y) && first_bad == UINT64_MAX) mark(x, y);
+              if (!(t.has_meta && c.metadata(t, f.group, index, x, y, b)) && !c.differs(st, x, y) &&
+                  first_bad == UINT64_MAX) {
+                mark(x, y);
+              }
             }
             ++index;
             pa += na;
@@ -1000,11 +1258,12 @@ class Comparer {
         g.data[1] == 1) {
       walk = ls.fields(t.layout->root(), true);
     }
-    const std::uint64_t step = ls.has_step ? ls.step : g.index;
+    const bool has_step = t.aligned || ls.has_step;
+    const std::uint64_t step = t.aligned ? g.step : ls.has_step ? ls.step : g.index;
     for (Stat* st : touched_) st->step_at_max = step;
     step_known_ = true;
     cur_step_ = step;
-    last_has_step_ = ls.has_step;
+    last_has_step_ = has_step;
     last_step_ = step;
     std::uint64_t first_bad = ls.first_bad, first_bad_run = ls.first_bad;
     bool decoded = false;
@@ -1022,6 +1281,10 @@ class Comparer {
         if (p.b < ls.index) continue;
         Stat& st = t.stats[p.group];
         ++st.values;
+        if (t.has_meta && !(run_[p.a] == golden_[p.b]) &&
+            metadata(t, p.group, p.b, run_[p.a], golden_[p.b], cdr(g.data))) {
+          continue;
+        }
         if (!same_scalar(st, run_[p.a], golden_[p.b]) && first_bad == UINT64_MAX) {
           first_bad = p.b;
           first_bad_run = p.a;
@@ -1038,7 +1301,7 @@ class Comparer {
         const Scalar& a = decoded ? run_[first_bad_run] : ls.bad_a;
         const Scalar& b = decoded ? golden_[first_bad] : ls.bad_b;
         Divergence d{
-            t.name,  ls.has_step,     step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b),
+            t.name,  has_step,        step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b),
             text(a), difference(a, b)};
         consider(key, std::move(d));
       }
@@ -1175,6 +1438,15 @@ class Comparer {
       }
       if (!t.side[kRun].has || !t.side[kGolden].has) continue;
       report_.topics.push_back(t.name);
+      if (t.aligned) {
+        for (int si : {kRun, kGolden}) {
+          for (const Pending& p : t.queue[si]) only(t, si, p);
+          t.queue[si].clear();
+        }
+        for (int si : {kGolden, kRun}) {
+          if (t.only[si].count > 0) report_.step_problems.push_back(t.name + ": " + only_summary(t, si));
+        }
+      }
       for (int si : {kRun, kGolden}) {
         if (t.queue[si].empty()) continue;
         const Pending& p = t.queue[si].front();
@@ -1203,7 +1475,7 @@ class Comparer {
         f.step_at_max = st.step_at_max;
         report_.fields.push_back(std::move(f));
       };
-      const bool has_step = t.mode == Topic::Mode::Fields && t.layout->has_step();
+      const bool has_step = t.aligned || (t.mode == Topic::Mode::Fields && t.layout->has_step());
       for (std::size_t gi = 0; gi < t.identical_counts.size(); ++gi)
         t.stats[gi].values += t.identical_counts[gi];
       if (t.mode == Topic::Mode::Fields) {
@@ -1216,6 +1488,11 @@ class Comparer {
         row("(bytes)", "bytes", t.stats[t.bytes_stat], false);
       }
       row("(log_time)", "time", t.stats[t.time_stat], has_step);
+    }
+    if (first_only_ && report_.first) {
+      const auto [ti, si] = *first_only_;
+      std::string& field = report_.first->field;
+      field = field.substr(0, field.size() - 1) + ": " + only_summary(topics_[ti], si) + ")";
     }
     report_.run_bytes = side_[kRun].bytes;
     report_.golden_bytes = side_[kGolden].bytes;
@@ -1237,11 +1514,17 @@ class Comparer {
   std::vector<Stat*> touched_;
   bool step_known_ = false;
   std::uint64_t cur_step_ = 0;
+  std::optional<std::pair<std::size_t, int>> first_only_;  // the first divergence is a step in one file only
 };
 
 }  // namespace
 
+std::string MetadataDifference::line() const {
+  return where + ": expected " + expected + ", actual " + actual;
+}
+
 std::string Divergence::line() const {
+  if (topic_level && topic.empty()) return field.substr(1, field.size() - 2);
   if (topic_level) return "topic " + topic + ": " + field.substr(1, field.size() - 2);
   std::string out = "topic " + topic + ", " + (has_step ? "step " : "message ") + std::to_string(step);
   if (!field.empty() && field.front() == '(' && expected.empty())

@@ -18,13 +18,16 @@ struct CheckOptions {
   // Log times differ between a live recording (receive time) and `rbsim run --record` (simulated
   // time) of the same run; payloads do not.
   bool compare_log_time = true;
+  // Metadata (the scene's name, description, viewport and background, the MCAP header's profile
+  // and library) is reported apart from physics; true makes a metadata difference a divergence.
+  bool strict_metadata = false;
 };
 
 // Where two recordings first differ. `field` is the full path ("bodies[3].x"), or for a message-
 // or topic-level difference a description in parentheses ("(message missing from the run)").
 struct Divergence {
   std::string topic;
-  bool has_step = false;  // true: `step` is the message's step field; false: message index
+  bool has_step = false;  // true: `step` is the simulated step; false: the message's index on its topic
   std::uint64_t step = 0;
   std::string field;
   std::string expected, actual, difference;  // golden value, run value, actual - expected
@@ -44,11 +47,24 @@ struct FieldStats {
   std::uint64_t step_at_max = 0;  // step (or message index) of max_abs
 };
 
+// A metadata value that differs (not physics: reported, a divergence only with strict_metadata).
+struct MetadataDifference {
+  std::string where;             // "/rbsim/scene, field name" or "MCAP header, library"
+  std::string expected, actual;  // golden value, run value
+  std::string line() const;      // "/rbsim/scene, field name: expected "chain", actual "mychain""
+};
+
 struct CheckReport {
-  std::optional<Divergence> first;                // none: the recordings match
-  std::uint64_t diverging_values = 0;             // values outside the tolerance
-  std::uint64_t diverging_messages = 0;           // messages with such a value, plus missing and extra ones
-  std::vector<std::string> topic_problems;        // topic-level differences (only in one file, schema)
+  std::optional<Divergence> first;          // none: the recordings match
+  std::uint64_t diverging_values = 0;       // values outside the tolerance
+  std::uint64_t diverging_messages = 0;     // messages with such a value, plus missing and extra ones
+  std::uint64_t one_file_messages = 0;      // of those: per-step messages whose step one file lacks
+  std::vector<std::string> topic_problems;  // topic-level differences (only in one file, schema)
+  // Per topic, the simulated steps only in the golden ("run lacks") or only in the run ("run has
+  // extra"), with their ranges and a likely cause: "/rbsim/body_states: run lacks steps 0..999
+  // (1,000 messages: recorder joined late?)", "... golden recorded every 10th step, run every 5th".
+  std::vector<std::string> step_problems;
+  std::vector<MetadataDifference> metadata;       // metadata differences (first per field)
   std::vector<FieldStats> fields;                 // topics by name, then fields in message order
   std::vector<std::string> topics;                // topics compared
   std::uint64_t messages = 0;                     // message pairs compared
@@ -56,9 +72,12 @@ struct CheckReport {
   bool passed() const { return !first.has_value(); }
 };
 
-// Compares a recording with a golden one. Messages pair up per topic in file order (rbsim writes
-// every topic in log-time order); a missing or extra message, a topic in only one file, a
-// different schema, log time or any field value outside the tolerance is a divergence. Integers,
+// Compares a recording with a golden one. Per-step messages (rbsim's body states, spring states,
+// energy terms, poses, markers and clock) pair up per topic by simulated step, round(stamp / dt)
+// with each file's dt from its scene description; other messages (the scene description itself,
+// topics of other types, a file without a scene description) pair up per topic in file order.
+// A step (or message) in only one file, a topic in only one file, a different schema, log time or
+// any physics field value outside the tolerance is a divergence; metadata is reported apart. Integers,
 // strings, bools and sequence lengths compare exactly. An Error means the inputs could not be
 // read (not MCAP, truncated, corrupted, bad CDR): a different outcome from a divergence.
 Result<CheckReport> check_logs(const std::string& run_path, const std::string& golden_path,
