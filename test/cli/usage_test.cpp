@@ -42,13 +42,16 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{}, "rbsim: error: no command given", "run, grade"},
         UsageCase{{"frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "run, grade"},
         UsageCase{{"help", "frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "--help"},
-        UsageCase{
-            {"log", "frob"}, "rbsim log: error: unknown command 'frob'", "info, doctor, recover, export"},
+        UsageCase{{"log", "frob"},
+                  "rbsim log: error: unknown command 'frob'",
+                  "info, doctor, recover, export, cat"},
         UsageCase{{"check", "a.mcap", "b.mcap", "--atol", "abc"}, "rbsim check: error:", "--atol"},
         UsageCase{{"check", "x", "y", "z"}, "rbsim check: error:", "rbsim check --help"},
         UsageCase{{"run", "scene.xml", "--steps", "-1"}, "rbsim run: error:", "--steps"},
         UsageCase{{"run", "scene.xml", "--no-such-flag"}, "rbsim run: error:", "--no-such-flag"},
-        UsageCase{{"log", "info"}, "rbsim log info: error:", "file"}));
+        UsageCase{{"log", "info"}, "rbsim log info: error:", "file"},
+        UsageCase{{"log", "cat"}, "rbsim log cat: error:", "file"},
+        UsageCase{{"log", "cat", "x.mcap", "--start", "-1"}, "rbsim log cat: error:", "--start"}));
 
 TEST(Help, HelpCommandShowsTheCommandsHelp) {
   const test::Outcome o = rbsim({"help", "log", "recover"});
@@ -71,7 +74,8 @@ TEST(Help, EveryCommandStatesItsExitStatus) {
                                                                                        {"log", "info"},
                                                                                        {"log", "doctor"},
                                                                                        {"log", "recover"},
-                                                                                       {"log", "export"}}) {
+                                                                                       {"log", "export"},
+                                                                                       {"log", "cat"}}) {
     std::vector<std::string> args = command;
     args.push_back("--help");
     const test::Outcome o = rbsim(args);

@@ -31,6 +31,7 @@ struct RunOptions {
   std::string progress = "auto";
   bool quiet = false;
   bool allow_nonfinite = false;
+  bool overwrite = false;
 };
 
 int fail(const std::string& message) {
@@ -73,7 +74,9 @@ int run(const RunOptions& o) {
     if (!render::parse_size(o.size, width, height))
       return fail("invalid --size \"" + o.size + "\" (expected WxH)");
     if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
-    sinks.push_back(render::make_frame_sink(o.frames, width, height, o.fps));
+    sinks.push_back(render::make_frame_sink(
+        o.frames, width, height, o.fps,
+        render::run_duration(steps, scene.world.dt, scene.duration, scene.step_count()), o.overwrite));
   }
   for (auto& sink : sinks) driver.add(*sink);
   if (Status st = driver.begin(); !st) return fail(st.error().message);
@@ -155,9 +158,14 @@ Subcommand add_run_command(CLI::App& parent) {
   app->add_option("--namespace", o->ns, "ROS namespace of the recorded topics (/<namespace>/body_states ...)")
       ->default_str("rbsim");
   app->add_option("--frames", o->frames,
-                  "Draw PNG frames into this folder during the run (see rbsim render)");
+                  "Draw PNG frames into this folder during the run, as rbsim render draws them: T x fps "
+                  "frames for a run of T = steps x dt (the scene's duration for its full length)");
   app->add_option("--fps", o->fps, "Frames per simulated second for --frames")->default_str("24");
   app->add_option("--size", o->size, "Frame size WxH for --frames")->default_str("1280x720");
+  app->add_flag(
+      "--overwrite", o->overwrite,
+      "With --frames: remove the frame files (frameNNNNN.png, nothing else) of an earlier run or render "
+      "from the folder first (a folder holding frames is refused otherwise)");
   app->add_option("--progress", o->progress,
                   "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
       ->check(CLI::IsMember({"auto", "always", "never"}))
