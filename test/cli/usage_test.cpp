@@ -42,8 +42,9 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{}, "rbsim: error: no command given", "run, grade"},
         UsageCase{{"frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "run, grade"},
         UsageCase{{"help", "frobnicate"}, "rbsim: error: unknown command 'frobnicate'", "--help"},
-        UsageCase{
-            {"log", "frob"}, "rbsim log: error: unknown command 'frob'", "info, doctor, recover, export"},
+        UsageCase{{"log", "frob"},
+                  "rbsim log: error: unknown command 'frob'",
+                  "info, doctor, recover, export, cat"},
         UsageCase{{"check", "a.mcap", "b.mcap", "--atol", "abc"}, "rbsim check: error:", "--atol"},
         UsageCase{{"check", "x", "y", "z"}, "rbsim check: error:", "rbsim check --help"},
         UsageCase{{"run", "scene.xml", "--steps", "-1"}, "rbsim run: error:", "--steps"},
@@ -64,7 +65,9 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{"record", "x.mcap", "--namespace", "a//b"}, "rbsim record: error: --namespace", "//"},
         // --duration is simulated time everywhere; a recorder's wall-clock limit has its own name.
         UsageCase{
-            {"record", "x.mcap", "--duration", "3"}, "rbsim record: error: --duration", "--wall-duration"}));
+            {"record", "x.mcap", "--duration", "3"}, "rbsim record: error: --duration", "--wall-duration"},
+        UsageCase{{"log", "cat"}, "rbsim log cat: error:", "file"},
+        UsageCase{{"log", "cat", "x.mcap", "--start", "-1"}, "rbsim log cat: error:", "--start"}));
 
 TEST(Help, HelpCommandShowsTheCommandsHelp) {
   const test::Outcome o = rbsim({"help", "log", "recover"});
@@ -96,7 +99,8 @@ TEST(Help, EveryCommandStatesItsExitStatus) {
                                                                                        {"log", "info"},
                                                                                        {"log", "doctor"},
                                                                                        {"log", "recover"},
-                                                                                       {"log", "export"}}) {
+                                                                                       {"log", "export"},
+                                                                                       {"log", "cat"}}) {
     std::vector<std::string> args = command;
     args.push_back("--help");
     const test::Outcome o = rbsim(args);

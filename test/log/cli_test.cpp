@@ -2,8 +2,14 @@
 // CSV files byte for byte, info/doctor/recover on good files, and every tool on bad inputs.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
+#include <array>
 #include <fstream>
+#include <map>
 #include <regex>
+#include <sstream>
+#include <utility>
 
 #include "log_test_util.hpp"
 #include "rbsim/subprocess.hpp"
@@ -200,7 +206,8 @@ TEST(LogCli, HelpForEveryCommand) {
                                         {"log", "info", "--help"},
                                         {"log", "doctor", "--help"},
                                         {"log", "recover", "--help"},
-                                        {"log", "export", "--help"}}) {
+                                        {"log", "export", "--help"},
+                                        {"log", "cat", "--help"}}) {
     Outcome o = rbsim(args, seconds(20));
     EXPECT_EQ(o.exit_code, 0) << describe(o);
     EXPECT_NE(o.out.find("Usage"), std::string::npos) << describe(o);
@@ -239,6 +246,102 @@ TEST(LogCli, InfoDoctorRecoverOnAGoodRecording) {
   EXPECT_EQ(same.exit_code, 1);
   EXPECT_NE(same.err.find("is an input of this command; refusing to write over it"), std::string::npos)
       << same.err;
+}
+
+// rbsim log cat: one JSON line per message, as many as rbsim log info counts, in log-time order,
+// with the values rbsim run wrote to its CSV.
+TEST(CatCli, PrintsEveryMessageAsJsonWithTheRecordedValues) {
+  TempDir dir;
+  const std::string file = (dir / "r.mcap").string(), csv = (dir / "run.csv").string();
+  Outcome run = rbsim(
+      {"run", source_path("scenes/cantilever.xml"), "-q", "--steps", "40", "--record", file, "--csv", csv});
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+
+  Outcome info = rbsim({"log", "info", file});
+  ASSERT_EQ(info.exit_code, 0) << describe(info);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(info.out, m, std::regex("messages: +([0-9]+)"))) << info.out;
+  const std::size_t messages = std::stoull(m[1]);
+
+  Outcome cat = rbsim({"log", "cat", file});
+  ASSERT_EQ(cat.exit_code, 0) << describe(cat);
+  EXPECT_TRUE(cat.err.empty()) << cat.err;
+  const std::vector<std::string> lines = lines_of(cat.out);
+  ASSERT_EQ(lines.size(), messages);
+
+  // x, y, theta of (step, body) as rbsim run --csv wrote them
+  std::map<std::pair<std::uint64_t, std::int64_t>, std::array<double, 3>> expected;
+  bool header = true;
+  for (const std::string& line : lines_of(read_text(csv))) {
+    if (std::exchange(header, false)) continue;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    ASSERT_GE(f.size(), 6u) << line;
+    expected[{std::stoull(f[0]), std::stoll(f[2])}] = {std::stod(f[3]), std::stod(f[4]), std::stod(f[5])};
+  }
+  ASSERT_FALSE(expected.empty());
+
+  std::uint64_t last_time = 0;
+  std::size_t body_states = 0, scenes = 0, bodies_checked = 0;
+  for (const std::string& line : lines) {
+    nlohmann::json j;
+    ASSERT_NO_THROW(j = nlohmann::json::parse(line)) << line.substr(0, 300);
+    ASSERT_TRUE(j.is_object());
+    for (const char* key : {"topic", "sequence", "log_time", "publish_time", "data"})
+      ASSERT_TRUE(j.contains(key)) << key << ": " << line.substr(0, 300);
+    const std::uint64_t t = j["log_time"].get<std::uint64_t>();
+    EXPECT_GE(t, last_time) << "log-time order";
+    last_time = t;
+    const std::string topic = j["topic"].get<std::string>();
+    scenes += topic == "/rbsim/scene";
+    if (topic != "/rbsim/body_states") continue;
+    ++body_states;
+    const nlohmann::json& data = j["data"];
+    const std::uint64_t step = data["step"].get<std::uint64_t>();
+    EXPECT_EQ(t,
+              static_cast<std::uint64_t>(data["header"]["stamp"]["sec"].get<std::int64_t>()) * 1000000000u +
+                  data["header"]["stamp"]["nanosec"].get<std::uint64_t>());
+    for (const nlohmann::json& b : data["bodies"]) {
+      const auto it = expected.find({step, b["id"].get<std::int64_t>()});
+      ASSERT_NE(it, expected.end()) << step;
+      EXPECT_EQ(b["x"].get<double>(), it->second[0]) << "step " << step;
+      EXPECT_EQ(b["y"].get<double>(), it->second[1]) << "step " << step;
+      EXPECT_EQ(b["theta"].get<double>(), it->second[2]) << "step " << step;
+      ++bodies_checked;
+    }
+  }
+  EXPECT_EQ(scenes, 1u);
+  EXPECT_EQ(body_states, 41u);
+  EXPECT_EQ(bodies_checked, expected.size());
+
+  // --topics, by its last name or as recorded, and --start/--end in seconds of log time
+  Outcome some =
+      rbsim({"log", "cat", file, "--topics", "body_states,/clock", "--start", "0.01", "--end", "0.02"});
+  ASSERT_EQ(some.exit_code, 0) << describe(some);
+  std::size_t clock = 0, states = 0;
+  for (const std::string& line : lines_of(some.out)) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    const std::string topic = j["topic"].get<std::string>();
+    clock += topic == "/clock";
+    states += topic == "/rbsim/body_states";
+    EXPECT_GE(j["log_time"].get<std::uint64_t>(), 10000000u);
+    EXPECT_LT(j["log_time"].get<std::uint64_t>(), 20000000u);
+  }
+  EXPECT_EQ(states, clock);
+  EXPECT_GT(states, 0u);
+  EXPECT_EQ(states + clock, lines_of(some.out).size());
+
+  // errors: an unknown topic, an unreadable file (1); a bad option (2)
+  Outcome unknown = rbsim({"log", "cat", file, "--topics", "no_such_topic"});
+  EXPECT_EQ(unknown.exit_code, 1) << describe(unknown);
+  EXPECT_NE(unknown.err.find("rbsim log cat: error: "), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("no_such_topic"), std::string::npos) << unknown.err;
+  Outcome missing = rbsim({"log", "cat", (dir / "missing.mcap").string()});
+  EXPECT_EQ(missing.exit_code, 1) << describe(missing);
+  write_text(dir / "junk.mcap", "not an mcap file at all");
+  EXPECT_EQ(rbsim({"log", "cat", (dir / "junk.mcap").string()}).exit_code, 1);
+  EXPECT_EQ(rbsim({"log", "cat", file, "--start", "x"}).exit_code, 2);
 }
 
 TEST(LogCli, DoctorReportsPlantedStatisticsError) {

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "rbsim/builders.hpp"
@@ -215,6 +217,63 @@ TEST(EncoderMarkersAndScene, DecodeCleanly) {
   std::vector<Scalar> v;
   ASSERT_TRUE(decoder_for(TopicId::Markers).decode(out, v).ok());
   EXPECT_EQ(v[0].u, 4u);  // three hull outlines and one spring list
+}
+
+// Little-endian CDR written by hand, aligned as CDR aligns (relative to the end of the header).
+struct Cdr {
+  rbsim::msgs::Bytes bytes{std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0}};
+  template <class T>
+  Cdr& put(T v) {
+    while ((bytes.size() - 4) % sizeof(T) != 0) bytes.push_back(std::byte{0});
+    const auto* p = reinterpret_cast<const std::byte*>(&v);
+    bytes.insert(bytes.end(), p, p + sizeof(T));
+    return *this;
+  }
+  Cdr& str(const std::string& s) {
+    put<std::uint32_t>(static_cast<std::uint32_t>(s.size() + 1));
+    for (char c : s) bytes.push_back(static_cast<std::byte>(c));
+    bytes.push_back(std::byte{0});
+    return *this;
+  }
+};
+
+TEST(MessageDecoder, ToJsonNestsObjectsAndArraysAndWritesNoNaN) {
+  const char* schema =
+      "float64 x\nfloat32 f\nstring name\nint32[] ids\nInner[2] pts\nbool ok\nuint8[] empty\n"
+      "================================================================================\n"
+      "MSG: test_msgs/Inner\nfloat64 a\n";
+  auto d = rbsim::msgs::MessageDecoder::create("test_msgs/msg/T", schema);
+  ASSERT_TRUE(d.ok()) << d.error().message;
+  Cdr c;
+  c.put(1.5).put(0.1f).str("a\"b\\c\n\x01").put<std::uint32_t>(2).put<std::int32_t>(-1).put<std::int32_t>(7);
+  c.put(std::nan(""))
+      .put(-std::numeric_limits<double>::infinity())
+      .put<std::uint8_t>(1)
+      .put<std::uint32_t>(0);
+  std::string out = "prefix ";
+  const auto st = d->to_json(c.bytes, out);
+  ASSERT_TRUE(st.ok()) << st.error().message;
+  EXPECT_EQ(out,
+            "prefix {\"x\":1.5,\"f\":0.1,\"name\":\"a\\\"b\\\\c\\n\\u0001\",\"ids\":[-1,7],"
+            "\"pts\":[{\"a\":null},{\"a\":null}],\"ok\":true,\"empty\":[]}");
+  // malformed data: an error, and `out` as it was
+  out = "kept";
+  EXPECT_FALSE(d->to_json(std::span(c.bytes).first(c.bytes.size() - 2), out).ok());
+  EXPECT_EQ(out, "kept");
+}
+
+TEST(MessageDecoder, ToJsonOfBodyStatesCarriesTheStatesValues) {
+  rbsim::Scene scene = spring_wind_scene();
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  rbsim::msgs::Bytes bytes;
+  rbsim::msgs::Encoder(scene).encode(TopicId::BodyStates, w.value(), bytes);
+  std::string json;
+  ASSERT_TRUE(decoder_for(TopicId::BodyStates).to_json(bytes, json).ok());
+  char x[64];
+  const auto r = std::to_chars(x, x + sizeof x, w->x()[1]);
+  EXPECT_NE(json.find("{\"id\":1,\"x\":" + std::string(x, r.ptr) + ","), std::string::npos) << json;
+  EXPECT_EQ(json.rfind("{\"header\":{\"stamp\":{\"sec\":0,\"nanosec\":0},\"frame_id\":", 0), 0u) << json;
 }
 
 TEST(MessageDecoder, RejectsEveryTruncationAndSurvivesMutation) {

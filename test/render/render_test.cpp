@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -160,6 +162,121 @@ TEST(Render, McapDrivenEqualsSceneDrivenPixelForPixel) {
   // and the frames do change over time (a moving scene)
   EXPECT_NE(read_png(dir / "from_scene" / "frame00000.png").rgb,
             read_png(dir / "from_scene" / "frame00035.png").rgb);
+}
+
+std::int64_t frame_files(const fs::path& dir) {
+  std::int64_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    n += rbsim::render::is_frame_file(e.path().filename().string());
+  return n;
+}
+
+// The frames a movie holds, counted by decoding it (ffprobe -count_frames); -1 when unreadable.
+std::int64_t movie_frames(const fs::path& mp4) {
+  const std::string cmd =
+      "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+      "stream=nb_read_frames -of csv=p=0 '" +
+      mp4.string() + "'";
+  std::FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return -1;
+  char buf[64] = {};
+  const bool got = std::fgets(buf, sizeof buf, p) != nullptr;
+  if (::pclose(p) != 0 || !got) return -1;
+  return std::atoll(buf);
+}
+
+// One rule: T x fps frames for T simulated seconds, whether drawn from the scene, from a recording
+// of its run, or during the run (rbsim run --frames); for the scene's own duration and for another.
+TEST(RenderCli, FrameCountIsTheSameFromSceneRecordingAndRun) {
+  const fs::path dir = temp_dir("samecount");
+  // dt 0.01 does not divide the duration 1.005: the full-length run has ceil(100.5) = 101 steps.
+  std::string text = kSquareScene;
+  text.replace(text.find("time=\"1.0\""), 10, "time=\"1.005\"");
+  const fs::path scene = write_scene(dir, text);
+  struct Case {
+    std::string name;
+    std::vector<std::string> duration;  // empty: the scene's
+    double fps;
+    std::int64_t expected;
+  };
+  for (const Case& c :
+       {Case{"full24", {}, 24.0, 24}, Case{"two24", {"--duration", "2"}, 24.0, 48},
+        Case{"two7", {"--duration", "2"}, 7.0, 14}, Case{"half10", {"--duration", "0.5"}, 10.0, 5}}) {
+    SCOPED_TRACE(c.name);
+    const std::string fps = std::to_string(c.fps);
+    const fs::path log = dir / (c.name + ".mcap"), during = dir / (c.name + "_run");
+    std::vector<std::string> args = {RBSIM_BINARY, "run",        scene.string(), "-q",
+                                     "--record",   log.string(), "--frames",     during.string(),
+                                     "--fps",      fps,          "--size",       "64x48"};
+    args.insert(args.end(), c.duration.begin(), c.duration.end());
+    std::string err;
+    ASSERT_EQ(run(args, &err), 0) << err;
+    EXPECT_EQ(frame_files(during), c.expected) << "rbsim run --frames";
+    for (const fs::path& input : {scene, log}) {
+      const fs::path out = dir / (c.name + "_" + input.extension().string().substr(1));
+      std::vector<std::string> r = {RBSIM_BINARY, "render", input.string(), "--out", out.string(),
+                                    "--fps",      fps,      "--size",       "64x48"};
+      r.insert(r.end(), c.duration.begin(), c.duration.end());
+      ASSERT_EQ(run(r, &err), 0) << err;
+      EXPECT_EQ(frame_files(out), c.expected) << "rbsim render " << input;
+      EXPECT_NE(err.find(" " + std::to_string(c.expected) + " frames "), std::string::npos) << err;
+    }
+  }
+}
+
+// A second, shorter render into the same folder: refused unless --overwrite, which removes the old
+// frames (and nothing else) first; the movie holds this render's frames only.
+TEST(RenderCli, MovieHoldsOnlyThisRendersFrames) {
+  const fs::path dir = temp_dir("movie");
+  const fs::path scene = write_scene(dir, kSquareScene);
+  const fs::path frames = dir / "frames";
+  fs::create_directories(frames);
+  std::ofstream(frames / "notes.txt") << "mine";
+  std::ofstream(frames / "frame_cover.png") << "mine too";
+  std::string err;
+  const std::vector<std::string> common = {RBSIM_BINARY,    "render", scene.string(), "--out",
+                                           frames.string(), "--size", "64x48"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = common;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  ASSERT_EQ(run(with({"--duration", "0.5", "--mp4", (dir / "a.mp4").string()}), &err), 0) << err;
+  EXPECT_EQ(frame_files(frames), 12);
+  EXPECT_EQ(movie_frames(dir / "a.mp4"), 12);
+
+  // the folder holds a render's frames: refused, nothing touched
+  EXPECT_EQ(run(with({"--duration", "0.25", "--mp4", (dir / "w.mp4").string()}), &err), 1);
+  EXPECT_NE(err.find("--overwrite"), std::string::npos) << err;
+  EXPECT_EQ(frame_files(frames), 12);
+  EXPECT_FALSE(fs::exists(dir / "w.mp4"));
+  // an existing movie: refused too
+  EXPECT_EQ(run(with({"--duration", "0.25", "--mp4", (dir / "a.mp4").string()}), &err), 1);
+  EXPECT_NE(err.find("--overwrite"), std::string::npos) << err;
+  EXPECT_EQ(movie_frames(dir / "a.mp4"), 12);
+
+  ASSERT_EQ(run(with({"--duration", "0.25", "--mp4", (dir / "w.mp4").string(), "--overwrite"}), &err), 0)
+      << err;
+  EXPECT_NE(err.find(" 6 frames "), std::string::npos) << err;
+  EXPECT_EQ(frame_files(frames), 6);
+  EXPECT_FALSE(fs::exists(frames / "frame00006.png"));
+  EXPECT_EQ(movie_frames(dir / "w.mp4"), 6);
+  EXPECT_TRUE(fs::exists(frames / "notes.txt"));
+  EXPECT_TRUE(fs::exists(frames / "frame_cover.png"));
+
+  // rbsim run --frames follows the same rule
+  EXPECT_EQ(run({RBSIM_BINARY, "run", scene.string(), "-q", "--duration", "0.1", "--frames", frames.string(),
+                 "--size", "64x48"},
+                &err),
+            1);
+  EXPECT_NE(err.find("--overwrite"), std::string::npos) << err;
+  EXPECT_EQ(run({RBSIM_BINARY, "run", scene.string(), "-q", "--duration", "0.1", "--frames", frames.string(),
+                 "--size", "64x48", "--overwrite"},
+                &err),
+            0)
+      << err;
+  EXPECT_EQ(frame_files(frames), 2);  // 0.1 s at 24 fps: frames at 0 and 1/24 s
+  EXPECT_TRUE(fs::exists(frames / "notes.txt"));
 }
 
 TEST(Plot, WritesAPngOfTheRequestedSize) {

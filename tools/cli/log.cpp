@@ -1,8 +1,11 @@
-// rbsim log: info, doctor, recover and export on MCAP recordings.
+// rbsim log: info, doctor, recover, export and cat on MCAP recordings.
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <string_view>
 
 #include "commands.hpp"
+#include "rbsim/cat.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_tools.hpp"
@@ -20,6 +23,8 @@ struct LogOptions {
   std::string csv, energy_csv, ns;
   bool quiet = false;
   bool overwrite = false;
+  std::vector<std::string> topics;
+  std::optional<double> start, end;
 };
 
 int fail(const char* command, const std::string& message) {
@@ -98,12 +103,28 @@ int export_command(const LogOptions& o) {
   return 0;
 }
 
+int cat_command(const LogOptions& o) {
+  log::CatOptions options;
+  for (const std::string& t : o.topics) {
+    if (!t.empty()) options.topics.push_back(t);
+  }
+  options.start = o.start;
+  options.end = o.end;
+  Status st = log::cat(o.file, options, [](std::string_view line) {
+    std::fwrite(line.data(), 1, line.size(), stdout);
+    std::fputc('\n', stdout);
+  });
+  std::fflush(stdout);
+  if (!st) return fail("cat", st.error().message);
+  return 0;
+}
+
 }  // namespace
 
 Subcommand add_log_command(CLI::App& parent) {
   auto o = std::make_shared<LogOptions>();
-  CLI::App* app =
-      parent.add_subcommand("log", "Inspect, check, repair and export MCAP recordings (rbsim run --record)");
+  CLI::App* app = parent.add_subcommand(
+      "log", "Inspect, check, repair, export and print MCAP recordings (rbsim run --record)");
   app->require_subcommand(1);
   app->footer("Run 'rbsim log <command> --help' for a command's options.");
 
@@ -162,11 +183,32 @@ Subcommand add_log_command(CLI::App& parent) {
       "Byte for byte what rbsim run wrote for the recorded steps (all of them, or every k-th with "
       "--record-every k).\nExit status: 0 success, 1 error, 2 usage error.");
 
-  return {app, [o, info, doctor, recover, exp]() -> int {
+  CLI::App* cat = app->add_subcommand(
+      "cat", "Print every message as one line of JSON, decoded by its schema (as 'mcap cat --json')");
+  cat->add_option("file", o->file, "MCAP file")->required();
+  cat->add_option("--topics", o->topics,
+                  "Only these topics, comma-separated; each as recorded (/rbsim/body_states) or by its "
+                  "last name (body_states)")
+      ->delimiter(',');
+  cat->add_option("--start", o->start, "Only messages logged at or after this many seconds")
+      ->check(non_negative());
+  cat->add_option("--end", o->end, "Only messages logged before this many seconds")->check(non_negative());
+  cat->footer(
+      "One JSON object per line and message, in log-time order (equal times in file order):\n"
+      "  {\"topic\":\"/rbsim/body_states\",\"sequence\":0,\"log_time\":0,\"publish_time\":0,\"data\":{...}}\n"
+      "log_time and publish_time are integer nanoseconds as recorded. data is the message decoded from its "
+      "channel's ros2msg schema as nested JSON: an object per message type, an array per array or "
+      "sequence, field names as in the .msg definitions; floats shortest round-trip, NaN and infinities as "
+      "null (JSON has neither); data is null for a channel without a ros2msg/CDR schema.\n"
+      "Exit status: 0 success, 1 error (unreadable or corrupt file, a message its schema cannot decode, an "
+      "unknown topic), 2 usage error.");
+
+  return {app, [o, info, doctor, recover, exp, cat]() -> int {
             if (info->parsed()) return info_command(*o);
             if (doctor->parsed()) return doctor_command(*o);
             if (recover->parsed()) return recover_command(*o);
             if (exp->parsed()) return export_command(*o);
+            if (cat->parsed()) return cat_command(*o);
             return 1;
           }};
 }

@@ -14,6 +14,7 @@ struct RenderArgs {
   std::string input, out, size = "1280x720", mp4;
   double fps = 24.0;
   std::optional<double> duration;
+  bool overwrite = false;
 };
 
 int render_command(const RenderArgs& a) {
@@ -29,12 +30,18 @@ int render_command(const RenderArgs& a) {
   o.out_dir = a.out;
   o.fps = a.fps;
   o.duration = a.duration;
+  o.overwrite = a.overwrite;
+  // Before any frame is drawn: the movie must not replace a file unasked, nor an input.
+  if (Status st = check_outputs({{a.out, "--out", true}, {a.mp4, "--mp4"}}, {a.input}, a.overwrite); !st)
+    return fail(st.error().message);
   Result<std::int64_t> frames = render::render(a.input, o);
   if (!frames) return fail(frames.error().message);
-  std::fprintf(stderr, "rbsim render: %lld frames (%dx%d at %g fps) in %s\n",
-               static_cast<long long>(frames.value()), o.width, o.height, o.fps, a.out.c_str());
+  std::fprintf(stderr, "rbsim render: %lld %s (%dx%d at %g fps) in %s\n",
+               static_cast<long long>(frames.value()), frames.value() == 1 ? "frame" : "frames", o.width,
+               o.height, o.fps, a.out.c_str());
   if (!a.mp4.empty()) {
-    if (Status st = render::make_movie(a.out, a.fps, a.mp4); !st) return fail(st.error().message);
+    if (Status st = render::make_movie(a.out, a.fps, frames.value(), a.mp4); !st)
+      return fail(st.error().message);
     std::fprintf(stderr, "rbsim render: movie %s\n", a.mp4.c_str());
   }
   return 0;
@@ -84,13 +91,22 @@ Subcommand add_render_command(CLI::App& parent) {
   app->add_option("--size", a->size, "Frame size WxH in pixels")->default_str("1280x720");
   app->add_option("--duration", a->duration, "Simulated seconds to draw (default: the scene's duration)")
       ->check(positive());
-  app->add_option("--mp4", a->mp4, "Also assemble the frames into an H.264 (yuv420p) movie with ffmpeg");
+  app->add_option("--mp4", a->mp4,
+                  "Also assemble this render's frames (and only them) into an H.264 (yuv420p) movie with "
+                  "ffmpeg");
+  app->add_flag("--overwrite", a->overwrite,
+                "Replace an earlier render: remove the frame files (frameNNNNN.png, nothing else) already in "
+                "--out first, and replace an existing --mp4 file");
   app->footer(
-      "Frame k shows time k / fps (the first step at or after it); duration x fps frames in all. Bodies are "
+      "Frames cover T simulated seconds: frame k shows time k / fps (the first step at or after it) for "
+      "k = 0 .. floor(T x fps) - 1, so T x fps frames. T is --duration, else the scene's duration, or for a "
+      "recording the run's: the scene's duration for a run of its full length, else the last recorded step "
+      "x dt (rbsim run --frames counts the same way). A folder that already holds frame files, or an "
+      "existing --mp4 file, is refused unless --overwrite, so old frames never end up in a movie. Bodies are "
       "filled hulls grown by their radius r in their scene colours, springs are lines in theirs (fixed ends "
       "ringed), on the scene's background, framed by its viewport (or fitted to the bodies).\n"
-      "Exit status: 0 success, 1 error (bad input, divergence, unwritable output, ffmpeg failure), 2 usage "
-      "error.");
+      "Exit status: 0 success, 1 error (bad input, divergence, unwritable or existing output, ffmpeg "
+      "failure), 2 usage error.");
   return {app, [a] { return render_command(*a); }};
 }
 

@@ -85,7 +85,9 @@ int run(const RunOptions& o) {
     if (!render::parse_size(o.size, width, height))
       return fail("invalid --size \"" + o.size + "\" (expected WxH)");
     if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
-    sinks.push_back(render::make_frame_sink(o.frames, width, height, o.fps));
+    sinks.push_back(render::make_frame_sink(
+        o.frames, width, height, o.fps,
+        render::run_duration(steps, scene.world.dt, scene.duration, scene.step_count()), o.overwrite));
   }
   for (auto& sink : sinks) driver.add(*sink);
   if (Status st = driver.begin(); !st) return fail(st.error().message);
@@ -172,15 +174,19 @@ Subcommand add_run_command(CLI::App& parent) {
       ->check(ros_namespace())
       ->default_str("rbsim")
       ->needs(record);
-  auto* frames = app->add_option("--frames", o->frames,
-                                 "Draw PNG frames into this folder during the run (see rbsim render)");
+  auto* frames =
+      app->add_option("--frames", o->frames,
+                      "Draw PNG frames into this folder during the run, as rbsim render draws them: "
+                      "T x fps frames for a run of T = steps x dt (the scene's duration for its full "
+                      "length)");
   app->add_option("--fps", o->fps, "Frames per simulated second for --frames")
       ->default_str("24")
       ->needs(frames);
   app->add_option("--size", o->size, "Frame size WxH for --frames")->default_str("1280x720")->needs(frames);
   app->add_flag("--overwrite", o->overwrite,
-                "Replace output files that exist (by default an existing output is refused before the run "
-                "starts; the scene itself is never written over)");
+                "Replace output files that exist, and remove the frame files (frameNNNNN.png, nothing "
+                "else) an earlier run or render left in the --frames folder (by default either is refused "
+                "before the run starts; the scene itself is never written over)");
   app->add_option("--progress", o->progress,
                   "Progress bar on stderr: auto (on a terminal, runs over 1 s), always, never")
       ->check(CLI::IsMember({"auto", "always", "never"}))

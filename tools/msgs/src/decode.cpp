@@ -1,5 +1,8 @@
 // Parsing ros2msg schemas and decoding CDR by them.
 #include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -55,8 +58,9 @@ class Walker {
   template <class Visit>
   bool type(std::size_t t, Visit& visit) {
     if (++depth_ > 64) return fail("types nest deeper than 64");
+    visit.begin_object();
     for (const MessageDecoder::Field& f : types_[t].fields) {
-      visit.enter(f.name);
+      visit.enter(f);
       std::uint64_t count = 1;
       if (f.array == MessageDecoder::Field::Array::Sequence) {
         std::uint32_t n = 0;
@@ -76,8 +80,9 @@ class Walker {
           return false;
         if (f.array != MessageDecoder::Field::Array::None) visit.unindex();
       }
-      visit.leave();
+      visit.leave(f);
     }
+    visit.end_object();
     --depth_;
     return true;
   }
@@ -120,8 +125,10 @@ class Walker {
 
 struct Collect {
   std::vector<Scalar>* out;
-  void enter(const std::string&) {}
-  void leave() {}
+  void begin_object() {}
+  void end_object() {}
+  void enter(const MessageDecoder::Field&) {}
+  void leave(const MessageDecoder::Field&) {}
   void index(std::uint64_t) {}
   void unindex() {}
   void scalar(const Scalar& s, bool) { out->push_back(s); }
@@ -133,8 +140,10 @@ struct PathOf {
   std::size_t seen = 0;
   std::vector<std::string> parts;
   std::string found;
-  void enter(const std::string& name) { parts.push_back((parts.empty() ? "" : ".") + name); }
-  void leave() { parts.pop_back(); }
+  void begin_object() {}
+  void end_object() {}
+  void enter(const MessageDecoder::Field& f) { parts.push_back((parts.empty() ? "" : ".") + f.name); }
+  void leave(const MessageDecoder::Field&) { parts.pop_back(); }
   void index(std::uint64_t k) { parts.push_back("[" + std::to_string(k) + "]"); }
   void unindex() { parts.pop_back(); }
   void scalar(const Scalar&, bool is_length) {
@@ -144,7 +153,100 @@ struct PathOf {
   }
 };
 
+// Writes the message as JSON while walking: objects for messages, arrays for arrays.
+struct Json {
+  explicit Json(std::string* o) : out(o) {}
+  std::string* out;
+  std::vector<bool> first;  // per open object: no member written yet
+  bool float32 = false;     // the field being written is float32
+  void begin_object() {
+    *out += '{';
+    first.push_back(true);
+  }
+  void end_object() {
+    *out += '}';
+    first.pop_back();
+  }
+  void enter(const MessageDecoder::Field& f) {
+    if (!first.back()) *out += ',';
+    first.back() = false;
+    append_json_string(*out, f.name);
+    *out += ':';
+    if (f.array != MessageDecoder::Field::Array::None) *out += '[';
+    float32 = f.primitive >= 0 && kPrimitives[f.primitive].kind == Scalar::Kind::Float &&
+              kPrimitives[f.primitive].size == 4;
+  }
+  void leave(const MessageDecoder::Field& f) {
+    if (f.array != MessageDecoder::Field::Array::None) *out += ']';
+  }
+  void index(std::uint64_t k) {
+    if (k > 0) *out += ',';
+  }
+  void unindex() {}
+  void scalar(const Scalar& s, bool is_length) {
+    if (is_length) return;  // the array's own length
+    char buf[40];
+    switch (s.kind) {
+      case Scalar::Kind::Bool:
+        *out += s.i ? "true" : "false";
+        return;
+      case Scalar::Kind::Int:
+        *out += std::to_string(s.i);
+        return;
+      case Scalar::Kind::UInt:
+      case Scalar::Kind::Length:
+        *out += std::to_string(s.u);
+        return;
+      case Scalar::Kind::String:
+        append_json_string(*out, s.s);
+        return;
+      case Scalar::Kind::Float: {
+        if (!std::isfinite(s.f)) {
+          *out += "null";  // JSON has no NaN or infinity
+          return;
+        }
+        const auto r = float32 ? std::to_chars(buf, buf + sizeof buf, static_cast<float>(s.f))
+                               : std::to_chars(buf, buf + sizeof buf, s.f);
+        out->append(buf, r.ptr);
+        return;
+      }
+    }
+  }
+};
+
 }  // namespace
+
+void append_json_string(std::string& out, std::string_view text) {
+  out += '"';
+  for (const char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
 
 std::string Scalar::to_string() const {
   switch (kind) {
@@ -282,6 +384,17 @@ Status MessageDecoder::decode(std::span<const std::byte> cdr, std::vector<Scalar
   Walker w(types_, cdr);
   Collect c{&out};
   if (!w.message(c)) return Error{"CDR: " + w.error};
+  return Ok{};
+}
+
+Status MessageDecoder::to_json(std::span<const std::byte> cdr, std::string& out) const {
+  const std::size_t start = out.size();
+  Walker w(types_, cdr);
+  Json j(&out);
+  if (!w.message(j)) {
+    out.resize(start);
+    return Error{"CDR: " + w.error};
+  }
   return Ok{};
 }
 

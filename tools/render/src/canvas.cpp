@@ -114,6 +114,11 @@ std::int64_t frame_count(double duration, double fps) {
   return n < 1.0 ? 1 : static_cast<std::int64_t>(n);
 }
 
+double run_duration(std::int64_t steps, double dt, double scene_duration, std::int64_t scene_steps) {
+  if (steps == scene_steps && std::isfinite(scene_duration)) return scene_duration;
+  return static_cast<double>(steps) * dt;
+}
+
 std::int64_t frame_step(std::int64_t frame, double fps, double dt) {
   return static_cast<std::int64_t>(std::ceil(static_cast<double>(frame) / fps / dt - 1e-9));
 }

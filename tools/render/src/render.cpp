@@ -3,12 +3,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <string_view>
 
 #include "process.hpp"
 
@@ -34,8 +37,26 @@ bool parse_size(const std::string& text, int& width, int& height) {
 }
 
 // ---------------------------------------------------------------------------------------------
-FrameWriter::FrameWriter(std::string dir, int width, int height, double fps)
-    : dir_(std::move(dir)), fps_(fps), canvas_(width, height) {}
+bool is_frame_file(const std::string& name) {
+  constexpr std::string_view prefix = "frame", suffix = ".png";
+  if (name.size() < prefix.size() + 5 + suffix.size() || !name.starts_with(prefix) || !name.ends_with(suffix))
+    return false;
+  for (std::size_t i = prefix.size(); i < name.size() - suffix.size(); ++i) {
+    if (name[i] < '0' || name[i] > '9') return false;
+  }
+  return true;
+}
+
+namespace {
+std::string frame_name(std::int64_t k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame%05lld.png", static_cast<long long>(k));
+  return name;
+}
+}  // namespace
+
+FrameWriter::FrameWriter(std::string dir, int width, int height, double fps, bool overwrite)
+    : dir_(std::move(dir)), fps_(fps), overwrite_(overwrite), canvas_(width, height) {}
 
 Status FrameWriter::open() {
   std::error_code ec;
@@ -46,6 +67,22 @@ Status FrameWriter::open() {
   if (f == nullptr) return Error{dir_ + ": output folder is not writable: " + std::strerror(errno)};
   std::fclose(f);
   std::remove(probe.c_str());
+  // Frames of an earlier render: never overwritten or mixed with this one's unless asked.
+  std::vector<fs::path> old;
+  for (fs::directory_iterator it(dir_, ec), end; !ec && it != end; it.increment(ec)) {
+    if (is_frame_file(it->path().filename().string())) old.push_back(it->path());
+  }
+  if (ec) return Error{dir_ + ": cannot list the output folder: " + ec.message()};
+  if (old.empty()) return Ok{};
+  if (!overwrite_) {
+    return Error{
+        dir_ + ": already holds " + std::to_string(old.size()) +
+        " frame files (frameNNNNN.png) of an earlier render; use --overwrite to replace them, or another "
+        "folder"};
+  }
+  for (const fs::path& p : old) {
+    if (!fs::remove(p, ec) && ec) return Error{p.string() + ": cannot remove an old frame: " + ec.message()};
+  }
   return Ok{};
 }
 
@@ -53,10 +90,17 @@ Status FrameWriter::offer(const Stage& stage, std::int64_t step, double dt, std:
   while (frame_step(next_, fps_, dt) <= step && next_ < frame_count(stage.duration, fps_)) {
     if (!camera_) camera_ = camera_for(stage, poses, canvas_.width(), canvas_.height());
     canvas_.draw(stage, poses, static_cast<double>(step) * dt, *camera_);
-    char name[32];
-    std::snprintf(name, sizeof name, "frame%05lld.png", static_cast<long long>(next_));
-    if (Status st = canvas_.write_png((fs::path(dir_) / name).string()); !st) return st;
+    if (Status st = canvas_.write_png((fs::path(dir_) / frame_name(next_)).string()); !st) return st;
     ++next_;
+  }
+  return Ok{};
+}
+
+Status FrameWriter::truncate(std::int64_t count) {
+  for (; next_ > count; --next_) {
+    const fs::path p = fs::path(dir_) / frame_name(next_ - 1);
+    std::error_code ec;
+    if (!fs::remove(p, ec) && ec) return Error{p.string() + ": cannot remove: " + ec.message()};
   }
   return Ok{};
 }
@@ -69,29 +113,39 @@ void poses_of(const World& world, std::vector<Pose>& out) {
     out[b] = {world.x()[b], world.y()[b], world.theta()[b]};
 }
 
-// Frames of [0, duration) as the run goes; an infinite duration leaves the length to the run
-// (rbsim run --steps / --duration).
+// Frames of [0, duration) as the run goes. `trim`: the frames end with the run too, at
+// run_duration() of its last step (rbsim run --frames; an interrupted run included).
 class FrameSink final : public Sink {
  public:
-  FrameSink(std::string dir, int width, int height, double fps, double duration = INFINITY)
-      : frames_(std::move(dir), width, height, fps), duration_(duration) {}
+  FrameSink(std::string dir, int width, int height, double fps, double duration, bool overwrite, bool trim)
+      : frames_(std::move(dir), width, height, fps, overwrite), fps_(fps), duration_(duration), trim_(trim) {}
   Status begin(const Scene& scene, const World& world) override {
     stage_ = stage_of(scene, world);
+    scene_duration_ = scene.duration;
+    scene_steps_ = scene.step_count();
     stage_.duration = duration_;
     if (Status st = frames_.open(); !st) return st;
     return write(world);
   }
   Status write(const World& world) override {
+    last_step_ = world.step_index();
     poses_of(world, poses_);
     return frames_.offer(stage_, world.step_index(), world.dt(), poses_);
   }
-  Status finish() override { return Ok{}; }
+  Status finish() override {
+    if (!trim_) return Ok{};
+    const double covered = run_duration(last_step_, stage_.dt, scene_duration_, scene_steps_);
+    return frames_.truncate(frame_count(std::min(duration_, covered), fps_));
+  }
   std::int64_t frames() const { return frames_.frames(); }
 
  private:
   FrameWriter frames_;
-  double duration_;
+  double fps_, duration_;
+  bool trim_;
   Stage stage_;
+  double scene_duration_ = 0.0;
+  std::int64_t scene_steps_ = 0, last_step_ = 0;
   std::vector<Pose> poses_;
 };
 
@@ -123,29 +177,40 @@ Result<int> run_process(const std::vector<std::string>& args) {
 
 }  // namespace detail
 
-std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, double fps) {
-  return std::make_unique<FrameSink>(std::move(dir), width, height, fps);
+std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, double fps, double duration,
+                                      bool overwrite) {
+  return std::make_unique<FrameSink>(std::move(dir), width, height, fps, duration, overwrite, /*trim=*/true);
 }
 
 Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
-  FrameWriter frames(o.out_dir, o.width, o.height, o.fps);
+  FrameWriter frames(o.out_dir, o.width, o.height, o.fps, o.overwrite);
   std::vector<Pose> poses;
   if (detail::is_mcap(input)) {
     log::RecordingOptions ro;
     ro.read = {msgs::TopicId::BodyStates};
     auto recording = log::Recording::open(input, ro);
     if (!recording) return recording.error();
-    Stage stage = stage_of(*recording.value()->scene());
-    if (o.duration) stage.duration = *o.duration;
+    const msgs::SceneMessage& scene = *recording.value()->scene();
+    Stage stage = stage_of(scene);
+    // The recording's T is known once its last step is read: draw up to it, then drop the frames
+    // at or after T (those showing exactly the last step's time, or past the scene's duration).
+    stage.duration = o.duration.value_or(INFINITY);
     if (Status st = frames.open(); !st) return st.error();
+    std::optional<std::uint64_t> last;
     Status st = recording.value()->read_steps([&](const log::RecordedStep& step) -> Status {
       if (step.body_states == nullptr) return Ok{};
+      last = step.step;
       poses.clear();
       for (const auto& b : step.body_states->bodies)
         poses.push_back({b.state.position.x(), b.state.position.y(), b.state.theta});
       return frames.offer(stage, static_cast<std::int64_t>(step.step), stage.dt, poses);
     });
     if (!st) return st.error();
+    if (!last) return Error{input + ": no body states recorded"};
+    const double covered = run_duration(static_cast<std::int64_t>(*last), stage.dt, scene.duration,
+                                        static_cast<std::int64_t>(scene.step_count));
+    if (Status t = frames.truncate(frame_count(std::min(stage.duration, covered), o.fps)); !t)
+      return t.error();
     return frames.frames();
   }
   Result<Scene> scene = load_scene(input);
@@ -153,7 +218,7 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
   Result<Driver> driver = Driver::create(scene.value());
   if (!driver) return driver.error();
   const double duration = o.duration.value_or(scene->duration);
-  FrameSink sink(o.out_dir, o.width, o.height, o.fps, duration);
+  FrameSink sink(o.out_dir, o.width, o.height, o.fps, duration, o.overwrite, /*trim=*/false);
   driver->add(sink);
   if (Status st = driver->begin(); !st) return st.error();
   DriverOptions options;
@@ -166,14 +231,14 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
   return sink.frames();
 }
 
-Status make_movie(const std::string& frames_dir, double fps, const std::string& mp4) {
+Status make_movie(const std::string& frames_dir, double fps, std::int64_t frames, const std::string& mp4) {
   const std::string temp = mp4 + ".tmp.mp4";
   char rate[32];
   std::snprintf(rate, sizeof rate, "%g", fps);
-  Result<int> code =
-      detail::run_process({"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i",
-                           (fs::path(frames_dir) / "frame%05d.png").string(), "-c:v", "libx264", "-pix_fmt",
-                           "yuv420p", "-crf", "20", "-movflags", "+faststart", temp});
+  Result<int> code = detail::run_process({"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i",
+                                          (fs::path(frames_dir) / "frame%05d.png").string(), "-frames:v",
+                                          std::to_string(frames), "-c:v", "libx264", "-pix_fmt", "yuv420p",
+                                          "-crf", "20", "-movflags", "+faststart", temp});
   if (!code) return Error{"ffmpeg: " + code.error().message};
   if (code.value() != 0) {
     std::remove(temp.c_str());

@@ -257,6 +257,9 @@ struct MsgField {
 // Fails on a malformed line, a bad array bound or a wstring.
 Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::string_view text);
 
+// Appends `text` to `out` as a JSON string: quoted, with '"', '\\' and control characters escaped.
+void append_json_string(std::string& out, std::string_view text);
+
 class MessageDecoder {
  public:
   // `type` names the root ("rbsim_msgs/msg/BodyStates"); `schema` is its ros2msg text with its
@@ -266,6 +269,11 @@ class MessageDecoder {
   // Appends the scalars of one message to `out` (cleared first). Fails cleanly on truncated or
   // malformed data: every length is checked against the bytes that remain.
   [[nodiscard]] Status decode(std::span<const std::byte> cdr, std::vector<Scalar>& out) const;
+  // Appends one message to `out` as one line of compact JSON: an object per message (nested types
+  // nested), an array per array or sequence, field names as in the schema. Floats are written
+  // shortest round-trip (float32 as float32), non-finite floats as null (JSON has no NaN or
+  // infinity), bool as true/false, strings escaped. On malformed data `out` is left as it was.
+  [[nodiscard]] Status to_json(std::span<const std::byte> cdr, std::string& out) const;
   // The field path of scalar `index` of that message, e.g. "bodies[3].x" or "bodies.length".
   std::string path(std::span<const std::byte> cdr, std::size_t index) const;
 

@@ -50,8 +50,15 @@ struct Camera {
 // when the scene has none, the extent of the bodies in `poses` with a margin.
 Camera camera_for(const Stage& stage, std::span<const Pose> poses, int width, int height);
 
-// Frames cover [0, duration) at `fps`: frame k shows time k / fps. count = floor(duration * fps).
+// The one frame rule of render, run --frames and movies: frames cover [0, T) at `fps`, frame k
+// shows time k / fps, for k = 0 .. count - 1 with count = floor(T * fps) (at least 1): T x fps
+// frames for T simulated seconds.
 std::int64_t frame_count(double duration, double fps);
+// The T of a run of `steps` steps of `dt` (times 0 .. steps x dt): the scene's duration when the
+// run is the scene's own length (steps == the scene's step count, ceil(duration / dt)), else
+// steps x dt. A scene rendered for its duration, a recording of its run (up to its last recorded
+// step) and `rbsim run --frames` of it thus give the same frames.
+double run_duration(std::int64_t steps, double dt, double scene_duration, std::int64_t scene_steps);
 // The step shown by frame k: the first step at or after its time.
 std::int64_t frame_step(std::int64_t frame, double fps, double dt);
 
@@ -76,26 +83,39 @@ class Canvas {
   int width_, height_;
 };
 
+// Whether `name` is a frame file's name: "frame" + at least five digits + ".png".
+bool is_frame_file(const std::string& name);
+
 // Writes frames "frame00000.png", ... into a folder (created if needed; must be writable).
+// A folder that already holds frame files (of an earlier render) is refused, so that they are
+// neither overwritten nor mixed with this render's in a movie, unless `overwrite`: they are then
+// removed first. No other file of the folder is touched.
 class FrameWriter {
  public:
-  FrameWriter(std::string dir, int width, int height, double fps);
-  [[nodiscard]] Status open();  // checks the folder is writable
-  // Draws frame `index` if `step` is the step it shows; returns how many frames were written.
+  FrameWriter(std::string dir, int width, int height, double fps, bool overwrite = false);
+  [[nodiscard]] Status open();  // checks the folder is writable and holds no frames (see above)
+  // Draws the frames of [0, stage.duration) that show `step` (the first offered step at or after
+  // their time); returns how many frames were written.
   [[nodiscard]] Status offer(const Stage& stage, std::int64_t step, double dt, std::span<const Pose> poses);
+  // Keeps the first `count` frames written, removing the files of any after them.
+  [[nodiscard]] Status truncate(std::int64_t count);
   std::int64_t frames() const { return next_; }
   const std::string& dir() const { return dir_; }
 
  private:
   std::string dir_;
   double fps_;
+  bool overwrite_;
   Canvas canvas_;
   std::optional<Camera> camera_;  // fixed at the first frame
   std::int64_t next_ = 0;         // next frame index
 };
 
-// A Sink that draws frames during a run (rbsim run --frames DIR).
-std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, double fps);
+// A Sink that draws frames during a run (rbsim run --frames DIR): T is run_duration() of the steps
+// the run did (`duration` when it is shorter), so a run of a scene's duration gives the frames
+// `rbsim render` gives of that scene. `overwrite` as for FrameWriter.
+std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, double fps, double duration,
+                                      bool overwrite);
 
 // Renders a scene (simulated on the fly) or an rbsim MCAP recording (drawn from its scene
 // description and body states) into `dir`. Returns the number of frames.
@@ -103,12 +123,17 @@ struct RenderOptions {
   std::string out_dir;
   int width = 1280, height = 720;
   double fps = 24.0;
-  std::optional<double> duration;  // default: the scene's (or the recording's) duration
+  // T; default: the scene's duration, or a recording's run_duration() of its last recorded step
+  // (never more than that).
+  std::optional<double> duration;
+  bool overwrite = false;  // see FrameWriter
 };
 Result<std::int64_t> render(const std::string& input, const RenderOptions& options);
 
-// Assembles dir/frame%05d.png into an H.264 yuv420p movie with ffmpeg.
-[[nodiscard]] Status make_movie(const std::string& frames_dir, double fps, const std::string& mp4);
+// Assembles dir/frame00000.png .. frame<frames - 1>.png (and no other) into an H.264 yuv420p movie
+// with ffmpeg, written under a temporary name and renamed over `mp4`.
+[[nodiscard]] Status make_movie(const std::string& frames_dir, double fps, std::int64_t frames,
+                                const std::string& mp4);
 
 // Plots kinetic (centre of mass, spin), potential and total energy and total linear and angular
 // momentum over time with gnuplot, from a scene (simulated) or a recording.
