@@ -307,6 +307,14 @@ TEST(Check, TopicInOnlyOneFileAndTopicSelection) {
   o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/nope"});
   EXPECT_EQ(o.exit_code, 2) << o;
   EXPECT_TRUE(contains(o.err, "/rbsim/nope is in neither log")) << o;
+  // Topics by their trailing names too, as rbsim record and rbsim log cat take them.
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "body_states,rbsim/energy,clock"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_TRUE(contains(o.out, "3 topics")) << o;
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "markers"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "states"});  // not a whole name
+  EXPECT_EQ(o.exit_code, 2) << o;
 }
 
 // Two recordings of the cantilever for 2000 steps whose first vertex mass differs by `dm`.

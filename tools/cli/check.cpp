@@ -90,8 +90,9 @@ int compare(const CheckArgs& a) {
   }
   print_table(r, a.all_fields);
   const double mb = static_cast<double>(r.run_bytes + r.golden_bytes) / 1e6;
-  std::printf("%zu topics, %llu message pairs, %s MB of message data in %s s (%s MB/s)", r.topics.size(),
-              static_cast<unsigned long long>(r.messages), g(mb).c_str(), g(wall).c_str(),
+  std::printf("%zu topic%s, %llu message pair%s, %s MB of message data in %s s (%s MB/s)", r.topics.size(),
+              r.topics.size() == 1 ? "" : "s", static_cast<unsigned long long>(r.messages),
+              r.messages == 1 ? "" : "s", g(mb).c_str(), g(wall).c_str(),
               g(wall > 0 ? mb / wall : 0.0).c_str());
   if (!r.passed() && (r.diverging_values > 0 || r.one_file_messages == 0)) {
     std::printf("; %llu values in %llu messages differ", static_cast<unsigned long long>(r.diverging_values),
@@ -152,7 +153,9 @@ Subcommand add_check_command(CLI::App& parent) {
   app->add_option("--rtol", a->options.rtol,
                   "Relative tolerance: a float matches when |actual - expected| <= atol + rtol * |expected| "
                   "(default 0: exact)");
-  app->add_option("--topics", a->options.topics, "Compare only these topics (comma-separated or repeated)")
+  app->add_option(
+         "--topics", a->options.topics,
+         "Compare only these topics (comma-separated or repeated; /rbsim/body_states or body_states)")
       ->delimiter(',');
   app->add_option("--exclude-topics", a->options.exclude_topics,
                   "Leave these topics out (comma-separated or repeated)")

@@ -342,10 +342,19 @@ class Comparer {
     }
   }
 
+  // A topic given as "/rbsim/body_states" or, as rbsim record takes it, by its trailing name(s)
+  // ("body_states", "rbsim/body_states", "clock").
+  static bool names(const std::string& topic, const std::string& name) {
+    if (name == topic) return true;
+    return !name.empty() && name[0] != '/' && topic.size() > name.size() && topic.ends_with(name) &&
+           topic[topic.size() - name.size() - 1] == '/';
+  }
+  static bool any_names(const std::vector<std::string>& list, const std::string& topic) {
+    return std::any_of(list.begin(), list.end(), [&](const std::string& n) { return names(topic, n); });
+  }
   bool selected(const std::string& topic) const {
-    if (std::find(o_.exclude_topics.begin(), o_.exclude_topics.end(), topic) != o_.exclude_topics.end())
-      return false;
-    return o_.topics.empty() || std::find(o_.topics.begin(), o_.topics.end(), topic) != o_.topics.end();
+    if (any_names(o_.exclude_topics, topic)) return false;
+    return o_.topics.empty() || any_names(o_.topics, topic);
   }
 
   Status step(int si) {
@@ -1022,7 +1031,7 @@ class Comparer {
 
   Result<CheckReport> finish() {
     for (const std::string& name : o_.topics) {
-      if (topic_index_.count(name) == 0) {
+      if (std::none_of(topics_.begin(), topics_.end(), [&](const Topic& t) { return names(t.name, name); })) {
         std::string known;
         for (const Topic& t : topics_) known += (known.empty() ? "" : ", ") + t.name;
         return Error{"--topics: " + name + " is in neither log (topics: " + (known.empty() ? "none" : known) +
