@@ -51,5 +51,16 @@ TEST(RecordCli, OutputInAMissingFolderIsRefusedBeforeStarting) {
   EXPECT_EQ(o.err.find("recording"), std::string::npos) << "refused before DDS started: " << o;
 }
 
+// An empty file is said to be one; `rbsim log recover` (which cannot help it) is not suggested.
+TEST(ReplayCli, EmptyFileIsNamedWithoutSuggestingRecover) {
+  test::TempDir dir;
+  const fs::path empty = dir / "empty.mcap";
+  test::write_text(empty, "");
+  const test::Outcome o = rbsim({"replay", empty.string(), "--domain", kQuietDomain});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_NE(o.err.find("empty file"), std::string::npos) << o;
+  EXPECT_EQ(o.err.find("recover"), std::string::npos) << o;
+}
+
 }  // namespace
 }  // namespace rbsim
