@@ -280,16 +280,22 @@ TEST(RbsimRun, WarningsGoToStderrAndTheRunSucceeds) {
   EXPECT_EQ(o.err_lines()[0], (dir / "warn.xml").string() + ":2: warning: unknown node <camera> ignored");
 }
 
-// A stiff explicit-Euler spring blows up: the run stops with a clear error at the first step
-// whose state is not finite, and the outputs hold every step before it as complete files: the
-// CSVs, and a finished, indexed MCAP recording that exports to the same CSV.
-TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
-  TempDir dir;
+// The explicit-Euler spring scene with every stiffness raised to 1e9: it diverges within 100 steps.
+std::string stiff_scene_text() {
   std::string text = read_text(kScenes + "/springtests/test00ee.xml");
   const std::string k = "k=\"";
   for (std::size_t at = text.find(k); at != std::string::npos; at = text.find(k, at + 1)) {
     text.replace(at + k.size(), text.find('"', at + k.size()) - (at + k.size()), "1e9");
   }
+  return text;
+}
+
+// A stiff explicit-Euler spring blows up: the run stops with a clear error at the first step
+// whose state is not finite, and the outputs hold every step before it as complete files: the
+// CSVs, and a finished, indexed MCAP recording that exports to the same CSV.
+TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
+  TempDir dir;
+  std::string text = stiff_scene_text();
   test::write_text(dir / "stiff.xml", text);
   const test::Outcome o =
       rbsim({"run", (dir / "stiff.xml").string(), "-q", "--csv", (dir / "b.csv").string(), "--energy-csv",
@@ -334,11 +340,7 @@ TEST(RbsimRun, DivergingSceneStopsWithAnErrorAndValidOutputs) {
 // message, whichever command meets it (run and node add what their outputs hold).
 TEST(RbsimRun, RenderAndPlotReportADivergenceAsRunDoes) {
   TempDir dir;
-  std::string text = read_text(kScenes + "/springtests/test00ee.xml");
-  const std::string k = "k=\"";
-  for (std::size_t at = text.find(k); at != std::string::npos; at = text.find(k, at + 1)) {
-    text.replace(at + k.size(), text.find('"', at + k.size()) - (at + k.size()), "1e9");
-  }
+  std::string text = stiff_scene_text();
   test::write_text(dir / "stiff.xml", text);
   const test::Outcome run = rbsim({"run", (dir / "stiff.xml").string(), "-q"});
   ASSERT_EQ(run.exit_code, 1) << describe(run);
