@@ -116,6 +116,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       const std::uint64_t now = wall_ns();
       const bool is_scene = t.subscription.spec().id == msgs::TopicId::Scene;
       if (scene_pending_ && !is_scene) {
+        held_bytes_ += sample.cdr.size();
         held_.push_back({static_cast<std::size_t>(&t - topics_.data()), std::move(sample), now});
         ++received_;
       } else {
@@ -133,8 +134,10 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       if (options_.max_messages > 0 && received_ >= options_.max_messages) return any;
     }
   }
-  // No scene description after kHoldNs: stop waiting for it (the readers find it wherever it is).
-  if (scene_pending_ && !held_.empty() && wall_ns() - held_.front().log_time > kHoldNs) {
+  // No scene description after kHoldNs (or kHoldBytes held): stop waiting for it (the readers
+  // find it wherever it is).
+  if (scene_pending_ && !held_.empty() &&
+      (wall_ns() - held_.front().log_time > kHoldNs || held_bytes_ > kHoldBytes)) {
     scene_pending_ = false;
     if (Status st = release_held(); !st) return st.error();
   }
@@ -167,6 +170,7 @@ Status Recorder::release_held() {
     if (Status st = write(topics_[h.topic], h.sample, h.log_time); !st) return st;
   }
   held_.clear();
+  held_bytes_ = 0;
   return Ok{};
 }
 

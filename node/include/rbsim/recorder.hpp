@@ -82,10 +82,12 @@ class Recorder {
   double dt_ = 0.0;  // from the scene description; 0 until it arrives
 
   // The scene description is written first, whatever order discovery delivers the topics in:
-  // per-step samples that arrive before it are held (at most kHoldNs of wall time), then written
-  // after it. Its log time is then that of the first held sample, so the file stays in log-time
-  // order.
+  // per-step samples that arrive before it are held (at most kHoldNs of wall time and kHoldBytes
+  // of payload), then written after it. Its log time is then that of the first held sample, so the file stays
+  // in log-time order.
   static constexpr std::uint64_t kHoldNs = 3'000'000'000;
+  static constexpr std::uint64_t kHoldBytes = std::uint64_t{64} << 20;
+  std::uint64_t held_bytes_ = 0;
   struct Held {
     std::size_t topic;
     Received sample;
