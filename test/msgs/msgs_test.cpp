@@ -43,6 +43,25 @@ TEST(TopicNames, FollowRos2Conventions) {
   EXPECT_EQ(rbsim::msgs::dds_type_name("geometry_msgs/PoseArray"), "geometry_msgs::msg::dds_::PoseArray_");
 }
 
+TEST(TopicNames, NamesTopicTakesTheWholeNameOrItsTrailingParts) {
+  using rbsim::msgs::names_topic;
+  EXPECT_TRUE(names_topic("/rbsim/body_states", "/rbsim/body_states"));
+  EXPECT_TRUE(names_topic("body_states", "/rbsim/body_states"));
+  EXPECT_TRUE(names_topic("rbsim/body_states", "/rbsim/body_states"));
+  EXPECT_TRUE(names_topic("clock", "/clock"));
+  EXPECT_FALSE(names_topic("states", "/rbsim/body_states"));  // not a whole part
+  EXPECT_FALSE(names_topic("/body_states", "/rbsim/body_states"));
+  EXPECT_FALSE(names_topic("", "/clock"));
+  EXPECT_FALSE(names_topic("/clock", "clock"));
+}
+
+TEST(TopicNames, TopicForTypeFindsOursInEitherSpelling) {
+  EXPECT_EQ(rbsim::msgs::topic_for_type("rbsim_msgs/msg/BodyStates"),
+            &rbsim::msgs::topic(TopicId::BodyStates));
+  EXPECT_EQ(rbsim::msgs::topic_for_type("rosgraph_msgs/Clock"), &rbsim::msgs::topic(TopicId::Clock));
+  EXPECT_EQ(rbsim::msgs::topic_for_type("std_msgs/msg/String"), nullptr);
+}
+
 TEST(Ros2msgSchema, AppendsEachDependencyOnceRosbag2Style) {
   auto schema = rbsim::msgs::ros2msg_schema("rbsim_msgs/msg/BodyStates");
   ASSERT_TRUE(schema.ok());

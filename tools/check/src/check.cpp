@@ -33,7 +33,6 @@ namespace rbsim::check {
 
 namespace {
 
-using msgs::canonical_type;
 using msgs::Scalar;
 using Kind = Scalar::Kind;
 
@@ -322,7 +321,7 @@ class Comparer {
   }
 
   static bool is_type(const std::string& schema_name, msgs::TopicId id) {
-    return canonical_type(schema_name, "") == canonical_type(msgs::topic(id).type, "");
+    return msgs::topic_for_type(schema_name) == &msgs::topic(id);
   }
 
   static std::string describe(const mcap::Status& st) {
@@ -342,15 +341,9 @@ class Comparer {
     }
   }
 
-  // A topic given as "/rbsim/body_states" or, as rbsim record takes it, by its trailing name(s)
-  // ("body_states", "rbsim/body_states", "clock").
-  static bool names(const std::string& topic, const std::string& name) {
-    if (name == topic) return true;
-    return !name.empty() && name[0] != '/' && topic.size() > name.size() && topic.ends_with(name) &&
-           topic[topic.size() - name.size() - 1] == '/';
-  }
   static bool any_names(const std::vector<std::string>& list, const std::string& topic) {
-    return std::any_of(list.begin(), list.end(), [&](const std::string& n) { return names(topic, n); });
+    return std::any_of(list.begin(), list.end(),
+                       [&](const std::string& n) { return msgs::names_topic(n, topic); });
   }
   bool selected(const std::string& topic) const {
     if (any_names(o_.exclude_topics, topic)) return false;
@@ -448,9 +441,9 @@ class Comparer {
       t.mode = Topic::Mode::Fields;
       t.stats.resize(t.layout->groups().size() + 1);
       t.time_stat = t.layout->groups().size();
-      for (const msgs::TopicSpec& spec : msgs::topics()) {
-        if (spec.per_step && is_type(g.schema_name, spec.id)) t.step_id = spec.id;
-      }
+      if (const msgs::TopicSpec* spec = msgs::topic_for_type(g.schema_name);
+          spec != nullptr && spec->per_step)
+        t.step_id = spec->id;
       t.aligned = t.step_id.has_value() && side_[kRun].dt > 0.0 && side_[kGolden].dt > 0.0;
       if (t.aligned) {
         // Messages queued before the other file defined the topic get their steps now.
@@ -1031,7 +1024,8 @@ class Comparer {
 
   Result<CheckReport> finish() {
     for (const std::string& name : o_.topics) {
-      if (std::none_of(topics_.begin(), topics_.end(), [&](const Topic& t) { return names(t.name, name); })) {
+      if (std::none_of(topics_.begin(), topics_.end(),
+                       [&](const Topic& t) { return msgs::names_topic(name, t.name); })) {
         std::string known;
         for (const Topic& t : topics_) known += (known.empty() ? "" : ", ") + t.name;
         return Error{"--topics: " + name + " is in neither log (topics: " + (known.empty() ? "none" : known) +

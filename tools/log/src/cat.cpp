@@ -13,13 +13,6 @@ namespace rbsim::log {
 
 namespace {
 
-// Whether `requested` names `topic`: the same name, or its trailing part(s) after a '/'.
-bool names_topic(const std::string& requested, const std::string& topic) {
-  if (requested == topic) return true;
-  if (requested.empty() || requested.front() == '/' || requested.size() >= topic.size()) return false;
-  return topic.ends_with(requested) && topic[topic.size() - requested.size() - 1] == '/';
-}
-
 std::optional<mcap::Timestamp> to_ns(std::optional<double> seconds) {
   if (!seconds) return std::nullopt;
   if (!(*seconds > 0.0)) return mcap::Timestamp{0};
@@ -49,7 +42,7 @@ Status cat(const std::string& path, const CatOptions& options,
     for (const std::string& requested : options.topics) {
       bool found = false;
       for (const std::string& topic : known) {
-        if (names_topic(requested, topic)) {
+        if (msgs::names_topic(requested, topic)) {
           chosen.insert(topic);
           found = true;
         }

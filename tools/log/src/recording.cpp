@@ -40,20 +40,12 @@ struct Slot {
 
 }  // namespace
 
-const msgs::TopicSpec* spec_for_type(std::string_view type) {
-  const std::string t = msgs::canonical_type(type, "");
-  for (const msgs::TopicSpec& spec : msgs::topics()) {
-    if (spec.type == t) return &spec;
-  }
-  return nullptr;
-}
-
 std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader) {
   std::vector<RecordedChannel> out;
   for (const auto& [id, channel] : reader.channels()) {
     const auto schema = reader.schemas().find(channel.schema_id);
     if (schema == reader.schemas().end()) continue;
-    const msgs::TopicSpec* spec = spec_for_type(schema->second.name);
+    const msgs::TopicSpec* spec = msgs::topic_for_type(schema->second.name);
     if (spec == nullptr) continue;
     RecordedChannel c{&channel, spec, {}};
     const std::string type(spec->type);

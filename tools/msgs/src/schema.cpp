@@ -62,6 +62,20 @@ const TopicSpec& topic(TopicId id) {
   return kTopics[static_cast<std::size_t>(id)];
 }
 
+const TopicSpec* topic_for_type(std::string_view type) {
+  const std::string t = canonical_type(type, "");
+  for (const TopicSpec& spec : kTopics) {
+    if (spec.type == t) return &spec;
+  }
+  return nullptr;
+}
+
+bool names_topic(std::string_view requested, std::string_view topic) {
+  if (requested == topic) return true;
+  if (requested.empty() || requested.front() == '/' || requested.size() >= topic.size()) return false;
+  return topic.ends_with(requested) && topic[topic.size() - requested.size() - 1] == '/';
+}
+
 std::string topic_name(const TopicSpec& spec, std::string_view ns) {
   if (spec.id == TopicId::Clock || ns.empty()) return "/" + std::string(spec.suffix);
   std::string name = "/" + std::string(ns);

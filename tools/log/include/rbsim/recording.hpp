@@ -26,10 +26,6 @@ namespace rbsim::log {
 // ---------------------------------------------------------------------------------------------
 // Channels by type
 
-// The topic of msgs::topics() whose type is `type` ("pkg/msg/Name", or "pkg/Name" as older tools
-// write it); null when it is none of ours.
-const msgs::TopicSpec* spec_for_type(std::string_view type);
-
 // A channel of a recording that carries one of our types.
 struct RecordedChannel {
   const mcap::Channel* channel = nullptr;  // points into the reader's channels()

@@ -39,6 +39,12 @@ struct TopicSpec {
 };
 std::span<const TopicSpec> topics();
 const TopicSpec& topic(TopicId id);
+// The topic of topics() whose type is `type` ("pkg/msg/Name", or "pkg/Name" as older tools write
+// it); null when it is none of ours.
+const TopicSpec* topic_for_type(std::string_view type);
+// Whether a topic name given on a command line names `topic`: the whole name
+// ("/rbsim/body_states") or its trailing part(s) after a '/' ("body_states", "rbsim/body_states").
+bool names_topic(std::string_view requested, std::string_view topic);
 // "/rbsim/body_states" for namespace "rbsim"; "/clock" always lives at the root.
 std::string topic_name(const TopicSpec& spec, std::string_view ns);
 // DDS names per ROS 2 conventions: "rt/rbsim/body_states", "rbsim_msgs::msg::dds_::BodyStates_".
