@@ -106,6 +106,31 @@ TEST(Driver, AStopRequestEndsThePassBeforeTheNextStep) {
   EXPECT_EQ(driver->world().step_index(), 10);
 }
 
+TEST(Driver, RunPassIsBeginRunFinishAndADivergenceIsItsError) {
+  const Scene calm = spring_scene();
+  Result<Driver> driver = Driver::create(calm);
+  ASSERT_TRUE(driver.ok());
+  Recorder r;
+  driver->add(r);
+  DriverOptions options;
+  options.steps = 5;
+  ASSERT_TRUE(driver->run_pass(options).ok());
+  EXPECT_EQ(r.begun, std::vector<std::int64_t>{0});
+  EXPECT_EQ(r.written, range(1, 5));
+  EXPECT_EQ(r.finished, 1);
+
+  const Scene stiff = spring_scene("1e9");
+  Result<Driver> diverging = Driver::create(stiff);
+  ASSERT_TRUE(diverging.ok());
+  Recorder d;
+  diverging->add(d);
+  options.steps = 10000;
+  const Status st = diverging->run_pass(options);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().message, describe_divergence(diverging->divergence()));
+  EXPECT_EQ(d.finished, 0);  // a diverged pass leaves its outputs unfinished
+}
+
 TEST(Driver, ADivergenceEndsThePassWithoutWritingTheDivergedStep) {
   const Scene scene = spring_scene("1e9");
   Result<Driver> driver = Driver::create(scene);

@@ -51,6 +51,14 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
   return PassEnd::Done;
 }
 
+Status Driver::run_pass(const DriverOptions& options) {
+  if (Status st = begin(); !st) return st;
+  const Result<PassEnd> end = run(options);
+  if (!end) return end.error();
+  if (end.value() == PassEnd::Diverged) return Error{describe_divergence(divergence_)};
+  return finish();
+}
+
 Status Driver::finish() {
   for (Sink* sink : sinks_) {
     if (Status st = sink->finish(); !st) return st;

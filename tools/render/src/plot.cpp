@@ -55,11 +55,7 @@ Result<std::vector<Sample>> samples_from_scene(const std::string& path, std::opt
   options.steps = steps_for(duration.value_or(scene->duration), driver->world().dt());
   SampleSink sink(options.steps);
   driver->add(sink);
-  if (Status st = driver->begin(); !st) return st.error();
-  const Result<PassEnd> end = driver->run(options);
-  if (!end) return end.error();
-  if (end.value() == PassEnd::Diverged) return Error{describe_divergence(driver->divergence())};
-  if (Status st = driver->finish(); !st) return st.error();
+  if (Status st = driver->run_pass(options); !st) return st.error();
   return std::move(sink.samples());
 }
 
@@ -91,7 +87,7 @@ Result<std::vector<Sample>> samples_from_log(const std::string& path) {
 
 Status plot(const std::string& input, const PlotOptions& o) {
   Result<std::vector<Sample>> samples =
-      detail::is_mcap(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
+      is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
   if (!samples) return samples.error();
 
   const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp", temp = o.out_png + ".tmp";
@@ -134,10 +130,6 @@ Status plot(const std::string& input, const PlotOptions& o) {
   fs::rename(temp, o.out_png, ec);
   if (ec) return Error{o.out_png + ": " + ec.message()};
   return Ok{};
-}
-
-bool is_recording(const std::string& path) {
-  return detail::is_mcap(path);
 }
 
 }  // namespace rbsim::render

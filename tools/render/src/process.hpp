@@ -8,6 +8,4 @@ namespace rbsim::render::detail {
 // Runs args[0] (looked up on PATH, no shell); its exit status, or an error naming the program
 // when it cannot be started.
 Result<int> run_process(const std::vector<std::string>& args);
-// True when the file starts with the MCAP magic.
-bool is_mcap(const std::string& path);
 }  // namespace rbsim::render::detail

@@ -151,14 +151,14 @@ class FrameSink final : public Sink {
 
 }  // namespace
 
-namespace detail {
-bool is_mcap(const std::string& path) {
+bool is_recording(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char magic[8] = {};
   in.read(magic, 8);
   return in.gcount() == 8 && std::memcmp(magic, mcap::kMagic, 8) == 0;
 }
 
+namespace detail {
 Result<int> run_process(const std::vector<std::string>& args) {
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -183,9 +183,9 @@ std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, do
 }
 
 Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
-  FrameWriter frames(o.out_dir, o.width, o.height, o.fps, o.overwrite);
-  std::vector<Pose> poses;
-  if (detail::is_mcap(input)) {
+  if (is_recording(input)) {
+    FrameWriter frames(o.out_dir, o.width, o.height, o.fps, o.overwrite);
+    std::vector<Pose> poses;
     log::RecordingOptions ro;
     ro.read = {msgs::TopicId::BodyStates};
     auto recording = log::Recording::open(input, ro);
@@ -220,14 +220,10 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
   const double duration = o.duration.value_or(scene->duration);
   FrameSink sink(o.out_dir, o.width, o.height, o.fps, duration, o.overwrite, /*trim=*/false);
   driver->add(sink);
-  if (Status st = driver->begin(); !st) return st.error();
   DriverOptions options;
   options.steps =
       frame_step(frame_count(duration, o.fps) - 1, o.fps, driver->world().dt());  // the last frame's
-  const Result<PassEnd> end = driver->run(options);
-  if (!end) return end.error();
-  if (end.value() == PassEnd::Diverged) return Error{describe_divergence(driver->divergence())};
-  if (Status st = driver->finish(); !st) return st.error();
+  if (Status st = driver->run_pass(options); !st) return st.error();
   return sink.frames();
 }
 

@@ -61,6 +61,10 @@ class Driver {
   // finish() on every sink in order, stopping at the first error. Also after a stop or a
   // divergence: every output then holds the steps written so far.
   [[nodiscard]] Status finish();
+  // One whole pass for a command that wants only the outputs (render, plot): begin(), run() and
+  // finish(). A divergence is an Error with describe_divergence's message, and the sinks are then
+  // not finished.
+  [[nodiscard]] Status run_pass(const DriverOptions& options);
 
   const World& world() const { return *world_; }
   std::int64_t steps_done() const { return steps_done_; }       // over all passes
