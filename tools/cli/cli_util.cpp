@@ -84,4 +84,12 @@ std::string count_of(std::int64_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
+Result<mcap::Compression> compression_option(const std::string& name, int level) {
+  mcap::Compression codec = mcap::Compression::Zstd;
+  if (!mcap::parse_compression(name, codec)) return Error{"--compression: unknown compression " + name};
+  if (const std::string bad = mcap::check_compression_level(codec, level); !bad.empty())
+    return Error{"--compression-level: " + bad};
+  return codec;
+}
+
 }  // namespace rbsim::cli

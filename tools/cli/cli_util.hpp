@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <string>
 
+#include "rbsim/core.hpp"
+#include "rbsim/mcap.hpp"
+
 namespace rbsim::cli {
 
 // Installs SIGINT/SIGTERM handlers that only raise a flag; long loops poll stop_requested() and
@@ -36,6 +39,10 @@ class Progress {
 };
 
 std::string format_seconds(double seconds);
+
+// --compression NAME with --compression-level LEVEL (0: the codec's default) as one codec choice;
+// the error names the option that is wrong.
+Result<mcap::Compression> compression_option(const std::string& name, int level = 0);
 
 // "1 body", "2 bodies": a count with its noun in the right number.
 std::string count_of(std::int64_t n, const char* one, const char* many);

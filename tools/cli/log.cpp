@@ -4,6 +4,7 @@
 #include <optional>
 #include <string_view>
 
+#include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/cat.hpp"
 #include "rbsim/csv.hpp"
@@ -63,9 +64,9 @@ int recover_command(const LogOptions& o) {
   mcap_tools::RecoverOptions options;
   if (Status st = check_outputs({{o.out, "OUT"}}, {o.file}, o.overwrite); !st)
     return fail("recover", st.error().message);
-  if (!mcap::parse_compression(o.compression, options.compression)) {
-    return fail("recover", "unknown compression " + o.compression);
-  }
+  const Result<mcap::Compression> codec = compression_option(o.compression);
+  if (!codec) return fail("recover", codec.error().message);
+  options.compression = codec.value();
   auto report = mcap_tools::recover(o.file, o.out, options);
   if (!report) return fail("recover", report.error().message);
   const mcap_tools::RecoverReport& r = report.value();

@@ -37,11 +37,9 @@ int record_command(RecordArgs a) {
                  "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.\n");
     return 2;
   }
-  if (!mcap::parse_compression(a.compression, a.rec.compression))
-    return fail("unknown compression " + a.compression);
-  if (const std::string bad = mcap::check_compression_level(a.rec.compression, a.rec.compression_level);
-      !bad.empty())
-    return fail("--compression-level: " + bad);
+  const Result<mcap::Compression> codec = compression_option(a.compression, a.rec.compression_level);
+  if (!codec) return fail(codec.error().message);
+  a.rec.compression = codec.value();
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
   // error, leaving a recoverable file, instead of SIGXFSZ killing it.
   std::signal(SIGXFSZ, SIG_IGN);

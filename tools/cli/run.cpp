@@ -72,11 +72,9 @@ int run(const RunOptions& o) {
     log::RecordOptions ro;
     ro.every = o.record_every;
     ro.ns = o.ns;
-    if (!mcap::parse_compression(o.compression, ro.compression))
-      return fail("unknown compression " + o.compression);
-    if (const std::string bad = mcap::check_compression_level(ro.compression, o.compression_level);
-        !bad.empty())
-      return fail("--compression-level: " + bad);
+    const Result<mcap::Compression> codec = compression_option(o.compression, o.compression_level);
+    if (!codec) return fail(codec.error().message);
+    ro.compression = codec.value();
     ro.compression_level = o.compression_level;
     sinks.push_back(log::make_mcap_sink(o.record, ro));
   }
