@@ -369,17 +369,25 @@ TEST(LogCli, DoctorReportsPlantedStatisticsError) {
       << o.err;
 }
 
-TEST(LogCli, RecoverTruncatedRecording) {
-  TempDir dir;
+// A 150-step cantilever recording in 32 KiB chunks, written to dir/cut.mcap cut off in the middle
+// of chunk `k`, as a killed recorder leaves it; its chunks as recorded.
+std::vector<ChunkCount> record_cut_inside_chunk(const TempDir& dir, std::size_t k) {
   RecordSpec spec;
   spec.chunk_size = 32 * 1024;
-  ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), dir / "r.mcap", 150, spec));
+  record_scene(source_path("scenes/cantilever.xml"), dir / "r.mcap", 150, spec);
   const mcap::Bytes b = read_bytes(dir / "r.mcap");
   const auto chunks = chunk_message_counts(dir / "r.mcap");
-  const std::uint64_t cut = (chunks[5].start + chunks[5].end) / 2;  // inside the sixth chunk
+  const std::uint64_t cut = (chunks.at(k).start + chunks.at(k).end) / 2;
+  write_bytes(dir / "cut.mcap", mcap::Bytes(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(cut)));
+  return chunks;
+}
+
+TEST(LogCli, RecoverTruncatedRecording) {
+  TempDir dir;
+  std::vector<ChunkCount> chunks;
+  ASSERT_NO_FATAL_FAILURE(chunks = record_cut_inside_chunk(dir, 5));  // inside the sixth chunk
   std::uint64_t kept = 0;
   for (int k = 0; k < 5; ++k) kept += chunks[static_cast<std::size_t>(k)].messages;
-  write_bytes(dir / "cut.mcap", mcap::Bytes(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(cut)));
   Outcome o = rbsim({"log", "recover", (dir / "cut.mcap").string(), (dir / "out.mcap").string()});
   EXPECT_EQ(o.exit_code, 0) << describe(o);  // OUT written: a success, as `mcap recover` has it
   ASSERT_EQ(o.err_lines().size(), 1u) << o.err;
@@ -401,13 +409,7 @@ TEST(LogCli, RecoverTruncatedRecording) {
 // writes nothing (an empty recording would only pass the damage on).
 TEST(LogCli, RecoverWritesNothingWhenNoMessageIsComplete) {
   TempDir dir;
-  RecordSpec spec;
-  spec.chunk_size = 32 * 1024;
-  ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), dir / "r.mcap", 150, spec));
-  const mcap::Bytes b = read_bytes(dir / "r.mcap");
-  const auto chunks = chunk_message_counts(dir / "r.mcap");
-  const std::uint64_t cut = (chunks[0].start + chunks[0].end) / 2;
-  write_bytes(dir / "cut.mcap", mcap::Bytes(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(cut)));
+  ASSERT_NO_FATAL_FAILURE(record_cut_inside_chunk(dir, 0));
   Outcome o = rbsim({"log", "recover", (dir / "cut.mcap").string(), (dir / "out.mcap").string()});
   EXPECT_EQ(o.exit_code, 1) << describe(o);
   EXPECT_NE(o.err.find("no complete message; nothing written"), std::string::npos) << o.err;
