@@ -1,0 +1,366 @@
+#!/usr/bin/env node
+"use strict";
+// An independent Foxglove WebSocket client against the real `rbsim node --foxglove`: npm
+// @foxglove/ws-protocol (FoxgloveClient) over `ws`, decoding with @foxglove/rosmsg and
+// @foxglove/rosmsg2-serialization, the stack Foxglove Studio uses.
+//
+//   client.js --case NAME --rbsim BUILD/rbsim --source-dir SRC --workdir DIR --npm BUILD/npm --index N
+//
+// Cases: bytes (every payload equals what `rbsim run --record` writes), late_joiner (latched
+// topics at once; a new session per loop), hostile (bad input gets a status error or a clean close),
+// slow_client (a client that stops reading is dropped from, the others lose nothing), faults (killed,
+// cycling and stalled clients do not slow the node). Only 127.0.0.1; every loop bounded.
+const fs = require("fs");
+const path = require("path");
+const net = require("net");
+const lib = require("./lib");
+const { Failure, sleep, until, Proc, startServer, endLine, Client, readMcap, runMain } = lib;
+
+function args() {
+  const a = {};
+  const argv = process.argv.slice(2);
+  for (let i = 0; i < argv.length; i += 2) a[argv[i].replace(/^--/, "")] = argv[i + 1];
+  for (const k of ["case", "rbsim", "source-dir", "workdir", "npm", "index"]) {
+    if (a[k] === undefined) throw new Error(`missing --${k}`);
+  }
+  return a;
+}
+
+const A = args();
+const need = lib.npmModules(A.npm);
+const workdir = path.resolve(A.workdir);
+fs.rmSync(workdir, { recursive: true, force: true });
+fs.mkdirSync(workdir, { recursive: true });
+const ns = `fg_${A.case}_${process.pid}`;
+const domain = lib.domainFor(Number(A.index));
+const scene = (name) => path.join(A["source-dir"], "scenes", name);
+const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
+const nodeArgs = (sceneFile, ...extra) => ["node", sceneFile, "--domain", domain, "--namespace", ns, ...extra];
+const start = (name, argv) => startServer(A.rbsim, argv, { name, logDir: workdir });
+const stepOf = (m) => m.time; // log time = simulated time: one value per step on every per-step topic
+
+// A grid scene of n octagons with springs (the benchmarks' builder, bench/make_grid_scene.py).
+function gridScene(n, dt, duration) {
+  const file = path.join(workdir, `grid${n}.xml`);
+  const r = require("child_process").spawnSync("python3",
+    [path.join(A["source-dir"], "bench", "make_grid_scene.py"), n, dt, duration], { encoding: "utf8" });
+  if (r.status !== 0) throw new Failure(`make_grid_scene.py: ${r.stderr}`);
+  fs.writeFileSync(file, r.stdout);
+  return file;
+}
+
+// Topics the node publishes once (latched): one message in the recording.
+const latchedIn = (rec) => new Set([...rec].filter(([, t]) => t.messages.length === 1).map(([topic]) => topic));
+
+// Per-step topic messages of a client that kept up: contiguous steps from its first to the last
+// one published (times of consecutive steps differ by the recording's step).
+function contiguous(check, who, msgs, want) {
+  if (!check(msgs.length > 0, `${who}: no messages`)) return;
+  const first = want.findIndex((w) => w.time === msgs[0].time);
+  if (!check(first >= 0, `${who}: first message at ${msgs[0].time} ns is not a recorded step`)) return;
+  const expected = want.length - first;
+  check(msgs.length === expected && msgs.every((m, i) => m.time === want[first + i].time),
+    `${who}: ${msgs.length} messages from step time ${msgs[0].time} ns, want every one of the ${expected} ` +
+      `recorded from there (first gap at ${msgs.findIndex((m, i) => m.time !== want[first + i]?.time)})`);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+async function caseBytes(check) {
+  // The same scene recorded by `rbsim run --record` (every step, uncompressed for @mcap/core).
+  const sceneFile = scene("airplane.xml");
+  const duration = 3;
+  const mcap = path.join(workdir, "run.mcap");
+  const run = new Proc("run", [A.rbsim, "run", sceneFile, "--duration", duration, "--record", mcap,
+    "--compression", "none", "--namespace", ns].map(String), { logDir: workdir });
+  if ((await run.wait(60000)) !== 0) throw new Failure(`rbsim run exited with ${run.code}\n${run.output()}`);
+  const rec = readMcap(need, mcap);
+  const latched = latchedIn(rec);
+  log(`recording: ${[...rec].map(([t, v]) => `${t} ${v.messages.length}`).join(", ")}`);
+
+  // Real time, so a client that connects right after the listening line sees nearly every step.
+  const [node, url] = await start("node", nodeArgs(sceneFile, "--rate", 1, "--duration", duration));
+  const c = await new Client(need, url, { name: "client" }).ready();
+  check(c.ws.protocol === "foxglove.websocket.v1", `negotiated subprotocol ${c.ws.protocol}`);
+  check(c.serverInfo.capabilities.includes("time"), `serverInfo capabilities ${c.serverInfo.capabilities}`);
+  check(typeof c.serverInfo.sessionId === "string" && c.serverInfo.sessionId.length > 0, "serverInfo has no sessionId");
+  check(JSON.stringify(c.topics()) === JSON.stringify([...rec.keys()].sort()),
+    `advertised ${c.topics()}, recorded ${[...rec.keys()].sort()}`);
+  for (const ch of c.channels.values()) {
+    const want = rec.get(ch.topic)?.channel;
+    if (!want) continue;
+    check(ch.encoding === "cdr" && ch.schemaEncoding === "ros2msg",
+      `${ch.topic}: encoding ${ch.encoding}, schemaEncoding ${ch.schemaEncoding}`);
+    check(ch.schemaName === want.schemaName, `${ch.topic}: schema name ${ch.schemaName}, MCAP ${want.schemaName}`);
+    check(ch.schema === want.schema, `${ch.topic}: schema text differs from the MCAP's`);
+  }
+  check((await node.wait(60000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  await until("the server to close the connection", 5000, () => c.closed);
+
+  const got = c.byTopic();
+  let compared = 0;
+  for (const [topic, { messages: want }] of rec) {
+    const msgs = got.get(topic) ?? [];
+    const byTime = new Map(want.map((w) => [w.time, w.data]));
+    let bad = 0;
+    for (const m of msgs) {
+      const data = latched.has(topic) ? want[0].data : byTime.get(m.time);
+      if (!data || !data.equals(m.data)) bad++;
+      compared++;
+    }
+    check(bad === 0, `${topic}: ${bad} of ${msgs.length} payloads differ from the recording's (matched by log time)`);
+    if (latched.has(topic)) {
+      check(msgs.length === 1, `${topic} (latched): ${msgs.length} messages, want exactly 1`);
+    } else {
+      contiguous(check, topic, msgs, want);
+      check(msgs.length >= want.length / 2, `${topic}: only ${msgs.length} of ${want.length} steps received`);
+      for (const m of msgs) {
+        const stamp = m.decoded.header?.stamp ?? m.decoded.clock;
+        if (stamp && BigInt(stamp.sec) * 1000000000n + BigInt(stamp.nanosec) !== m.time) {
+          check(false, `${topic}: decoded stamp ${stamp.sec}.${stamp.nanosec} != log time ${m.time}`);
+          break;
+        }
+      }
+    }
+  }
+  check(c.messages.every((m) => m.decoded !== undefined), "a message was not decoded");
+  check(c.times.length > 0 && c.times.every((t, i) => i === 0 || t >= c.times[i - 1]),
+    `time messages: ${c.times.length}, want some, non-decreasing`);
+  log(`${compared} payloads compared byte for byte, ${c.times.length} time messages`);
+}
+
+async function caseLateJoiner(check) {
+  const sceneFile = scene("cantilever.xml");
+  const [node, url] = await start("node", nodeArgs(sceneFile, "--rate", 1, "--duration", 1, "--loop"));
+  const a = await new Client(need, url, { name: "early" }).ready();
+  await sleep(1500); // past the first loop: the latched messages went out long ago
+  const t0 = performance.now();
+  const b = new Client(need, url, { name: "late" });
+  await b.ready();
+  const latchedTopics = ["scene", "markers"].map((s) => `/${ns}/${s}`).filter((t) => b.topics().includes(t));
+  check(latchedTopics.length > 0, `no latched topic advertised among ${b.topics()}`);
+  await until("latched messages for the late joiner", 2000, () =>
+    latchedTopics.every((t) => b.messages.some((m) => m.topic === t)));
+  log(`late joiner got ${latchedTopics} ${(performance.now() - t0).toFixed(0)} ms after connecting`);
+  for (const t of latchedTopics) {
+    const first = b.messages.findIndex((m) => m.topic === t);
+    const perStep = b.messages.findIndex((m) => !latchedTopics.includes(m.topic) && m.topic !== "/clock");
+    check(perStep < 0 || first < perStep + 200, `${t}: came only after ${first} messages`);
+    const early = a.messages.filter((m) => m.topic === t).at(-1);
+    check(early && early.data.equals(b.messages[first].data), `${t}: late joiner's copy differs from the early client's`);
+  }
+  // A new session on every start of the scene: serverInfo again with a new sessionId.
+  const sessions = new Set();
+  a.client.on("serverInfo", (info) => sessions.add(info.sessionId));
+  await sleep(2500);
+  check(sessions.size >= 2, `${sessions.size} new sessionIds in 2.5 s of a 1 s looping scene, want >= 2`);
+  check(!sessions.has(b.serverInfo.sessionId), "a loop kept the sessionId");
+  node.kill("SIGINT");
+  check((await node.wait(15000)) === 0, `node exited with ${node.code} on SIGINT\n${node.output()}`);
+}
+
+// A raw WebSocket (no FoxgloveClient) for inputs no well-behaved client sends.
+function raw(url, protocols) {
+  const WebSocket = need("ws");
+  const ws = new WebSocket(url, protocols, { maxPayload: 64 << 20 });
+  const r = { ws, statuses: [], opened: false, closeCode: undefined, refused: undefined };
+  ws.on("open", () => (r.opened = true));
+  ws.on("message", (data, isBinary) => {
+    if (isBinary) return;
+    const msg = JSON.parse(data.toString());
+    if (msg.op === "status") r.statuses.push(msg);
+  });
+  ws.on("unexpected-response", (_req, res) => {
+    r.refused = res.statusCode;
+    ws.terminate();
+  });
+  ws.on("error", (e) => (r.error = e.message));
+  ws.on("close", (code) => (r.closeCode = code));
+  return r;
+}
+
+// Sends `frames` on a fresh connection; the server must answer with a status error or close
+// cleanly (a close frame, not a dropped socket).
+async function expectRejected(check, url, what, send) {
+  const r = raw(url, ["foxglove.websocket.v1"]);
+  await until(`${what}: open`, 5000, () => r.opened || r.closeCode !== undefined);
+  send(r.ws);
+  await until(`${what}: a status error or a close`, 5000,
+    () => r.statuses.some((s) => s.level === 2) || r.closeCode !== undefined);
+  const clean = r.closeCode !== undefined && r.closeCode !== 1006;
+  check(r.statuses.some((s) => s.level === 2) || clean,
+    `${what}: no status error, close code ${r.closeCode}`);
+  log(`${what}: ${r.statuses.length ? `status "${r.statuses.at(-1).message}"` : `closed ${r.closeCode}`}`);
+  r.ws.terminate();
+}
+
+async function caseHostile(check) {
+  const [node, url] = await start("node", nodeArgs(scene("cantilever.xml"), "--rate", 1, "--loop"));
+  // The handshake: any subprotocol but Foxglove's two is refused; either of those is accepted.
+  for (const protos of [["foo.bar.v1"], []]) {
+    const r = raw(url, protos);
+    await until(`handshake ${protos}`, 5000, () => r.opened || r.refused !== undefined || r.closeCode !== undefined);
+    check(!r.opened, `subprotocols [${protos}] accepted: want the handshake refused`);
+    r.ws.terminate();
+  }
+  for (const protos of [["foxglove.sdk.v1"], ["foxglove.websocket.v1"], ["x", "foxglove.sdk.v1"]]) {
+    const r = raw(url, protos);
+    await until(`handshake ${protos}`, 5000, () => r.opened || r.closeCode !== undefined);
+    check(r.opened && protos.includes(r.ws.protocol), `subprotocols [${protos}]: opened ${r.opened}, chose ${r.ws.protocol}`);
+    r.ws.terminate();
+  }
+  await expectRejected(check, url, "malformed JSON", (ws) => ws.send("{\"op\": \"subscribe\", "));
+  await expectRejected(check, url, "not an object", (ws) => ws.send("[1, 2, 3]"));
+  await expectRejected(check, url, "unknown op", (ws) => ws.send(JSON.stringify({ op: "frobnicate" })));
+  await expectRejected(check, url, "subscribe without fields", (ws) => ws.send(JSON.stringify({ op: "subscribe" })));
+  await expectRejected(check, url, "unknown channel id", (ws) =>
+    ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: 1, channelId: 987654 }] })));
+  await expectRejected(check, url, "unknown subscription id", (ws) =>
+    ws.send(JSON.stringify({ op: "unsubscribe", subscriptionIds: [424242] })));
+  await expectRejected(check, url, "client binary frame", (ws) => ws.send(Buffer.from([1, 7, 0, 0, 0, 1, 2, 3])));
+  await expectRejected(check, url, "empty binary frame", (ws) => ws.send(Buffer.alloc(0)));
+  await expectRejected(check, url, "text frame over 1 MiB", (ws) =>
+    ws.send(JSON.stringify({ op: "subscribe", subscriptions: [], pad: "x".repeat((1 << 20) + 10) })));
+  await expectRejected(check, url, "binary frame over 1 MiB", (ws) => ws.send(Buffer.alloc((1 << 20) + 10, 1)));
+
+  // Hundreds of connects and disconnects: clean closes, abrupt resets, TCP connections that never
+  // finish the handshake, 20 at a time.
+  const port = Number(new URL(url).port);
+  const t0 = performance.now();
+  for (let round = 0; round < 15; round++) {
+    await Promise.all(Array.from({ length: 20 }, (_, k) => churn(url, port, (round * 20 + k) % 4)));
+  }
+  log(`300 connects/disconnects in ${((performance.now() - t0) / 1000).toFixed(1)} s`);
+  check(node.alive(), `the node died\n${node.output()}`);
+  // Still serving: a well-behaved client gets advertisements and data.
+  const c = await new Client(need, url, { name: "after" }).ready();
+  await until("data after the abuse", 5000, () => c.messages.length > 50);
+  c.close();
+  node.kill("SIGINT");
+  check((await node.wait(15000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  check(endLine(node) !== undefined, `no end line\n${node.err}`);
+}
+
+// One connect/disconnect of a given kind, bounded by a 5 s timer.
+function churn(url, port, kind) {
+  return new Promise((resolve) => {
+    const done = () => {
+      clearTimeout(timer);
+      resolve();
+    };
+    const timer = setTimeout(done, 5000);
+    if (kind === 3) {
+      // TCP only, half a handshake, then gone.
+      const s = net.connect(port, "127.0.0.1", () => {
+        s.write("GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n");
+        s.destroy();
+        done();
+      });
+      s.on("error", done);
+      return;
+    }
+    const r = raw(url, ["foxglove.websocket.v1"]);
+    r.ws.on("open", () => {
+      if (kind === 0) r.ws.close(1000);
+      else if (kind === 1) r.ws.terminate();
+      else r.ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: 1, channelId: 1 }] }), () => r.ws.terminate());
+    });
+    r.ws.on("close", done);
+    r.ws.on("error", done);
+  });
+}
+
+// Stops reading from the socket: the kernel buffers fill, then the server's queue.
+const stall = (client) => client.ws._socket.pause();
+
+async function caseSlowClient(check) {
+  const duration = 12;
+  const sceneFile = gridScene(100, 0.001, duration);
+  const [node, url] = await start("node", nodeArgs(sceneFile, "--rate", 1));
+  const good = await new Client(need, url, { name: "good", decode: false }).ready();
+  const slow = await new Client(need, url, { name: "slow", decode: false }).ready();
+  await until("data", 5000, () => slow.messages.length > 100);
+  stall(slow);
+  const stalledAt = slow.messages.length;
+  log(`slow client stops reading after ${stalledAt} messages`);
+  await sleep(9000);
+  slow.ws._socket.resume();
+  // Whatever was in flight arrives, then the status warning and the close (or the reset).
+  await until("the stalled client to be disconnected", 8000, () => slow.closed);
+  check(slow.closed, "the client that stopped reading was not disconnected");
+  check((await node.wait(60000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  log(node.err.trim().split("\n").at(-1));
+  check(/\d+ disconnected for not reading/.test(node.err), `end line does not count the disconnect\n${node.err}`);
+  const perStep = [...good.byTopic()].filter(([t]) => !/\/(scene|markers)$/.test(t));
+  check(perStep.length > 0, "good client: no per-step topics");
+  for (const [topic, msgs] of perStep) {
+    // The good client kept up: every step from its first to the node's last.
+    const last = msgs.at(-1).time;
+    const dt = msgs.length > 1 ? msgs[1].time - msgs[0].time : 1n;
+    const expected = Number((last - msgs[0].time) / dt) + 1;
+    check(msgs.length === expected, `good client lost ${expected - msgs.length} of ${expected} on ${topic}`);
+    check(last === BigInt(Math.round(duration * 1e9)), `good client's last ${topic} at ${last} ns, want ${duration} s`);
+  }
+}
+
+// A client in a child process, killed mid-stream by the driver.
+function childClient(url) {
+  return new Proc("child", [process.execPath, __filename, "--case", "child", "--url", url, "--npm", A.npm,
+    "--rbsim", "-", "--source-dir", "-", "--workdir", path.join(workdir, "child"), "--index", "0"], {});
+}
+
+async function caseChild() {
+  const c = await new Client(need, A.url, { name: "child" }).ready();
+  c.onmessage = () => {};
+  await sleep(60000);
+}
+
+async function caseFaults(check) {
+  // Real time with dt = 1 ms: the node's step rate is the real-time rate while nothing holds it up.
+  const steps = 6000;
+  const sceneFile = gridScene(100, 0.001, steps / 1000);
+  const [base] = await start("baseline", nodeArgs(sceneFile, "--rate", 1));
+  check((await base.wait(60000)) === 0, `baseline node exited with ${base.code}\n${base.output()}`);
+  const want = endLine(base);
+  if (!want) throw new Failure(`baseline: no end line\n${base.err}`);
+
+  const [node, url] = await start("node", nodeArgs(sceneFile, "--rate", 1));
+  const good = await new Client(need, url, { name: "good", decode: false }).ready();
+  const stalled = await new Client(need, url, { name: "stalled", decode: false }).ready();
+  stall(stalled);
+  const port = Number(new URL(url).port);
+  // Clients in other processes killed mid-stream, while 100 connect/disconnect cycles run.
+  const children = Array.from({ length: 4 }, () => childClient(url));
+  const cycles = (async () => {
+    for (let k = 0; k < 100; k++) await churn(url, port, k % 4);
+  })();
+  for (const [k, child] of children.entries()) {
+    await sleep(400 + 300 * k);
+    child.kill("SIGKILL");
+  }
+  await cycles;
+  check((await node.wait(60000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  const got = endLine(node);
+  log(`no clients: ${want.rate} steps/s; with killed, cycling, stalled and one good client: ${got?.rate} steps/s`);
+  log(node.err.trim().split("\n").at(-1));
+  check(got && got.steps === want.steps, `node ran ${got?.steps} steps, want ${want.steps}`);
+  if (A.sanitized) {
+    log("sanitized build: step rates not compared (instrumented binaries)");
+  } else {
+    check(got && Math.abs(got.rate - want.rate) <= 0.1 * want.rate,
+      `step rate ${got?.rate} steps/s, want within 10% of ${want.rate} (no clients)`);
+  }
+  for (const [topic, msgs] of good.byTopic()) {
+    if (/\/(scene|markers)$/.test(topic)) continue;
+    const dt = msgs[1].time - msgs[0].time;
+    const expected = Number((msgs.at(-1).time - msgs[0].time) / dt) + 1;
+    check(msgs.length === expected && msgs.at(-1).time === BigInt(steps) * 1000000n,
+      `good client: ${msgs.length} of ${expected} on ${topic}, last at ${msgs.at(-1).time} ns`);
+  }
+}
+
+const cases = { bytes: caseBytes, late_joiner: caseLateJoiner, hostile: caseHostile, slow_client: caseSlowClient,
+  faults: caseFaults };
+if (A.case === "child") caseChild();
+else if (!cases[A.case]) throw new Error(`unknown case ${A.case}`);
+else runMain(`foxglove.${A.case}`, cases[A.case]);
