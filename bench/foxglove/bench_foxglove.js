@@ -1,0 +1,173 @@
+#!/usr/bin/env node
+"use strict";
+// Driver of scripts/bench-foxglove: the real `rbsim node --foxglove` on 127.0.0.1, Node clients
+// from test/foxglove_client/lib.js, every wait bounded. Prints the figures beside their targets
+// and exits 1 when one is missed.
+//   (a) latency, step published -> decoded, 100 bodies: the Node client over the Foxglove
+//       WebSocket against a Python cyclonedds subscriber over DDS, same node, same steps;
+//   (b) 1,000 bodies at real time, dt = 1 ms, 3 clients in their own processes: dropped messages;
+//   (c) payload bytes per step of the 1,000-body scene's default topics, before and after.
+const fs = require("fs");
+const os = require("os");
+const path = require("path");
+const { spawnSync } = require("child_process");
+const lib = require("../../test/foxglove_client/lib");
+const { Failure, sleep, until, Proc, startServer, endLine, Client } = lib;
+
+const A = {};
+for (let i = 2; i < process.argv.length; i += 2) A[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
+if (A.child) {
+  childClient().catch((e) => {
+    console.error(e.stack);
+    process.exit(1);
+  });
+  return;
+}
+const need = lib.npmModules(A.npm);
+const work = fs.mkdtempSync(path.join(os.tmpdir(), "rbsim_bench_foxglove_"));
+const domain = 100 + (process.pid % 100); // the benchmarks' domains (test/e2e uses 200..)
+
+function grid(n, duration) {
+  const file = path.join(work, `grid${n}.xml`);
+  const r = spawnSync("python3", [path.join(A.root, "bench", "make_grid_scene.py"), n, 0.001, duration],
+    { encoding: "utf8" });
+  if (r.status !== 0) throw new Failure(r.stderr);
+  fs.writeFileSync(file, r.stdout);
+  return file;
+}
+
+const quantile = (xs, q) => {
+  const s = [...xs].sort((a, b) => a - b);
+  return s[Math.min(s.length - 1, Math.floor(q * s.length))];
+};
+const us = (ns) => (ns / 1000).toFixed(0);
+const nowNs = () => (performance.timeOrigin + performance.now()) * 1e6; // CLOCK_REALTIME, as time.time_ns()
+
+async function latency() {
+  const seconds = 8;
+  const scene = grid(100, seconds);
+  const ns = `bench_fg_${process.pid}`;
+  const dds = new Proc("dds", [path.join(A.venv, "bin", "python"), path.join(__dirname, "dds_latency.py"),
+    "--domain", String(domain), "--namespace", ns, "--seconds", String(seconds + 10)]);
+  await dds.waitFor(/READY/, 30000);
+  const [node, url] = await startServer(A.rbsim, ["node", scene, "--rate", 1, "--domain", domain, "--namespace", ns]);
+  const c = new Client(need, url, { name: "latency", subscribeAll: false });
+  const fox = new Map(); // step -> received ns
+  c.onmessage = (m) => fox.set(Number(m.decoded.step), nowNs());
+  await c.ready();
+  for (const ch of c.channels.values()) if (ch.topic.endsWith("/body_states")) c.subscribe(ch);
+  await node.wait(seconds * 1000 + 30000);
+  await dds.wait(30000);
+  const rows = dds.out.trim().split("\n").map((l) => l.split(" ").map(Number));
+  // Steps both received, past the first second (discovery, subscription, warm-up).
+  const both = rows.filter(([step]) => step >= 1000 && fox.has(step));
+  if (both.length < 1000) throw new Failure(`latency: only ${both.length} steps received by both\n${dds.output()}`);
+  const ddsLat = both.map(([, src, rcv]) => rcv - src);
+  const foxLat = both.map(([step, src]) => fox.get(step) - src);
+  const [dm, d99, fm, f99] = [quantile(ddsLat, 0.5), quantile(ddsLat, 0.99), quantile(foxLat, 0.5), quantile(foxLat, 0.99)];
+  const ratio = fm / dm;
+  console.log(`(a) latency, step published -> decoded, 100 bodies (BodyStates ${c.messages.at(-1)?.data.length} B), ` +
+    `${both.length} steps at real time, wall clock resolution 1 us:`);
+  console.log(`    DDS (Python cyclonedds) median ${us(dm)} us, p99 ${us(d99)} us; ` +
+    `Foxglove WebSocket (Node client) median ${us(fm)} us, p99 ${us(f99)} us`);
+  console.log(`    ratio of medians ${ratio.toFixed(2)}x (target <= 2x), of p99 ${(f99 / d99).toFixed(2)}x` +
+    `: ${ratio <= 2 ? "met" : "MISSED"}`);
+  return ratio <= 2;
+}
+
+// A client in its own process: subscribes to everything, counts per topic, checks each per-step
+// topic has every step from its first message on, prints one JSON line when the server closes.
+async function childClient() {
+  const needC = lib.npmModules(A.npm);
+  const c = new Client(needC, A.url, { name: "child", decode: false });
+  const last = new Map();
+  const stats = { messages: 0, bytes: 0, gaps: 0, statuses: [] };
+  c.onmessage = (m) => {
+    stats.messages++;
+    stats.bytes += m.data.length;
+    const prev = last.get(m.topic);
+    if (prev !== undefined && m.time - prev !== 1000000n) stats.gaps++;
+    last.set(m.topic, m.time);
+  };
+  c.messages = { push() {} }; // count only: keep nothing
+  await c.ready();
+  await until("the server to close", 600000, () => c.closed, 50);
+  stats.statuses = c.statuses.map((s) => s.message);
+  console.log(JSON.stringify(stats));
+}
+
+async function fanOut() {
+  const seconds = 5;
+  const scene = grid(1000, seconds);
+  const [node, url] = await startServer(A.rbsim, ["node", scene, "--rate", 1, "--domain", domain,
+    "--namespace", `bench_fg3_${process.pid}`]);
+  const clients = [0, 1, 2].map((k) => new Proc(`client${k}`, [process.execPath, __filename, "--child", "1",
+    "--url", url, "--npm", A.npm], {}));
+  await node.wait(seconds * 1000 + 120000);
+  const results = [];
+  for (const c of clients) {
+    await c.wait(30000);
+    results.push(JSON.parse(c.out.trim().split("\n").at(-1) || "{}"));
+  }
+  const end = endLine(node);
+  const fox = /foxglove: .*/.exec(node.err)?.[0] ?? "?";
+  console.log(`(b) 1,000 bodies, dt = 1 ms, real time, 3 clients: node ${end?.rate} steps/s over ${end?.steps} steps; ${fox}`);
+  results.forEach((r, k) => console.log(`    client ${k}: ${r.messages} messages, ${(r.bytes / 1e6).toFixed(0)} MB, ` +
+    `${r.gaps} gaps in per-step topics, ${r.statuses?.length ?? "?"} status warnings`));
+  const dropped = Number(/(\d+) dropped/.exec(fox)?.[1] ?? NaN);
+  const ok = dropped === 0 && results.every((r) => r.gaps === 0) && end && end.rate >= 0.9 * 1000;
+  console.log(`    dropped ${dropped} (target 0 for clients that keep up), real time ${end && end.rate >= 900 ? "kept" : "NOT kept"}: ${ok ? "met" : "MISSED"}`);
+  return ok;
+}
+
+// Payload bytes per step of the default topics of `rbsim` (a recording, uncompressed): per-step
+// topics per step, and the latched ones once.
+function bytesPerStep(rbsim, tag) {
+  const steps = 100;
+  const scene = grid(1000, steps * 0.001);
+  const out = path.join(work, `${tag}.mcap`);
+  const r = spawnSync(rbsim, ["run", scene, "--record", out, "--compression", "none", "-q"], { encoding: "utf8" });
+  if (r.status !== 0) throw new Failure(`${rbsim} run --record: ${r.stderr}`);
+  let perStep = 0;
+  let once = 0;
+  const topics = [];
+  for (const [topic, { messages }] of lib.readMcap(need, out)) {
+    const bytes = messages.reduce((s, m) => s + m.data.length, 0);
+    if (messages.length === 1) once += bytes;
+    else perStep += bytes / messages.length;
+    topics.push(topic);
+  }
+  return { perStep, once, topics };
+}
+
+function bytes() {
+  const after = bytesPerStep(A.rbsim, "after");
+  const before = A.before ? bytesPerStep(A.before, "before") : undefined;
+  const kb = (b) => `${(b / 1000).toFixed(1)} KB`;
+  console.log(`(c) bytes per step, 1,000 bodies, default topics (payloads, uncompressed):`);
+  if (before) console.log(`    before (${A.before}): ${kb(before.perStep)} per step + ${kb(before.once)} once [${before.topics.join(" ")}]`);
+  console.log(`    after: ${kb(after.perStep)} per step + ${kb(after.once)} once [${after.topics.join(" ")}]`);
+  if (!before) {
+    console.log("    no --before binary: ratio not measured: MISSED");
+    return false;
+  }
+  const ratio = before.perStep / after.perStep;
+  console.log(`    ${ratio.toFixed(2)}x smaller (target >= 3x): ${ratio >= 3 ? "met" : "MISSED"}`);
+  return ratio >= 3;
+}
+
+(async () => {
+  const only = A.only ? A.only.split(",") : ["a", "b", "c"];
+  const results = [];
+  try {
+    if (only.includes("a")) results.push(await latency());
+    if (only.includes("b")) results.push(await fanOut());
+    if (only.includes("c")) results.push(bytes());
+  } catch (e) {
+    console.log(`bench-foxglove: ${e instanceof Failure ? e.message : e.stack}`);
+    results.push(false);
+  }
+  fs.rmSync(work, { recursive: true, force: true });
+  await sleep(10);
+  process.exit(results.every(Boolean) ? 0 : 1);
+})();
