@@ -144,8 +144,6 @@ async function caseLateJoiner(check) {
   log(`late joiner got ${latchedTopics} ${(performance.now() - t0).toFixed(0)} ms after connecting`);
   for (const t of latchedTopics) {
     const first = b.messages.findIndex((m) => m.topic === t);
-    const perStep = b.messages.findIndex((m) => !latchedTopics.includes(m.topic) && m.topic !== "/clock");
-    check(perStep < 0 || first < perStep + 200, `${t}: came only after ${first} messages`);
     const early = a.messages.filter((m) => m.topic === t).at(-1);
     check(early && early.data.equals(b.messages[first].data), `${t}: late joiner's copy differs from the early client's`);
   }
