@@ -211,7 +211,7 @@ function readMcap(need, file) {
   const topics = new Map();
   for (let rec; (rec = reader.nextRecord()); ) {
     if (rec.type === "Schema") schemas.set(rec.id, rec);
-    else if (rec.type === "Channel") {
+    else if (rec.type === "Channel" && !channels.has(rec.id)) {  // again in the summary section
       const s = schemas.get(rec.schemaId);
       channels.set(rec.id, { ...rec, schemaName: s.name, schemaEncoding: s.encoding, schema: Buffer.from(s.data).toString() });
       topics.set(rec.topic, { channel: channels.get(rec.id), messages: [] });
