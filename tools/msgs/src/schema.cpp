@@ -61,6 +61,12 @@ std::span<const TopicSpec> topics() {
 const TopicSpec& topic(TopicId id) {
   return kTopics[static_cast<std::size_t>(id)];
 }
+TopicSet default_topics() {
+  TopicSet set;
+  set.set();
+  set.reset(static_cast<std::size_t>(TopicId::Poses));
+  return set;
+}
 
 const TopicSpec* topic_for_type(std::string_view type) {
   const std::string t = canonical_type(type, "");

@@ -9,6 +9,7 @@
 // the pad count in the header's last byte (options), exactly as Cyclone DDS serialises it.
 #pragma once
 
+#include <bitset>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -39,6 +40,10 @@ struct TopicSpec {
 };
 std::span<const TopicSpec> topics();
 const TopicSpec& topic(TopicId id);
+// A selection of topics, indexed by TopicId.
+using TopicSet = std::bitset<kTopicCount>;
+// What is published and recorded unless a command line chooses: every topic but the PoseArray.
+TopicSet default_topics();
 // The topic of topics() whose type is `type` ("pkg/msg/Name", or "pkg/Name" as older tools write
 // it); null when it is none of ours.
 const TopicSpec* topic_for_type(std::string_view type);
