@@ -110,7 +110,7 @@ async function startServer(rbsim, args, opts = {}) {
 
 // The node's closing line: steps and steps per second.
 function endLine(proc) {
-  const m = /rbsim \w+: (?:done|stopped) after (\d+) steps in \S+ \(([\d.e+]+) steps\/s\)/.exec(proc.err);
+  const m = /rbsim \w+: (?:done|stopped) after (\d+) steps in .+? \(([\d.e+]+) steps\/s\)/.exec(proc.err);
   return m ? { steps: Number(m[1]), rate: Number(m[2]) } : undefined;
 }
 
@@ -223,8 +223,9 @@ function readMcap(need, file) {
   return topics;
 }
 
-// A distinct DDS domain per test index: clear of the e2e tests (200..232) and the benchmarks (100..199).
-const domainFor = (index) => 233 + (index % 20);
+// A distinct DDS domain per test index (80..99): clear of the e2e tests (200..232), the benchmarks
+// (100..199) and test/foxglove (61).
+const domainFor = (index) => 80 + (index % 20);
 
 // The colours of a FOSSSim scene's bodies, [r, g, b] in 0..1, from its <rigidbodycolor> elements.
 function sceneColours(xmlFile) {
