@@ -308,7 +308,8 @@ async function caseSlowClient(check) {
     const dt = msgs.length > 1 ? msgs[1].time - msgs[0].time : 1n;
     const expected = Number((last - msgs[0].time) / dt) + 1;
     check(msgs.length === expected, `good client lost ${expected - msgs.length} of ${expected} on ${topic}`);
-    check(last === BigInt(Math.round(duration * 1e9)), `good client's last ${topic} at ${last} ns, want ${duration} s`);
+    check(last === BigInt(Math.round(duration * 1e9)),
+      `good client: last ${topic} at ${last} ns, want the last step's ${duration} s`);
   }
 }
 
@@ -319,7 +320,8 @@ function childClient(url) {
 }
 
 async function caseChild() {
-  const c = await new Client(need, A.url, { name: "child" }).ready();
+  const c = await new Client(need, A.url, { name: "child", decode: false }).ready();
+  c.messages = { push() {} }; // keep nothing: it only has to be mid-stream when it is killed
   c.onmessage = () => {};
   await sleep(60000);
 }
@@ -327,7 +329,9 @@ async function caseChild() {
 async function caseFaults(check) {
   // Real time with dt = 1 ms: the node's step rate is the real-time rate while nothing holds it up.
   const steps = 6000;
-  const sceneFile = gridScene(100, 0.001, steps / 1000);
+  // 20 bodies: light enough that the node keeps real time on a busy 2-core machine, so a server
+  // that held it up would show.
+  const sceneFile = gridScene(20, 0.001, steps / 1000);
   const [base] = await start("baseline", nodeArgs(sceneFile, "--rate", 1));
   check((await base.wait(60000)) === 0, `baseline node exited with ${base.code}\n${base.output()}`);
   const want = endLine(base);
@@ -363,8 +367,9 @@ async function caseFaults(check) {
     if (/\/(scene|markers)$/.test(topic)) continue;
     const dt = msgs[1].time - msgs[0].time;
     const expected = Number((msgs.at(-1).time - msgs[0].time) / dt) + 1;
-    check(msgs.length === expected && msgs.at(-1).time === BigInt(steps) * 1000000n,
-      `good client: ${msgs.length} of ${expected} on ${topic}, last at ${msgs.at(-1).time} ns`);
+    check(msgs.length === expected, `good client lost ${expected - msgs.length} of ${expected} on ${topic}`);
+    check(msgs.at(-1).time === BigInt(steps) * 1000000n,
+      `good client: last ${topic} at ${msgs.at(-1).time} ns, want the last step's ${steps * 1e6} ns`);
   }
 }
 
