@@ -2,10 +2,14 @@
 // measured like ddsperf's ping/pong: `rbsim_bench_dds pong` echoes every sample of /bench/ping
 // back on /bench/pong; `rbsim_bench_dds ping N` sends N samples one at a time and reports half
 // the round-trip times (median and p99, microseconds).
+// `rbsim_bench_dds listen TOPIC SECONDS` subscribes to a node's BodyStates topic (its QoS) and, for
+// every sample, prints "STEP SOURCE_NS DECODED_NS": the writer's source timestamp and the wall
+// clock once decoded (both CLOCK_REALTIME), the DDS side of scripts/bench-foxglove's latency.
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -40,11 +44,53 @@ bool wait_take(rbsim::node::Subscription& sub, dds_entity_t waitset, rbsim::node
   return false;
 }
 
+std::int64_t realtime_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+int listen(std::uint32_t domain, const std::string& topic, double seconds) {
+  auto participant = rbsim::node::Participant::create(domain);
+  if (!participant) return std::fprintf(stderr, "%s\n", participant.error().message.c_str()), 1;
+  const auto& spec = rbsim::msgs::topic(rbsim::msgs::TopicId::BodyStates);
+  auto sub = rbsim::node::Subscription::create(participant.value(), spec, topic, rbsim::node::qos_for(spec));
+  if (!sub) return std::fprintf(stderr, "%s\n", sub.error().message.c_str()), 1;
+  const dds_entity_t waitset = dds_create_waitset(participant->handle());
+  dds_waitset_attach(waitset, dds_create_readcondition(sub->reader(), DDS_ANY_STATE), 0);
+  std::printf("READY\n");
+  std::fflush(stdout);
+  std::vector<std::array<std::int64_t, 3>> rows;
+  rbsim::node::Received got;
+  rbsim::msgs::BodyStatesMessage msg;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+  while (Clock::now() < deadline) {
+    if (!sub->take(got)) {
+      dds_waitset_wait(waitset, nullptr, 0, DDS_MSECS(50));
+      continue;
+    }
+    if (!rbsim::msgs::decode_body_states(got.cdr, msg)) continue;
+    rows.push_back({static_cast<std::int64_t>(msg.step), got.source_time_ns, realtime_ns()});
+  }
+  for (const auto& r : rows)
+    std::printf("%lld %lld %lld\n", static_cast<long long>(r[0]), static_cast<long long>(r[1]),
+                static_cast<long long>(r[2]));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 4 && std::strcmp(argv[1], "listen") == 0) {
+    const std::uint32_t domain = argc >= 6 && std::strcmp(argv[4], "--domain") == 0
+                                     ? static_cast<std::uint32_t>(std::stoul(argv[5]))
+                                     : 77;
+    return listen(domain, argv[2], std::stod(argv[3]));
+  }
   if (argc < 2 || (std::strcmp(argv[1], "ping") != 0 && std::strcmp(argv[1], "pong") != 0)) {
-    std::fprintf(stderr, "usage: rbsim_bench_dds ping [N] [--domain D] | pong [--domain D]\n");
+    std::fprintf(stderr,
+                 "usage: rbsim_bench_dds ping [N] [--domain D] | pong [--domain D] | listen TOPIC SECONDS "
+                 "[--domain D]\n");
     return 2;
   }
   const bool ping = std::strcmp(argv[1], "ping") == 0;

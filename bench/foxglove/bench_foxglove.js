@@ -4,7 +4,8 @@
 // from test/foxglove_client/lib.js, every wait bounded. Prints the figures beside their targets
 // and exits 1 when one is missed.
 //   (a) latency, step published -> decoded, 100 bodies: the Node client over the Foxglove
-//       WebSocket against a Python cyclonedds subscriber over DDS, same node, same steps;
+//       WebSocket against a C++ Cyclone DDS subscriber (rbsim_bench_dds listen), same node, same
+//       steps, from the DDS sample's source timestamp (CLOCK_REALTIME, as both receive times);
 //   (b) 1,000 bodies at real time, dt = 1 ms, 3 clients in their own processes: dropped messages;
 //   (c) payload bytes per step of the 1,000-body scene's default topics, before and after.
 const fs = require("fs");
@@ -41,16 +42,20 @@ const quantile = (xs, q) => {
   return s[Math.min(s.length - 1, Math.floor(q * s.length))];
 };
 const us = (ns) => (ns / 1000).toFixed(0);
-const nowNs = () => (performance.timeOrigin + performance.now()) * 1e6; // CLOCK_REALTIME, as time.time_ns()
+const nowNs = () => (performance.timeOrigin + performance.now()) * 1e6; // CLOCK_REALTIME, to a microsecond
 
 async function latency() {
   const seconds = 8;
   const scene = grid(100, seconds);
   const ns = `bench_fg_${process.pid}`;
-  const dds = new Proc("dds", [path.join(A.venv, "bin", "python"), path.join(__dirname, "dds_latency.py"),
-    "--domain", String(domain), "--namespace", ns, "--seconds", String(seconds + 10)]);
+  // Both DDS ends on rbsim's loopback configuration (as scripts/bench-dds).
+  const env = { ...lib.rbsimEnv(), CYCLONEDDS_URI: `file://${path.join(A.root, "node", "config", "cyclonedds-loopback.xml")}` };
+  // A C++ DDS subscriber that decodes each sample with rbsim's decoder (bench/dds: listen).
+  const dds = new Proc("dds", [A["bench-dds"], "listen", `/${ns}/body_states`, String(seconds + 10), "--domain",
+    String(domain)], { env });
   await dds.waitFor(/READY/, 30000);
-  const [node, url] = await startServer(A.rbsim, ["node", scene, "--rate", 1, "--domain", domain, "--namespace", ns]);
+  const [node, url] = await startServer(A.rbsim, ["node", scene, "--rate", 1, "--domain", domain, "--namespace", ns],
+    { env });
   const c = new Client(need, url, { name: "latency", subscribeAll: false });
   const fox = new Map(); // step -> received ns
   c.onmessage = (m) => fox.set(Number(m.decoded.step), nowNs());
@@ -68,7 +73,7 @@ async function latency() {
   const ratio = fm / dm;
   console.log(`(a) latency, step published -> decoded, 100 bodies (BodyStates ${c.messages.at(-1)?.data.length} B), ` +
     `${both.length} steps at real time, wall clock resolution 1 us:`);
-  console.log(`    DDS (Python cyclonedds) median ${us(dm)} us, p99 ${us(d99)} us; ` +
+  console.log(`    DDS (C++ subscriber) median ${us(dm)} us, p99 ${us(d99)} us; ` +
     `Foxglove WebSocket (Node client) median ${us(fm)} us, p99 ${us(f99)} us`);
   console.log(`    ratio of medians ${ratio.toFixed(2)}x (target <= 2x), of p99 ${(f99 / d99).toFixed(2)}x` +
     `: ${ratio <= 2 ? "met" : "MISSED"}`);
