@@ -104,6 +104,10 @@ async function childClient() {
 async function fanOut() {
   const seconds = 5;
   const scene = grid(1000, seconds);
+  // The same node with no client: what this machine sustains without the server's work.
+  const [alone] = await startServer(A.rbsim, ["node", scene, "--rate", 1, "--domain", domain,
+    "--namespace", `bench_fg0_${process.pid}`]);
+  await alone.wait(seconds * 1000 + 120000);
   const [node, url] = await startServer(A.rbsim, ["node", scene, "--rate", 1, "--domain", domain,
     "--namespace", `bench_fg3_${process.pid}`]);
   const clients = [0, 1, 2].map((k) => new Proc(`client${k}`, [process.execPath, __filename, "--child", "1",
@@ -115,8 +119,9 @@ async function fanOut() {
     results.push(JSON.parse(c.out.trim().split("\n").at(-1) || "{}"));
   }
   const end = endLine(node);
-  const fox = /foxglove: .*/.exec(node.err)?.[0] ?? "?";
-  console.log(`(b) 1,000 bodies, dt = 1 ms, real time, 3 clients: node ${end?.rate} steps/s over ${end?.steps} steps; ${fox}`);
+  const fox = /; (foxglove: .*)/.exec(node.err)?.[1] ?? "?";
+  console.log(`(b) 1,000 bodies, dt = 1 ms, real time: node alone ${endLine(alone)?.rate} steps/s; with 3 clients ` +
+    `${end?.rate} steps/s over ${end?.steps} steps; ${fox}`);
   results.forEach((r, k) => console.log(`    client ${k}: ${r.messages} messages, ${(r.bytes / 1e6).toFixed(0)} MB, ` +
     `${r.gaps} gaps in per-step topics, ${r.statuses?.length ?? "?"} status warnings`));
   const dropped = Number(/(\d+) dropped/.exec(fox)?.[1] ?? NaN);
