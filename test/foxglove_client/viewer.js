@@ -101,7 +101,7 @@ runMain("foxglove_client.viewer", async (check) => {
   const page0 = `http://127.0.0.1:${web.address().port}/index.html`;
   const browser = await chromium.launch({ executablePath: CHROMIUM, headless: true, args: CHROMIUM_ARGS });
   try {
-    const page = await browser.newPage({ viewport: { width: 1280, height: 720 } });
+    const page = await browser.newPage({ viewport: { width: 1600, height: 900 } });
     const errors = [];
     page.on("pageerror", (e) => errors.push(e.message));
     // Anything but 127.0.0.1 is refused before it leaves the browser.
