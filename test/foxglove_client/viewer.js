@@ -119,10 +119,11 @@ runMain("foxglove_client.viewer", async (check) => {
     }
     log(`topics listed ${((performance.now() - t0) / 1000).toFixed(1)} s after opening the page`);
     check(missing.length === 0, `topics not listed in Foxglove: ${missing.join(" ")}`);
-    // Dismiss the 3D panel's first-use hint so it does not cover the scene, then let it draw.
-    await page.locator("button[aria-label='Close'], [data-testid='CloseIcon']").first().click({ timeout: 2000 })
-      .catch(() => {});
+    // Let it draw, then dismiss the 3D panel's first-use hint (it covers the plot's legend).
     await page.waitForTimeout(3000);
+    const hint = page.getByText("Open settings to configure topics and layers.");
+    await hint.locator("xpath=..").locator("button").first().click({ timeout: 2000 }).catch(() => {});
+    await hint.waitFor({ state: "hidden", timeout: 2000 }).catch(() => {});
     // The 3D panel's canvas: the largest one (the plot's is smaller).
     const rect = await page.evaluate(() => {
       const cs = [...document.querySelectorAll("canvas")].map((c) => c.getBoundingClientRect())
