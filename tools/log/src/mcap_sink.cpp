@@ -82,7 +82,7 @@ mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t 
                                    int compression_level) {
   mcap::WriterOptions o;
   o.profile = "ros2";
-  o.library = "rbsim 0.1.0";
+  o.library = std::string("rbsim ") + version();
   o.compression = compression;
   o.compression_level = compression_level;
   o.chunk_size = chunk_size;
