@@ -19,7 +19,8 @@ TEST(Pendulum, ShorterRunIsReported) {
   const ::testing::AssertionResult check = rbsim::testing::CheckLogs(run, kGolden);
   ASSERT_FALSE(check);
   // The failure explains itself: rbsim check's report, naming the steps the run lacks.
-  EXPECT_NE(std::string(check.message()).find("run lacks steps 101..200"), std::string::npos) << check.message();
+  EXPECT_NE(std::string(check.message()).find("run lacks steps 101..200"), std::string::npos)
+      << check.message();
 }
 
 }  // namespace

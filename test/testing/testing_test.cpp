@@ -25,7 +25,9 @@ class UpdateGoldens {
   ~UpdateGoldens() { ::unsetenv(kUpdateGoldensVariable); }
 };
 
-std::string message(const ::testing::AssertionResult& r) { return r.message(); }
+std::string message(const ::testing::AssertionResult& r) {
+  return r.message();
+}
 
 TEST(RecordScene, WritesWhatRbsimRunRecordWrites) {
   TempDir dir;
@@ -55,8 +57,10 @@ TEST(RecordScene, ReportsBadInput) {
   EXPECT_NE(message(RecordScene(dir.path() / "missing.xml", out)).find("missing.xml"), std::string::npos);
   EXPECT_NE(message(RecordScene(kPendulum, out, {.topics = {"nope"}})).find("unknown topic 'nope'"),
             std::string::npos);
-  EXPECT_NE(message(RecordScene(kPendulum, out, {.steps = -1})).find("steps must be >= 0"), std::string::npos);
-  EXPECT_NE(message(RecordScene(kPendulum, out, {.record_every = 0})).find("record_every"), std::string::npos);
+  EXPECT_NE(message(RecordScene(kPendulum, out, {.steps = -1})).find("steps must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(message(RecordScene(kPendulum, out, {.record_every = 0})).find("record_every"),
+            std::string::npos);
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -90,7 +94,8 @@ TEST(CheckLogs, ExplainsADivergenceWithRbsimChecksReport) {
   // The same report as the command line's (which adds its timing).
   const auto cli = rbsim::test::rbsim({"check", run, golden});
   EXPECT_EQ(cli.exit_code, 1) << cli;
-  EXPECT_EQ(cli.out.substr(0, cli.out.rfind("MB of message data")), m.substr(0, m.rfind("MB of message data")));
+  EXPECT_EQ(cli.out.substr(0, cli.out.rfind("MB of message data")),
+            m.substr(0, m.rfind("MB of message data")));
   // A tolerance wide enough passes (spring stiffness is a scene value, compared like any other).
   EXPECT_TRUE(CheckLogs(run, golden, {.atol = 10.0}));
 }

@@ -58,13 +58,13 @@ void append_table(std::string& out, const CheckReport& r, bool all_fields) {
           f->max_abs == 0.0 ? "-" : (f->has_step ? "step " : "msg ") + std::to_string(f->step_at_max);
       append(out, "  %-*s  %-*s  %-6s  %10llu  %10s  %10s  %12s  %10llu\n", static_cast<int>(topic_w),
              f->topic.c_str(), static_cast<int>(field_w), f->field.c_str(), f->kind.c_str(),
-             static_cast<unsigned long long>(f->values), g(f->max_abs).c_str(), g(f->max_rel).c_str(), at.c_str(),
-             static_cast<unsigned long long>(f->over));
+             static_cast<unsigned long long>(f->values), g(f->max_abs).c_str(), g(f->max_rel).c_str(),
+             at.c_str(), static_cast<unsigned long long>(f->over));
     }
   }
   if (identical > 0) {
-    append(out, "  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical, identical == 1 ? "" : "s",
-           all_fields || rows.empty() ? "" : " (--all-fields lists them)");
+    append(out, "  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical,
+           identical == 1 ? "" : "s", all_fields || rows.empty() ? "" : " (--all-fields lists them)");
   }
 }
 
@@ -91,8 +91,8 @@ std::string format_report(const std::string& run, const std::string& golden, con
   append_table(out, r, format.all_fields);
   const double mb = static_cast<double>(r.run_bytes + r.golden_bytes) / 1e6;
   append(out, "%zu topic%s, %llu message pair%s, %s MB of message data", r.topics.size(),
-         r.topics.size() == 1 ? "" : "s", static_cast<unsigned long long>(r.messages), r.messages == 1 ? "" : "s",
-         g(mb).c_str());
+         r.topics.size() == 1 ? "" : "s", static_cast<unsigned long long>(r.messages),
+         r.messages == 1 ? "" : "s", g(mb).c_str());
   if (format.wall_seconds) {
     const double wall = *format.wall_seconds;
     append(out, " in %s s (%s MB/s)", g(wall).c_str(), g(wall > 0 ? mb / wall : 0.0).c_str());

@@ -23,7 +23,8 @@ namespace {
   return ::testing::AssertionFailure() << "rbsim::testing::" << what << ": " << message;
 }
 
-Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>& names, std::string_view ns) {
+Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>& names,
+                                                  std::string_view ns) {
   std::vector<msgs::TopicId> ids;
   for (const std::string& name : names) {
     const msgs::TopicSpec* found = nullptr;
@@ -32,7 +33,8 @@ Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>
     }
     if (found == nullptr) {
       std::string known;
-      for (const msgs::TopicSpec& spec : msgs::topics()) known += (known.empty() ? "" : ", ") + msgs::topic_name(spec, ns);
+      for (const msgs::TopicSpec& spec : msgs::topics())
+        known += (known.empty() ? "" : ", ") + msgs::topic_name(spec, ns);
       return Error{"unknown topic '" + name + "' (topics: " + known + ")"};
     }
     ids.push_back(found->id);
@@ -55,10 +57,12 @@ Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>
   if (options.steps) steps = *options.steps;
   if (steps < 0) return failure("RecordScene", "steps must be >= 0 (got " + std::to_string(steps) + ")");
   if (options.record_every < 1) {
-    return failure("RecordScene", "record_every must be >= 1 (got " + std::to_string(options.record_every) + ")");
+    return failure("RecordScene",
+                   "record_every must be >= 1 (got " + std::to_string(options.record_every) + ")");
   }
   if (Status st = check_outputs({{out_mcap, "out_mcap"}}, {scene_path}, options.overwrite); !st) {
-    return failure("RecordScene", st.error().message + (options.overwrite ? "" : " (RecordOptions::overwrite)"));
+    return failure("RecordScene",
+                   st.error().message + (options.overwrite ? "" : " (RecordOptions::overwrite)"));
   }
   log::RecordOptions ro;
   ro.every = options.record_every;
@@ -74,7 +78,8 @@ Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>
   DriverOptions run;
   run.steps = steps;
   if (Status st = created->run_pass(run); !st) return failure("RecordScene", st.error().message);
-  return ::testing::AssertionSuccess() << "recorded " << steps << " steps of " << scene_path << " to " << out_mcap;
+  return ::testing::AssertionSuccess()
+         << "recorded " << steps << " steps of " << scene_path << " to " << out_mcap;
 }
 
 ::testing::AssertionResult CheckLogs(const std::string& actual_mcap, const std::string& golden_mcap,
@@ -95,8 +100,10 @@ bool GoldenUpdateRequested() {
   return value != nullptr && std::string_view(value) == "1";
 }
 
-::testing::AssertionResult UpdateGoldenIfRequested(const std::string& scene_path, const std::string& actual_mcap,
-                                                   const std::string& golden_mcap, const Tolerance& tolerance) {
+::testing::AssertionResult UpdateGoldenIfRequested(const std::string& scene_path,
+                                                   const std::string& actual_mcap,
+                                                   const std::string& golden_mcap,
+                                                   const Tolerance& tolerance) {
   const char* what = "UpdateGoldenIfRequested";
   if (!GoldenUpdateRequested()) {
     std::error_code ec;

@@ -22,10 +22,10 @@ namespace rbsim::testing {
 struct RecordOptions {
   std::optional<std::int64_t> steps{};  // steps to run; default: the scene's duration
   std::optional<double> duration{};     // simulated seconds, ceil(T / dt) steps (steps wins)
-  std::int64_t record_every = 1;      // record every k-th step (step 0 always)
+  std::int64_t record_every = 1;        // record every k-th step (step 0 always)
   std::vector<std::string> topics{};    // e.g. {"body_states", "energy"}; empty: the default set
-  std::string ns = "rbsim";           // ROS namespace of the topics
-  bool overwrite = false;             // replace an existing output file
+  std::string ns = "rbsim";             // ROS namespace of the topics
+  bool overwrite = false;               // replace an existing output file
 };
 
 // Runs a scene in process and writes the MCAP `rbsim run SCENE --record OUT` writes with the same
@@ -35,8 +35,8 @@ struct RecordOptions {
                                        const RecordOptions& options = {});
 
 struct Tolerance {
-  double atol = 0.0;                // a float matches when |actual - expected| <= atol + rtol |expected|
-  double rtol = 0.0;                // both 0: bit-exact
+  double atol = 0.0;                  // a float matches when |actual - expected| <= atol + rtol |expected|
+  double rtol = 0.0;                  // both 0: bit-exact
   std::vector<std::string> topics{};  // compare only these ("body_states", "/rbsim/energy"); empty: all
 };
 
@@ -55,7 +55,9 @@ bool GoldenUpdateRequested();
 // missing golden fails, saying how to create it). With it, verifies `actual_mcap` as a golden of
 // `scene_path` independently of the simulator (`rbsim check --verify-golden`) and only then
 // replaces the golden with it (atomically); a recording the verifier rejects is never written.
-::testing::AssertionResult UpdateGoldenIfRequested(const std::string& scene_path, const std::string& actual_mcap,
-                                                   const std::string& golden_mcap, const Tolerance& tolerance = {});
+::testing::AssertionResult UpdateGoldenIfRequested(const std::string& scene_path,
+                                                   const std::string& actual_mcap,
+                                                   const std::string& golden_mcap,
+                                                   const Tolerance& tolerance = {});
 
 }  // namespace rbsim::testing
