@@ -277,7 +277,7 @@ TEST(RecordCli, TopicsChoosesWhatIsRecorded) {
 // A recording made before the viewer topics (EnergyTerms without the potential split, per-step
 // PoseArray and MarkerArray): every reader still takes it, and export recomputes the split exactly
 // as the run's energy CSV has it.
-TEST(LogCli, RecordingsOfTheFormerLayoutStillRead) {
+TEST(ReadersCli, RecordingsOfTheFormerLayoutStillRead) {
   TempDir dir;
   const std::string old = data_path("old-format/airplane-before-viewer-topics.mcap");
   const std::string scene = source_path("scenes/airplane.xml");
