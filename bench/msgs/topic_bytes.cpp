@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   scene.world = rbsim::builders::grid(n, /*wind_and_springs=*/true);
   scene.duration = 1.0;
   for (int b = 0; b < n; ++b) scene.body_colors.push_back(rbsim::default_body_color(b));
-  scene.spring_colors.assign(scene.world.springs.size(), rbsim::Color{0.25, 0.25, 0.25});  // the loader's default
+  scene.spring_colors.assign(scene.world.springs.size(),
+                             rbsim::Color{0.25, 0.25, 0.25});  // the loader's default
   auto world = rbsim::World::create(scene.world);
   if (!world) {
     std::fprintf(stderr, "rbsim_bench_topic_bytes: %s\n", world.error().message.c_str());
