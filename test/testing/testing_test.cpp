@@ -55,7 +55,7 @@ TEST(RecordScene, ReportsBadInput) {
   TempDir dir;
   const std::string out = dir.path() / "run.mcap";
   EXPECT_NE(message(RecordScene(dir.path() / "missing.xml", out)).find("missing.xml"), std::string::npos);
-  EXPECT_NE(message(RecordScene(kPendulum, out, {.topics = {"nope"}})).find("unknown topic 'nope'"),
+  EXPECT_NE(message(RecordScene(kPendulum, out, {.topics = {"nope"}})).find("unknown topic \"nope\""),
             std::string::npos);
   EXPECT_NE(message(RecordScene(kPendulum, out, {.steps = -1})).find("steps must be >= 0"),
             std::string::npos);

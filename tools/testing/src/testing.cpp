@@ -23,25 +23,6 @@ namespace {
   return ::testing::AssertionFailure() << "rbsim::testing::" << what << ": " << message;
 }
 
-Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>& names,
-                                                  std::string_view ns) {
-  std::vector<msgs::TopicId> ids;
-  for (const std::string& name : names) {
-    const msgs::TopicSpec* found = nullptr;
-    for (const msgs::TopicSpec& spec : msgs::topics()) {
-      if (msgs::names_topic(name, msgs::topic_name(spec, ns))) found = &spec;
-    }
-    if (found == nullptr) {
-      std::string known;
-      for (const msgs::TopicSpec& spec : msgs::topics())
-        known += (known.empty() ? "" : ", ") + msgs::topic_name(spec, ns);
-      return Error{"unknown topic '" + name + "' (topics: " + known + ")"};
-    }
-    ids.push_back(found->id);
-  }
-  return ids;
-}
-
 }  // namespace
 
 ::testing::AssertionResult RecordScene(const std::string& scene_path, const std::string& out_mcap,
@@ -67,9 +48,13 @@ Result<std::vector<msgs::TopicId>> resolve_topics(const std::vector<std::string>
   log::RecordOptions ro;
   ro.every = options.record_every;
   ro.ns = options.ns;
-  Result<std::vector<msgs::TopicId>> topics = resolve_topics(options.topics, options.ns);
-  if (!topics) return failure("RecordScene", topics.error().message);
-  ro.topics = std::move(topics.value());
+  if (!options.topics.empty()) {
+    std::string list;
+    for (const std::string& name : options.topics) list += (list.empty() ? "" : ",") + name;
+    Result<msgs::TopicSet> topics = msgs::parse_topic_set(list, options.ns);
+    if (!topics) return failure("RecordScene", topics.error().message);
+    ro.topics = topics.value();
+  }
 
   Result<Driver> created = Driver::create(scene);
   if (!created) return failure("RecordScene", scene.path + ": " + created.error().message);
