@@ -79,6 +79,7 @@ Status FoxgloveSink::write(const World& world) {
 }
 
 Status FoxgloveSink::finish() {
+  (void)server_->flush(2.0);  // a client that does not keep up is not waited for longer
   return Ok{};
 }
 
