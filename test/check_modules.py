@@ -22,6 +22,7 @@ MODULES = {
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "node": ("node", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
     "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check"}),
+    "foxglove": ("tools/foxglove", {"core", "scene", "io", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"rbsim/([A-Za-z0-9_]+\.hpp)"', re.M)

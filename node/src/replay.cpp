@@ -52,9 +52,11 @@ struct Replay::Impl {
   ReplayOptions options;
   mcap::IndexedReader reader;
   std::vector<Publisher> publishers;
-  std::map<std::uint16_t, std::size_t> route;  // replayed channel id -> publisher index
-  std::set<std::uint16_t> latched_channels;    // replayed channels of latched topics (scene, markers)
-  std::vector<std::string> topics;             // replayed channel topics (the read filter)
+  std::map<std::uint16_t, std::size_t> route;       // replayed channel id -> publisher index
+  std::set<std::uint16_t> latched_channels;         // replayed channels of latched topics (scene, markers)
+  std::map<std::uint16_t, std::size_t> output_of;   // replayed channel id -> index in outputs_
+  std::map<std::uint16_t, msgs::TopicId> topic_of;  // replayed channel id -> its topic's id
+  std::vector<std::string> topics;                  // replayed channel topics (the read filter)
   std::optional<std::size_t> clock_publisher;
   std::size_t wait_publisher = 0;
 };
@@ -159,14 +161,23 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
         count = it->second;
       }
     }
-    r->outputs_.push_back({c.channel->topic, topic, count});
+    std::string schema;
+    if (const auto s = im.reader.schemas().find(c.channel->schema_id); s != im.reader.schemas().end())
+      schema.assign(reinterpret_cast<const char*>(s->second.data.data()), s->second.data.size());
+    im.output_of.emplace(c.channel->id, r->outputs_.size());
+    im.topic_of.emplace(c.channel->id, c.spec->id);
+    r->outputs_.push_back({c.channel->topic, topic, count, std::string(c.spec->type), std::move(schema),
+                           c.spec->transient_local});
   }
   if (options.clock) {
     const msgs::TopicSpec& spec = msgs::topic(msgs::TopicId::Clock);
     auto index = publisher_for(spec, msgs::topic_name(spec, ""));
     if (!index) return index.error();
     im.clock_publisher = index.value();
-    r->outputs_.push_back({"", msgs::topic_name(spec, ""), 0});
+    auto schema = msgs::ros2msg_schema(spec.type);
+    if (!schema) return schema.error();
+    r->outputs_.push_back(
+        {"", msgs::topic_name(spec, ""), 0, std::string(spec.type), std::move(schema.value()), false});
   }
   im.wait_publisher = states_publisher.value_or(0);
 
@@ -204,8 +215,30 @@ Status Replay::finish(double timeout_s) {
   return Ok{};
 }
 
-Result<bool> Replay::play(bool (*stop)()) {
+Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
   Impl& im = *impl_;
+  if (tap != nullptr && tap->pass) tap->pass();
+  // The simulated time of a message for the tap: its own stamp, else the last one seen (the scene
+  // description carries none the tap needs), else its log time.
+  std::optional<std::uint64_t> last_sim;
+  auto to_tap = [&](std::uint16_t channel, std::uint64_t log_time, std::span<const std::byte> cdr) {
+    if (tap == nullptr || !tap->message) return;
+    std::uint64_t t = last_sim.value_or(log_time);
+    const msgs::TopicId id = im.topic_of.at(channel);
+    std::optional<msgs::Time> stamp;
+    if (id == msgs::TopicId::Scene) {
+      // Once per pass: a live recording's log time is wall time, the scene's stamp is simulated.
+      if (auto scene = msgs::decode_scene(cdr)) stamp = scene.value().stamp;
+    } else {
+      stamp = msgs::decode_stamp(id, cdr);
+    }
+    if (stamp) {
+      t = static_cast<std::uint64_t>(std::max<std::int32_t>(0, stamp->sec)) * 1'000'000'000ull +
+          stamp->nanosec;
+      if (id != msgs::TopicId::Scene) last_sim = t;
+    }
+    tap->message(im.output_of.at(channel), t, cdr);
+  };
   const std::string& path = im.options.path;
   const double offset_ns = std::max(0.0, im.options.start_offset) * 1e9;
   const std::uint64_t start = offset_ns >= static_cast<double>(mcap::kMaxTime - first_log_time_)
@@ -232,6 +265,7 @@ Result<bool> Replay::play(bool (*stop)()) {
     for (const auto& [ch, m] : latched) {
       if (stop()) return false;
       if (Status s = im.publishers[im.route.at(ch)].publish(bytes(m.data)); !s) return s.error();
+      to_tap(ch, m.log_time, bytes(m.data));
       ++published_;
       if (m.log_time >= start) sent_early.insert(ch);
     }
@@ -278,12 +312,14 @@ Result<bool> Replay::play(bool (*stop)()) {
         return false;
       }
       last_clock = m.log_time;
+      if (tap != nullptr && tap->message) tap->message(outputs_.size() - 1, m.log_time, cdr);
       ++published_;
     }
     if (Status s = im.publishers[route->second].publish(bytes(m.data)); !s) {
       failure = s.error();
       return false;
     }
+    to_tap(m.channel_id, m.log_time, bytes(m.data));
     ++published_;
     return true;
   });

@@ -5,6 +5,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rbsim/foxglove.hpp"
 
 namespace rbsim::cli {
 
@@ -22,11 +28,22 @@ Subcommand add_record_command(CLI::App& parent);  // record.cpp
 Subcommand add_replay_command(CLI::App& parent);  // replay.cpp
 Subcommand add_log_command(CLI::App& parent);     // log.cpp: info, doctor, recover, export
 Subcommand add_check_command(CLI::App& parent);   // check.cpp: golden-log comparison
+Subcommand add_bridge_command(CLI::App& parent);  // bridge.cpp: DDS -> Foxglove relay
 
 // The DDS commands' --domain (record.cpp): bound to `domain`, which starts as ROS_DOMAIN_ID (or 0),
 // so the command line wins; an invalid ROS_DOMAIN_ID leaves node::kDomainFromEnvironment for
 // Participant::create to report. Also puts the help on ROS 2's DDS environment variables before
 // the command's own footer.
 CLI::Option* add_domain_option(CLI::App* app, std::uint32_t& domain);
+
+// --foxglove [ADDR:]PORT (foxglove.cpp): a bad value is a usage error naming the option.
+CLI::Option* add_foxglove_option(CLI::App* app, std::optional<std::string>& address, bool required = false);
+// Starts the Foxglove server on `address` and prints, prefixed with `command`, the line
+// "foxglove: listening on ws://ADDR:PORT" (the actual port), the app.foxglove.dev link and where the
+// layout file is. Errors: a port in use, an address not on this host.
+Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const std::string& address,
+                                                         std::vector<foxglove::ChannelSpec> channels);
+// "foxglove: 2 clients, 1200 messages queued, 0 dropped for slow clients" for a command's end line.
+std::string foxglove_summary(const foxglove::Server& server);
 
 }  // namespace rbsim::cli

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
       rbsim::cli::add_render_command(app), rbsim::cli::add_plot_command(app),
       rbsim::cli::add_node_command(app),   rbsim::cli::add_record_command(app),
       rbsim::cli::add_replay_command(app), rbsim::cli::add_log_command(app),
-      rbsim::cli::add_check_command(app),
+      rbsim::cli::add_check_command(app),  rbsim::cli::add_bridge_command(app),
   };
   if (argc == 1) return usage_error(&app, "no command given (commands: " + command_names(app) + ")");
   // `rbsim help [command [subcommand]]`, as git has it: the same as `rbsim command --help`.

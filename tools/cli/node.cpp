@@ -21,6 +21,7 @@ struct NodeArgs {
   std::int32_t wait_for = 0;
   bool quiet = false;
   std::string topics;
+  std::optional<std::string> foxglove;  // [ADDR:]PORT
 };
 
 int fail(const std::string& m) {
@@ -39,6 +40,23 @@ int node_command(const NodeArgs& a) {
   if (!participant) return fail(participant.error().message);
   auto sink = node::DdsSink::create(participant.value(), a.node);
   if (!sink) return fail(sink.error().message);
+  // The Foxglove server serves beside DDS: the DDS sink paces the steps (it comes first in the
+  // driver), the Foxglove sink publishes each step right after it.
+  std::unique_ptr<foxglove::Server> server;
+  std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
+  if (a.foxglove) {
+    foxglove::SinkOptions fo;
+    fo.publish_every = a.node.publish_every;
+    fo.topics = a.node.topics;
+    fo.ns = a.node.ns;
+    std::vector<foxglove::ChannelId> ids;
+    auto channels = foxglove::ros2_channels(fo.topics, a.node.ns, &ids);
+    if (!channels) return fail(channels.error().message);
+    auto started = start_foxglove("rbsim node", *a.foxglove, std::move(channels.value()));
+    if (!started) return fail(started.error().message);
+    server = std::move(started.value());
+    foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);
+  }
   install_stop_handlers();
   if (!a.quiet) {
     std::fprintf(stderr,
@@ -56,6 +74,7 @@ int node_command(const NodeArgs& a) {
   if (!created) return fail(created.error().message);
   Driver& driver = created.value();
   driver.add(*sink.value());
+  if (foxglove_sink) driver.add(*foxglove_sink);
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;
@@ -77,10 +96,11 @@ int node_command(const NodeArgs& a) {
   if (!a.quiet) {
     const std::int64_t total_steps = driver.steps_done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published\n",
+    std::fprintf(stderr, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published%s\n",
                  stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
                  format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
-                 static_cast<unsigned long long>(sink.value()->published()));
+                 static_cast<unsigned long long>(sink.value()->published()),
+                 server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;
 }
@@ -116,8 +136,10 @@ Subcommand add_node_command(CLI::App& parent) {
                   "Per-step writers keep the last N samples instead of all: the node never waits for a slow "
                   "subscriber, which may then lose samples (ROS 2's default profile is keep last 10)")
       ->check(positive());
-  add_topics_option(app, a->topics, a->node.ns, a->node.topics, "Topics to publish");
-  app->add_flag("-q,--quiet", a->quiet, "No start and end lines");
+  add_topics_option(app, a->topics, a->node.ns, a->node.topics, "Topics to publish (DDS and --foxglove)");
+  add_foxglove_option(app, a->foxglove);
+  app->add_flag("-q,--quiet", a->quiet,
+                "No start and end lines (--foxglove's listening line is always printed)");
   app->footer(
       "Topics (DDS name rt/<namespace>/<name>, type pkg::msg::dds_::Name_, CDR): scene "
       "(rbsim_msgs/SceneDescription) and markers (visualization_msgs/MarkerArray: body shapes in their "
@@ -126,8 +148,11 @@ Subcommand add_node_command(CLI::App& parent) {
       "/clock (rosgraph_msgs/Clock) and, with --topics, poses (geometry_msgs/PoseArray), all reliable, "
       "volatile, keep all: a slow subscriber slows the node down rather than losing samples (--keep-last N "
       "trades that for a node that never waits).\n"
+      "--foxglove serves the same topics to Foxglove beside DDS: encoding cdr, ros2msg schemas as in MCAP, "
+      "log time = simulated time; a client that falls behind loses the oldest per-step messages (never the "
+      "latched scene and markers), one that stops reading is disconnected.\n"
       "Exit status: 0 done, or stopped by Ctrl-C/SIGTERM (cleanly); 1 error (bad scene, DDS failure, "
-      "divergence); 2 usage error.");
+      "divergence, --foxglove port in use); 2 usage error.");
   return {app, [a] { return node_command(*a); }};
 }
 

@@ -18,6 +18,7 @@ struct ReplayArgs {
   bool loop = false;
   std::int32_t wait_for = 0;
   bool quiet = false;
+  std::optional<std::string> foxglove;  // [ADDR:]PORT
 };
 
 int fail(const std::string& m) {
@@ -34,6 +35,37 @@ int replay_command(ReplayArgs a) {
   node::Replay& replay = *opened.value();
   for (const std::string& w : replay.warnings())
     std::fprintf(stderr, "rbsim replay: warning: %s\n", w.c_str());
+  // --foxglove: one channel per replayed output with the recording's own schema; the replay's
+  // pacing is the one clock, the server is fed from the tap as each message goes out over DDS.
+  std::unique_ptr<foxglove::Server> server;
+  node::Replay::Tap tap;
+  std::uint64_t last_time = 0;
+  if (a.foxglove) {
+    std::vector<foxglove::ChannelSpec> channels;
+    for (const auto& o : replay.outputs()) {
+      foxglove::ChannelSpec c;
+      c.topic = o.topic;
+      c.schema_name = o.type;
+      c.schema = o.schema;
+      c.latched = o.latched;
+      channels.push_back(std::move(c));
+    }
+    auto started = start_foxglove("rbsim replay", *a.foxglove, std::move(channels));
+    if (!started) return fail(started.error().message);
+    server = std::move(started.value());
+    foxglove::Server* srv = server.get();
+    tap.pass = [srv, &last_time] {
+      srv->new_session();
+      last_time = 0;
+    };
+    tap.message = [srv, &last_time](std::size_t output, std::uint64_t t, std::span<const std::byte> cdr) {
+      if (t > last_time) {
+        srv->time(t);
+        last_time = t;
+      }
+      srv->publish(static_cast<foxglove::ChannelId>(output + 1), t, cdr);
+    };
+  }
   install_stop_handlers();
   if (!a.quiet) {
     const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
@@ -64,7 +96,7 @@ int replay_command(ReplayArgs a) {
   std::uint64_t passes = 0;
   bool complete = true;
   do {
-    auto played = replay.play(stop_requested);
+    auto played = replay.play(stop_requested, server ? &tap : nullptr);
     if (!played) return fail(played.error().message);
     complete = played.value();
     if (complete) ++passes;
@@ -72,10 +104,12 @@ int replay_command(ReplayArgs a) {
   if (complete) {
     if (Status st = replay.finish(); !st) return fail(st.error().message);
   }
+  if (server) (void)server->flush(2.0);  // viewers that keep up get the end of the log
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim replay: %s after %llu complete pass%s, %llu messages published\n",
+    std::fprintf(stderr, "rbsim replay: %s after %llu complete pass%s, %llu messages published%s\n",
                  complete ? "done" : "stopped", static_cast<unsigned long long>(passes),
-                 passes == 1 ? "" : "es", static_cast<unsigned long long>(replay.published()));
+                 passes == 1 ? "" : "es", static_cast<unsigned long long>(replay.published()),
+                 server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;
 }
@@ -115,13 +149,16 @@ Subcommand add_replay_command(CLI::App& parent) {
          "Per-step writers keep the last N samples instead of all (the replay never waits for a slow "
          "subscriber, which may then lose samples)")
       ->check(positive());
-  app->add_flag("-q,--quiet", a->quiet, "Only errors");
+  add_foxglove_option(app, a->foxglove);
+  app->add_flag("-q,--quiet", a->quiet, "Only errors (and --foxglove's listening line)");
   app->footer(
       "Every channel whose schema is an rbsim type (rbsim_msgs/SceneDescription, BodyStates, SpringStates, "
       "EnergyTerms, geometry_msgs/PoseArray, visualization_msgs/MarkerArray, rosgraph_msgs/Clock) is "
       "republished byte for byte with the node's QoS (the scene description transient local), in log-time "
       "order. "
-      "Ctrl-C stops cleanly.\n"
+      "Ctrl-C stops cleanly. --foxglove also serves them to Foxglove with the recording's schemas (log time "
+      "= "
+      "the messages' simulated time; a new session on every --loop pass).\n"
       "Exit status: 0 done or stopped by Ctrl-C/SIGTERM, 1 error (unreadable recording, no rbsim topics, DDS "
       "failure), 2 usage error.");
   return {app, [a] { return replay_command(*a); }};

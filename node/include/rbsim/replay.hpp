@@ -1,9 +1,12 @@
 // rbsim replay: a recording republished over DDS.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,6 +44,9 @@ class Replay {
         recorded;       // channel topic in the log ("/rbsim/body_states"), empty for the synthesized /clock
     std::string topic;  // topic published
     std::uint64_t messages = 0;  // messages of the channel in the log (0 when unknown)
+    std::string type;            // "rbsim_msgs/msg/BodyStates" (the recorded schema's name)
+    std::string schema;          // the recorded ros2msg schema text (this build's for the synthesized /clock)
+    bool latched = false;        // transient local (the scene description)
   };
   const std::vector<Output>& outputs() const { return outputs_; }
   std::uint64_t first_log_time() const { return first_log_time_; }
@@ -49,8 +55,17 @@ class Replay {
   // Waits until `count` subscriptions match the body-state publisher (or, without body states,
   // the first one); false when `stop` turned true.
   bool wait_for_subscribers(std::int32_t count, bool (*stop)());
+  // A second consumer of what is published (rbsim replay --foxglove): `message` gets every message
+  // as it is published, with the index of its output (outputs()) and its simulated time (the
+  // message's own stamp; the log time for messages without one), `pass` is called at the start of
+  // every play(). Called on the thread that plays; must not block.
+  struct Tap {
+    std::function<void()> pass;
+    std::function<void(std::size_t output, std::uint64_t sim_time_ns, std::span<const std::byte> cdr)>
+        message;
+  };
   // Plays the log once from the start offset; Ok(false) when `stop` turned true on the way.
-  Result<bool> play(bool (*stop)());
+  Result<bool> play(bool (*stop)(), const Tap* tap = nullptr);
   // Waits (bounded) until the subscribers acknowledged everything published, so nothing in
   // flight is lost when the replay exits.
   [[nodiscard]] Status finish(double timeout_s = 30.0);

@@ -83,7 +83,6 @@ std::span<const TopicSpec> topics() {
 const TopicSpec& topic(TopicId id) {
   return kTopics[static_cast<std::size_t>(id)];
 }
-
 const TopicSpec* topic_for_type(std::string_view type) {
   const std::string t = canonical_type(type, "");
   for (const TopicSpec& spec : kTopics) {

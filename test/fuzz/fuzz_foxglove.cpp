@@ -1,0 +1,73 @@
+// libFuzzer target: the Foxglove server's client-message handler (ClientProtocol) and the queue
+// its replies go into. The input is a sequence of client frames separated by a 0x00 byte; a frame
+// whose first byte is 0x01 is handed over as a binary frame, any other as a text frame, all to one
+// ClientProtocol, so subscribe/unsubscribe sequences build up state. After every frame the
+// bookkeeping must agree with itself and every reply must be a JSON status; the replies and a
+// message per subscription go through a small ClientQueue, whose limits must hold.
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "rbsim/foxglove.hpp"
+
+namespace fox = rbsim::foxglove;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  constexpr std::uint32_t kChannels = 7;
+  fox::ClientProtocol protocol(kChannels);
+  fox::ClientQueue queue(fox::QueueLimits{8, 4096});
+  fox::ClientProtocol::Outcome out;
+  fox::ClientQueue::Frame frame;
+  const std::string_view input(reinterpret_cast<const char*>(data), size);
+  std::size_t start = 0;
+  std::uint64_t step = 0;
+  // At most 64 frames an input: more only repeats the same paths, slower.
+  for (int frames = 0; frames < 64 && start <= input.size(); ++frames) {
+    std::size_t end = input.find('\0', start);
+    if (end == std::string_view::npos) end = input.size();
+    const std::string_view f = input.substr(start, end - start);
+    if (!f.empty() && f[0] == '\x01') {
+      protocol.handle_binary(f.size(), out);
+    } else {
+      protocol.handle_text(f, out);
+    }
+    // Bookkeeping: the count is the number of channels with a subscription, ids unique.
+    std::size_t count = 0;
+    for (fox::ChannelId ch = 1; ch <= kChannels; ++ch) {
+      const auto sub = protocol.subscription(ch);
+      if (!sub) continue;
+      ++count;
+      for (fox::ChannelId other = ch + 1; other <= kChannels; ++other) {
+        if (protocol.subscription(other) == sub) __builtin_trap();
+      }
+    }
+    if (count != protocol.subscription_count()) __builtin_trap();
+    for (const auto& s : out.subscribed) {
+      if (protocol.subscription(s.channel) != s.id) __builtin_trap();
+    }
+    for (const auto& s : out.unsubscribed) queue.remove_subscription(s.id);
+    if (out.replies.size() > 1) __builtin_trap();  // one status per frame at most
+    for (const std::string& r : out.replies) {
+      const auto j = nlohmann::json::parse(r, nullptr, false);
+      if (j.is_discarded() || j.value("op", "") != "status") __builtin_trap();
+      queue.push_text(r);
+    }
+    for (fox::ChannelId ch = 1; ch <= kChannels; ++ch) {
+      if (const auto sub = protocol.subscription(ch)) {
+        const std::byte payload[64]{};
+        queue.push_message(ch == 1 ? fox::ClientQueue::Kind::Latched : fox::ClientQueue::Kind::PerStep, *sub,
+                           step, payload);
+      }
+    }
+    queue.push_time(step++);
+    if (step % 3 == 0) queue.pop(frame);
+    if (end == input.size()) break;
+    start = end + 1;
+  }
+  while (queue.pop(frame)) {
+  }
+  if (queue.bytes() != 0 || queue.size() != 0) __builtin_trap();
+  return 0;
+}

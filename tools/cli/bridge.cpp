@@ -1,0 +1,111 @@
+// rbsim bridge: the DDS topics of any rbsim node relayed to Foxglove over its WebSocket protocol
+// (what foxglove_bridge does for ROS 2, with no ROS install).
+#include <cstdio>
+#include <memory>
+
+#include "cli_util.hpp"
+#include "commands.hpp"
+#include "rbsim/dds.hpp"
+#include "rbsim/relay.hpp"
+#include "validators.hpp"
+
+namespace rbsim::cli {
+
+namespace {
+struct BridgeArgs {
+  std::optional<std::string> foxglove;  // [ADDR:]PORT (required)
+  std::string ns = "rbsim";
+  std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
+  bool quiet = false;
+};
+
+int fail(const std::string& m) {
+  std::fprintf(stderr, "rbsim bridge: error: %s\n", m.c_str());
+  return 1;
+}
+
+// The simulated time a sample carries (ns): the scene description's stamp, a per-step message's
+// header stamp or clock; nullopt when it has none.
+std::optional<std::uint64_t> sim_time(const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
+  std::optional<msgs::Time> stamp;
+  if (spec.id == msgs::TopicId::Scene) {
+    if (auto scene = msgs::decode_scene(cdr)) stamp = scene.value().stamp;
+  } else {
+    stamp = msgs::decode_stamp(spec.id, cdr);
+  }
+  if (!stamp || stamp->sec < 0) return std::nullopt;
+  return static_cast<std::uint64_t>(stamp->sec) * 1'000'000'000ull + stamp->nanosec;
+}
+
+int bridge_command(const BridgeArgs& a) {
+  auto participant = node::Participant::create(a.domain);
+  if (!participant) return fail(participant.error().message);
+  std::vector<foxglove::ChannelId> ids;
+  msgs::TopicSet all;
+  all.set();  // every topic a node may publish: the viewer chooses what to subscribe to
+  auto channels = foxglove::ros2_channels(all, a.ns, &ids);
+  if (!channels) return fail(channels.error().message);
+  auto relay = node::Relay::create(participant.value(), a.ns);
+  if (!relay) return fail(relay.error().message);
+  auto started = start_foxglove("rbsim bridge", *a.foxglove, std::move(channels.value()));
+  if (!started) return fail(started.error().message);
+  foxglove::Server& server = *started.value();
+  install_stop_handlers();
+  if (!a.quiet) {
+    std::fprintf(stderr, "rbsim bridge: relaying /%s/* and /clock on %s (Ctrl-C stops)\n", a.ns.c_str(),
+                 participant.value().description().c_str());
+  }
+  std::uint64_t last_time = 0, scenes = 0;
+  const node::Relay::OnSample on_sample = [&](const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
+    const std::optional<std::uint64_t> t = sim_time(spec, cdr);
+    if (spec.id == msgs::TopicId::Scene) {
+      // A scene (re)started: a new session, so viewers drop what they showed of the last one.
+      server.new_session();
+      last_time = 0;
+      ++scenes;
+    } else if (t && *t > last_time) {
+      server.time(*t);
+      last_time = *t;
+    }
+    server.publish(ids[static_cast<std::size_t>(spec.id)], t.value_or(last_time), cdr);
+  };
+  while (!stop_requested()) {
+    auto polled = relay.value()->poll(100'000'000, on_sample);
+    if (!polled) return fail(polled.error().message);
+  }
+  if (!a.quiet) {
+    std::fprintf(
+        stderr, "rbsim bridge: stopped after %llu samples (%llu scene descriptions, %llu lost in DDS); %s\n",
+        static_cast<unsigned long long>(relay.value()->received()), static_cast<unsigned long long>(scenes),
+        static_cast<unsigned long long>(relay.value()->lost()), foxglove_summary(server).c_str());
+  }
+  return 0;
+}
+}  // namespace
+
+Subcommand add_bridge_command(CLI::App& parent) {
+  auto a = std::make_shared<BridgeArgs>();
+  CLI::App* app = parent.add_subcommand(
+      "bridge",
+      "Relay the DDS topics of a running rbsim node to Foxglove (its WebSocket protocol; no ROS needed)");
+  add_foxglove_option(app, a->foxglove, true);
+  add_domain_option(app, a->domain);
+  app->add_option("--namespace", a->ns, "ROS namespace of the node's topics")
+      ->check(ros_namespace())
+      ->default_str("rbsim");
+  app->add_flag("-q,--quiet", a->quiet, "No start and end lines (the listening line is always printed)");
+  app->footer(
+      "Subscribes to every rbsim topic under /<namespace> and /clock (the scene description transient local, "
+      "so a "
+      "bridge started after the node still gets it; the per-step topics keep last 256, so a bridge never "
+      "slows the "
+      "node) and serves them as Foxglove channels (encoding cdr, ros2msg schemas, log time = simulated "
+      "time). "
+      "Every scene description that arrives (a node started, or a --loop pass) starts a new session. Ctrl-C "
+      "stops.\n"
+      "Exit status: 0 stopped by Ctrl-C/SIGTERM, 1 error (DDS failure, --foxglove port in use), 2 usage "
+      "error.");
+  return {app, [a] { return bridge_command(*a); }};
+}
+
+}  // namespace rbsim::cli

@@ -1,0 +1,284 @@
+// The Foxglove WebSocket server: rbsim's topics served live to Foxglove (app.foxglove.dev or the
+// desktop app) with no ROS install, the protocol foxglove_bridge speaks
+// (https://github.com/foxglove/ws-protocol, docs/spec.md).
+//
+// Three layers, the first two pure (no I/O, no threads) so that tests and the fuzzer drive them
+// directly:
+//  - the protocol: the JSON a server sends (serverInfo, advertise, status), the binary frames
+//    (messageData, time), the subprotocol choice, and ClientProtocol, which parses one client frame
+//    and keeps that client's subscriptions;
+//  - flow control: ClientQueue, the bounded per-client queue that drops the oldest per-step
+//    message (never a latched one or a control message) when a client falls behind;
+//  - the Server (websocketpp on its own I/O thread) and FoxgloveSink, the Sink that publishes a
+//    run into it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rbsim/core.hpp"
+#include "rbsim/io.hpp"
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::foxglove {
+
+// ---------------------------------------------------------------------------------------------
+// Protocol
+
+// The subprotocols served, in the server's order of preference; a client offering neither is
+// refused in the handshake.
+inline constexpr std::string_view kSubprotocols[] = {"foxglove.sdk.v1", "foxglove.websocket.v1"};
+// The subprotocol to answer a client that offered `offered` (in its order): the first one it
+// offers that we speak (the client's choice); nullopt refuses the connection.
+std::optional<std::string_view> choose_subprotocol(std::span<const std::string> offered);
+
+// Client frames larger than this are refused (a status error from ClientProtocol; the transport
+// closes a connection that sends one, as it would otherwise have to buffer it).
+inline constexpr std::size_t kMaxClientFrame = 1 << 20;
+
+enum class StatusLevel : std::uint8_t { Info = 0, Warning = 1, Error = 2 };
+
+// A channel the server advertises (ids are 1-based positions in the server's channel list).
+struct ChannelSpec {
+  std::string topic;             // "/rbsim/body_states"
+  std::string encoding = "cdr";  // message encoding
+  std::string schema_name;       // "rbsim_msgs/msg/BodyStates"
+  std::string schema;            // the ros2msg text, as in MCAP
+  std::string schema_encoding = "ros2msg";
+  bool latched = false;  // the last message goes to every new subscription at once
+};
+using ChannelId = std::uint32_t;
+using SubscriptionId = std::uint32_t;
+
+std::string server_info_json(std::string_view name, std::string_view session_id);
+// Every channel of `channels`, channel i (0-based) with id i + 1.
+std::string advertise_json(std::span<const ChannelSpec> channels);
+std::string status_json(StatusLevel level, std::string_view message);
+
+// The binary frames a server sends (little endian): messageData is opcode 0x01, the subscription
+// id (uint32), the log time (uint64 ns) and the payload; time is opcode 0x02 and the time (ns).
+inline constexpr std::size_t kMessageDataHeader = 1 + 4 + 8;
+void append_message_data(std::string& out, SubscriptionId subscription, std::uint64_t log_time_ns,
+                         std::span<const std::byte> payload);
+void append_time(std::string& out, std::uint64_t time_ns);
+
+// One client's side of the protocol: parses its frames and keeps its subscriptions. Channels are
+// 1 .. channel_count. Any input is answered, never thrown on: a malformed frame, an unknown op,
+// an unknown channel or subscription id, a binary frame (we do not offer clientPublish) or a frame
+// over kMaxClientFrame gives one status error per frame (naming at most a few of the problems),
+// and the valid parts of a subscribe or unsubscribe still take effect.
+class ClientProtocol {
+ public:
+  explicit ClientProtocol(std::uint32_t channel_count);
+
+  struct Subscription {
+    SubscriptionId id = 0;
+    ChannelId channel = 0;
+    bool operator==(const Subscription&) const = default;
+  };
+  struct Outcome {
+    std::vector<Subscription> subscribed;    // new, in request order
+    std::vector<Subscription> unsubscribed;  // ended, in request order
+    std::vector<std::string> replies;        // JSON text frames to send back (status)
+    void clear() {
+      subscribed.clear();
+      unsubscribed.clear();
+      replies.clear();
+    }
+  };
+  // Handles one text frame (`out` is cleared first).
+  void handle_text(std::string_view frame, Outcome& out);
+  // Handles one binary frame of `size` bytes (`out` is cleared first).
+  void handle_binary(std::size_t size, Outcome& out);
+
+  // The subscription on `channel`, if any.
+  std::optional<SubscriptionId> subscription(ChannelId channel) const;
+  std::size_t subscription_count() const { return count_; }
+  std::uint32_t channel_count() const { return static_cast<std::uint32_t>(by_channel_.size()); }
+
+ private:
+  std::vector<std::optional<SubscriptionId>> by_channel_;  // index channel - 1
+  std::size_t count_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Flow control
+
+struct QueueLimits {
+  std::size_t max_messages = 1024;    // frames queued for one client
+  std::size_t max_bytes = 64u << 20;  // their bytes
+};
+
+// The frames waiting for one client. Control frames (serverInfo, advertise, status) and latched
+// messages are never dropped; when a per-step message (or time) would go over a limit, the oldest
+// queued per-step frames are dropped until it fits (the new one itself when nothing droppable is
+// queued). The first drop of a burst queues one status warning; the burst ends once the queue has
+// drained to half its limits. Buffers are recycled: a queue that is fed and drained at a steady
+// pace does not allocate.
+class ClientQueue {
+ public:
+  enum class Kind : std::uint8_t { Control, Latched, PerStep };
+  struct Frame {
+    Kind kind = Kind::Control;
+    bool binary = false;
+    SubscriptionId subscription = 0;  // messageData only
+    std::string data;                 // the whole WebSocket message
+  };
+
+  explicit ClientQueue(QueueLimits limits = {});
+
+  void push_text(std::string_view json);
+  void push_message(Kind kind, SubscriptionId subscription, std::uint64_t log_time_ns,
+                    std::span<const std::byte> payload);
+  void push_time(std::uint64_t time_ns);  // per step: droppable
+  // Moves the oldest frame into `out` (whose old buffer is kept for reuse); false when empty.
+  bool pop(Frame& out);
+  // The size of the oldest frame (0 when empty).
+  std::size_t front_size() const;
+  // Removes the queued messages of an ended subscription.
+  void remove_subscription(SubscriptionId subscription);
+
+  bool empty() const { return count_ == 0; }
+  std::size_t size() const { return count_; }
+  std::size_t bytes() const { return bytes_; }
+  std::uint64_t dropped() const { return dropped_; }    // per-step frames dropped so far
+  std::uint64_t warnings() const { return warnings_; }  // overflow bursts (one warning each)
+
+ private:
+  Frame& slot(std::size_t i) { return ring_[(head_ + i) % ring_.size()]; }
+  const Frame& slot(std::size_t i) const { return ring_[(head_ + i) % ring_.size()]; }
+  Frame& emplace(Kind kind);  // a new last frame with an empty recycled buffer
+  void make_room(std::size_t incoming_bytes, bool droppable, bool& drop_incoming);
+  void erase_at(std::size_t i);
+  void recycle(std::string&& buffer);
+  std::string take_buffer();
+
+  QueueLimits limits_;
+  std::vector<Frame> ring_;
+  std::size_t head_ = 0, count_ = 0, bytes_ = 0;
+  std::vector<std::string> pool_;  // spare buffers
+  std::uint64_t dropped_ = 0, warnings_ = 0;
+  bool in_burst_ = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The server
+
+struct ServerOptions {
+  std::string address = "127.0.0.1";  // an IPv4 or IPv6 address; 0.0.0.0 serves every interface
+  std::uint16_t port = 8765;          // 0: any free port (Server::port() says which)
+  std::string name = "rbsim";         // serverInfo name
+  QueueLimits queue;
+  // What is handed to the socket layer per client at most (the rest waits in its queue, where
+  // the drop rule applies); one frame always goes when nothing is in flight.
+  std::size_t max_in_flight_bytes = 4u << 20;
+  // A client that reads nothing of what is in flight for this long is disconnected.
+  double stall_timeout_s = 5.0;
+};
+
+// "127.0.0.1:8765", "8765" (the default address), "0.0.0.0:0", "[::1]:8765" -> options.address
+// and options.port; the error says what is wrong.
+[[nodiscard]] Status parse_listen_address(std::string_view text, ServerOptions& options);
+// "ws://127.0.0.1:8765" ("ws://[::1]:8765" for IPv6).
+std::string websocket_url(std::string_view address, std::uint16_t port);
+// The link that opens Foxglove on `url`: https://app.foxglove.dev/?ds=foxglove-websocket&ds.url=...
+std::string foxglove_app_link(std::string_view url);
+
+// Counts over the server's life.
+struct ServerStats {
+  std::uint64_t clients = 0;       // connections accepted
+  std::uint64_t refused = 0;       // handshakes refused (no foxglove subprotocol)
+  std::uint64_t dropped = 0;       // per-step frames dropped for slow clients
+  std::uint64_t warnings = 0;      // overflow bursts warned about
+  std::uint64_t disconnected = 0;  // clients disconnected for not reading
+  std::uint64_t published = 0;     // messages handed to the server (publish calls that queued)
+};
+
+// Serves a fixed set of channels on its own I/O thread. publish(), time() and new_session() are
+// called from one producer thread (the simulation, a replay, a DDS relay); they only copy into
+// the subscribed clients' queues, so a slow or stalled client never slows the producer or the
+// other clients.
+class Server {
+ public:
+  // Listens and starts the I/O thread. Errors: a bad address, a port in use.
+  static Result<std::unique_ptr<Server>> start(const ServerOptions& options,
+                                               std::vector<ChannelSpec> channels);
+  ~Server();  // stop()
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  std::uint16_t port() const;  // the port listened on (the chosen one for port 0)
+  const std::vector<ChannelSpec>& channels() const;
+  // A new session (a scene start, a --loop pass, a new scene in a relay): every client gets a
+  // serverInfo with a new sessionId (Foxglove then clears what it has shown), and the latched
+  // messages of the old session are forgotten.
+  void new_session();
+  // True when some client subscribes to `channel` (cheap: lets a producer skip encoding).
+  bool subscribed(ChannelId channel) const;
+  // Queues a message for the subscribers of `channel` (1-based); a latched channel also keeps it
+  // for later subscriptions.
+  void publish(ChannelId channel, std::uint64_t log_time_ns, std::span<const std::byte> payload);
+  // Queues a time message for every client.
+  void time(std::uint64_t time_ns);
+  std::size_t client_count() const;
+  ServerStats stats() const;
+  // Waits until every client has been handed everything queued for it and the socket layer has
+  // written it (or `timeout_s` passed, or the clients are gone): the end of a run reaches viewers
+  // that keep up before the server closes. True when everything went out.
+  bool flush(double timeout_s);
+  // Closes every connection and joins the I/O thread (idempotent).
+  void stop();
+
+  struct Impl;
+
+ private:
+  Server() = default;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The channels of `topics` (msgs::topics() order) under namespace `ns`: encoding cdr, schema the
+// ros2msg text rosbag2 writes, latched = transient local. `ids[topic id]` receives the channel id
+// (0 for a topic not selected).
+Result<std::vector<ChannelSpec>> ros2_channels(const msgs::TopicSet& topics, std::string_view ns,
+                                               std::vector<ChannelId>* ids = nullptr);
+
+// ---------------------------------------------------------------------------------------------
+// The sink
+
+struct SinkOptions {
+  msgs::TopicSet topics = msgs::default_topics();
+  std::string ns = "rbsim";        // the namespace of the frames in /tf and the markers
+  std::int64_t publish_every = 1;  // every k-th step (as DdsSink)
+  // Real-time factor to pace at; 0 leaves pacing to another sink (rbsim node's DdsSink paces, and
+  // the driver calls the sinks one after the other, so the pace happens once).
+  double rate = 0.0;
+};
+
+// Publishes a run into a Server started with ros2_channels(options.topics, ns): at begin() a new
+// session and every selected latched topic; at each published step the time and every selected
+// per-step topic that has a subscriber (nothing is encoded for a channel nobody watches).
+class FoxgloveSink final : public Sink {
+ public:
+  FoxgloveSink(Server& server, std::vector<ChannelId> ids, const SinkOptions& options);
+  Status begin(const Scene& scene, const World& world) override;
+  Status write(const World& world) override;
+  // Flushes the server (bounded, 2 s): viewers that keep up get the last steps.
+  Status finish() override;
+
+ private:
+  void publish(const msgs::TopicSpec& spec, const World& world);
+  Server* server_;
+  std::vector<ChannelId> ids_;  // by TopicId
+  SinkOptions options_;
+  std::unique_ptr<msgs::Encoder> encoder_;
+  msgs::Bytes buffer_;
+  std::int64_t start_ns_ = 0, start_step_ = 0;
+};
+
+}  // namespace rbsim::foxglove

@@ -1,0 +1,421 @@
+// The Foxglove WebSocket protocol without I/O: what the server says, and one client's frames
+// parsed into subscriptions or a status error.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstring>
+
+#include "rbsim/foxglove.hpp"
+
+namespace rbsim::foxglove {
+
+std::optional<std::string_view> choose_subprotocol(std::span<const std::string> offered) {
+  for (const std::string& o : offered) {
+    for (std::string_view ours : kSubprotocols) {
+      if (o == ours) return ours;
+    }
+  }
+  return std::nullopt;
+}
+
+std::string server_info_json(std::string_view name, std::string_view session_id) {
+  nlohmann::json j = {{"op", "serverInfo"},
+                      {"name", std::string(name)},
+                      {"capabilities", nlohmann::json::array({"time"})},
+                      {"metadata", nlohmann::json::object()},
+                      {"sessionId", std::string(session_id)}};
+  return j.dump();
+}
+
+std::string advertise_json(std::span<const ChannelSpec> channels) {
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    const ChannelSpec& c = channels[i];
+    list.push_back({{"id", i + 1},
+                    {"topic", c.topic},
+                    {"encoding", c.encoding},
+                    {"schemaName", c.schema_name},
+                    {"schema", c.schema},
+                    {"schemaEncoding", c.schema_encoding}});
+  }
+  return nlohmann::json{{"op", "advertise"}, {"channels", std::move(list)}}.dump();
+}
+
+std::string status_json(StatusLevel level, std::string_view message) {
+  // Invalid UTF-8 (a client's bytes quoted back) is replaced, not thrown on.
+  return nlohmann::json{
+      {"op", "status"}, {"level", static_cast<int>(level)}, {"message", std::string(message)}}
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+namespace {
+void append_le(std::string& out, std::uint64_t v, int bytes) {
+  for (int i = 0; i < bytes; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+}
+}  // namespace
+
+void append_message_data(std::string& out, SubscriptionId subscription, std::uint64_t log_time_ns,
+                         std::span<const std::byte> payload) {
+  out.push_back('\x01');
+  append_le(out, subscription, 4);
+  append_le(out, log_time_ns, 8);
+  const std::size_t at = out.size();
+  out.resize(at + payload.size());
+  if (!payload.empty()) std::memcpy(out.data() + at, payload.data(), payload.size());
+}
+
+void append_time(std::string& out, std::uint64_t time_ns) {
+  out.push_back('\x02');
+  append_le(out, time_ns, 8);
+}
+
+// ---------------------------------------------------------------------------------------------
+// ClientProtocol
+
+namespace {
+// nlohmann's parser keeps its own stack, but a deeply nested value is still walked recursively
+// elsewhere (dump, compare): no client message of this protocol nests deeper than 3.
+constexpr int kMaxDepth = 16;
+bool too_deep(std::string_view text) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (char c : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxDepth) return true;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return false;
+}
+
+// A protocol id: a JSON integer in [0, 2^32). (An out parameter: GCC 12 misreports an
+// std::optional<uint32_t> here as maybe uninitialized under -O2.)
+bool as_id(const nlohmann::json& j, std::uint32_t& out) {
+  if (j.is_number_unsigned()) {
+    const auto v = j.get<std::uint64_t>();
+    if (v > UINT32_MAX) return false;
+    out = static_cast<std::uint32_t>(v);
+    return true;
+  }
+  if (j.is_number_integer()) {
+    const auto v = j.get<std::int64_t>();
+    if (v < 0 || v > UINT32_MAX) return false;
+    out = static_cast<std::uint32_t>(v);
+    return true;
+  }
+  return false;
+}
+bool member_id(const nlohmann::json& object, const char* key, std::uint32_t& out) {
+  const auto it = object.find(key);
+  return it != object.end() && as_id(*it, out);
+}
+
+std::string shown(const nlohmann::json& j) {
+  std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  return s;
+}
+
+// Collects the problems of one frame into one status error, naming the first few.
+struct Problems {
+  std::vector<std::string> list;
+  std::size_t count = 0;
+  void add(std::string p) {
+    if (list.size() < 5) list.push_back(std::move(p));
+    ++count;
+  }
+  void flush(std::vector<std::string>& replies) const {
+    if (count == 0) return;
+    std::string m;
+    for (const std::string& p : list) m += (m.empty() ? "" : "; ") + p;
+    if (count > list.size()) m += "; and " + std::to_string(count - list.size()) + " more";
+    replies.push_back(status_json(StatusLevel::Error, m));
+  }
+};
+
+// The ops of the protocol this server does not offer (its serverInfo advertises only `time`).
+constexpr std::string_view kUnofferedOps[] = {"advertise",
+                                              "unadvertise",
+                                              "getParameters",
+                                              "setParameters",
+                                              "subscribeParameterUpdates",
+                                              "unsubscribeParameterUpdates",
+                                              "subscribeConnectionGraph",
+                                              "unsubscribeConnectionGraph",
+                                              "fetchAsset",
+                                              "advertiseServices"};
+}  // namespace
+
+ClientProtocol::ClientProtocol(std::uint32_t channel_count) : by_channel_(channel_count) {}
+
+std::optional<SubscriptionId> ClientProtocol::subscription(ChannelId channel) const {
+  if (channel == 0 || channel > by_channel_.size()) return std::nullopt;
+  return by_channel_[channel - 1];
+}
+
+void ClientProtocol::handle_binary(std::size_t size, Outcome& out) {
+  out.clear();
+  out.replies.push_back(
+      status_json(StatusLevel::Error,
+                  "binary message of " + std::to_string(size) +
+                      " bytes refused: this server does not accept client publishing or service calls"));
+}
+
+void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
+  out.clear();
+  auto error = [&](const std::string& m) { out.replies.push_back(status_json(StatusLevel::Error, m)); };
+  if (frame.size() > kMaxClientFrame) {
+    error("message of " + std::to_string(frame.size()) + " bytes refused: the limit is " +
+          std::to_string(kMaxClientFrame));
+    return;
+  }
+  if (too_deep(frame)) {
+    error("malformed message: JSON nested deeper than " + std::to_string(kMaxDepth));
+    return;
+  }
+  const nlohmann::json j = nlohmann::json::parse(frame.begin(), frame.end(), nullptr, false);
+  if (j.is_discarded()) {
+    error("malformed message: not valid JSON");
+    return;
+  }
+  if (!j.is_object()) {
+    error("malformed message: not a JSON object");
+    return;
+  }
+  const auto op_it = j.find("op");
+  if (op_it == j.end() || !op_it->is_string()) {
+    error("malformed message: no \"op\" string");
+    return;
+  }
+  const auto& op = op_it->get_ref<const std::string&>();
+  Problems problems;
+  if (op == "subscribe") {
+    const auto subs = j.find("subscriptions");
+    if (subs == j.end() || !subs->is_array()) {
+      error("subscribe: \"subscriptions\" must be an array");
+      return;
+    }
+    for (const nlohmann::json& s : *subs) {
+      if (!s.is_object()) {
+        problems.add("subscribe: entry " + shown(s) + " is not an object");
+        continue;
+      }
+      std::uint32_t id = 0, ch = 0;
+      if (!member_id(s, "id", id) || !member_id(s, "channelId", ch)) {
+        problems.add("subscribe: entry " + shown(s) + " needs integer \"id\" and \"channelId\" in [0, 2^32)");
+        continue;
+      }
+      if (ch == 0 || ch > by_channel_.size()) {
+        problems.add("subscribe: unknown channel " + std::to_string(ch));
+        continue;
+      }
+      if (by_channel_[ch - 1]) {
+        problems.add("subscribe: already subscribed to channel " + std::to_string(ch) + " (subscription " +
+                     std::to_string(*by_channel_[ch - 1]) + ")");
+        continue;
+      }
+      if (std::find(by_channel_.begin(), by_channel_.end(), std::optional<SubscriptionId>(id)) !=
+          by_channel_.end()) {
+        problems.add("subscribe: subscription id " + std::to_string(id) + " is already in use");
+        continue;
+      }
+      by_channel_[ch - 1] = id;
+      ++count_;
+      out.subscribed.push_back({id, ch});
+    }
+  } else if (op == "unsubscribe") {
+    const auto ids = j.find("subscriptionIds");
+    if (ids == j.end() || !ids->is_array()) {
+      error("unsubscribe: \"subscriptionIds\" must be an array");
+      return;
+    }
+    for (const nlohmann::json& v : *ids) {
+      std::uint32_t id = 0;
+      if (!as_id(v, id)) {
+        problems.add("unsubscribe: " + shown(v) + " is not a subscription id");
+        continue;
+      }
+      const auto it = std::find(by_channel_.begin(), by_channel_.end(), std::optional<SubscriptionId>(id));
+      if (it == by_channel_.end()) {
+        problems.add("unsubscribe: unknown subscription " + std::to_string(id));
+        continue;
+      }
+      it->reset();
+      --count_;
+      out.unsubscribed.push_back({id, static_cast<ChannelId>(it - by_channel_.begin() + 1)});
+    }
+  } else if (std::find(std::begin(kUnofferedOps), std::end(kUnofferedOps), op) != std::end(kUnofferedOps)) {
+    error("op \"" + shown(*op_it) + "\" is not supported by this server (capabilities: time)");
+    return;
+  } else {
+    error("unknown op " + shown(*op_it));
+    return;
+  }
+  problems.flush(out.replies);
+}
+
+// ---------------------------------------------------------------------------------------------
+// ClientQueue
+
+namespace {
+constexpr std::size_t kPoolMax = 16;  // spare buffers kept
+}
+
+ClientQueue::ClientQueue(QueueLimits limits) : limits_(limits) {
+  limits_.max_messages = std::max<std::size_t>(limits_.max_messages, 1);
+  ring_.resize(std::min<std::size_t>(limits_.max_messages, 64) + 8);
+}
+
+std::string ClientQueue::take_buffer() {
+  if (pool_.empty()) return {};
+  std::string b = std::move(pool_.back());
+  pool_.pop_back();
+  b.clear();
+  return b;
+}
+
+void ClientQueue::recycle(std::string&& buffer) {
+  if (buffer.capacity() == 0 || pool_.size() >= kPoolMax) return;
+  pool_.push_back(std::move(buffer));
+}
+
+void ClientQueue::erase_at(std::size_t i) {
+  Frame& f = slot(i);
+  bytes_ -= f.data.size();
+  recycle(std::move(f.data));
+  f.data = std::string();
+  // Shift the older frames up by one: drops happen near the front, so this is short.
+  for (std::size_t k = i; k > 0; --k) std::swap(slot(k), slot(k - 1));
+  head_ = (head_ + 1) % ring_.size();
+  --count_;
+}
+
+void ClientQueue::make_room(std::size_t incoming, bool droppable, bool& drop_incoming) {
+  drop_incoming = false;
+  auto over = [&] { return count_ + 1 > limits_.max_messages || bytes_ + incoming > limits_.max_bytes; };
+  if (!over()) return;
+  std::size_t first_droppable = 0;
+  while (first_droppable < count_ && slot(first_droppable).kind != Kind::PerStep) ++first_droppable;
+  // Control and latched frames alone over the limit: they are kept, the queue grows.
+  if (first_droppable == count_ && !droppable) return;
+  if (!in_burst_) {
+    // The first drop of a burst tells the client, once; the warning counts against the limit.
+    in_burst_ = true;
+    ++warnings_;
+    const std::string m = status_json(
+        StatusLevel::Warning,
+        "rbsim: this client is not keeping up: dropping the oldest per-step messages (queue limit " +
+            std::to_string(limits_.max_messages) + " messages, " + std::to_string(limits_.max_bytes >> 20) +
+            " MiB); latched topics are kept");
+    Frame& f = emplace(Kind::Control);
+    f.data.assign(m);
+    bytes_ += f.data.size();
+  }
+  std::size_t i = first_droppable;
+  while (over()) {
+    while (i < count_ && slot(i).kind != Kind::PerStep) ++i;
+    if (i == count_) break;
+    erase_at(i);  // index i now holds the next newer frame
+    ++dropped_;
+  }
+  if (over() && droppable) {
+    drop_incoming = true;  // nothing droppable is left: the newest goes
+    ++dropped_;
+  }
+}
+
+ClientQueue::Frame& ClientQueue::emplace(Kind kind) {
+  if (count_ == ring_.size()) {
+    // Grow (only control and latched frames can outnumber the limit): unroll the ring first.
+    std::vector<Frame> bigger(ring_.size() * 2);
+    for (std::size_t i = 0; i < count_; ++i) bigger[i] = std::move(slot(i));
+    ring_ = std::move(bigger);
+    head_ = 0;
+  }
+  Frame& f = ring_[(head_ + count_) % ring_.size()];
+  ++count_;
+  f.kind = kind;
+  f.binary = false;
+  f.subscription = 0;
+  f.data = take_buffer();
+  return f;
+}
+
+void ClientQueue::push_text(std::string_view json) {
+  bool drop = false;
+  make_room(json.size(), false, drop);
+  Frame& f = emplace(Kind::Control);
+  f.data.assign(json);
+  bytes_ += f.data.size();
+}
+
+void ClientQueue::push_message(Kind kind, SubscriptionId subscription, std::uint64_t log_time_ns,
+                               std::span<const std::byte> payload) {
+  const bool droppable = kind == Kind::PerStep;
+  bool drop = false;
+  make_room(kMessageDataHeader + payload.size(), droppable, drop);
+  if (drop) return;
+  Frame& f = emplace(droppable ? Kind::PerStep : Kind::Latched);
+  f.binary = true;
+  f.subscription = subscription;
+  append_message_data(f.data, subscription, log_time_ns, payload);
+  bytes_ += f.data.size();
+}
+
+void ClientQueue::push_time(std::uint64_t time_ns) {
+  bool drop = false;
+  make_room(9, true, drop);
+  if (drop) return;
+  Frame& f = emplace(Kind::PerStep);
+  f.binary = true;
+  append_time(f.data, time_ns);
+  bytes_ += f.data.size();
+}
+
+bool ClientQueue::pop(Frame& out) {
+  if (count_ == 0) return false;
+  Frame& f = slot(0);
+  bytes_ -= f.data.size();
+  recycle(std::move(out.data));
+  out.kind = f.kind;
+  out.binary = f.binary;
+  out.subscription = f.subscription;
+  out.data = std::move(f.data);
+  f.data = std::string();
+  head_ = (head_ + 1) % ring_.size();
+  --count_;
+  if (in_burst_ && count_ <= limits_.max_messages / 2 && bytes_ <= limits_.max_bytes / 2) in_burst_ = false;
+  return true;
+}
+
+std::size_t ClientQueue::front_size() const {
+  return count_ == 0 ? 0 : slot(0).data.size();
+}
+
+void ClientQueue::remove_subscription(SubscriptionId subscription) {
+  std::size_t i = 0;
+  while (i < count_) {
+    const Frame& f = slot(i);
+    if (f.kind != Kind::Control && f.binary && f.subscription == subscription && !f.data.empty() &&
+        f.data[0] == '\x01') {
+      erase_at(i);  // index i now holds the next newer frame
+      continue;
+    }
+    ++i;
+  }
+}
+
+}  // namespace rbsim::foxglove

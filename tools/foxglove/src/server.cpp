@@ -1,0 +1,350 @@
+// The Foxglove server: clients, their queues and the pump that feeds the transport.
+//
+// Threads: the producer (simulation, replay or DDS relay) calls publish()/time()/new_session(),
+// which copy into client queues under `mu` and wake the I/O thread; everything else (handshake,
+// client frames, sending, stall detection) runs on the I/O thread. The producer never waits on a
+// socket: the worst it waits for is `mu` while the I/O thread moves frames to websocketpp.
+#include <arpa/inet.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "rbsim/foxglove.hpp"
+#include "transport.hpp"
+
+namespace rbsim::foxglove {
+
+namespace {
+std::int64_t monotonic_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+constexpr int kTickMs = 10;  // the pump also runs this often: the stall check, websocketpp's drain
+}  // namespace
+
+struct Client {
+  detail::ConnectionId connection = 0;
+  ClientProtocol protocol;
+  ClientQueue queue;
+  std::size_t in_flight = 0;          // websocketpp's buffered amount after the last pump
+  std::int64_t last_progress_ns = 0;  // when the client last read something (or had nothing to read)
+  bool dropping = false;              // disconnected for not reading; waiting for the close
+  Client(detail::ConnectionId id, std::uint32_t channels, const QueueLimits& limits)
+      : connection(id), protocol(channels), queue(limits) {}
+};
+
+struct Server::Impl {
+  ServerOptions options;
+  std::vector<ChannelSpec> channels;
+  std::unique_ptr<detail::Transport> transport;
+  std::string advertise;  // the same for every client
+
+  mutable std::mutex mu;  // guards everything below
+  std::vector<std::unique_ptr<Client>> clients;
+  std::string server_info;
+  std::uint64_t sessions = 0;
+  struct Latched {
+    bool has = false;
+    std::uint64_t log_time = 0;
+    std::vector<std::byte> payload;
+  };
+  std::vector<Latched> latched;  // by channel - 1
+  ServerStats totals;            // of closed clients, plus the counters kept here
+  std::atomic<std::size_t> client_count{0};
+  std::unique_ptr<std::atomic<std::uint32_t>[]> subscribers;  // by channel - 1
+
+  // I/O thread scratch, reused.
+  ClientQueue::Frame frame;
+  ClientProtocol::Outcome outcome;
+
+  Client* find(detail::ConnectionId id) {
+    for (auto& c : clients) {
+      if (c->connection == id) return c.get();
+    }
+    return nullptr;
+  }
+
+  void new_session_locked() {
+    ++sessions;
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count();
+    server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions));
+    for (Latched& l : latched) l.has = false;
+  }
+
+  void opened(detail::ConnectionId id) {
+    std::lock_guard lock(mu);
+    auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()), options.queue);
+    c->queue.push_text(server_info);
+    c->queue.push_text(advertise);
+    c->last_progress_ns = monotonic_ns();
+    ++totals.clients;
+    pump(*c, c->last_progress_ns);
+    clients.push_back(std::move(c));
+    client_count = clients.size();
+  }
+
+  void closed(detail::ConnectionId id) {
+    std::lock_guard lock(mu);
+    for (auto it = clients.begin(); it != clients.end(); ++it) {
+      Client& c = **it;
+      if (c.connection != id) continue;
+      for (ChannelId ch = 1; ch <= channels.size(); ++ch) {
+        if (c.protocol.subscription(ch)) --subscribers[ch - 1];
+      }
+      totals.dropped += c.queue.dropped();
+      totals.warnings += c.queue.warnings();
+      clients.erase(it);
+      break;
+    }
+    client_count = clients.size();
+  }
+
+  void message(detail::ConnectionId id, const std::string& payload, bool binary) {
+    std::lock_guard lock(mu);
+    Client* c = find(id);
+    if (c == nullptr) return;
+    if (binary) {
+      c->protocol.handle_binary(payload.size(), outcome);
+    } else {
+      c->protocol.handle_text(payload, outcome);
+    }
+    for (const auto& s : outcome.unsubscribed) {
+      --subscribers[s.channel - 1];
+      c->queue.remove_subscription(s.id);
+    }
+    for (const auto& s : outcome.subscribed) {
+      ++subscribers[s.channel - 1];
+      const Latched& l = latched[s.channel - 1];
+      if (l.has) c->queue.push_message(ClientQueue::Kind::Latched, s.id, l.log_time, l.payload);
+    }
+    for (const std::string& r : outcome.replies) c->queue.push_text(r);
+    pump(*c, monotonic_ns());
+  }
+
+  // Hands queued frames to websocketpp while less than max_in_flight_bytes is buffered there,
+  // and disconnects a client that has read nothing for stall_timeout_s.
+  void pump(Client& c, std::int64_t now) {
+    if (c.dropping) return;
+    std::size_t buffered = transport->buffered(c.connection);
+    if (buffered == 0 || buffered < c.in_flight) c.last_progress_ns = now;
+    while (!c.queue.empty()) {
+      const std::size_t next = c.queue.front_size();
+      if (buffered > 0 && buffered + next > options.max_in_flight_bytes) break;
+      c.queue.pop(frame);
+      if (!transport->send(c.connection, frame.data, frame.binary)) break;
+      buffered = transport->buffered(c.connection);
+    }
+    c.in_flight = buffered;
+    const bool waiting = buffered > 0 || !c.queue.empty();
+    if (waiting && static_cast<double>(now - c.last_progress_ns) > options.stall_timeout_s * 1e9) {
+      c.dropping = true;
+      ++totals.disconnected;
+      transport->drop(c.connection);
+    }
+  }
+
+  void pump_all() {
+    std::lock_guard lock(mu);
+    const std::int64_t now = monotonic_ns();
+    for (auto& c : clients) pump(*c, now);
+  }
+};
+
+Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
+                                              std::vector<ChannelSpec> channels) {
+  std::unique_ptr<Server> s(new Server());
+  s->impl_ = std::make_unique<Impl>();
+  Impl& im = *s->impl_;
+  im.options = options;
+  im.channels = std::move(channels);
+  im.advertise = advertise_json(im.channels);
+  im.latched.resize(im.channels.size());
+  im.subscribers = std::make_unique<std::atomic<std::uint32_t>[]>(im.channels.size());
+  for (std::size_t i = 0; i < im.channels.size(); ++i) im.subscribers[i] = 0;
+  im.new_session_locked();
+  im.transport = detail::Transport::create();
+  detail::TransportHandlers h;
+  h.choose_subprotocol = [](const std::vector<std::string>& offered) {
+    const auto chosen = choose_subprotocol(offered);
+    return chosen ? std::string(*chosen) : std::string();
+  };
+  Impl* p = &im;
+  h.on_open = [p](detail::ConnectionId id) { p->opened(id); };
+  h.on_close = [p](detail::ConnectionId id) { p->closed(id); };
+  h.on_message = [p](detail::ConnectionId id, const std::string& payload, bool binary) {
+    p->message(id, payload, binary);
+  };
+  h.on_pump = [p] { p->pump_all(); };
+  h.on_refused = [p] {
+    std::lock_guard lock(p->mu);
+    ++p->totals.refused;
+  };
+  const std::string err =
+      im.transport->listen(options.address, options.port, kMaxClientFrame, kTickMs, std::move(h));
+  if (!err.empty()) {
+    return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
+  }
+  im.transport->run();
+  return s;
+}
+
+Server::~Server() {
+  stop();
+}
+
+void Server::stop() {
+  if (impl_ && impl_->transport) impl_->transport->stop();
+}
+
+std::uint16_t Server::port() const {
+  return impl_->transport->port();
+}
+
+const std::vector<ChannelSpec>& Server::channels() const {
+  return impl_->channels;
+}
+
+void Server::new_session() {
+  Impl& im = *impl_;
+  {
+    std::lock_guard lock(im.mu);
+    im.new_session_locked();
+    for (auto& c : im.clients) c->queue.push_text(im.server_info);
+  }
+  im.transport->wake();
+}
+
+bool Server::subscribed(ChannelId channel) const {
+  if (channel == 0 || channel > impl_->channels.size()) return false;
+  return impl_->subscribers[channel - 1].load(std::memory_order_relaxed) > 0;
+}
+
+void Server::publish(ChannelId channel, std::uint64_t log_time_ns, std::span<const std::byte> payload) {
+  Impl& im = *impl_;
+  if (channel == 0 || channel > im.channels.size()) return;
+  const bool latched = im.channels[channel - 1].latched;
+  if (!latched && !subscribed(channel)) return;
+  bool queued = false;
+  {
+    std::lock_guard lock(im.mu);
+    if (latched) {
+      Impl::Latched& l = im.latched[channel - 1];
+      l.has = true;
+      l.log_time = log_time_ns;
+      l.payload.assign(payload.begin(), payload.end());  // reuses its capacity
+    }
+    for (auto& c : im.clients) {
+      if (const auto sub = c->protocol.subscription(channel)) {
+        c->queue.push_message(latched ? ClientQueue::Kind::Latched : ClientQueue::Kind::PerStep, *sub,
+                              log_time_ns, payload);
+        queued = true;
+      }
+    }
+    if (queued) ++im.totals.published;
+  }
+  if (queued) im.transport->wake();
+}
+
+void Server::time(std::uint64_t time_ns) {
+  Impl& im = *impl_;
+  if (im.client_count.load(std::memory_order_relaxed) == 0) return;
+  {
+    std::lock_guard lock(im.mu);
+    for (auto& c : im.clients) c->queue.push_time(time_ns);
+  }
+  im.transport->wake();
+}
+
+std::size_t Server::client_count() const {
+  return impl_->client_count.load();
+}
+
+bool Server::flush(double timeout_s) {
+  Impl& im = *impl_;
+  const std::int64_t deadline = monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  while (true) {
+    bool pending = false;
+    {
+      std::lock_guard lock(im.mu);
+      for (const auto& c : im.clients)
+        pending = pending || (!c->dropping && (!c->queue.empty() || c->in_flight > 0));
+    }
+    if (!pending) return true;
+    if (monotonic_ns() >= deadline) return false;
+    im.transport->wake();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+ServerStats Server::stats() const {
+  std::lock_guard lock(impl_->mu);
+  ServerStats s = impl_->totals;
+  for (const auto& c : impl_->clients) {
+    s.dropped += c->queue.dropped();
+    s.warnings += c->queue.warnings();
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Addresses and links
+
+Status parse_listen_address(std::string_view text, ServerOptions& options) {
+  std::string address = "127.0.0.1";
+  std::string_view port_text = text;
+  if (!text.empty() && text.front() == '[') {
+    const auto close = text.find("]:");
+    if (close == std::string_view::npos) return Error{"\"" + std::string(text) + "\": expected [IPv6]:PORT"};
+    address = std::string(text.substr(1, close - 1));
+    port_text = text.substr(close + 2);
+    in6_addr a6{};
+    if (inet_pton(AF_INET6, address.c_str(), &a6) != 1)
+      return Error{"\"" + address + "\" is not an IPv6 address"};
+  } else if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
+    address = std::string(text.substr(0, colon));
+    port_text = text.substr(colon + 1);
+    if (address == "localhost") address = "127.0.0.1";
+    in_addr a4{};
+    if (inet_pton(AF_INET, address.c_str(), &a4) != 1)
+      return Error{"\"" + address + "\" is not an IPv4 address (use 127.0.0.1, 0.0.0.0 or [IPv6])"};
+  }
+  if (port_text.empty() || port_text.size() > 5 ||
+      port_text.find_first_not_of("0123456789") != std::string_view::npos) {
+    return Error{"\"" + std::string(text) + "\": expected [ADDR:]PORT with PORT in 0..65535"};
+  }
+  const unsigned long port = std::stoul(std::string(port_text));
+  if (port > 65535) return Error{"port " + std::string(port_text) + " is out of range (0..65535)"};
+  options.address = address;
+  options.port = static_cast<std::uint16_t>(port);
+  return Ok{};
+}
+
+std::string websocket_url(std::string_view address, std::uint16_t port) {
+  const bool v6 = address.find(':') != std::string_view::npos;
+  return "ws://" + (v6 ? "[" + std::string(address) + "]" : std::string(address)) + ":" +
+         std::to_string(port);
+}
+
+std::string foxglove_app_link(std::string_view url) {
+  std::string encoded;
+  for (const char ch : url) {
+    const auto c = static_cast<unsigned char>(ch);
+    if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
+        c == '.' || c == '~') {
+      encoded.push_back(ch);
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", c);
+      encoded += hex;
+    }
+  }
+  return "https://app.foxglove.dev/?ds=foxglove-websocket&ds.url=" + encoded;
+}
+
+}  // namespace rbsim::foxglove

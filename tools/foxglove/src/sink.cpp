@@ -1,0 +1,86 @@
+// A run published into the Foxglove server: the channels of rbsim's topics and the sink.
+#include <time.h>
+
+#include <cmath>
+
+#include "rbsim/foxglove.hpp"
+
+namespace rbsim::foxglove {
+
+Result<std::vector<ChannelSpec>> ros2_channels(const msgs::TopicSet& topics, std::string_view ns,
+                                               std::vector<ChannelId>* ids) {
+  std::vector<ChannelSpec> channels;
+  if (ids != nullptr) ids->assign(msgs::kTopicCount, 0);
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (!topics.test(static_cast<std::size_t>(spec.id))) continue;
+    auto schema = msgs::ros2msg_schema(spec.type);
+    if (!schema) return schema.error();
+    ChannelSpec c;
+    c.topic = msgs::topic_name(spec, ns);
+    c.schema_name = std::string(spec.type);
+    c.schema = std::move(schema.value());
+    c.latched = spec.transient_local;
+    channels.push_back(std::move(c));
+    if (ids != nullptr) (*ids)[static_cast<std::size_t>(spec.id)] = static_cast<ChannelId>(channels.size());
+  }
+  return channels;
+}
+
+namespace {
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+void sleep_until(std::int64_t deadline_ns) {
+  const timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000),
+                    static_cast<long>(deadline_ns % 1'000'000'000)};
+  (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+}
+}  // namespace
+
+FoxgloveSink::FoxgloveSink(Server& server, std::vector<ChannelId> ids, const SinkOptions& options)
+    : server_(&server), ids_(std::move(ids)), options_(options) {
+  ids_.resize(msgs::kTopicCount, 0);
+  if (options_.publish_every < 1) options_.publish_every = 1;
+}
+
+void FoxgloveSink::publish(const msgs::TopicSpec& spec, const World& world) {
+  const ChannelId ch = ids_[static_cast<std::size_t>(spec.id)];
+  if (ch == 0 || !options_.topics.test(static_cast<std::size_t>(spec.id))) return;
+  // Nothing is encoded for a channel nobody watches; a latched one is kept for later subscribers.
+  if (!spec.transient_local && !server_->subscribed(ch)) return;
+  encoder_->encode(spec.id, world, buffer_);
+  server_->publish(ch, msgs::sim_time_ns(world), buffer_);
+}
+
+Status FoxgloveSink::begin(const Scene& scene, const World& world) {
+  encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
+  start_ns_ = monotonic_ns();
+  start_step_ = world.step_index();
+  server_->new_session();
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (spec.transient_local) publish(spec, world);
+  }
+  return write(world);
+}
+
+Status FoxgloveSink::write(const World& world) {
+  if (world.step_index() % options_.publish_every != 0) return Ok{};
+  if (options_.rate > 0.0) {
+    const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / options_.rate;
+    sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
+  }
+  server_->time(msgs::sim_time_ns(world));
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (spec.per_step) publish(spec, world);
+  }
+  return Ok{};
+}
+
+Status FoxgloveSink::finish() {
+  (void)server_->flush(2.0);  // a client that does not keep up is not waited for longer
+  return Ok{};
+}
+
+}  // namespace rbsim::foxglove

@@ -1,0 +1,267 @@
+// websocketpp + standalone asio behind transport.hpp. Compiled as C++17 (see CMakeLists.txt).
+// Everything here runs on the one I/O thread, except wake() and stop(), which post to it.
+#include "transport.hpp"
+
+#include <websocketpp/config/asio_no_tls.hpp>
+#include <websocketpp/server.hpp>
+
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <asio/posix/stream_descriptor.hpp>
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace rbsim::foxglove::detail {
+
+namespace {
+
+using WsServer = websocketpp::server<websocketpp::config::asio>;
+using Hdl = websocketpp::connection_hdl;
+
+class AsioTransport final : public Transport {
+ public:
+  ~AsioTransport() override { stop(); }
+
+  std::string listen(const std::string& address, std::uint16_t port, std::size_t max_message_size,
+                     int tick_ms, TransportHandlers handlers) override {
+    handlers_ = std::move(handlers);
+    tick_ = std::chrono::milliseconds(tick_ms);
+    // websocketpp logs to stdout by default; the server reports what matters itself.
+    ws_.clear_access_channels(websocketpp::log::alevel::all);
+    ws_.clear_error_channels(websocketpp::log::elevel::all);
+    websocketpp::lib::error_code ec;
+    ws_.init_asio(&io_, ec);
+    if (ec) return ec.message();
+    // Lets a restarted server take its port while old connections sit in TIME_WAIT (on Linux it
+    // does not let two servers listen on one port: a second one still gets "address in use").
+    ws_.set_reuse_addr(true);
+    ws_.set_max_message_size(max_message_size);
+    ws_.set_listen_backlog(64);
+    ws_.set_validate_handler([this](Hdl h) { return validate(h); });
+    ws_.set_open_handler([this](Hdl h) { opened(h); });
+    ws_.set_close_handler([this](Hdl h) { closed(h); });
+    ws_.set_fail_handler([this](Hdl h) { closed(h); });
+    ws_.set_message_handler([this](Hdl h, WsServer::message_ptr m) {
+      const auto it = ids_.find(h);
+      if (it == ids_.end() || !handlers_.on_message) return;
+      handlers_.on_message(it->second, m->get_payload(), m->get_opcode() != websocketpp::frame::opcode::text);
+    });
+    asio::error_code aec;
+    const asio::ip::address ip = asio::ip::make_address(address, aec);
+    if (aec) return "bad address \"" + address + "\": " + aec.message();
+    const asio::ip::tcp::endpoint endpoint(ip, port);
+    ws_.listen(endpoint, ec);
+    if (ec) return bind_error(endpoint, ec.message());
+    const asio::ip::tcp::endpoint local = ws_.get_local_endpoint(aec);
+    if (aec) return aec.message();
+    port_ = local.port();
+    ws_.start_accept(ec);
+    if (ec) return ec.message();
+    listening_ = true;
+    return {};
+  }
+
+  std::uint16_t port() const override { return port_; }
+
+  void run() override {
+    timer_ = std::make_unique<asio::steady_timer>(io_);
+    arm_timer();
+    // wake() writes to an eventfd the I/O thread reads: no allocation on the producer's thread
+    // (an asio::post from outside the I/O thread allocates its handler every time).
+    const int fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (fd >= 0) {
+      wake_fd_ = std::make_unique<asio::posix::stream_descriptor>(io_, fd);
+      arm_wake();
+    }
+    thread_ = std::thread([this] {
+      // A handler that throws (an allocation failure) must not take the process down with it
+      // unseen: asio lets the exception out of run(); keep serving.
+      while (true) {
+        try {
+          io_.run();
+          break;
+        } catch (const std::exception&) {
+        }
+      }
+    });
+  }
+
+  void wake() override {
+    if (wake_pending_.exchange(true)) return;
+    if (wake_fd_) {
+      const std::uint64_t one = 1;
+      if (::write(wake_fd_->native_handle(), &one, sizeof one) == sizeof one) return;
+    }
+    asio::post(io_, [this] {  // no eventfd: the timer's tick would do, this is sooner
+      wake_pending_ = false;
+      if (handlers_.on_pump) handlers_.on_pump();
+    });
+  }
+
+  void stop() override {
+    std::lock_guard<std::mutex> lock(stop_mutex_);
+    if (stopped_) return;
+    stopped_ = true;
+    if (thread_.joinable()) {
+      asio::post(io_, [this] { shutdown(); });
+      thread_.join();
+    } else if (listening_) {
+      shutdown();
+      io_.run();  // let the cancelled accept finish
+    }
+  }
+
+  bool send(ConnectionId id, const std::string& data, bool binary) override {
+    WsServer::connection_ptr con = find(id);
+    if (!con) return false;
+    const websocketpp::lib::error_code ec =
+        con->send(data.data(), data.size(),
+                  binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
+    return !ec;
+  }
+
+  std::size_t buffered(ConnectionId id) const override {
+    WsServer::connection_ptr con = find(id);
+    return con ? con->get_buffered_amount() : 0;
+  }
+
+  void drop(ConnectionId id) override {
+    WsServer::connection_ptr con = find(id);
+    if (!con) return;
+    // A peer that does not read would never let a close frame through: close the socket, which
+    // fails the pending read and write and makes websocketpp end the connection.
+    asio::error_code ec;
+    con->get_raw_socket().close(ec);
+  }
+
+ private:
+  WsServer::connection_ptr find(ConnectionId id) const {
+    const auto it = hdls_.find(id);
+    if (it == hdls_.end()) return nullptr;
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = const_cast<WsServer&>(ws_).get_con_from_hdl(it->second, ec);
+    return ec ? nullptr : con;
+  }
+
+  // websocketpp reports a failed bind as "Underlying Transport Error"; a bind of our own says
+  // what went wrong ("Address already in use").
+  std::string bind_error(const asio::ip::tcp::endpoint& endpoint, const std::string& fallback) {
+    asio::ip::tcp::acceptor probe(io_);
+    asio::error_code ec;
+    probe.open(endpoint.protocol(), ec);
+    if (!ec) probe.set_option(asio::socket_base::reuse_address(true), ec);
+    if (!ec) probe.bind(endpoint, ec);
+    return ec ? ec.message() : fallback;
+  }
+
+  bool validate(Hdl h) {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws_.get_con_from_hdl(h, ec);
+    if (ec) return false;
+    const std::string chosen =
+        handlers_.choose_subprotocol ? handlers_.choose_subprotocol(con->get_requested_subprotocols()) : "";
+    if (chosen.empty()) {
+      if (handlers_.on_refused) handlers_.on_refused();
+      con->set_status(websocketpp::http::status_code::bad_request);
+      con->set_body(
+          "rbsim: a Foxglove WebSocket client must offer the subprotocol foxglove.sdk.v1 or "
+          "foxglove.websocket.v1\n");
+      return false;
+    }
+    con->select_subprotocol(chosen, ec);
+    return !ec;
+  }
+
+  void opened(Hdl h) {
+    const ConnectionId id = next_id_++;
+    ids_.emplace(h, id);
+    hdls_.emplace(id, h);
+    if (handlers_.on_open) handlers_.on_open(id);
+  }
+
+  void closed(Hdl h) {
+    const auto it = ids_.find(h);
+    if (it == ids_.end()) return;  // a failed handshake: never opened
+    const ConnectionId id = it->second;
+    ids_.erase(it);
+    hdls_.erase(id);
+    if (handlers_.on_close) handlers_.on_close(id);
+  }
+
+  void arm_wake() {
+    wake_fd_->async_read_some(asio::buffer(&wake_count_, sizeof wake_count_),
+                              [this](const asio::error_code& ec, std::size_t) {
+                                if (ec || shutting_down_) return;
+                                wake_pending_ = false;
+                                if (handlers_.on_pump) handlers_.on_pump();
+                                arm_wake();
+                              });
+  }
+
+  void arm_timer() {
+    timer_->expires_after(tick_);
+    timer_->async_wait([this](const asio::error_code& ec) {
+      if (ec || shutting_down_) return;
+      if (handlers_.on_pump) handlers_.on_pump();
+      arm_timer();
+    });
+  }
+
+  void shutdown() {
+    shutting_down_ = true;
+    if (timer_) timer_->cancel();
+    if (wake_fd_) {
+      asio::error_code ec2;
+      wake_fd_->close(ec2);
+    }
+    websocketpp::lib::error_code ec;
+    if (listening_) ws_.stop_listening(ec);
+    // Close every connection; a peer that does not answer the close is dropped by websocketpp's
+    // close-handshake timeout. Then nothing is left for io_.run() and the thread ends.
+    for (const auto& entry : hdls_) {
+      WsServer::connection_ptr con = ws_.get_con_from_hdl(entry.second, ec);
+      if (ec) continue;
+      if (con->get_buffered_amount() > 0) {
+        asio::error_code aec;
+        con->get_raw_socket().close(aec);  // a backlog would hold the close frame back
+      } else {
+        con->close(websocketpp::close::status::going_away, "server stopping", ec);
+      }
+    }
+    // A peer that does not answer the close within 500 ms is dropped (websocketpp would wait
+    // 5 s), so Ctrl-C ends the command promptly.
+    timer_ = std::make_unique<asio::steady_timer>(io_);
+    timer_->expires_after(std::chrono::milliseconds(500));
+    timer_->async_wait([this](const asio::error_code& ec2) {
+      if (ec2) return;
+      for (const auto& entry : hdls_) drop(entry.first);
+    });
+  }
+
+  asio::io_context io_;
+  WsServer ws_;
+  TransportHandlers handlers_;
+  std::chrono::milliseconds tick_{10};
+  std::unique_ptr<asio::steady_timer> timer_;
+  std::thread thread_;
+  std::atomic<bool> wake_pending_{false};
+  std::unique_ptr<asio::posix::stream_descriptor> wake_fd_;
+  std::uint64_t wake_count_ = 0;
+  std::mutex stop_mutex_;
+  bool stopped_ = false, listening_ = false, shutting_down_ = false;
+  std::uint16_t port_ = 0;
+  ConnectionId next_id_ = 1;
+  std::map<Hdl, ConnectionId, std::owner_less<Hdl>> ids_;
+  std::map<ConnectionId, Hdl> hdls_;
+};
+
+}  // namespace
+
+std::unique_ptr<Transport> Transport::create() {
+  return std::make_unique<AsioTransport>();
+}
+
+}  // namespace rbsim::foxglove::detail
