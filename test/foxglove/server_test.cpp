@@ -289,6 +289,39 @@ TEST(FoxgloveServer, AStalledClientSlowsNeitherTheProducerNorOthersAndIsDisconne
   EXPECT_GT(server->stats().dropped, 0u);
 }
 
+TEST(FoxgloveServer, FlushWaitsForAReaderButNotForeverForAStaller) {
+  auto server = start();
+  ASSERT_TRUE(server);
+  WsClient reader;
+  handshake(reader, server->port());
+  ASSERT_TRUE(reader.send_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":2}]})"));
+  ASSERT_TRUE(eventually([&] { return server->subscribed(2); }));
+  const std::vector<std::byte> payload(64 * 1024);
+  int got = 0;
+  std::thread t([&] {
+    while (got < 50) {
+      auto f = reader.read();
+      if (!f) break;
+      if (as_data(*f)) ++got;
+    }
+  });
+  for (int i = 0; i < 50; ++i) server->publish(2, static_cast<std::uint64_t>(i), payload);
+  EXPECT_TRUE(server->flush(10.0));
+  t.join();
+  EXPECT_EQ(got, 50);
+
+  // A client that reads nothing: flush gives up at its timeout.
+  WsClient staller;
+  ASSERT_EQ(staller.connect(server->port(), {"foxglove.sdk.v1"}, 4096), 101);
+  ASSERT_TRUE(staller.send_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":2}]})"));
+  ASSERT_TRUE(eventually([&] { return server->client_count() == 2; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (int i = 0; i < 200; ++i) server->publish(2, static_cast<std::uint64_t>(i), payload);
+  const auto t0 = Clock::now();
+  EXPECT_FALSE(server->flush(0.3));
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 2.0);
+}
+
 TEST(FoxgloveServer, APortInUseIsAClearError) {
   auto first = start();
   ASSERT_TRUE(first);

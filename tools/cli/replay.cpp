@@ -104,6 +104,7 @@ int replay_command(ReplayArgs a) {
   if (complete) {
     if (Status st = replay.finish(); !st) return fail(st.error().message);
   }
+  if (server) (void)server->flush(2.0);  // viewers that keep up get the end of the log
   if (!a.quiet) {
     std::fprintf(stderr, "rbsim replay: %s after %llu complete pass%s, %llu messages published%s\n",
                  complete ? "done" : "stopped", static_cast<unsigned long long>(passes),

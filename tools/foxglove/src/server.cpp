@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <mutex>
+#include <thread>
 
 #include "rbsim/foxglove.hpp"
 #include "transport.hpp"
@@ -262,6 +263,23 @@ void Server::time(std::uint64_t time_ns) {
 
 std::size_t Server::client_count() const {
   return impl_->client_count.load();
+}
+
+bool Server::flush(double timeout_s) {
+  Impl& im = *impl_;
+  const std::int64_t deadline = monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  while (true) {
+    bool pending = false;
+    {
+      std::lock_guard lock(im.mu);
+      for (const auto& c : im.clients)
+        pending = pending || (!c->dropping && (!c->queue.empty() || c->in_flight > 0));
+    }
+    if (!pending) return true;
+    if (monotonic_ns() >= deadline) return false;
+    im.transport->wake();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 ServerStats Server::stats() const {

@@ -55,7 +55,7 @@ void FoxgloveSink::publish(const msgs::TopicSpec& spec, const World& world) {
 }
 
 Status FoxgloveSink::begin(const Scene& scene, const World& world) {
-  encoder_ = std::make_unique<msgs::Encoder>(scene);
+  encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
   start_ns_ = monotonic_ns();
   start_step_ = world.step_index();
   server_->new_session();
@@ -79,6 +79,7 @@ Status FoxgloveSink::write(const World& world) {
 }
 
 Status FoxgloveSink::finish() {
+  (void)server_->flush(2.0);  // a client that does not keep up is not waited for longer
   return Ok{};
 }
 

@@ -5,6 +5,10 @@
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <asio/posix/stream_descriptor.hpp>
 #include <atomic>
 #include <map>
 #include <mutex>
@@ -65,6 +69,13 @@ class AsioTransport final : public Transport {
   void run() override {
     timer_ = std::make_unique<asio::steady_timer>(io_);
     arm_timer();
+    // wake() writes to an eventfd the I/O thread reads: no allocation on the producer's thread
+    // (an asio::post from outside the I/O thread allocates its handler every time).
+    const int fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (fd >= 0) {
+      wake_fd_ = std::make_unique<asio::posix::stream_descriptor>(io_, fd);
+      arm_wake();
+    }
     thread_ = std::thread([this] {
       // A handler that throws (an allocation failure) must not take the process down with it
       // unseen: asio lets the exception out of run(); keep serving.
@@ -80,7 +91,11 @@ class AsioTransport final : public Transport {
 
   void wake() override {
     if (wake_pending_.exchange(true)) return;
-    asio::post(io_, [this] {
+    if (wake_fd_) {
+      const std::uint64_t one = 1;
+      if (::write(wake_fd_->native_handle(), &one, sizeof one) == sizeof one) return;
+    }
+    asio::post(io_, [this] {  // no eventfd: the timer's tick would do, this is sooner
       wake_pending_ = false;
       if (handlers_.on_pump) handlers_.on_pump();
     });
@@ -176,6 +191,16 @@ class AsioTransport final : public Transport {
     if (handlers_.on_close) handlers_.on_close(id);
   }
 
+  void arm_wake() {
+    wake_fd_->async_read_some(asio::buffer(&wake_count_, sizeof wake_count_),
+                              [this](const asio::error_code& ec, std::size_t) {
+                                if (ec || shutting_down_) return;
+                                wake_pending_ = false;
+                                if (handlers_.on_pump) handlers_.on_pump();
+                                arm_wake();
+                              });
+  }
+
   void arm_timer() {
     timer_->expires_after(tick_);
     timer_->async_wait([this](const asio::error_code& ec) {
@@ -188,6 +213,10 @@ class AsioTransport final : public Transport {
   void shutdown() {
     shutting_down_ = true;
     if (timer_) timer_->cancel();
+    if (wake_fd_) {
+      asio::error_code ec2;
+      wake_fd_->close(ec2);
+    }
     websocketpp::lib::error_code ec;
     if (listening_) ws_.stop_listening(ec);
     // Close every connection; a peer that does not answer the close is dropped by websocketpp's
@@ -219,6 +248,8 @@ class AsioTransport final : public Transport {
   std::unique_ptr<asio::steady_timer> timer_;
   std::thread thread_;
   std::atomic<bool> wake_pending_{false};
+  std::unique_ptr<asio::posix::stream_descriptor> wake_fd_;
+  std::uint64_t wake_count_ = 0;
   std::mutex stop_mutex_;
   bool stopped_ = false, listening_ = false, shutting_down_ = false;
   std::uint16_t port_ = 0;

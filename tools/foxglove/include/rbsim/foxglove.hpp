@@ -228,6 +228,10 @@ class Server {
   void time(std::uint64_t time_ns);
   std::size_t client_count() const;
   ServerStats stats() const;
+  // Waits until every client has been handed everything queued for it and the socket layer has
+  // written it (or `timeout_s` passed, or the clients are gone): the end of a run reaches viewers
+  // that keep up before the server closes. True when everything went out.
+  bool flush(double timeout_s);
   // Closes every connection and joins the I/O thread (idempotent).
   void stop();
 
@@ -249,6 +253,7 @@ Result<std::vector<ChannelSpec>> ros2_channels(const msgs::TopicSet& topics, std
 
 struct SinkOptions {
   msgs::TopicSet topics = msgs::default_topics();
+  std::string ns = "rbsim";        // the namespace of the frames in /tf and the markers
   std::int64_t publish_every = 1;  // every k-th step (as DdsSink)
   // Real-time factor to pace at; 0 leaves pacing to another sink (rbsim node's DdsSink paces, and
   // the driver calls the sinks one after the other, so the pace happens once).
@@ -263,6 +268,7 @@ class FoxgloveSink final : public Sink {
   FoxgloveSink(Server& server, std::vector<ChannelId> ids, const SinkOptions& options);
   Status begin(const Scene& scene, const World& world) override;
   Status write(const World& world) override;
+  // Flushes the server (bounded, 2 s): viewers that keep up get the last steps.
   Status finish() override;
 
  private:
