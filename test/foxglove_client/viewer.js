@@ -122,7 +122,7 @@ runMain("foxglove_client.viewer", async (check) => {
     // Let it draw, then dismiss the 3D panel's first-use hint (it covers the plot's legend).
     await page.waitForTimeout(3000);
     const hint = page.getByText("Open settings to configure topics and layers.");
-    await hint.locator("xpath=..").locator("button").first().click({ timeout: 2000 }).catch(() => {});
+    await hint.locator("xpath=ancestor::div[.//button][1]//button").first().click({ timeout: 3000 }).catch(() => {});
     await hint.waitFor({ state: "hidden", timeout: 2000 }).catch(() => {});
     // The 3D panel's canvas: the largest one (the plot's is smaller).
     const rect = await page.evaluate(() => {
