@@ -132,11 +132,12 @@ async function fanOut() {
 
 // Payload bytes per step of the default topics of `rbsim` (a recording, uncompressed): per-step
 // topics per step, and the latched ones once.
-function bytesPerStep(rbsim, tag) {
+function bytesPerStep(rbsim, tag, ...extra) {
   const steps = 100;
   const scene = grid(1000, steps * 0.001);
   const out = path.join(work, `${tag}.mcap`);
-  const r = spawnSync(rbsim, ["run", scene, "--record", out, "--compression", "none", "-q"], { encoding: "utf8" });
+  const r = spawnSync(rbsim, ["run", scene, "--record", out, "--compression", "none", "-q", ...extra],
+    { encoding: "utf8" });
   if (r.status !== 0) throw new Failure(`${rbsim} run --record: ${r.stderr}`);
   let perStep = 0;
   let once = 0;
@@ -163,6 +164,10 @@ function bytes() {
   }
   const ratio = before.perStep / after.perStep;
   console.log(`    ${ratio.toFixed(2)}x smaller (target >= 3x): ${ratio >= 3 ? "met" : "MISSED"}`);
+  // For information: what a viewer needs (--topics tf,springs,clock; the markers come latched).
+  const viewer = bytesPerStep(A.rbsim, "viewer", "--topics", "tf,springs,clock,markers");
+  console.log(`    a viewer's topics only (--topics tf,springs,clock,markers): ${kb(viewer.perStep)} per step, ` +
+    `${(before.perStep / viewer.perStep).toFixed(2)}x smaller than before`);
   return ratio >= 3;
 }
 
