@@ -391,4 +391,4 @@ const cases = { bytes: caseBytes, late_joiner: caseLateJoiner, hostile: caseHost
   faults: caseFaults };
 if (A.case === "child") caseChild();
 else if (!cases[A.case]) throw new Error(`unknown case ${A.case}`);
-else runMain(`foxglove.${A.case}`, cases[A.case]);
+else runMain(`foxglove_client.${A.case}`, cases[A.case]);
