@@ -8,8 +8,9 @@
 //
 // Cases: bytes (every payload equals what `rbsim run --record` writes), late_joiner (latched
 // topics at once; a new session per loop), hostile (bad input gets a status error or a clean close),
-// slow_client (a client that stops reading is dropped from, the others lose nothing), faults (killed,
-// cycling and stalled clients do not slow the node). Only 127.0.0.1; every loop bounded.
+// slow_client (one that stops reading loses messages and is disconnected, another loses nothing),
+// faults (killed, cycling and stalled clients do not slow the node; another loses nothing).
+// Messages are matched by log time, which is simulated time. Only 127.0.0.1; every loop bounded.
 const fs = require("fs");
 const path = require("path");
 const net = require("net");
@@ -37,7 +38,6 @@ const scene = (name) => path.join(A["source-dir"], "scenes", name);
 const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
 const nodeArgs = (sceneFile, ...extra) => ["node", sceneFile, "--domain", domain, "--namespace", ns, ...extra];
 const start = (name, argv) => startServer(A.rbsim, argv, { name, logDir: workdir });
-const stepOf = (m) => m.time; // log time = simulated time: one value per step on every per-step topic
 
 // A grid scene of n octagons with springs (the benchmarks' builder, bench/make_grid_scene.py).
 function gridScene(n, dt, duration) {
