@@ -115,7 +115,7 @@ async function caseBytes(check) {
       contiguous(check, topic, msgs, want);
       check(msgs.length >= want.length / 2, `${topic}: only ${msgs.length} of ${want.length} steps received`);
       for (const m of msgs) {
-        const stamp = m.decoded.header?.stamp ?? m.decoded.clock;
+        const stamp = m.decoded.header?.stamp ?? m.decoded.clock ?? m.decoded.transforms?.[0]?.header.stamp;
         if (stamp && BigInt(stamp.sec) * 1000000000n + BigInt(stamp.nanosec) !== m.time) {
           check(false, `${topic}: decoded stamp ${stamp.sec}.${stamp.nanosec} != log time ${m.time}`);
           break;
