@@ -80,7 +80,8 @@ async function caseBytes(check) {
 
   // Real time, so a client that connects right after the listening line sees nearly every step.
   const [node, url] = await start("node", nodeArgs(sceneFile, "--rate", 1, "--duration", duration));
-  const c = await new Client(need, url, { name: "client" }).ready();
+  // Decoded after the run: a receive path light enough to keep up at 1,000 steps/s on a busy machine.
+  const c = await new Client(need, url, { name: "client", decode: "later" }).ready();
   check(c.ws.protocol === "foxglove.websocket.v1", `negotiated subprotocol ${c.ws.protocol}`);
   check(c.serverInfo.capabilities.includes("time"), `serverInfo capabilities ${c.serverInfo.capabilities}`);
   check(typeof c.serverInfo.sessionId === "string" && c.serverInfo.sessionId.length > 0, "serverInfo has no sessionId");
@@ -96,6 +97,10 @@ async function caseBytes(check) {
   }
   check((await node.wait(60000)) === 0, `node exited with ${node.code}\n${node.output()}`);
   await until("the server to close the connection", 5000, () => c.closed);
+  c.decodeAll();
+  // A client that fell behind anyway (a CPU-starved machine) loses the oldest per-step messages:
+  // then it must have been told so (a status warning); otherwise every step must be there.
+  const warned = c.statuses.some((s) => s.level === 1);
 
   const got = c.byTopic();
   let compared = 0;
@@ -112,7 +117,7 @@ async function caseBytes(check) {
     if (latched.has(topic)) {
       check(msgs.length === 1, `${topic} (latched): ${msgs.length} messages, want exactly 1`);
     } else {
-      contiguous(check, topic, msgs, want);
+      if (!warned) contiguous(check, topic, msgs, want);
       check(msgs.length >= want.length / 2, `${topic}: only ${msgs.length} of ${want.length} steps received`);
       for (const m of msgs) {
         const stamp = m.decoded.header?.stamp ?? m.decoded.clock ?? m.decoded.transforms?.[0]?.header.stamp;
@@ -126,7 +131,8 @@ async function caseBytes(check) {
   check(c.messages.every((m) => m.decoded !== undefined), "a message was not decoded");
   check(c.times.length > 0 && c.times.every((t, i) => i === 0 || t >= c.times[i - 1]),
     `time messages: ${c.times.length}, want some, non-decreasing`);
-  log(`${compared} payloads compared byte for byte, ${c.times.length} time messages`);
+  log(`${compared} payloads compared byte for byte, ${c.times.length} time messages` +
+    (warned ? `; fell behind: ${c.statuses.map((s) => s.message).join("; ")}` : ""));
 }
 
 // The topics a run publishes once (latched), from a short `rbsim run --record` of the scene.

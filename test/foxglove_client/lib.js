@@ -165,7 +165,7 @@ class Client {
     const c = this.subs.get(subId);
     const bytes = Buffer.from(data.buffer, data.byteOffset, data.byteLength);
     const m = { topic: c ? c.topic : `?sub${subId}`, time: timestamp, data: Buffer.from(bytes), received: performance.now() };
-    if (c && this.decode) m.decoded = this.reader(c).readMessage(m.data);
+    if (c && this.decode === true) m.decoded = this.reader(c).readMessage(m.data);
     this.messages.push(m);
     if (this.onmessage) this.onmessage(m);
   }
@@ -180,6 +180,13 @@ class Client {
       return n > 0 && Date.now() - since >= quietMs;
     });
     return this;
+  }
+  // Decodes what was received undecoded (decode: "later" keeps the receive path light).
+  decodeAll() {
+    const byTopic = new Map([...this.channels.values()].map((c) => [c.topic, c]));
+    for (const m of this.messages) {
+      if (!m.decoded && byTopic.has(m.topic)) m.decoded = this.reader(byTopic.get(m.topic)).readMessage(m.data);
+    }
   }
   topics() {
     return [...new Set([...this.channels.values()].map((c) => c.topic))].sort();
