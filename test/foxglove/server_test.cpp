@@ -227,13 +227,23 @@ TEST(FoxgloveServer, HostileInputGetsAStatusAndTheConnectionKeepsWorking) {
   EXPECT_EQ(as_data(*f)->payload, "ok");
 }
 
-TEST(FoxgloveServer, AFrameOverTheLimitClosesTheConnection) {
+TEST(FoxgloveServer, AFrameOverTheLimitIsRefusedAndAHugeOneClosesTheConnection) {
   auto server = start();
   ASSERT_TRUE(server);
   WsClient c;
   handshake(c, server->port());
+  // Over the 1 MiB limit: read whole and answered with a status error; the connection stays.
   (void)c.send_text(std::string(kMaxClientFrame + 10, ' '));
-  // A close frame (1009, message too big) or the end of the stream; never a hang or a crash.
+  bool refused = false;
+  for (int i = 0; i < 10 && !refused; ++i) {
+    auto f = c.read();
+    ASSERT_TRUE(f) << "connection ended instead of a status error";
+    refused = f->opcode == 1 && f->data.find("\"status\"") != std::string::npos &&
+              f->data.find("limit") != std::string::npos;
+  }
+  EXPECT_TRUE(refused);
+  // Over what the transport reads: a close frame (1009) or the end of the stream; never a hang.
+  (void)c.send_text(std::string(kMaxReadFrame + 10, ' '));
   bool closed = false;
   for (int i = 0; i < 10 && !closed; ++i) {
     auto f = c.read();

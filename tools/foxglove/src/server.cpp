@@ -186,7 +186,7 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
     ++p->totals.refused;
   };
   const std::string err =
-      im.transport->listen(options.address, options.port, kMaxClientFrame, kTickMs, std::move(h));
+      im.transport->listen(options.address, options.port, kMaxReadFrame, kTickMs, std::move(h));
   if (!err.empty()) {
     return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
   }

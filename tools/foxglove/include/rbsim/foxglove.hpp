@@ -41,6 +41,11 @@ std::optional<std::string_view> choose_subprotocol(std::span<const std::string> 
 // Client frames larger than this are refused (a status error from ClientProtocol; the transport
 // closes a connection that sends one, as it would otherwise have to buffer it).
 inline constexpr std::size_t kMaxClientFrame = 1 << 20;
+// Client frames up to this size are read whole and refused with a status error when over
+// kMaxClientFrame; only a larger one makes the transport close the connection (1009) mid-frame.
+// Reading the frame before answering is what lets the answer arrive: closing a socket with unread
+// data resets the connection, and the peer's kernel then drops the close frame it had not read.
+inline constexpr std::size_t kMaxReadFrame = 16 * kMaxClientFrame;
 
 enum class StatusLevel : std::uint8_t { Info = 0, Warning = 1, Error = 2 };
 
