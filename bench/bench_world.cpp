@@ -19,6 +19,7 @@
 //                      memory_bytes() for rbsim, the only figure for Box2D
 #include <benchmark/benchmark.h>
 #include <malloc.h>
+#include <string_view>
 
 #include <cmath>
 #include <cstdint>
@@ -211,6 +212,15 @@ void register_all() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // rbsim_bench_world --scene gravity|wind_springs N: the XML of a BM_Step case's world, for
+  // scripts/bench-runner to time `rbsim run` on exactly the world BM_Step steps.
+  if (argc == 4 && std::string_view(argv[1]) == "--scene") {
+    const std::string_view which = argv[2];
+    if (which != "gravity" && which != "wind_springs") return 2;
+    const rbsim::WorldDef def = rbsim::builders::grid(std::stoi(argv[3]), which == "wind_springs", true);
+    std::fputs(rbsim::builders::to_scene_xml(def, 1000.0).c_str(), stdout);
+    return 0;
+  }
   register_all();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

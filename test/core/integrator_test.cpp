@@ -334,3 +334,52 @@ TEST(WorldFindNonfinite, NamesTheBodyAndQuantity) {
 
 }  // namespace
 }  // namespace rbsim
+
+namespace rbsim {
+namespace {
+
+TEST(WorldVelocitiesWithin, EveryLaneAndTheTailAgainstTheLimit) {
+  // 7 bodies: two SIMD iterations of 4 values would miss none, and 3 values go through the tail.
+  for (std::int32_t body = 0; body < 7; ++body) {
+    for (int q = 0; q < 3; ++q) {
+      for (double bad :
+           {2.5, -2.5, std::nan(""), static_cast<double>(INFINITY), -static_cast<double>(INFINITY)}) {
+        World w = make_world(builders::free_bodies(Integrator::SymplecticEuler, 0.01, 7));
+        for (std::int32_t b = 0; b < 7; ++b) {
+          BodyState s = w.state(BodyId{b});
+          s.velocity = {1.0, -1.0};
+          s.omega = 0.5;
+          w.set_state(BodyId{b}, s);
+        }
+        EXPECT_TRUE(w.velocities_within(2.0));
+        BodyState s = w.state(BodyId{body});
+        double* fields[] = {&s.velocity.x(), &s.velocity.y(), &s.omega};
+        *fields[q] = bad;
+        w.set_state(BodyId{body}, s);
+        EXPECT_FALSE(w.velocities_within(2.0)) << "body " << body << " value " << q << " = " << bad;
+        EXPECT_TRUE(w.velocities_within(3.0) || !std::isfinite(bad));
+        EXPECT_EQ(std::isnan(bad), std::isnan(w.peak_velocity()));
+      }
+    }
+  }
+}
+
+TEST(WorldFiniteBound, KeepsEveryDerivedQuantityFinite) {
+  World w = make_world(builders::grid(50, true));
+  const double bound = w.finite_bound();
+  EXPECT_GT(bound, 1e100);  // ordinary scenes never leave the cheap check
+  // Every state value at the bound, with the signs that add up: still nothing non-finite.
+  for (std::int32_t b = 0; b < w.body_count(); ++b) {
+    w.set_state(BodyId{b}, BodyState{{bound, -bound}, bound, {-bound, bound}, bound});
+  }
+  EXPECT_FALSE(w.find_nonfinite().has_value());
+  // Absurd masses leave no room: every check is then exact.
+  WorldDef heavy = builders::free_bodies(Integrator::SymplecticEuler, 0.01, 2);
+  for (BodyDef& body : heavy.bodies) {
+    for (double& m : body.masses) m = 1e300;
+  }
+  EXPECT_EQ(make_world(heavy).finite_bound(), 0.0);
+}
+
+}  // namespace
+}  // namespace rbsim

@@ -2,6 +2,7 @@
 // diverged, sink error), over one pass and over several (rbsim node --loop).
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -234,6 +235,49 @@ TEST(Driver, WorldTotalsAreThePerBodySums) {
   EXPECT_EQ(t.momentum.x(), px);
   EXPECT_EQ(t.momentum.y(), py);
   EXPECT_EQ(t.angular, l);
+}
+
+// The driver checks only the velocities against a limit after each step (World::finite_bound());
+// it must still stop exactly where a full find_nonfinite() after every step would.
+TEST(Driver, StopsWhereAnExactCheckAfterEveryStepStops) {
+  for (const char* k : {"1e9", "1e5", "3e3"}) {
+    const Scene scene = spring_scene(k);
+    Result<World> reference = World::create(scene.world);
+    ASSERT_TRUE(reference.ok());
+    std::optional<World::NonFinite> expected;
+    while (reference->step_index() < 10000 && !expected) {
+      reference->step();
+      expected = reference->find_nonfinite();
+    }
+    Result<Driver> driver = Driver::create(scene);
+    ASSERT_TRUE(driver.ok());
+    DriverOptions options;
+    options.steps = 10000;
+    ASSERT_TRUE(driver->begin().ok());
+    const Result<PassEnd> end = driver->run(options);
+    ASSERT_TRUE(end.ok());
+    ASSERT_EQ(end.value() == PassEnd::Diverged, expected.has_value()) << "k = " << k;
+    if (!expected) continue;
+    EXPECT_EQ(driver->divergence().step, reference->step_index()) << "k = " << k;
+    EXPECT_EQ(driver->divergence().body, expected->body.index);
+    EXPECT_STREQ(driver->divergence().quantity, expected->quantity);
+  }
+}
+
+TEST(Driver, AFiniteStateWhoseKineticEnergyOverflowsIsADivergence) {
+  Scene scene = spring_scene();
+  scene.world.bodies[1].velocity = {1e200, 0.0};  // T = M v^2 / 2 overflows; the state does not
+  Result<Driver> driver = Driver::create(scene);
+  ASSERT_TRUE(driver.ok());
+  DriverOptions options;
+  options.steps = 10;
+  ASSERT_TRUE(driver->begin().ok());
+  const Result<PassEnd> end = driver->run(options);
+  ASSERT_TRUE(end.ok());
+  ASSERT_EQ(end.value(), PassEnd::Diverged);
+  EXPECT_EQ(driver->divergence().step, 1);
+  EXPECT_EQ(driver->divergence().body, 1);
+  EXPECT_STREQ(driver->divergence().quantity, "T_point");
 }
 
 }  // namespace

@@ -224,6 +224,18 @@ class World {
   };
   std::optional<NonFinite> find_nonfinite() const;
 
+  // The divergence check's cheap pass. While every |x|, |y|, |theta|, |vx|, |vy|, |omega| is at
+  // most finite_bound() (fixed by create() from the masses, inertias, stiffnesses, gravity and
+  // spring geometry), every quantity derived from the state (P, L, T, U, E, spring states) is
+  // finite, so a runner needs find_nonfinite()'s exact search only when a peak exceeds it.
+  double finite_bound() const { return finite_bound_; }
+  // max |vx|, |vy|, |omega| (or max |x|, |y|, |theta|); NaN when any of them is NaN.
+  double peak_velocity() const;
+  double peak_position() const;
+  // Whether every |vx|, |vy|, |omega| is at most `limit` (false for NaN): the per-step pass,
+  // vectorised.
+  bool velocities_within(double limit) const;
+
   // Heap bytes held by the world (capacity of every array), for the per-body memory budget.
   std::size_t memory_bytes() const;
   std::int32_t shape_count() const { return static_cast<std::int32_t>(shapes_.size()); }
@@ -237,6 +249,7 @@ class World {
   using WindMoments = detail::WindMoments;
   World() = default;
 
+  double compute_finite_bound() const;
   void update_rotations();
   void accumulate_gravity();
   void accumulate_springs();
@@ -245,6 +258,7 @@ class World {
 
   Integrator integrator_ = Integrator::SymplecticEuler;
   double dt_ = 0.0;
+  double finite_bound_ = 0.0;
   std::int64_t step_ = 0;
 
   // Hot state, one entry per body.

@@ -1,6 +1,7 @@
 #include "rbsim/builders.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 namespace rbsim::builders {
@@ -101,6 +102,46 @@ WorldDef grid(std::int32_t n, bool wind_and_springs, bool distinct_shapes) {
     }
   }
   return w;
+}
+
+std::string to_scene_xml(const WorldDef& world, double duration) {
+  std::string out;
+  char buf[256];
+  const auto add = [&](const char* format, auto... values) {
+    std::snprintf(buf, sizeof buf, format, values...);
+    out += buf;
+  };
+  out += "<scene>\n  <simtype type=\"rigid-body\"/>\n";
+  add("  <duration time=\"%.17g\"/>\n", duration);
+  add("  <rigidbodyintegrator type=\"%s\" dt=\"%.17g\"/>\n", to_string(world.integrator), world.dt);
+  std::size_t vertex = 0;
+  for (const BodyDef& b : world.bodies) {
+    for (std::size_t v = 0; v < b.hull.size(); ++v) {
+      add("  <rigidbodyvertex x=\"%.17g\" y=\"%.17g\" m=\"%.17g\"/>\n", b.hull[v].x(), b.hull[v].y(),
+          b.masses[v]);
+    }
+    out += "  <rigidbody";
+    for (std::size_t v = 0; v < b.hull.size(); ++v) add(" p=\"%zu\"", vertex + v);
+    add(" vx=\"%.17g\" vy=\"%.17g\" omega=\"%.17g\" r=\"%.17g\"/>\n", b.velocity.x(), b.velocity.y(), b.omega,
+        b.radius);
+    vertex += b.hull.size();
+  }
+  for (const SpringDef& s : world.springs) {
+    add("  <rigidbodyspringforce i=\"%d\" pix=\"%.17g\" piy=\"%.17g\" j=\"%d\" pjx=\"%.17g\" pjy=\"%.17g\" "
+        "k=\"%.17g\" "
+        "l0=\"%.17g\"/>\n",
+        s.body_i, s.anchor_i.x(), s.anchor_i.y(), s.body_j, s.anchor_j.x(), s.anchor_j.y(), s.stiffness,
+        s.rest_length);
+  }
+  for (const GravityDef& g : world.gravity) {
+    add("  <rigidbodygravityforce fx=\"%.17g\" fy=\"%.17g\"/>\n", g.acceleration.x(), g.acceleration.y());
+  }
+  for (const WindDef& w : world.winds) {
+    add("  <rigidbodywindforce beta=\"%.17g\" fx=\"%.17g\" fy=\"%.17g\" pointsperedge=\"%d\"/>\n", w.beta,
+        w.velocity.x(), w.velocity.y(), w.points_per_edge);
+  }
+  out += "</scene>\n";
+  return out;
 }
 
 }  // namespace rbsim::builders

@@ -2,6 +2,8 @@
 // and large synthetic worlds.
 #pragma once
 
+#include <string>
+
 #include <cstdint>
 
 #include "rbsim/core.hpp"
@@ -31,5 +33,9 @@ WorldDef square_in_wind(Integrator integrator, double dt, Vec2 wind, double beta
 // gravity, wind with 4 points per edge and one spring per body (to its neighbour, or to a fixed
 // point for the last). `distinct_shapes` perturbs every hull so no two share a Shape.
 WorldDef grid(std::int32_t n, bool wind_and_springs, bool distinct_shapes = true);
+
+// The FOSSSim XML scene of a definition (numbers round-trip), so a command-line run and an
+// in-process benchmark step the same world.
+std::string to_scene_xml(const WorldDef& world, double duration);
 
 }  // namespace rbsim::builders
