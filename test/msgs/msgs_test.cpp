@@ -5,6 +5,7 @@
 #include <limits>
 #include <random>
 
+#include "decoder_for.hpp"
 #include "rbsim/builders.hpp"
 #include "rbsim/msgs.hpp"
 
@@ -22,15 +23,6 @@ rbsim::Scene spring_wind_scene() {
   for (int b = 0; b < 3; ++b) scene.body_colors.push_back(rbsim::default_body_color(b));
   scene.spring_colors.assign(3, rbsim::Color{0.1, 0.2, 0.3});
   return scene;
-}
-
-rbsim::msgs::MessageDecoder decoder_for(TopicId id) {
-  const auto type = rbsim::msgs::topic(id).type;
-  auto schema = rbsim::msgs::ros2msg_schema(type);
-  EXPECT_TRUE(schema.ok());
-  auto d = rbsim::msgs::MessageDecoder::create(type, schema.value());
-  EXPECT_TRUE(d.ok()) << d.error().message;
-  return std::move(d.value());
 }
 
 TEST(TopicNames, FollowRos2Conventions) {

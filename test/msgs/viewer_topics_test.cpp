@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "decoder_for.hpp"
 #include "rbsim/builders.hpp"
 #include "rbsim/msgs.hpp"
 
@@ -125,15 +126,6 @@ rbsim::Scene scene_with_anchor() {
     scene.spring_colors.push_back(rbsim::Color{0.1 * static_cast<double>(k + 1), 0.5, 0.25});
   scene.duration = 1.0;
   return scene;
-}
-
-rbsim::msgs::MessageDecoder decoder_for(TopicId id) {
-  const auto type = rbsim::msgs::topic(id).type;
-  auto schema = rbsim::msgs::ros2msg_schema(type);
-  EXPECT_TRUE(schema.ok());
-  auto d = rbsim::msgs::MessageDecoder::create(type, schema.value());
-  EXPECT_TRUE(d.ok()) << d.error().message;
-  return std::move(d.value());
 }
 
 TEST(EncoderTf, OneTransformPerBodyInItsNamespacedFrame) {
