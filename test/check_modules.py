@@ -21,6 +21,7 @@ MODULES = {
     "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "node": ("node", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
+    "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }

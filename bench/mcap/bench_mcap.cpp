@@ -14,11 +14,11 @@
 //                               RBSIM_BENCH_RECORD_STEPS steps (default 2000): World::step,
 //                               find_nonfinite, sinks; sink begin and finish are timed too
 //     off                         no sink (the baseline)
-//     all_zstd|all_lz4|all_none   log::make_mcap_sink, every topic (what --record does)
+//     all_zstd|all_lz4|all_none   log::make_mcap_sink, the default topics (what --record does)
 //     body_states                 only /rbsim/body_states (RecordOptions::topics), zstd
-//     markers                     only /rbsim/markers, zstd
-//     all_but_markers             every topic except /rbsim/markers, zstd
-//     every10, every100           every topic, zstd, --record-every 10 / 100
+//     tf                          only /tf, zstd
+//     every_topic                 every topic, poses included, zstd
+//     every10, every100           the default topics, zstd, --record-every 10 / 100
 //     body_states_every10         only /rbsim/body_states, zstd, --record-every 10
 //
 // Throughput: bytes_per_second / items_per_second count uncompressed message bytes / messages
@@ -313,7 +313,7 @@ struct RecordVariant {
   const char* name;
   bool record = false;
   mcap::Compression compression = mcap::Compression::Zstd;
-  std::vector<msgs::TopicId> topics;  // empty: every topic
+  msgs::TopicSet topics;
   std::int64_t every = 1;
 };
 
@@ -424,22 +424,23 @@ void register_all() {
         ->Unit(benchmark::kMillisecond);
   }
   using T = msgs::TopicId;
-  const auto all = std::vector<T>{};
+  const auto only = [](std::initializer_list<T> ids) {
+    msgs::TopicSet set;
+    for (T id : ids) set.set(static_cast<std::size_t>(id));
+    return set;
+  };
+  const msgs::TopicSet all = msgs::default_topics();
   static const std::vector<RecordVariant> variants = {
       {"off", false, mcap::Compression::Zstd, all, 1},
       {"all_zstd", true, mcap::Compression::Zstd, all, 1},
       {"all_lz4", true, mcap::Compression::Lz4, all, 1},
       {"all_none", true, mcap::Compression::None, all, 1},
-      {"body_states", true, mcap::Compression::Zstd, {T::BodyStates}, 1},
-      {"markers", true, mcap::Compression::Zstd, {T::Markers}, 1},
-      {"all_but_markers",
-       true,
-       mcap::Compression::Zstd,
-       {T::Scene, T::BodyStates, T::SpringStates, T::Energy, T::Poses, T::Clock},
-       1},
+      {"body_states", true, mcap::Compression::Zstd, only({T::BodyStates}), 1},
+      {"tf", true, mcap::Compression::Zstd, only({T::Tf}), 1},
+      {"every_topic", true, mcap::Compression::Zstd, msgs::TopicSet().set(), 1},
       {"every10", true, mcap::Compression::Zstd, all, 10},
       {"every100", true, mcap::Compression::Zstd, all, 100},
-      {"body_states_every10", true, mcap::Compression::Zstd, {T::BodyStates}, 10},
+      {"body_states_every10", true, mcap::Compression::Zstd, only({T::BodyStates}), 10},
   };
   for (const RecordVariant& v : variants) {
     benchmark::RegisterBenchmark((std::string("BM_Record/") + v.name).c_str(), bm_record, v)

@@ -219,6 +219,12 @@ std::uint64_t Subscription::lost() const {
   return static_cast<std::uint64_t>(lost.total_count) + static_cast<std::uint64_t>(rejected.total_count);
 }
 
+std::int32_t Subscription::matched() const {
+  dds_subscription_matched_status_t st{};
+  if (dds_get_subscription_matched_status(reader_, &st) < 0) return 0;
+  return static_cast<std::int32_t>(st.current_count);
+}
+
 const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns) {
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (name == spec.suffix || name == msgs::topic_name(spec, ns)) return &spec;

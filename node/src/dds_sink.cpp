@@ -1,4 +1,5 @@
 // The node's output: every topic of a step published over DDS, paced to wall time.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -11,10 +12,13 @@ Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant,
   if (options.publish_every < 1) {
     return Error{"publish every " + std::to_string(options.publish_every) + " steps: must be at least 1"};
   }
+  if (options.topics.none()) return Error{"no topics to publish"};
   std::unique_ptr<DdsSink> sink(new DdsSink());
   sink->options_ = options;
   sink->publishers_.resize(msgs::kTopicCount);
-  for (const msgs::TopicSpec& spec : msgs::topics()) {
+  sink->ids_ = msgs::topic_ids(options.topics);
+  for (const msgs::TopicId id : sink->ids_) {
+    const msgs::TopicSpec& spec = msgs::topic(id);
     auto pub = Publisher::create(participant, spec, msgs::topic_name(spec, options.ns),
                                  qos_for(spec, options.keep_last));
     if (!pub) return pub.error();
@@ -31,10 +35,13 @@ Status DdsSink::publish(msgs::TopicId id, const World& world) {
 }
 
 Status DdsSink::begin(const Scene& scene, const World& world) {
-  encoder_ = std::make_unique<msgs::Encoder>(scene);
+  encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
   restart_clock();
   start_step_ = world.step_index();
-  if (Status st = publish(msgs::TopicId::Scene, world); !st) return st;
+  for (const msgs::TopicId id : ids_) {
+    if (msgs::topic(id).per_step) continue;
+    if (Status st = publish(id, world); !st) return st;
+  }
   return write(world);
 }
 
@@ -49,23 +56,27 @@ Status DdsSink::write(const World& world) {
     const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / options_.rate;
     sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
   }
-  for (const msgs::TopicSpec& spec : msgs::topics()) {
-    if (!spec.per_step) continue;
-    if (Status st = publish(spec.id, world); !st) return st;
+  for (const msgs::TopicId id : ids_) {
+    if (!msgs::topic(id).per_step) continue;
+    if (Status st = publish(id, world); !st) return st;
   }
   return Ok{};
 }
 
 Status DdsSink::finish() {
   for (auto& p : publishers_) {
+    if (!p) continue;
     if (Status st = p->flush(30.0); !st) return st;
   }
   return Ok{};
 }
 
 bool DdsSink::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
-  const auto& states = publishers_[static_cast<std::size_t>(msgs::TopicId::BodyStates)];
-  while (states->matched() < count) {
+  const auto per_step =
+      std::find_if(ids_.begin(), ids_.end(), [](msgs::TopicId id) { return msgs::topic(id).per_step; });
+  const auto& watched =
+      publishers_[static_cast<std::size_t>(per_step != ids_.end() ? *per_step : ids_.front())];
+  while (watched->matched() < count) {
     if (stop()) return false;
     sleep_until(monotonic_ns() + 20'000'000);
   }

@@ -82,7 +82,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
     if (!sub) return sub.error();
     dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
     r->topics_.push_back(Topic{std::move(sub.value()), 0, 0, Gaps{}});
-    if (spec->id == msgs::TopicId::Scene) r->scene_pending_ = true;
+    r->latched_pending_.push_back(!spec->per_step);
+    if (!spec->per_step) r->holding_ = true;
   }
   return r;
 }
@@ -114,31 +115,34 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
         newest->second = sample.source_time_ns;
       }
       const std::uint64_t now = wall_ns();
-      const bool is_scene = t.subscription.spec().id == msgs::TopicId::Scene;
-      if (scene_pending_ && !is_scene) {
+      const std::size_t index = static_cast<std::size_t>(&t - topics_.data());
+      const bool latched = !t.subscription.spec().per_step;
+      // Held: per-step samples while a latched topic is outstanding, and the markers while the
+      // scene description is (it goes first).
+      if (holding_ && (!latched || (t.subscription.spec().id != msgs::TopicId::Scene && scene_pending()))) {
         held_bytes_ += sample.cdr.size();
-        held_.push_back({static_cast<std::size_t>(&t - topics_.data()), std::move(sample), now});
+        held_.push_back({index, std::move(sample), now});
+        if (latched) latched_pending_[index] = false;  // it came: only its writing waits
         ++received_;
       } else {
-        if (is_scene && scene_pending_) {
-          scene_pending_ = false;
-          const std::uint64_t log_time = held_.empty() ? now : std::min(now, held_.front().log_time);
-          if (Status st = write(t, sample, log_time); !st) return st.error();
-          ++received_;
+        const std::uint64_t log_time = held_.empty() ? now : std::min(now, held_.front().log_time);
+        if (Status st = write(t, sample, log_time); !st) return st.error();
+        ++received_;
+        latched_pending_[index] = false;
+        if (holding_ && !latched_outstanding()) {
+          holding_ = false;
           if (Status st = release_held(); !st) return st.error();
-        } else {
-          if (Status st = write(t, sample, now); !st) return st.error();
-          ++received_;
         }
       }
       if (options_.max_messages > 0 && received_ >= options_.max_messages) return any;
     }
   }
-  // No scene description after kHoldNs (or kHoldBytes held): stop waiting for it (the readers
-  // find it wherever it is).
-  if (scene_pending_ && !held_.empty() &&
-      (wall_ns() - held_.front().log_time > kHoldNs || held_bytes_ > kHoldBytes)) {
-    scene_pending_ = false;
+  // A latched topic that has no publisher any more need not be waited for; none after kHoldNs
+  // (or kHoldBytes held): stop waiting (the readers find latched messages wherever they are).
+  if (holding_ &&
+      (!latched_outstanding() ||
+       (!held_.empty() && (wall_ns() - held_.front().log_time > kHoldNs || held_bytes_ > kHoldBytes)))) {
+    holding_ = false;
     if (Status st = release_held(); !st) return st.error();
   }
   return any;
@@ -159,15 +163,46 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
   const msgs::TopicId id = t.subscription.spec().id;
   if (id == msgs::TopicId::Scene) {
     if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
+  } else if (!t.subscription.spec().per_step) {
+    // latched: no per-step sequence to check for gaps
   } else if (const auto stamp = msgs::decode_stamp(id, sample.cdr)) {
     t.gaps.add(static_cast<std::int64_t>(stamp->sec) * 1'000'000'000 + stamp->nanosec, dt_);
   }
   return Ok{};
 }
 
+bool Recorder::latched_outstanding() const {
+  bool scene_seen = true;
+  for (std::size_t i = 0; i < topics_.size(); ++i) {
+    if (latched_pending_[i] && topics_[i].subscription.spec().id == msgs::TopicId::Scene) scene_seen = false;
+  }
+  for (std::size_t i = 0; i < topics_.size(); ++i) {
+    if (!latched_pending_[i]) continue;
+    // The scene description is always waited for; other latched topics while a node offers them
+    // (or until the scene description came, discovery of their writer having had that long).
+    if (topics_[i].subscription.spec().id == msgs::TopicId::Scene || !scene_seen ||
+        topics_[i].subscription.matched() > 0)
+      return true;
+  }
+  return false;
+}
+
+bool Recorder::scene_pending() const {
+  for (std::size_t i = 0; i < topics_.size(); ++i) {
+    if (latched_pending_[i] && topics_[i].subscription.spec().id == msgs::TopicId::Scene) return true;
+  }
+  return false;
+}
+
 Status Recorder::release_held() {
-  for (Held& h : held_) {
-    if (Status st = write(topics_[h.topic], h.sample, h.log_time); !st) return st;
+  // Latched samples first, at the earliest held log time, so the file stays in log-time order.
+  const std::uint64_t first = held_.empty() ? 0 : held_.front().log_time;
+  for (const bool latched : {true, false}) {
+    for (Held& h : held_) {
+      Topic& t = topics_[h.topic];
+      if (t.subscription.spec().per_step == latched) continue;
+      if (Status st = write(t, h.sample, latched ? first : h.log_time); !st) return st;
+    }
   }
   held_.clear();
   held_bytes_ = 0;

@@ -53,9 +53,9 @@ struct Replay::Impl {
   mcap::IndexedReader reader;
   std::vector<Publisher> publishers;
   std::map<std::uint16_t, std::size_t> route;       // replayed channel id -> publisher index
+  std::set<std::uint16_t> latched_channels;         // replayed channels of latched topics (scene, markers)
   std::map<std::uint16_t, std::size_t> output_of;   // replayed channel id -> index in outputs_
   std::map<std::uint16_t, msgs::TopicId> topic_of;  // replayed channel id -> its topic's id
-  std::set<std::uint16_t> scene_channels;           // replayed channels carrying the scene description
   std::vector<std::string> topics;                  // replayed channel topics (the read filter)
   std::optional<std::size_t> clock_publisher;
   std::size_t wait_publisher = 0;
@@ -151,7 +151,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     auto index = publisher_for(*c.spec, topic);
     if (!index) return index.error();
     im.route.emplace(c.channel->id, index.value());
-    if (c.spec->id == msgs::TopicId::Scene) im.scene_channels.insert(c.channel->id);
+    if (c.spec->transient_local) im.latched_channels.insert(c.channel->id);
     if (c.spec->id == msgs::TopicId::BodyStates && !states_publisher) states_publisher = index.value();
     im.topics.push_back(c.channel->topic);
     std::uint64_t count = 0;
@@ -245,24 +245,24 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
                                   ? mcap::kMaxTime
                                   : first_log_time_ + static_cast<std::uint64_t>(std::llround(offset_ns));
 
-  // The scene description goes first: per scene channel, the last one before the start, or else
-  // the first one of the played part (which is then not sent a second time).
-  std::map<std::uint16_t, mcap::Message> scenes;
+  // The latched topics (scene description, markers) go first: per latched channel, the last
+  // message before the start, or else the first one of the played part (then not sent twice).
+  std::map<std::uint16_t, mcap::Message> latched;
   std::set<std::uint16_t> sent_early;
-  if (!im.scene_channels.empty()) {
+  if (!im.latched_channels.empty()) {
     mcap::ReadMessagesOptions o;
     for (const auto& [id, channel] : im.reader.channels()) {
-      if (im.scene_channels.count(id) > 0) o.topics.push_back(channel.topic);
+      if (im.latched_channels.count(id) > 0) o.topics.push_back(channel.topic);
     }
     auto st = im.reader.read_messages(o, [&](const mcap::MessageEntry& e) {
       const std::uint16_t ch = e.message.channel_id;
-      if (im.scene_channels.count(ch) == 0) return true;
-      if (e.message.log_time < start || scenes.count(ch) == 0) scenes[ch] = e.message;
+      if (im.latched_channels.count(ch) == 0) return true;
+      if (e.message.log_time < start || latched.count(ch) == 0) latched[ch] = e.message;
       // Past the start with one per channel: the rest of the log cannot change the choice.
-      return e.message.log_time < start || scenes.size() < im.scene_channels.size();
+      return e.message.log_time < start || latched.size() < im.latched_channels.size();
     });
     if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
-    for (const auto& [ch, m] : scenes) {
+    for (const auto& [ch, m] : latched) {
       if (stop()) return false;
       if (Status s = im.publishers[im.route.at(ch)].publish(bytes(m.data)); !s) return s.error();
       to_tap(ch, m.log_time, bytes(m.data));
@@ -285,8 +285,8 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     const mcap::Message& m = e.message;
     const auto route = im.route.find(m.channel_id);
     if (route == im.route.end()) return true;  // a channel of the same name we do not replay
-    if (sent_early.count(m.channel_id) > 0 && scenes.at(m.channel_id).log_time == m.log_time &&
-        scenes.at(m.channel_id).sequence == m.sequence) {
+    if (sent_early.count(m.channel_id) > 0 && latched.at(m.channel_id).log_time == m.log_time &&
+        latched.at(m.channel_id).sequence == m.sequence) {
       sent_early.erase(m.channel_id);
       return true;
     }

@@ -6,6 +6,8 @@
 #include "rbsim_msgs/msg/SceneDescription.h"
 #include "rbsim_msgs/msg/SpringStates.h"
 #include "rosgraph_msgs/msg/Clock.h"
+#include "tf2_msgs/msg/TFMessage.h"
+#include "visualization_msgs/msg/Marker.h"
 #include "visualization_msgs/msg/MarkerArray.h"
 
 namespace rbsim::node {
@@ -23,6 +25,10 @@ const dds_topic_descriptor_t* descriptor(msgs::TopicId id) {
       return &geometry_msgs_msg_dds__PoseArray__desc;
     case msgs::TopicId::Markers:
       return &visualization_msgs_msg_dds__MarkerArray__desc;
+    case msgs::TopicId::Tf:
+      return &tf2_msgs_msg_dds__TFMessage__desc;
+    case msgs::TopicId::Springs:
+      return &visualization_msgs_msg_dds__Marker__desc;
     case msgs::TopicId::Clock:
       return &rosgraph_msgs_msg_dds__Clock__desc;
   }

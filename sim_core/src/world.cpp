@@ -9,6 +9,10 @@
 
 namespace rbsim {
 
+const char* version() {
+  return RBSIM_VERSION;
+}
+
 const char* to_string(Integrator integrator) {
   switch (integrator) {
     case Integrator::ExplicitEuler:

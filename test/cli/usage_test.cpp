@@ -66,6 +66,20 @@ INSTANTIATE_TEST_SUITE_P(
         // --duration is simulated time everywhere; a recorder's wall-clock limit has its own name.
         UsageCase{
             {"record", "x.mcap", "--duration", "3"}, "rbsim record: error: --duration", "--wall-duration"},
+        // --topics: an unknown name is named, with the valid ones; checked in the chosen namespace.
+        UsageCase{{"run", "scene.xml", "--record", "x.mcap", "--topics", "body_states,tfs"},
+                  "rbsim run: error: --topics",
+                  "unknown topic \"tfs\" (topics: scene, markers, body_states"},
+        UsageCase{{"run", "scene.xml", "--record", "x.mcap", "--namespace", "a", "--topics", "/rbsim/energy"},
+                  "rbsim run: error: --topics",
+                  "unknown topic \"/rbsim/energy\""},
+        UsageCase{{"run", "scene.xml", "--topics", "tf"},
+                  "rbsim run: error: --topics requires --record",
+                  "--record"},
+        UsageCase{{"node", "scene.xml", "--topics", "poses,bogus"},
+                  "rbsim node: error: --topics",
+                  "unknown topic \"bogus\""},
+        UsageCase{{"node", "scene.xml", "--topics", ","}, "rbsim node: error: --topics", "no topic given"},
         UsageCase{{"log", "cat"}, "rbsim log cat: error:", "file"},
         UsageCase{{"log", "cat", "x.mcap", "--start", "-1"}, "rbsim log cat: error:", "--start"}));
 

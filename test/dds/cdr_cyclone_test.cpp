@@ -244,6 +244,9 @@ void fill_energy(const Scene&, const World& w, void* out) {
   m.kinetic_point = t_point;
   m.kinetic_spin = t_spin;
   m.total = potential + t_point + t_spin;
+  const rbsim::Energy e = w.energy();
+  m.potential_gravity = e.u_gravity;
+  m.potential_spring = e.u_spring;
 }
 
 void fill_poses(const Scene&, const World& w, void* out) {
@@ -255,8 +258,9 @@ void fill_poses(const Scene&, const World& w, void* out) {
 
 // Everything not described by the marker is empty: no texture, mesh, text or per-vertex UVs.
 void marker_defaults(visualization_msgs_msg_dds__Marker_& mk, builtin_interfaces_msg_dds__Time_ stamp,
-                     std::string_view ns, std::int32_t id, std::int32_t type) {
-  set_header(mk.header, stamp, "world");
+                     std::string_view ns, std::int32_t id, std::int32_t type,
+                     std::string_view frame = "world") {
+  set_header(mk.header, stamp, frame);
   mk.ns = str(ns);
   mk.id = id;
   mk.type = type;
@@ -275,42 +279,92 @@ void marker_defaults(visualization_msgs_msg_dds__Marker_& mk, builtin_interfaces
   mk.mesh_use_embedded_materials = false;
 }
 
-// One LINE_STRIP per body: its closed hull outline in body space, placed by the marker pose, line
-// width = the body's rendering diameter. Then one LINE_LIST of all springs (width 0.05, grey),
-// each segment coloured with its spring's colour at both ends.
+// Per body, in its frame "rbsim/body_<i>" (frame-locked): its hull as a TRIANGLE_LIST (scale 1) and
+// its closed outline as a LINE_STRIP of width 2 r, both in the body's colour. Then the fixed spring
+// anchors as one SPHERE_LIST in world (0.15 across), each in its spring's colour.
 void fill_markers(const Scene& s, const World& w, void* out) {
   auto& m = *static_cast<visualization_msgs_msg_dds__MarkerArray_*>(out);
   const auto stamp = stamp_of(w);
-  const bool springs = w.spring_count() > 0;
-  auto* markers = alloc_seq(m.markers, static_cast<std::size_t>(w.body_count()) + (springs ? 1 : 0));
+  std::vector<rbsim::Vec2> anchors;
+  std::vector<rbsim::Color> anchor_colors;
+  for (std::int32_t k = 0; k < w.spring_count(); ++k) {
+    const rbsim::SpringDef& sp = w.spring(rbsim::SpringId{k});
+    if (sp.body_i == rbsim::kFixed)
+      anchors.push_back(sp.anchor_i), anchor_colors.push_back(s.spring_colors[k]);
+    if (sp.body_j == rbsim::kFixed)
+      anchors.push_back(sp.anchor_j), anchor_colors.push_back(s.spring_colors[k]);
+  }
+  const auto n = static_cast<std::size_t>(w.body_count());
+  auto* markers = alloc_seq(m.markers, 2 * n + (anchors.empty() ? 0 : 1));
   for (std::int32_t b = 0; b < w.body_count(); ++b) {
     const rbsim::BodyId id{b};
-    auto& mk = markers[b];
-    marker_defaults(mk, stamp, "bodies", b, visualization_msgs_msg_dds__Marker_Constants_LINE_STRIP);
-    mk.pose = planar_pose(w.x()[b], w.y()[b], w.theta()[b]);
-    mk.scale = {2.0 * w.radius(id), 0.0, 0.0};
-    mk.color = rgba(s.body_colors[static_cast<std::size_t>(b)]);
+    const std::string frame = "rbsim/body_" + std::to_string(b);
     const auto hull = w.hull(id);
-    auto* pts = alloc_seq(mk.points, hull.size() + 1);
+    auto& fill = markers[2 * b];
+    marker_defaults(fill, stamp, "hulls", b, visualization_msgs_msg_dds__Marker_Constants_TRIANGLE_LIST,
+                    frame);
+    fill.pose = planar_pose(0.0, 0.0, 0.0);
+    fill.scale = {1.0, 1.0, 1.0};
+    fill.color = rgba(s.body_colors[static_cast<std::size_t>(b)]);
+    fill.frame_locked = true;
+    const std::vector<std::uint32_t> tri = rbsim::msgs::triangulate(hull);
+    auto* tp = alloc_seq(fill.points, tri.size());
+    for (std::size_t i = 0; i < tri.size(); ++i) tp[i] = point3(hull[tri[i]]);
+    alloc_seq(fill.colors, 0);
+    auto& line = markers[2 * b + 1];
+    marker_defaults(line, stamp, "outlines", b, visualization_msgs_msg_dds__Marker_Constants_LINE_STRIP,
+                    frame);
+    line.pose = planar_pose(0.0, 0.0, 0.0);
+    line.scale = {2.0 * w.radius(id), 0.0, 0.0};
+    line.color = rgba(s.body_colors[static_cast<std::size_t>(b)]);
+    line.frame_locked = true;
+    auto* pts = alloc_seq(line.points, hull.size() + 1);
     for (std::size_t i = 0; i < hull.size(); ++i) pts[i] = point3(hull[i]);
     pts[hull.size()] = point3(hull[0]);
-    alloc_seq(mk.colors, 0);
+    alloc_seq(line.colors, 0);
   }
-  if (springs) {
-    auto& mk = markers[w.body_count()];
-    marker_defaults(mk, stamp, "springs", 0, visualization_msgs_msg_dds__Marker_Constants_LINE_LIST);
+  if (!anchors.empty()) {
+    auto& mk = markers[2 * n];
+    marker_defaults(mk, stamp, "anchors", 0, visualization_msgs_msg_dds__Marker_Constants_SPHERE_LIST);
     mk.pose = planar_pose(0.0, 0.0, 0.0);
-    mk.scale = {0.05, 0.0, 0.0};
+    mk.scale = {0.15, 0.15, 0.15};
     mk.color = rgba(rbsim::Color{0.25, 0.25, 0.25});
-    const auto n = static_cast<std::size_t>(w.spring_count());
-    auto* pts = alloc_seq(mk.points, 2 * n);
-    auto* colors = alloc_seq(mk.colors, 2 * n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const rbsim::SpringState st = w.spring_state(rbsim::SpringId{static_cast<std::int32_t>(k)});
-      pts[2 * k] = point3(st.end_i);
-      pts[2 * k + 1] = point3(st.end_j);
-      colors[2 * k] = colors[2 * k + 1] = rgba(s.spring_colors[k]);
+    auto* pts = alloc_seq(mk.points, anchors.size());
+    auto* colors = alloc_seq(mk.colors, anchors.size());
+    for (std::size_t k = 0; k < anchors.size(); ++k) {
+      pts[k] = point3(anchors[k]);
+      colors[k] = rgba(anchor_colors[k]);
     }
+  }
+}
+
+// One LINE_LIST in world of every spring (width 0.05, grey), each segment in its spring's colour.
+void fill_springs(const Scene& s, const World& w, void* out) {
+  auto& mk = *static_cast<visualization_msgs_msg_dds__Marker_*>(out);
+  marker_defaults(mk, stamp_of(w), "springs", 0, visualization_msgs_msg_dds__Marker_Constants_LINE_LIST);
+  mk.pose = planar_pose(0.0, 0.0, 0.0);
+  mk.scale = {0.05, 0.0, 0.0};
+  mk.color = rgba(rbsim::Color{0.25, 0.25, 0.25});
+  const auto n = static_cast<std::size_t>(w.spring_count());
+  auto* pts = alloc_seq(mk.points, 2 * n);
+  auto* colors = alloc_seq(mk.colors, 2 * n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const rbsim::SpringState st = w.spring_state(rbsim::SpringId{static_cast<std::int32_t>(k)});
+    pts[2 * k] = point3(st.end_i);
+    pts[2 * k + 1] = point3(st.end_j);
+    colors[2 * k] = colors[2 * k + 1] = rgba(s.spring_colors[k]);
+  }
+}
+
+// One TransformStamped per body: world -> rbsim/body_<i>, translation (x, y, 0), rotation theta about z.
+void fill_tf(const Scene&, const World& w, void* out) {
+  auto& m = *static_cast<tf2_msgs_msg_dds__TFMessage_*>(out);
+  auto* ts = alloc_seq(m.transforms, static_cast<std::size_t>(w.body_count()));
+  for (std::int32_t b = 0; b < w.body_count(); ++b) {
+    set_header(ts[b].header, stamp_of(w), "world");
+    ts[b].child_frame_id = str("rbsim/body_" + std::to_string(b));
+    ts[b].transform.translation = {w.x()[b], w.y()[b], 0.0};
+    ts[b].transform.rotation = {0.0, 0.0, std::sin(0.5 * w.theta()[b]), std::cos(0.5 * w.theta()[b])};
   }
 }
 
@@ -331,6 +385,8 @@ const TypeCase kCases[] = {
     {TopicId::Energy, &rbsim_msgs_msg_dds__EnergyTerms__desc, fill_energy},
     {TopicId::Poses, &geometry_msgs_msg_dds__PoseArray__desc, fill_poses},
     {TopicId::Markers, &visualization_msgs_msg_dds__MarkerArray__desc, fill_markers},
+    {TopicId::Tf, &tf2_msgs_msg_dds__TFMessage__desc, fill_tf},
+    {TopicId::Springs, &visualization_msgs_msg_dds__Marker__desc, fill_springs},
     {TopicId::Clock, &rosgraph_msgs_msg_dds__Clock__desc, fill_clock},
 };
 
@@ -544,8 +600,8 @@ TEST_P(CycloneCdr, EncoderBytesEqualCycloneSerialisation) {
   EXPECT_EQ(ours_.size() % 4, 0u);
   for (std::size_t i = ours_.size() - pad; i < ours_.size(); ++i)
     EXPECT_EQ(ours_[i], std::byte{0}) << "pad byte " << i;
-  if (GetParam() == TopicId::Markers) {
-    EXPECT_EQ(pad, 3u);
+  if (GetParam() == TopicId::Markers || GetParam() == TopicId::Springs) {
+    EXPECT_EQ(pad, 3u);  // a Marker ends with a bool
   } else {
     EXPECT_EQ(hex(ours_, 0, 4), "00 01 00 00 ");
   }

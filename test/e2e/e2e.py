@@ -324,10 +324,16 @@ def stamp_of(cdr):
     return struct.unpack_from("<iI", cdr, 4)
 
 
+# What a node publishes by default: the latched scene description and markers, once per run, and
+# six per-step topics.
+LATCHED = ("scene", "markers")
+PER_STEP = ("body_states", "spring_states", "energy", "tf", "springs", "clock")
+
+
 def sim_stamp(suffix, cdr):
     """The simulated time of a per-step message: its header stamp (the clock for /clock; the
-    first marker's, after the sequence length, for markers)."""
-    return struct.unpack_from("<iI", cdr, 8 if suffix == "markers" else 4)
+    first marker's or transform's, after the sequence length, for markers and /tf)."""
+    return struct.unpack_from("<iI", cdr, 8 if suffix in ("markers", "tf") else 4)
 
 
 def step_of(cdr):
@@ -348,10 +354,12 @@ def expect_indexed(ctx, log, count=None):
         ctx.check(len(log.messages) == count, f"{log.path}: {len(log.messages)} messages, want {count}")
 
 
-def same_payloads(ctx, got, want, what, by_suffix=False):
-    """Every topic's payloads equal, message for message."""
+def same_payloads(ctx, got, want, what, by_suffix=False, skip=()):
+    """Every topic's payloads equal, message for message (but the topics named in `skip`)."""
     g = got.by_suffix() if by_suffix else {t: got.payloads(t) for t in got.topics()}
     w = want.by_suffix() if by_suffix else {t: want.payloads(t) for t in want.topics()}
+    g = {t: v for t, v in g.items() if t.rsplit("/", 1)[-1] not in skip}
+    w = {t: v for t, v in w.items() if t.rsplit("/", 1)[-1] not in skip}
     ok = ctx.check(sorted(g) == sorted(w), f"{what}: topics {sorted(g)} != {sorted(w)}")
     for t in sorted(set(g) & set(w)):
         a, b = g[t], w[t]
@@ -416,7 +424,7 @@ def counts_line(proc):
 
 def live_recording(ctx, scene, every, out, tag, env=None, steps_total=None):
     """Recorder first, then the node (--rate 0, --wait-for-subscribers 1): the complete run."""
-    expected = 1 + 6 * (steps_total // every + 1)
+    expected = len(LATCHED) + len(PER_STEP) * (steps_total // every + 1)
     rec = ctx.rb(f"record-{tag}", *record_args(ctx, out, "--max-messages", expected, "--wall-duration", 90), env=env)
     node = ctx.rb(f"node-{tag}", *node_args(ctx, scene, "--rate", 0, "--publish-every", every,
                                             "--wait-for-subscribers", 1), env=env)
@@ -430,6 +438,15 @@ def live_recording(ctx, scene, every, out, tag, env=None, steps_total=None):
     first_in_time = Log(out).messages[0][0]
     ctx.check(first_in_file.endswith("/scene") and first_in_time.endswith("/scene"),
               f"{out}: first message on {first_in_file} (file order), {first_in_time} (log time), want the scene")
+    # The latched markers once, before every per-step message; /tf every published step.
+    in_file = [m[0] for m in read_stream_messages(out)]
+    markers = [i for i, t in enumerate(in_file) if t.endswith("/markers")]
+    per_step = [i for i, t in enumerate(in_file) if t.rsplit("/", 1)[-1] in PER_STEP]
+    ctx.check(len(markers) == 1, f"{out}: {len(markers)} markers messages, want 1 (latched)")
+    ctx.check(bool(markers and per_step) and markers[0] < per_step[0],
+              f"{out}: the markers are not written before the per-step messages")
+    tf = sum(1 for t in in_file if t == "/tf")
+    ctx.check(tf == steps_total // every + 1, f"{out}: {tf} /tf messages, want {steps_total // every + 1}")
     return expected
 
 
@@ -455,7 +472,9 @@ def case_node_record(ctx):
                   f"offered_qos_profiles of {suffix}: live {got.offered(suffix)}, run {want.offered(suffix)}")
     golden = os.path.join(ctx.src, "test", "golden", "airplane.mcap")
     if os.path.exists(golden):
-        same_payloads(ctx, got, Log(golden), "live recording vs golden test/golden/airplane.mcap", by_suffix=True)
+        # /tf and the markers name the body frames in the node's namespace, the golden's in rbsim's.
+        same_payloads(ctx, got, Log(golden), "live recording vs golden test/golden/airplane.mcap", by_suffix=True,
+                      skip=("tf", "markers"))
         gold_run = ctx.path("run-rbsim-ns.mcap")
         ctx.rbrun("run-record-rbsim", "run", scene, "--record", gold_run, "--record-every", every)
         rbsim_check(ctx, gold_run, golden, "check-run-golden", live=False)
@@ -491,9 +510,10 @@ def case_late_recorder(ctx):
     expect_indexed(ctx, got)
     g = got.by_suffix()
     w = want.by_suffix()
-    ctx.check(g.get("scene") == w["scene"], f"late recorder: scene description {len(g.get('scene', []))} messages, "
-                                            f"want the run's one (transient local)")
-    for t in ("body_states", "spring_states", "energy", "poses", "markers", "clock"):
+    for t in LATCHED:
+        ctx.check(g.get(t) == w[t], f"late recorder: {t} {len(g.get(t, []))} messages, want the run's one "
+                                    f"(transient local)")
+    for t in PER_STEP:
         part = g.get(t, [])
         ctx.check(len(part) > 20, f"late recorder: only {len(part)} {t} messages in 2 s")
         ctx.check(contiguous_slice(part, w[t]), f"late recorder: {t} is not a contiguous, byte-equal part of the run")
@@ -578,21 +598,24 @@ def case_replay_options(ctx):
     ctx.check(0.85 <= span <= 1.6, f"replay --rate 2 of 2 s of log: body states spread over {span:.3f} s, want ~1 s")
     ctx.log(f"--rate 2: body states spread over {span:.3f} s of wall time (replay process {wall:.2f} s)")
 
-    # --topics: only the scene description and the body states.
+    # --topics: only the scene description, the markers, the body states and /tf.
     # (with --keep-last 5000, more than the log holds: nothing can be dropped, and the recording
     # says what the replay offered, like rosbag2 records a publisher's QoS)
-    got, _ = replay_into("topics", ("--rate", 0, "--topics", f"body_states,/{ctx.ns}/scene", "--keep-last", 5000))
-    ctx.check(got.offered("body_states") == ("keep_last", "5000") and got.offered("scene") == ("keep_last", "1"),
-              f"replay --keep-last 5000: recorded offers {got.offered('body_states')}, {got.offered('scene')}")
+    got, _ = replay_into("topics", ("--rate", 0, "--topics", f"body_states,/{ctx.ns}/scene,markers,/tf", "--keep-last",
+                                    5000))
+    ctx.check(got.offered("body_states") == ("keep_last", "5000") and got.offered("scene") == ("keep_last", "1")
+              and got.offered("markers") == ("keep_last", "1"),
+              f"replay --keep-last 5000: recorded offers {got.offered('body_states')}, {got.offered('scene')}, "
+              f"{got.offered('markers')}")
     g = got.by_suffix()
-    ctx.check(sorted(g) == ["body_states", "scene"], f"replay --topics: recorded {sorted(g)}")
-    ctx.check(g.get("body_states") == w["body_states"] and g.get("scene") == w["scene"],
+    ctx.check(sorted(g) == ["body_states", "markers", "scene", "tf"], f"replay --topics: recorded {sorted(g)}")
+    ctx.check(all(g.get(t) == w[t] for t in ("body_states", "markers", "scene", "tf")),
               "replay --topics: payloads differ from the log's")
 
     # --namespace: the same payloads under another namespace.
     other = ctx.ns + "_remap"
     got, _ = replay_into("namespace", ("--rate", 0, "--namespace", other), max_messages=n, ns=other)
-    ctx.check(all(t == "/clock" or t.startswith(f"/{other}/") for t in got.topics()),
+    ctx.check(all(t in ("/clock", "/tf") or t.startswith(f"/{other}/") for t in got.topics()),
               f"replay --namespace: topics {got.topics()}")
     same_payloads(ctx, got, want, "replay --namespace", by_suffix=True)
 
@@ -609,7 +632,8 @@ def case_replay_options(ctx):
     g = got.by_suffix()
     ctx.check(bool(got.messages) and first_published(got).endswith("/scene"),
               f"replay --start-offset: first published {first_published(got)}, not the scene")
-    ctx.check(g.get("scene") == w["scene"], "replay --start-offset: scene description missing or different")
+    for t in LATCHED:
+        ctx.check(g.get(t) == w[t], f"replay --start-offset: {t} missing or different")
     steps = [step_of(p) for p in g.get("body_states", [])]
     ctx.check(steps == list(range(1000, 2001, every)), f"replay --start-offset 1: steps {steps[:3]}..{steps[-3:]}")
     ctx.check(g.get("body_states") == w["body_states"][50:], "replay --start-offset: payloads differ")
@@ -635,6 +659,7 @@ def case_replay_options(ctx):
                                                  f"({len(steps)}) are not two passes")
     ctx.check(len(g.get("scene", [])) >= 2, f"replay --loop: {len(g.get('scene', []))} scene descriptions, want one "
                                             f"per pass")
+    ctx.check(len(g.get("markers", [])) >= 2, f"replay --loop: {len(g.get('markers', []))} markers, want one per pass")
     ctx.log(f"--loop: {len(steps) / per_step:.1f} passes recorded in 1.5 s at --rate 10")
 
     # Ctrl-C while waiting for subscribers, and in the middle of a paced replay: exit 0.
@@ -800,8 +825,9 @@ def case_python_subscriber(ctx):
                                    "--domain", str(ctx.domain), "--namespace", ctx.ns, "--count", str(len(steps)),
                                    "--timeout", "60", "--out", out], env=env)
     sub.wait_for_text("READY", 30)
+    # PoseArray is not a default topic: --topics asks for it.
     node = ctx.rb("node", *node_args(ctx, scene, "--rate", 0, "--wait-for-subscribers", 1, "--publish-every", every,
-                                     "--duration", duration), env=env)
+                                     "--duration", duration, "--topics", "body_states,poses"), env=env)
     exited_ok(ctx, node, 60)
     exited_ok(ctx, sub, 60, "Python subscriber")
     states, poses = [], []
@@ -1037,15 +1063,16 @@ def case_netns_link_flap(ctx):
         counts = counts_line(rec)
         ctx.require(counts is not None, f"no counts line from the recorder:\n{rec.stderr()}")
         received, reported_lost = counts
-        # The transient-local scene description is sent again each time the node finds the
-        # recorder again: compare it once.
+        # The transient-local scene description and markers are sent again each time the node finds
+        # the recorder again: compare them once.
         got_by, want_by = got.by_suffix(), want.by_suffix()
-        scenes = got_by.get("scene", [])
-        ctx.check(len(scenes) >= 1 and all(p == want_by["scene"][0] for p in scenes),
-                  f"{len(scenes)} scene descriptions recorded, or one differs from the run's")
+        for latched in LATCHED:
+            again = got_by.get(latched, [])
+            ctx.check(len(again) >= 1 and all(p == want_by[latched][0] for p in again),
+                      f"{len(again)} {latched} messages recorded, or one differs from the run's")
         missing, extra = 0, 0
         for suffix, payloads in want_by.items():
-            if suffix == "scene":
+            if suffix in LATCHED:
                 continue
             have = got_by.get(suffix, [])
             want_steps = {sim_stamp(suffix, p): p for p in payloads}
@@ -1073,7 +1100,7 @@ def case_ros_env(ctx):
     ctx.rbrun("run-record", "run", scene, "--record", run, "--record-every", every, "--namespace", ctx.ns)
     want = Log(run)
     steps = max(step_of(p) for p in want.by_suffix()["body_states"])
-    expected = 1 + 6 * (steps // every + 1)
+    expected = len(LATCHED) + len(PER_STEP) * (steps // every + 1)
     d = str(ctx.domain)
     on_d = dict(ctx.env(), ROS_DOMAIN_ID=d)
     # No --domain: ROS_DOMAIN_ID decides.
@@ -1298,7 +1325,7 @@ def case_soak(ctx):
                         str(seconds)], stdout=f, check=True, timeout=60)
     steps = int(round(seconds / dt))
     published = steps // every + 1
-    expected = 1 + 6 * published
+    expected = len(LATCHED) + len(PER_STEP) * published
     live = ctx.path("live.mcap")
     rec = ctx.rb("record", *record_args(ctx, live, "--wall-duration", seconds + 120, "--max-messages", expected))
     node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--publish-every", every, "--wait-for-subscribers", 1))

@@ -289,16 +289,16 @@ void copy_without(const fs::path& in, const fs::path& out, const std::string& to
 TEST(Check, TopicInOnlyOneFileAndTopicSelection) {
   TempDir tmp;
   const fs::path partial = tmp / "partial.mcap";
-  copy_without(kChainGolden, partial, "/rbsim/markers");
+  copy_without(kChainGolden, partial, "/rbsim/springs");
   Outcome o = rbsim({"check", partial.string(), kChainGolden.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
   EXPECT_TRUE(
-      contains(o.out, "first divergence: topic /rbsim/markers: topic only in the golden (501 messages)"))
+      contains(o.out, "first divergence: topic /rbsim/springs: topic only in the golden (501 messages)"))
       << o;
   o = rbsim({"check", kChainGolden.string(), partial.string()});
   EXPECT_EQ(o.exit_code, 1) << o;
-  EXPECT_TRUE(contains(o.out, "topic /rbsim/markers: topic only in the run")) << o;
-  o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "/rbsim/markers"});
+  EXPECT_TRUE(contains(o.out, "topic /rbsim/springs: topic only in the run")) << o;
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "/rbsim/springs"});
   EXPECT_EQ(o.exit_code, 0) << o;
   o = rbsim(
       {"check", partial.string(), kChainGolden.string(), "--topics", "/rbsim/body_states,/rbsim/energy"});
@@ -311,7 +311,7 @@ TEST(Check, TopicInOnlyOneFileAndTopicSelection) {
   o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "body_states,rbsim/energy,clock"});
   EXPECT_EQ(o.exit_code, 0) << o;
   EXPECT_TRUE(contains(o.out, "3 topics")) << o;
-  o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "markers"});
+  o = rbsim({"check", partial.string(), kChainGolden.string(), "--exclude-topics", "springs"});
   EXPECT_EQ(o.exit_code, 0) << o;
   o = rbsim({"check", partial.string(), kChainGolden.string(), "--topics", "states"});  // not a whole name
   EXPECT_EQ(o.exit_code, 2) << o;
@@ -393,7 +393,9 @@ void copy_joined_late(const fs::path& in, const fs::path& out, std::size_t n) {
   for (const auto& [id, channel] : reader.channels()) ASSERT_TRUE(writer.add_channel(channel).ok());
   std::map<std::string, std::size_t> seen;
   const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
-    if (e.channel->topic == "/rbsim/scene" || seen[e.channel->topic]++ >= n) {
+    // The latched topics reach a late joiner too.
+    if (e.channel->topic == "/rbsim/scene" || e.channel->topic == "/rbsim/markers" ||
+        seen[e.channel->topic]++ >= n) {
       EXPECT_TRUE(writer.write_message(e.message).ok());
     }
     return true;
@@ -416,7 +418,7 @@ TEST(Check, LateJoiningRecordingReportsTheMissingLeadingSteps) {
                         R"(steps 0, 200, \.\.\., 19800 \(100 messages: recorder joined late\?\))")))
       << o;
   for (const char* topic :
-       {"/rbsim/body_states", "/rbsim/spring_states", "/rbsim/energy", "/rbsim/poses", "/rbsim/markers"}) {
+       {"/rbsim/body_states", "/rbsim/spring_states", "/rbsim/energy", "/tf", "/rbsim/springs"}) {
     EXPECT_TRUE(
         contains(o.out, std::string("steps in one file only: ") + topic +
                             ": run lacks steps 0, 200, ..., 19800 (100 messages: recorder joined late?)"))

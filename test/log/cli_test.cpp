@@ -225,7 +225,7 @@ TEST(LogCli, InfoDoctorRecoverOnAGoodRecording) {
 
   Outcome info = rbsim({"log", "info", file});
   EXPECT_EQ(info.exit_code, 0) << describe(info);
-  for (const char* needle : {"profile:     ros2", "messages:    1807", "duration:    0.300000000 s",
+  for (const char* needle : {"profile:     ros2", "messages:    1808", "duration:    0.300000000 s",
                              "compression:", "zstd: [", "/rbsim/body_states", "301 msgs",
                              "rbsim_msgs/msg/BodyStates [ros2msg]", "/clock", "rosgraph_msgs/msg/Clock"}) {
     EXPECT_NE(info.out.find(needle), std::string::npos) << needle << "\n" << info.out;
@@ -239,13 +239,74 @@ TEST(LogCli, InfoDoctorRecoverOnAGoodRecording) {
 
   Outcome recover = rbsim({"log", "recover", file, (dir / "copy.mcap").string()});
   EXPECT_EQ(recover.exit_code, 0) << describe(recover);
-  EXPECT_NE(recover.out.find("kept 1807 messages"), std::string::npos) << recover.out;
+  EXPECT_NE(recover.out.find("kept 1808 messages"), std::string::npos) << recover.out;
   EXPECT_NE(recover.out.find("input intact"), std::string::npos) << recover.out;
   EXPECT_EQ(rbsim({"log", "doctor", (dir / "copy.mcap").string()}).exit_code, 0);
   Outcome same = rbsim({"log", "recover", file, file});
   EXPECT_EQ(same.exit_code, 1);
   EXPECT_NE(same.err.find("is an input of this command; refusing to write over it"), std::string::npos)
       << same.err;
+}
+
+// rbsim run --record --topics: exactly the chosen topics (and the scene description), in every
+// spelling msgs::names_topic understands; the default set has no PoseArray.
+TEST(RecordCli, TopicsChoosesWhatIsRecorded) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/cantilever.xml");
+  const std::string chosen = (dir / "chosen.mcap").string(), all = (dir / "default.mcap").string();
+  Outcome run = rbsim({"run", scene, "-q", "--steps", "20", "--record", chosen, "--namespace", "bots",
+                       "--topics", "poses,/tf,bots/springs"});
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+  Outcome info = rbsim({"log", "info", chosen});
+  ASSERT_EQ(info.exit_code, 0) << describe(info);
+  for (const char* topic : {"/bots/scene ", "/bots/poses ", "/tf ", "/bots/springs "}) {
+    EXPECT_NE(info.out.find(topic), std::string::npos) << topic << "\n" << info.out;
+  }
+  for (const char* topic : {"/bots/body_states", "/bots/markers", "/clock", "/bots/energy"}) {
+    EXPECT_EQ(info.out.find(topic), std::string::npos) << topic << "\n" << info.out;
+  }
+  EXPECT_NE(info.out.find("messages:    64"), std::string::npos) << info.out;  // 1 + 3 x 21
+  run = rbsim({"run", scene, "-q", "--steps", "20", "--record", all});
+  ASSERT_EQ(run.exit_code, 0) << describe(run);
+  info = rbsim({"log", "info", all});
+  EXPECT_EQ(info.out.find("poses"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("/rbsim/markers        1 msgs"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("/tf                   21 msgs"), std::string::npos) << info.out;
+}
+
+// A recording made before the viewer topics (EnergyTerms without the potential split, per-step
+// PoseArray and MarkerArray): every reader still takes it, and export recomputes the split exactly
+// as the run's energy CSV has it.
+TEST(ReadersCli, RecordingsOfTheFormerLayoutStillRead) {
+  TempDir dir;
+  const std::string old = data_path("old-format/airplane-before-viewer-topics.mcap");
+  const std::string scene = source_path("scenes/airplane.xml");
+  Outcome o = rbsim({"log", "export", old, "--energy-csv", (dir / "old.csv").string(), "--csv",
+                     (dir / "old-bodies.csv").string()});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  o = rbsim({"run", scene, "-q", "--energy-csv", (dir / "run.csv").string(), "--csv",
+             (dir / "run-bodies.csv").string()});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_EQ(every_kth_step(read_text(dir / "run.csv"), 100), read_text(dir / "old.csv"));
+  EXPECT_EQ(every_kth_step(read_text(dir / "run-bodies.csv"), 100), read_text(dir / "old-bodies.csv"));
+  o = rbsim({"check", "--verify-golden", scene, old, "--fosssim-dir", data_path("fosssim")});
+  EXPECT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_NE(o.out.find("info markers: the per-step outlines"), std::string::npos) << o.out;
+  o = rbsim({"log", "cat", old, "--topics", "energy", "--end", "0.001"});
+  EXPECT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_EQ(o.out.find("potential_gravity"), std::string::npos) << o.out;
+  o = rbsim({"plot", old, "--out", (dir / "p.png").string()});
+  EXPECT_EQ(o.exit_code, 0) << describe(o);
+  // The new layout: the split is in the message, and export takes it from there.
+  const std::string now = (dir / "now.mcap").string();
+  o = rbsim({"run", scene, "-q", "--steps", "300", "--record", now});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  o = rbsim({"log", "export", now, "--energy-csv", (dir / "now.csv").string()});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  const std::vector<std::string> run_rows = lines_of(read_text(dir / "run.csv"));
+  ASSERT_GT(run_rows.size(), 302u);
+  EXPECT_EQ(lines_of(read_text(dir / "now.csv")),
+            std::vector<std::string>(run_rows.begin(), run_rows.begin() + 302));
 }
 
 // rbsim log cat: one JSON line per message, as many as rbsim log info counts, in log-time order,
@@ -358,7 +419,7 @@ TEST(LogCli, DoctorReportsPlantedStatisticsError) {
   write_bytes(dir / "r.mcap", b);
   Outcome o = rbsim({"log", "doctor", (dir / "r.mcap").string()});
   EXPECT_EQ(o.exit_code, 1) << describe(o);
-  EXPECT_NE(o.out.find("error: Statistics has message count 612, but actual number of messages is 607"),
+  EXPECT_NE(o.out.find("error: Statistics has message count 613, but actual number of messages is 608"),
             std::string::npos)
       << o.out;
   ASSERT_EQ(o.err_lines().size(), 1u) << o.err;

@@ -20,7 +20,7 @@ TEST(Info, RecordingFromItsSummary) {
   EXPECT_FALSE(i.scanned);
   EXPECT_EQ(i.header.profile, "ros2");
   EXPECT_EQ(i.header.library, "rbsim 0.1.0");
-  EXPECT_EQ(i.messages, 1u + 6u * 101u);  // scene once, six per-step topics for steps 0..100
+  EXPECT_EQ(i.messages, 2u + 6u * 101u);  // scene and markers once, six per-step topics for steps 0..100
   EXPECT_EQ(i.start, 0u);
   EXPECT_EQ(i.end, 100'000'000u);  // cantilever: dt = 0.001
   const auto chunks = chunk_message_counts(dir / "r.mcap");
@@ -29,15 +29,17 @@ TEST(Info, RecordingFromItsSummary) {
   EXPECT_EQ(i.compression[0].compression, "zstd");
   EXPECT_EQ(i.compression[0].chunks, chunks.size());
   EXPECT_GT(i.compression[0].uncompressed_bytes, i.compression[0].compressed_bytes);
-  ASSERT_EQ(i.channels.size(), 7u);
-  EXPECT_EQ(i.channels[1].channel.topic, "/rbsim/body_states");
-  EXPECT_EQ(i.channels[1].schema_name, "rbsim_msgs/msg/BodyStates");
-  EXPECT_EQ(i.channels[1].schema_encoding, "ros2msg");
-  EXPECT_EQ(i.channels[1].messages, 101u);
+  ASSERT_EQ(i.channels.size(), 8u);
+  EXPECT_EQ(i.channels[2].channel.topic, "/rbsim/body_states");
+  EXPECT_EQ(i.channels[2].schema_name, "rbsim_msgs/msg/BodyStates");
+  EXPECT_EQ(i.channels[2].schema_encoding, "ros2msg");
+  EXPECT_EQ(i.channels[2].messages, 101u);
   EXPECT_EQ(i.channels[0].messages, 1u);
+  EXPECT_EQ(i.channels[1].channel.topic, "/rbsim/markers");
+  EXPECT_EQ(i.channels[1].messages, 1u);
   const std::string text = mcap_tools::format_info(i);
   for (const char* needle :
-       {"library:     rbsim 0.1.0", "profile:     ros2", "messages:    607", "duration:    0.100000000 s",
+       {"library:     rbsim 0.1.0", "profile:     ros2", "messages:    608", "duration:    0.100000000 s",
         "start:       0.000000000 s", "end:         0.100000000 s", "zstd: [", "/rbsim/energy",
         "rbsim_msgs/msg/EnergyTerms [ros2msg]", "101 msgs (1010.00 Hz)", "attachments: 0", "metadata: 0"}) {
     EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;

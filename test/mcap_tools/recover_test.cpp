@@ -81,8 +81,8 @@ TEST_F(RecoverTest, IntactInputIsCopiedWhole) {
   EXPECT_TRUE(r.value().input_intact);
   EXPECT_EQ(r.value().messages, messages_.size());
   EXPECT_EQ(r.value().chunks, chunks_.size());
-  EXPECT_EQ(r.value().schemas, 7u);
-  EXPECT_EQ(r.value().channels, 7u);
+  EXPECT_EQ(r.value().schemas, 8u);
+  EXPECT_EQ(r.value().channels, 8u);
   EXPECT_EQ(r.value().incomplete_chunks + r.value().corrupt_chunks + r.value().dropped_messages, 0u);
   check_recovered(messages_.size());
 }

@@ -194,8 +194,11 @@ TEST(EncoderEnergy, TotalsMatchWorldEnergy) {
   std::vector<Scalar> v;
   ASSERT_TRUE(decoder_for(TopicId::Energy).decode(out, v).ok());
   const rbsim::Energy e = w->energy();
-  // the last six scalars: momentum.x, momentum.y, angular, potential, kinetic_point, kinetic_spin, total
-  const std::size_t n = v.size();
+  // the scalars at the end: momentum.x, momentum.y, angular, potential, kinetic_point, kinetic_spin,
+  // total, potential_gravity, potential_spring
+  const std::size_t n = v.size() - 2;
+  EXPECT_EQ(v[n].f, e.u_gravity);  // the world's own sums, bit for bit
+  EXPECT_EQ(v[n + 1].f, e.u_spring);
   EXPECT_NEAR(v[n - 4].f, e.potential(), 1e-12 * std::abs(e.potential()) + 1e-15);
   EXPECT_DOUBLE_EQ(v[n - 3].f, e.t_point);
   EXPECT_DOUBLE_EQ(v[n - 2].f, e.t_spin);
@@ -235,7 +238,8 @@ TEST(EncoderMarkersAndScene, DecodeCleanly) {
   enc.markers(w.value(), out);
   std::vector<Scalar> v;
   ASSERT_TRUE(decoder_for(TopicId::Markers).decode(out, v).ok());
-  EXPECT_EQ(v[0].u, 4u);  // three hull outlines and one spring list
+  // three hulls filled and outlined, and the fixed spring anchors
+  EXPECT_EQ(v[0].u, 7u);
 }
 
 // Little-endian CDR written by hand, aligned as CDR aligns (relative to the end of the header).
@@ -434,7 +438,8 @@ TEST(DecodeTyped, SpringStatesEnergyTermsAndPosesAgreeWithTheSchemaDecoder) {
     v.push_back(double(energy.forces.size()));
     for (const auto& f : energy.forces) v.insert(v.end(), {double(f.kind), double(f.index), f.potential});
     v.insert(v.end(), {energy.momentum.x(), energy.momentum.y(), energy.angular_momentum, energy.potential,
-                       energy.kinetic_point, energy.kinetic_spin, energy.total});
+                       energy.kinetic_point, energy.kinetic_spin, energy.total, energy.potential_gravity,
+                       energy.potential_spring});
     expect_same(TopicId::Energy, out, v);
   }
   for (std::size_t n = 0; n < out.size() - 3; ++n)
@@ -476,7 +481,8 @@ TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {
     ASSERT_TRUE(got.has_value()) << spec.suffix;
     EXPECT_EQ(got->sec, want.sec) << spec.suffix;
     EXPECT_EQ(got->nanosec, want.nanosec) << spec.suffix;
-    const std::size_t header = spec.id == TopicId::Markers ? 16 : 12;  // encapsulation, [length,] stamp
+    const std::size_t header =
+        spec.id == TopicId::Markers || spec.id == TopicId::Tf ? 16 : 12;  // encapsulation, [length,] stamp
     EXPECT_FALSE(rbsim::msgs::decode_stamp(spec.id, std::span(out).first(header - 1)).has_value())
         << spec.suffix;
   }

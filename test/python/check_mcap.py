@@ -11,10 +11,11 @@ in one run, then reads the recording with the official Python `mcap` reader (CRC
     LocalMessageDefinitionSource::get_full_text() over tools/msgs/definitions;
   * every message of every topic decodes, and the decoded values equal the run's own outputs:
     body states and per-body energy terms bit-exact against the CSV (shortest round-trip decimals)
-    and the FOSSSim binary, totals against the energy CSV, PoseArray against x, y, theta, /clock
-    and all stamps against step * dt, the scene description's masses and inertias against the
-    FOSSSim constants block;
-  * message counts per topic (steps + 1 per-step topics, 1 scene description; fewer with
+    and the FOSSSim binary, totals against the energy CSV, /tf against x, y, theta, the springs
+    marker against the spring states, /clock and all stamps against step * dt, the scene
+    description's masses and inertias against the FOSSSim constants block, the latched markers'
+    hulls (triangle areas), outlines and anchors against the scene description;
+  * message counts per topic (steps + 1 per-step topics, 1 scene description and markers; fewer with
     --record-every), sequence numbers, the Statistics record, data-section and summary CRCs;
   * the indexed (seeking) reader's topic / time-range queries return exactly the right subset.
 
@@ -107,8 +108,9 @@ TOPICS = {
     "/rbsim/body_states": ("rbsim_msgs/msg/BodyStates", False, True),
     "/rbsim/spring_states": ("rbsim_msgs/msg/SpringStates", False, True),
     "/rbsim/energy": ("rbsim_msgs/msg/EnergyTerms", False, True),
-    "/rbsim/poses": ("geometry_msgs/msg/PoseArray", False, True),
-    "/rbsim/markers": ("visualization_msgs/msg/MarkerArray", False, True),
+    "/rbsim/markers": ("visualization_msgs/msg/MarkerArray", True, False),
+    "/tf": ("tf2_msgs/msg/TFMessage", False, True),
+    "/rbsim/springs": ("visualization_msgs/msg/Marker", False, True),
     "/clock": ("rosgraph_msgs/msg/Clock", False, True),
 }
 
@@ -537,6 +539,10 @@ def main() -> int:
                         spr += f.potential
                 c.equal(grav, tot["U_gravity"], "gravity potentials == energy CSV U_gravity", f"step {step}")
                 c.equal(spr, tot["U_spring"], "spring potentials == energy CSV U_spring", f"step {step}")
+                c.equal(msg.potential_gravity, tot["U_gravity"], "energy potential_gravity == energy CSV U_gravity",
+                        f"step {step}")
+                c.equal(msg.potential_spring, tot["U_spring"], "energy potential_spring == energy CSV U_spring",
+                        f"step {step}")
                 # U and E add the same terms in another order: equal up to rounding.
                 scale = 1e-13 * (abs(grav) + abs(spr) + abs(msg.kinetic_point) + abs(msg.kinetic_spin) + 1.0)
                 c.close(msg.potential, tot["U"], "energy potential == energy CSV U", f"step {step}", rel=0, abs_=scale)
@@ -548,21 +554,19 @@ def main() -> int:
                     [(0, g) for g in range(n_gravity)] + [(1, k) for k in range(n_springs)], "energy forces",
                     f"step {step}")
 
-        m, msg = by_step.get("/rbsim/poses", {}).get(step, (None, None))
-        if c.check(msg is not None, "missing message", f"/rbsim/poses step {step}"):
-            stamp_ok("/rbsim/poses", step, m, msg.header.stamp)
-            c.equal(len(msg.poses), bodies, "poses count", f"step {step}")
-            for b, p in enumerate(msg.poses[:bodies]):
-                x, y, theta = rows_k[b][2:5]
-                c.equal((p.position.x, p.position.y, p.position.z), (x, y, 0.0), "pose position == CSV x, y",
+        m, msg = by_step.get("/tf", {}).get(step, (None, None))
+        if c.check(msg is not None, "missing message", f"/tf step {step}"):
+            c.equal(len(msg.transforms), bodies, "tf count", f"step {step}")
+            for b, t in enumerate(msg.transforms[:bodies]):
+                stamp_ok("/tf", step, m, t.header.stamp)
+                c.equal((t.header.frame_id, t.child_frame_id), ("world", f"rbsim/body_{b}"), "tf frames",
                         f"step {step} body {b}")
-                q = p.orientation
+                x, y, theta = rows_k[b][2:5]
+                tr, q = t.transform.translation, t.transform.rotation
+                c.equal((tr.x, tr.y, tr.z), (x, y, 0.0), "tf translation == CSV x, y", f"step {step} body {b}")
                 # Rotation theta about +z: (0, 0, sin(theta/2), cos(theta/2)), same libm as rbsim.
                 c.equal((q.x, q.y, q.z, q.w), (0.0, 0.0, math.sin(0.5 * theta), math.cos(0.5 * theta)),
-                        "pose orientation == theta", f"step {step} body {b} theta {theta!r}")
-                back = 2.0 * math.atan2(q.z, q.w)
-                c.close(math.remainder(back - theta, 2 * math.pi), 0.0, "pose orientation encodes theta",
-                        f"step {step} body {b}", abs_=1e-9)
+                        "tf rotation == theta", f"step {step} body {b} theta {theta!r}")
 
         m, msg = by_step.get("/clock", {}).get(step, (None, None))
         if c.check(msg is not None, "missing message", f"/clock step {step}"):
@@ -599,39 +603,56 @@ def main() -> int:
                     c.equal(energy_msg.forces[n_gravity + k].potential, st.potential,
                             "energy spring potential == spring_states", f"step {step} spring {k}")
 
-        m, msg = by_step.get("/rbsim/markers", {}).get(step, (None, None))
-        if c.check(msg is not None, "missing message", f"/rbsim/markers step {step}"):
-            c.equal(len(msg.markers), bodies + (1 if n_springs else 0), "marker count", f"step {step}")
-            for b, mk in enumerate(msg.markers[:bodies]):
-                body = scene.bodies[b]
-                stamp_ok("/rbsim/markers", step, m, mk.header.stamp)
-                c.equal((mk.ns, mk.id, mk.type, mk.action, mk.header.frame_id), ("bodies", b, 4, 0, "world"),
-                        "body marker", f"step {step} marker {b}")
-                pose = by_step.get("/rbsim/poses", {}).get(step, (None, None))[1]
-                if pose is not None and b < len(pose.poses):
-                    p, q = pose.poses[b], mk.pose
-                    c.equal((q.position.x, q.position.y, q.position.z, q.orientation.x, q.orientation.y,
-                             q.orientation.z, q.orientation.w),
-                            (p.position.x, p.position.y, p.position.z, p.orientation.x, p.orientation.y,
-                             p.orientation.z, p.orientation.w), "body marker pose == PoseArray", f"step {step} body {b}")
-                c.equal(mk.scale.x, 2.0 * body.radius, "body marker width == 2 r", f"step {step} body {b}")
+        m, mk = by_step.get("/rbsim/springs", {}).get(step, (None, None))
+        if c.check(mk is not None, "missing message", f"/rbsim/springs step {step}") and springs_msg is not None:
+            stamp_ok("/rbsim/springs", step, m, mk.header.stamp)
+            c.equal((mk.ns, mk.id, mk.type, mk.action, mk.header.frame_id), ("springs", 0, 5, 0, "world"),
+                    "spring marker", f"step {step}")
+            want = []
+            for st in springs_msg.springs:
+                want += [(st.end_i.x, st.end_i.y, 0.0), (st.end_j.x, st.end_j.y, 0.0)]
+            c.equal([(pt.x, pt.y, pt.z) for pt in mk.points], want, "spring marker points == spring_states ends",
+                    f"step {step}")
+            colours = []
+            for sp in scene.springs:
+                colours += [(sp.color.r, sp.color.g, sp.color.b, sp.color.a)] * 2
+            c.equal([(cl.r, cl.g, cl.b, cl.a) for cl in mk.colors], colours, "spring marker colours", f"step {step}")
+
+    # --- The latched markers, once at step 0: per body its hull filled (TRIANGLE_LIST, triangle areas
+    # summing to the hull's) and outlined (closed LINE_STRIP of width 2 r) in its frame; fixed anchors.
+    markers = decoded.get("/rbsim/markers", [])
+    if markers:
+        m, msg = markers[0]
+        c.equal(m.log_time, 0, "markers log_time")
+        anchors = []
+        for sp in scene.springs:
+            for body, a in ((sp.body_i, sp.anchor_i), (sp.body_j, sp.anchor_j)):
+                if body < 0:
+                    anchors.append((a.x, a.y, 0.0))
+        c.equal(len(msg.markers), 2 * bodies + (1 if anchors else 0), "marker count")
+        for b, body in enumerate(scene.bodies[: len(msg.markers) // 2]):
+            fill, line = msg.markers[2 * b], msg.markers[2 * b + 1]
+            for mk in (fill, line):
+                c.equal((mk.header.frame_id, mk.frame_locked, mk.lifetime.sec, mk.lifetime.nanosec),
+                        (f"rbsim/body_{b}", True, 0, 0), "body marker frame", f"body {b}")
                 c.equal((mk.color.r, mk.color.g, mk.color.b, mk.color.a),
                         (body.color.r, body.color.g, body.color.b, body.color.a), "body marker colour", f"body {b}")
-                hull = [(v.x, v.y, 0.0) for v in body.hull]
-                c.equal([(pt.x, pt.y, pt.z) for pt in mk.points], hull + hull[:1], "body marker outline == hull",
-                        f"step {step} body {b}")
-            if n_springs and len(msg.markers) > bodies and springs_msg is not None:
-                mk = msg.markers[bodies]
-                c.equal((mk.ns, mk.id, mk.type, mk.action), ("springs", 0, 5, 0), "spring marker", f"step {step}")
-                want = []
-                for st in springs_msg.springs:
-                    want += [(st.end_i.x, st.end_i.y, 0.0), (st.end_j.x, st.end_j.y, 0.0)]
-                c.equal([(pt.x, pt.y, pt.z) for pt in mk.points], want, "spring marker points == spring_states ends",
-                        f"step {step}")
-                colours = []
-                for sp in scene.springs:
-                    colours += [(sp.color.r, sp.color.g, sp.color.b, sp.color.a)] * 2
-                c.equal([(cl.r, cl.g, cl.b, cl.a) for cl in mk.colors], colours, "spring marker colours", f"step {step}")
+            hull = [(v.x, v.y) for v in body.hull]
+            area = abs(sum(hull[i][0] * hull[(i + 1) % len(hull)][1] - hull[(i + 1) % len(hull)][0] * hull[i][1]
+                           for i in range(len(hull)))) / 2
+            pts = [(p.x, p.y) for p in fill.points]
+            tiles = sum(((p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0])) / 2
+                        for p0, p1, p2 in zip(pts[0::3], pts[1::3], pts[2::3]))
+            c.equal(fill.type, 11, "hull marker type", f"body {b}")
+            c.close(tiles, area, "hull triangles' area == hull area", f"body {b}", rel=1e-9, abs_=1e-15)
+            c.equal(line.type, 4, "outline marker type", f"body {b}")
+            c.equal(line.scale.x, 2.0 * body.radius, "outline width == 2 r", f"body {b}")
+            c.equal([(p.x, p.y, p.z) for p in line.points], [(x, y, 0.0) for x, y in hull + hull[:1]],
+                    "outline == hull", f"body {b}")
+        if anchors and len(msg.markers) == 2 * bodies + 1:
+            mk = msg.markers[-1]
+            c.equal((mk.type, mk.header.frame_id), (7, "world"), "anchor marker")
+            c.equal([(p.x, p.y, p.z) for p in mk.points], anchors, "anchor marker points == fixed spring ends")
 
     # --- Indexed reader queries: topic and time-range views against the full decode.
     def view(topics=None, **bounds):
@@ -661,7 +682,7 @@ def main() -> int:
             "indexed view: single topic, starting_after", one)
     c.check(view(["/rbsim/scene"]) == [x for x in full if x[0] == "/rbsim/scene"], "indexed view: scene only", "")
     c.equal(view(None, starting_at=lo, ending_before=lo), [], "indexed view: empty range")
-    c.equal(view(["/rbsim/markers"], starting_at=ts[-1] + 1), [], "indexed view: after the end")
+    c.equal(view(["/rbsim/springs"], starting_at=ts[-1] + 1), [], "indexed view: after the end")
     # Every message at the first recorded time after step 0 (all per-step topics, no scene).
     if len(ts) > 1:
         got = view(None, starting_at=ts[1], ending_at=ts[1])

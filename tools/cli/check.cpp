@@ -29,45 +29,6 @@ int fail(const std::string& message) {
   return kError;
 }
 
-std::string g(double v, const char* format = "%.3g") {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
-
-void print_table(const check::CheckReport& r, bool all_fields) {
-  std::size_t topic_w = 5, field_w = 5;
-  std::size_t identical = 0;
-  std::vector<const check::FieldStats*> rows;
-  for (const check::FieldStats& f : r.fields) {
-    if (!all_fields && f.max_abs == 0.0 && f.over == 0) {
-      ++identical;
-      continue;
-    }
-    rows.push_back(&f);
-    topic_w = std::max(topic_w, f.topic.size());
-    field_w = std::max(field_w, f.field.size());
-  }
-  std::printf("per-field max error (run - golden, array indices collapsed):\n");
-  if (!rows.empty()) {
-    std::printf("  %-*s  %-*s  %-6s  %10s  %10s  %10s  %12s  %10s\n", static_cast<int>(topic_w), "topic",
-                static_cast<int>(field_w), "field", "kind", "values", "max |diff|", "max rel", "at",
-                "over tol");
-    for (const check::FieldStats* f : rows) {
-      const std::string at =
-          f->max_abs == 0.0 ? "-" : (f->has_step ? "step " : "msg ") + std::to_string(f->step_at_max);
-      std::printf("  %-*s  %-*s  %-6s  %10llu  %10s  %10s  %12s  %10llu\n", static_cast<int>(topic_w),
-                  f->topic.c_str(), static_cast<int>(field_w), f->field.c_str(), f->kind.c_str(),
-                  static_cast<unsigned long long>(f->values), g(f->max_abs).c_str(), g(f->max_rel).c_str(),
-                  at.c_str(), static_cast<unsigned long long>(f->over));
-    }
-  }
-  if (identical > 0) {
-    std::printf("  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical,
-                identical == 1 ? "" : "s", all_fields || rows.empty() ? "" : " (--all-fields lists them)");
-  }
-}
-
 int compare(const CheckArgs& a) {
   const std::string& run = a.files[0];
   const std::string& golden = a.files[1];
@@ -75,34 +36,11 @@ int compare(const CheckArgs& a) {
   Result<check::CheckReport> result = check::check_logs(run, golden, a.options);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!result) return fail(result.error().message);
-  const check::CheckReport& r = result.value();
-  std::printf("rbsim check: %s vs golden %s (atol %s, rtol %s): %s\n", run.c_str(), golden.c_str(),
-              g(a.options.atol, "%g").c_str(), g(a.options.rtol, "%g").c_str(),
-              r.passed() ? "MATCH" : "DIVERGED");
-  if (r.first) std::printf("first divergence: %s\n", r.first->line().c_str());
-  for (const std::string& p : r.topic_problems) std::printf("topic difference: %s\n", p.c_str());
-  for (const std::string& p : r.step_problems) std::printf("steps in one file only: %s\n", p.c_str());
-  if (!r.metadata.empty()) {
-    std::printf("metadata differs (%s):\n",
-                a.options.strict_metadata ? "a divergence with --strict-metadata"
-                                          : "not physics, reported only; --strict-metadata fails on it");
-    for (const check::MetadataDifference& m : r.metadata) std::printf("  %s\n", m.line().c_str());
-  }
-  print_table(r, a.all_fields);
-  const double mb = static_cast<double>(r.run_bytes + r.golden_bytes) / 1e6;
-  std::printf("%zu topic%s, %llu message pair%s, %s MB of message data in %s s (%s MB/s)", r.topics.size(),
-              r.topics.size() == 1 ? "" : "s", static_cast<unsigned long long>(r.messages),
-              r.messages == 1 ? "" : "s", g(mb).c_str(), g(wall).c_str(),
-              g(wall > 0 ? mb / wall : 0.0).c_str());
-  if (!r.passed() && (r.diverging_values > 0 || r.one_file_messages == 0)) {
-    std::printf("; %llu values in %llu messages differ", static_cast<unsigned long long>(r.diverging_values),
-                static_cast<unsigned long long>(r.diverging_messages - r.one_file_messages));
-  }
-  if (r.one_file_messages > 0) {
-    std::printf("; %llu messages in one file only", static_cast<unsigned long long>(r.one_file_messages));
-  }
-  std::printf("\n");
-  return r.passed() ? kMatch : kDiverged;
+  check::ReportFormat format;
+  format.all_fields = a.all_fields;
+  format.wall_seconds = wall;
+  std::fputs(check::format_report(run, golden, a.options, result.value(), format).c_str(), stdout);
+  return result->passed() ? kMatch : kDiverged;
 }
 
 int verify(const CheckArgs& a) {

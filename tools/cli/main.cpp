@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rbsim/core.hpp"
 
 namespace {
 
@@ -39,7 +40,7 @@ int usage_error(CLI::App* command, const std::string& what) {
 
 int main(int argc, char** argv) {
   CLI::App app{"rbsim: 2D rigid-body simulator for FOSSSim scenes", "rbsim"};
-  app.set_version_flag("--version", "rbsim 0.1.0");
+  app.set_version_flag("--version", std::string("rbsim ") + rbsim::version());
   app.require_subcommand(1);
   app.footer(
       "Run 'rbsim <command> --help' (or 'rbsim help <command>') for a command's options.\n"

@@ -20,6 +20,7 @@ struct NodeArgs {
   bool allow_nonfinite = false;
   std::int32_t wait_for = 0;
   bool quiet = false;
+  std::string topics;
   std::optional<std::string> foxglove;  // [ADDR:]PORT
 };
 
@@ -46,6 +47,8 @@ int node_command(const NodeArgs& a) {
   if (a.foxglove) {
     foxglove::SinkOptions fo;
     fo.publish_every = a.node.publish_every;
+    fo.topics = a.node.topics;
+    fo.ns = a.node.ns;
     std::vector<foxglove::ChannelId> ids;
     auto channels = foxglove::ros2_channels(fo.topics, a.node.ns, &ids);
     if (!channels) return fail(channels.error().message);
@@ -57,7 +60,7 @@ int node_command(const NodeArgs& a) {
   install_stop_handlers();
   if (!a.quiet) {
     std::fprintf(stderr,
-                 "rbsim node: %s on domain %u, topics under /%s (and /clock), rate %s, %lld steps%s\n",
+                 "rbsim node: %s on domain %u, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
                  scene.name.c_str(), a.node.domain, a.node.ns.c_str(),
                  a.node.rate > 0 ? (std::to_string(a.node.rate) + "x").c_str() : "as fast as possible",
                  static_cast<long long>(steps), a.loop ? ", looping" : "");
@@ -133,22 +136,21 @@ Subcommand add_node_command(CLI::App& parent) {
                   "Per-step writers keep the last N samples instead of all: the node never waits for a slow "
                   "subscriber, which may then lose samples (ROS 2's default profile is keep last 10)")
       ->check(positive());
+  add_topics_option(app, a->topics, a->node.ns, a->node.topics, "Topics to publish (DDS and --foxglove)");
   add_foxglove_option(app, a->foxglove);
   app->add_flag("-q,--quiet", a->quiet,
                 "No start and end lines (--foxglove's listening line is always printed)");
   app->footer(
       "Topics (DDS name rt/<namespace>/<name>, type pkg::msg::dds_::Name_, CDR): scene "
-      "(rbsim_msgs/SceneDescription, reliable, transient local, keep last 1: late joiners get it), "
-      "body_states, "
-      "spring_states, energy, poses (geometry_msgs/PoseArray), markers (visualization_msgs/MarkerArray) and "
-      "/clock "
-      "(rosgraph_msgs/Clock), all reliable, volatile, keep all: a slow subscriber slows the node down rather "
-      "than "
-      "losing samples (--keep-last N trades that for a node that never waits).\n"
-      "--foxglove serves the same topics (but the PoseArray) to Foxglove beside DDS: encoding cdr, ros2msg "
-      "schemas "
-      "as in MCAP, log time = simulated time; a client that falls behind loses the oldest per-step messages "
-      "(never the latched scene), one that stops reading is disconnected.\n"
+      "(rbsim_msgs/SceneDescription) and markers (visualization_msgs/MarkerArray: body shapes in their "
+      "frames), reliable, transient local, keep last 1: late joiners get them; body_states, spring_states, "
+      "energy, /tf (tf2_msgs/TFMessage: world -> <namespace>/body_<i>), springs (visualization_msgs/Marker), "
+      "/clock (rosgraph_msgs/Clock) and, with --topics, poses (geometry_msgs/PoseArray), all reliable, "
+      "volatile, keep all: a slow subscriber slows the node down rather than losing samples (--keep-last N "
+      "trades that for a node that never waits).\n"
+      "--foxglove serves the same topics to Foxglove beside DDS: encoding cdr, ros2msg schemas as in MCAP, "
+      "log time = simulated time; a client that falls behind loses the oldest per-step messages (never the "
+      "latched scene and markers), one that stops reading is disconnected.\n"
       "Exit status: 0 done, or stopped by Ctrl-C/SIGTERM (cleanly); 1 error (bad scene, DDS failure, "
       "divergence, --foxglove port in use); 2 usage error.");
   return {app, [a] { return node_command(*a); }};

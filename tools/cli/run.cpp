@@ -27,6 +27,8 @@ struct RunOptions {
   std::string compression = "zstd";
   int compression_level = 0;
   std::string ns = "rbsim";
+  std::string topics;                                 // --topics LIST
+  msgs::TopicSet topic_set = msgs::default_topics();  // what --topics chose
   std::string frames, size = "1280x720";
   double fps = 24.0;
   std::string progress = "auto";
@@ -72,6 +74,7 @@ int run(const RunOptions& o) {
     log::RecordOptions ro;
     ro.every = o.record_every;
     ro.ns = o.ns;
+    ro.topics = o.topic_set;
     const Result<mcap::Compression> codec = compression_option(o.compression, o.compression_level);
     if (!codec) return fail(codec.error().message);
     ro.compression = codec.value();
@@ -153,8 +156,8 @@ Subcommand add_run_command(CLI::App& parent) {
                   "with the reference solver's");
   auto* record = app->add_option(
       "--record", o->record,
-      "Record every topic (scene description once, then body states, spring states, energy terms, "
-      "PoseArray, MarkerArray and /clock per step) to an MCAP file in the rosbag2 layout");
+      "Record the topics (scene description and markers once, then body states, spring states, energy "
+      "terms, /tf, springs and /clock per step; --topics chooses) to an MCAP file in the rosbag2 layout");
   // Options of one output need that output: given alone they would be silently ignored.
   app->add_option("--record-every", o->record_every, "Record every k-th step (step 0 always)")
       ->check(positive())
@@ -172,6 +175,7 @@ Subcommand add_run_command(CLI::App& parent) {
       ->check(ros_namespace())
       ->default_str("rbsim")
       ->needs(record);
+  add_topics_option(app, o->topics, o->ns, o->topic_set, "Topics to record")->needs(record);
   auto* frames =
       app->add_option("--frames", o->frames,
                       "Draw PNG frames into this folder during the run, as rbsim render draws them: "

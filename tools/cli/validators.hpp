@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "rbsim/msgs.hpp"
+
 namespace rbsim::cli {
 
 // A number at least `min` (strictly above it when `strict`). A value that is not a number passes
@@ -61,6 +63,25 @@ inline CLI::Validator ros_namespace() {
         return {};
       },
       "NAMESPACE");
+}
+
+// --topics LIST (msgs::parse_topic_set) on `app`, checked once the command line is parsed, so full
+// names may use the namespace `ns` holds by then; a bad list is a usage error naming the topic.
+// `out` keeps its default (msgs::default_topics()) when the option is not given.
+inline CLI::Option* add_topics_option(CLI::App* app, std::string& list, const std::string& ns,
+                                      msgs::TopicSet& out, const std::string& what) {
+  CLI::Option* opt = app->add_option("--topics", list,
+                                     what +
+                                         ", comma-separated: scene (always), markers, body_states, "
+                                         "spring_states, energy, tf, springs, clock, poses; default all "
+                                         "but poses");
+  app->parse_complete_callback([opt, &list, &ns, &out] {
+    if (opt->count() == 0) return;
+    Result<msgs::TopicSet> set = msgs::parse_topic_set(list, ns);
+    if (!set) throw CLI::ValidationError("--topics", set.error().message);
+    out = set.value();
+  });
+  return opt;
 }
 
 inline CLI::Validator non_negative() {

@@ -94,7 +94,8 @@ class Subscription {
   // Takes one sample if there is one.
   bool take(Received& out);
   std::int32_t reader() const { return reader_; }
-  std::uint64_t lost() const;  // samples DDS reports lost or rejected
+  std::uint64_t lost() const;    // samples DDS reports lost or rejected
+  std::int32_t matched() const;  // publications currently matched
   const std::string& ros_topic() const { return ros_topic_; }
   const msgs::TopicSpec& spec() const { return *spec_; }
 

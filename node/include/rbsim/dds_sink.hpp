@@ -18,9 +18,10 @@ struct NodeOptions {
   double rate = 1.0;               // real-time factor; 0: as fast as possible
   std::int64_t publish_every = 1;  // publish every k-th step; create() refuses < 1
   std::int32_t keep_last = 0;      // per-step writers keep last N instead of keep all (0)
+  msgs::TopicSet topics = msgs::default_topics();
 };
-// Publishes the scene description at begin() and the per-step topics on every k-th step,
-// pacing steps to wall time by `rate`.
+// Publishes the selected latched topics (scene description, markers: transient local) at begin()
+// and the selected per-step topics on every k-th step, pacing steps to wall time by `rate`.
 class DdsSink final : public Sink {
  public:
   static Result<std::unique_ptr<DdsSink>> create(const Participant& participant, const NodeOptions& options);
@@ -29,7 +30,8 @@ class DdsSink final : public Sink {
   // Waits (bounded) until subscribers acknowledged everything, so nothing in flight is lost
   // when the node exits.
   Status finish() override;
-  // Waits until `count` subscriptions match the body-state topic; false when `stop` turned true.
+  // Waits until `count` subscriptions match the first selected per-step topic (body states by
+  // default); false when `stop` turned true.
   bool wait_for_subscribers(std::int32_t count, bool (*stop)());
   // Restarts the pacing clock (e.g. when --loop starts the scene again).
   void restart_clock();
@@ -39,7 +41,8 @@ class DdsSink final : public Sink {
   DdsSink() = default;
   Status publish(msgs::TopicId id, const World& world);
   NodeOptions options_;
-  std::vector<std::optional<Publisher>> publishers_;  // by TopicId
+  std::vector<std::optional<Publisher>> publishers_;  // by TopicId; empty when not selected
+  std::vector<msgs::TopicId> ids_;                    // the selected topics, latched first
   std::unique_ptr<msgs::Encoder> encoder_;
   msgs::Bytes buffer_;
   std::int64_t start_ns_ = 0;  // monotonic clock at the paced step

@@ -81,10 +81,13 @@ class Recorder {
   std::uint64_t received_ = 0;
   double dt_ = 0.0;  // from the scene description; 0 until it arrives
 
-  // The scene description is written first, whatever order discovery delivers the topics in:
-  // per-step samples that arrive before it are held (at most kHoldNs of wall time and kHoldBytes
-  // of payload), then written after it. Its log time is then that of the first held sample, so the file stays
-  // in log-time order.
+  // The latched topics (scene description, markers) are written first, whatever order discovery
+  // delivers the topics in: per-step samples that arrive before them are held (at most kHoldNs of
+  // wall time and kHoldBytes of payload), then written after them, the scene description first.
+  // Held samples wait for the scene description, and for the markers only while a publisher of
+  // them is matched (a node run with
+  // --topics may not publish them). A latched sample written while samples are held takes the log
+  // time of the first held one, so the file stays in log-time order.
   static constexpr std::uint64_t kHoldNs = 3'000'000'000;
   static constexpr std::uint64_t kHoldBytes = std::uint64_t{64} << 20;
   std::uint64_t held_bytes_ = 0;
@@ -93,7 +96,10 @@ class Recorder {
     Received sample;
     std::uint64_t log_time;
   };
-  bool scene_pending_ = false;  // the scene topic is recorded and nothing came on it yet
+  bool holding_ = false;               // a latched topic is recorded and has not delivered yet
+  std::vector<bool> latched_pending_;  // per topics_ entry: latched, nothing came on it yet
+  [[nodiscard]] bool latched_outstanding() const;
+  [[nodiscard]] bool scene_pending() const;
   std::vector<Held> held_;
   [[nodiscard]] Status write(Topic& topic, const Received& sample, std::uint64_t log_time);
   [[nodiscard]] Status release_held();

@@ -20,6 +20,10 @@
 
 namespace rbsim {
 
+// rbsim's version, "MAJOR.MINOR.PATCH": project(VERSION) in the top-level CMakeLists.txt, the one
+// place it is set (rbsim --version, the MCAP header's library string, the packages).
+const char* version();
+
 using Vec2 = Eigen::Vector2d;
 
 // ---------------------------------------------------------------------------------------------

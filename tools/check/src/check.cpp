@@ -223,8 +223,46 @@ struct Side {
   std::uint64_t ordinal = 0, bytes = 0, consumed = 0;
   bool done = false;
   double dt = 0.0;  // from the first scene description (0: none, messages pair by position)
+  std::optional<msgs::SceneMessage> scene;  // the first scene description, when it decodes
   mcap::Header header;
 };
+
+// Why two scene descriptions are not the same scene, or "" when they are: a different structure
+// (bodies, hull vertex counts, which bodies each spring joins, force fields, integrator). Values
+// (masses, vertex positions, stiffnesses, dt) are left to the field comparison and its tolerance:
+// a perturbed run of the same scene is compared value by value.
+std::string scene_difference(const msgs::SceneMessage& golden, const msgs::SceneMessage& run) {
+  const auto counts = [](const std::string& what, std::size_t g, std::size_t r) {
+    return what + ": golden " + std::to_string(g) + ", run " + std::to_string(r);
+  };
+  if (golden.bodies.size() != run.bodies.size())
+    return counts("bodies", golden.bodies.size(), run.bodies.size());
+  if (golden.springs.size() != run.springs.size())
+    return counts("springs", golden.springs.size(), run.springs.size());
+  if (golden.gravity.size() != run.gravity.size())
+    return counts("gravity fields", golden.gravity.size(), run.gravity.size());
+  if (golden.winds.size() != run.winds.size())
+    return counts("wind fields", golden.winds.size(), run.winds.size());
+  if (golden.integrator != run.integrator) {
+    return "integrator: golden '" + golden.integrator + "', run '" + run.integrator + "'";
+  }
+  for (std::size_t i = 0; i < golden.bodies.size(); ++i) {
+    if (golden.bodies[i].hull.size() != run.bodies[i].hull.size()) {
+      return counts("hull vertices of body " + std::to_string(i), golden.bodies[i].hull.size(),
+                    run.bodies[i].hull.size());
+    }
+  }
+  const auto end = [](std::int32_t b) { return b == kFixed ? std::string("fixed") : std::to_string(b); };
+  for (std::size_t i = 0; i < golden.springs.size(); ++i) {
+    const SpringDef& g = golden.springs[i];
+    const SpringDef& r = run.springs[i];
+    if (g.body_i != r.body_i || g.body_j != r.body_j) {
+      return "spring " + std::to_string(i) + " joins bodies " + end(g.body_i) + "-" + end(g.body_j) +
+             " in the golden, " + end(r.body_i) + "-" + end(r.body_j) + " in the run";
+    }
+  }
+  return "";
+}
 
 std::string with_path(const Side& s, const std::string& what) {
   return s.role + " log " + s.path + ": " + what;
@@ -258,6 +296,20 @@ class Comparer {
         d.topic_level = true;
         d.field = "(" + report_.metadata.back().line() + ")";
         consider(Key{0, problem_ordinal_++}, std::move(d));
+      }
+    }
+    if (side_[kRun].scene && side_[kGolden].scene) {
+      // Recordings of two different scenes differ in nearly every value; one line says why.
+      const std::string why = scene_difference(*side_[kGolden].scene, *side_[kRun].scene);
+      if (!why.empty()) {
+        report_.scene_mismatch = "the run and the golden record different scenes (golden " +
+                                 quoted(side_[kGolden].scene->name) + ", run " +
+                                 quoted(side_[kRun].scene->name) + "): " + why;
+        Divergence d;
+        d.topic_level = true;
+        d.field = "(" + report_.scene_mismatch + ")";
+        consider(Key{0, problem_ordinal_++}, std::move(d));
+        return std::move(report_);
       }
     }
     while (!side_[kRun].done || !side_[kGolden].done) {
@@ -314,6 +366,7 @@ class Comparer {
     const mcap::Status st = index.read_messages(options, [&](const mcap::MessageEntry& e) {
       Result<msgs::SceneMessage> scene = msgs::decode_scene(cdr(e.message.data));
       if (scene && std::isfinite(scene->dt) && scene->dt > 0.0) s.dt = scene->dt;
+      if (scene) s.scene = std::move(scene.value());
       return false;
     });
     if (!st.ok()) return Error{with_path(s, describe(st))};

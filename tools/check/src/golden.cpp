@@ -66,6 +66,9 @@ struct GoldenLog {
   TopicMessages<msgs::SpringStatesMessage> springs;
   TopicMessages<msgs::EnergyTermsMessage> energy;
   TopicMessages<msgs::PosesMessage> poses;
+  TopicMessages<msgs::TfMessage> tf;
+  TopicMessages<msgs::MarkerMessage> springs_marker;
+  TopicMessages<std::vector<msgs::MarkerMessage>> markers;  // latched: one expected
 };
 
 Result<GoldenLog> read_log(const std::string& path) {
@@ -92,41 +95,73 @@ Result<GoldenLog> read_log(const std::string& path) {
 
   mcap::IndexedReader reader;
   if (auto st = reader.open(path); !st.ok()) return Error{path + ": " + st.message};
+  // The topics the recording reader does not join, decoded here: poses, /tf, springs, markers.
   std::map<std::uint16_t, msgs::TopicId> route;
+  std::map<msgs::TopicId, std::string> extra;
   for (const log::RecordedChannel& c : log::recorded_channels(reader)) {
-    if (c.spec->id == msgs::TopicId::Scene && c.channel->topic == r.topic(msgs::TopicId::Scene)) {
+    const msgs::TopicId id = c.spec->id;
+    if (id == msgs::TopicId::Scene && c.channel->topic == r.topic(msgs::TopicId::Scene)) {
       route.emplace(c.channel->id, msgs::TopicId::Scene);
-    } else if (c.spec->id == msgs::TopicId::Poses && c.problem.empty()) {
-      if (!g.poses.topic.empty() && g.poses.topic != c.channel->topic) {
-        return Error{path + ": two topics carry " + std::string(c.spec->type) + ": " + g.poses.topic +
-                     " and " + c.channel->topic};
+    } else if ((id == msgs::TopicId::Poses || id == msgs::TopicId::Tf || id == msgs::TopicId::Springs ||
+                id == msgs::TopicId::Markers) &&
+               c.problem.empty()) {
+      std::string& topic = extra[id];
+      if (!topic.empty() && topic != c.channel->topic) {
+        return Error{path + ": two topics carry " + std::string(c.spec->type) + ": " + topic + " and " +
+                     c.channel->topic};
       }
-      g.poses.topic = c.channel->topic;
-      route.emplace(c.channel->id, msgs::TopicId::Poses);
+      topic = c.channel->topic;
+      route.emplace(c.channel->id, id);
     }
   }
+  g.poses.topic = extra[msgs::TopicId::Poses];
+  g.tf.topic = extra[msgs::TopicId::Tf];
+  g.springs_marker.topic = extra[msgs::TopicId::Springs];
+  g.markers.topic = extra[msgs::TopicId::Markers];
   mcap::ReadMessagesOptions o;
-  for (const std::string& t : {r.topic(msgs::TopicId::Scene), g.poses.topic}) {
+  for (const std::string& t :
+       {r.topic(msgs::TopicId::Scene), g.poses.topic, g.tf.topic, g.springs_marker.topic, g.markers.topic}) {
     if (!t.empty()) o.topics.push_back(t);
   }
   if (o.topics.empty()) return g;
   std::optional<Error> failure;
   msgs::PosesMessage poses;
+  msgs::TfMessage tf;
+  msgs::MarkerMessage marker;
+  std::vector<msgs::MarkerMessage> markers;
   auto st = reader.read_messages(o, [&](const mcap::MessageEntry& e) {
     const auto it = route.find(e.message.channel_id);
     if (it == route.end()) return true;
-    if (it->second == msgs::TopicId::Scene) {
-      if (g.scene_messages++ == 0) g.scene_log_time = e.message.log_time;
-      return true;
+    const auto cdr = std::as_bytes(std::span<const std::uint8_t>(e.message.data));
+    const auto decoded = [&](Status d, const std::string& topic, std::size_t n) {
+      if (!d)
+        failure = Error{path + ": " + topic + " message " + std::to_string(n) + ": " + d.error().message};
+      return static_cast<bool>(d);
+    };
+    switch (it->second) {
+      case msgs::TopicId::Scene:
+        if (g.scene_messages++ == 0) g.scene_log_time = e.message.log_time;
+        return true;
+      case msgs::TopicId::Poses:
+        if (!decoded(msgs::decode_poses(cdr, poses), g.poses.topic, g.poses.messages.size())) return false;
+        g.poses.add(poses, e.message.log_time);
+        return true;
+      case msgs::TopicId::Tf:
+        if (!decoded(msgs::decode_tf(cdr, tf), g.tf.topic, g.tf.messages.size())) return false;
+        g.tf.add(tf, e.message.log_time);
+        return true;
+      case msgs::TopicId::Springs:
+        if (!decoded(msgs::decode_marker(cdr, marker), g.springs_marker.topic,
+                     g.springs_marker.messages.size()))
+          return false;
+        g.springs_marker.add(marker, e.message.log_time);
+        return true;
+      default:
+        if (!decoded(msgs::decode_marker_array(cdr, markers), g.markers.topic, g.markers.messages.size()))
+          return false;
+        g.markers.add(markers, e.message.log_time);
+        return true;
     }
-    if (Status d = msgs::decode_poses(std::as_bytes(std::span<const std::uint8_t>(e.message.data)), poses);
-        !d) {
-      failure = Error{path + ": " + g.poses.topic + " message " + std::to_string(g.poses.messages.size()) +
-                      ": " + d.error().message};
-      return false;
-    }
-    g.poses.add(poses, e.message.log_time);
-    return true;
   });
   if (!st.ok()) return Error{path + ": " + st.message};
   if (failure) return *failure;
@@ -465,6 +500,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   const auto& springs = golden.springs;
   const auto& energy = golden.energy;
   const bool poses = !golden.poses.messages.empty();
+  const bool tf = !golden.tf.messages.empty();
+  const bool springs_marker = !golden.springs_marker.messages.empty();
 
   // 1. The recorded scene description against the scene file.
   {
@@ -612,7 +649,7 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       tally.add(sec * 1e9 + nsec, static_cast<double>(ns), 0.0,
                 [&] { return "step " + std::to_string(steps[m]) + " header stamp"; });
     }
-    if (!steps.empty() &&
+    if (options.whole_run && !steps.empty() &&
         (steps.back() > static_cast<std::uint64_t>(v.steps) ||
          static_cast<std::uint64_t>(v.steps) - steps.back() >= std::max<std::uint64_t>(K, 1))) {
       tally.fail("the recording ends at step " + std::to_string(steps.back()) + ", the scene runs " +
@@ -631,6 +668,8 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     for (const auto& msg : springs.messages) others[0].steps.push_back(msg.step);
     for (const auto& msg : energy.messages) others[1].steps.push_back(msg.step);
     if (poses) others.push_back({golden.poses.topic, golden.poses.log_time, {}});
+    if (tf) others.push_back({golden.tf.topic, golden.tf.log_time, {}});
+    if (springs_marker) others.push_back({golden.springs_marker.topic, golden.springs_marker.log_time, {}});
     for (const Other& t : others) {
       if (t.log_time.size() != states.messages.size()) {
         tally.fail(t.topic + " has " + std::to_string(t.log_time.size()) + " messages, " + states.topic +
@@ -671,7 +710,10 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
   for (const State& s : state) terms.push_back(terms_of(model, s));
   {
     const double rtol = options.recompute_rtol;
-    Tally e, sp, po;
+    Tally e, sp, po, tfs, spm;
+    // Body frames are "<namespace>/body_<i>", the namespace that of the body-state topic.
+    std::string ns = states.topic.substr(0, states.topic.rfind('/'));
+    if (!ns.empty()) ns.erase(0, 1);
     for (std::size_t m = 0; m < state.size(); ++m) {
       const Terms& t = terms[m];
       const std::string at = "step " + std::to_string(steps[m]);
@@ -706,6 +748,16 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       near(e, en.kinetic_point, t.kinetic_point, "kinetic_point");
       near(e, en.kinetic_spin, t.kinetic_spin, "kinetic_spin");
       near(e, en.total, t.total, "total");
+      if (en.has_split) {
+        double ug = 0.0, us = 0.0;
+        for (std::size_t i = 0; i < t.force_potential.size(); ++i) {
+          (i < model.gravity.size() ? ug : us) += t.force_potential[i];
+        }
+        near(e, en.potential_gravity, ug, "potential_gravity");
+        near(e, en.potential_spring, us, "potential_spring");
+        near(e, en.potential_gravity + en.potential_spring, t.potential,
+             "potential_gravity + potential_spring");
+      }
       std::vector<double> ex, ey, fx, fy, len, rest, pot;
       for (std::size_t k = 0; k < t.springs.size(); ++k) {
         ex.push_back(t.springs[k].end_i.x());
@@ -738,6 +790,54 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
         each(po, field(ps, [](const Pose& p) { return p.qz; }), "poses[].orientation.z", qz);
         each(po, field(ps, [](const Pose& p) { return p.qw; }), "poses[].orientation.w", qw);
       }
+      if (tf) {
+        using T = msgs::TfMessage::Transform;
+        const auto& ts = golden.tf.messages[m].transforms;
+        std::vector<double> qz, qw, zero(bodies, 0.0);
+        for (std::size_t b = 0; b < bodies; ++b) {
+          qz.push_back(std::sin(0.5 * state[m].theta[b]));
+          qw.push_back(std::cos(0.5 * state[m].theta[b]));
+        }
+        each(tfs, field(ts, [](const T& x) { return x.x; }), "transforms[].translation.x", state[m].x);
+        each(tfs, field(ts, [](const T& x) { return x.y; }), "transforms[].translation.y", state[m].y);
+        each(tfs, field(ts, [](const T& x) { return x.z; }), "transforms[].translation.z", zero);
+        each(tfs, field(ts, [](const T& x) { return x.qx; }), "transforms[].rotation.x", zero);
+        each(tfs, field(ts, [](const T& x) { return x.qy; }), "transforms[].rotation.y", zero);
+        each(tfs, field(ts, [](const T& x) { return x.qz; }), "transforms[].rotation.z", qz);
+        each(tfs, field(ts, [](const T& x) { return x.qw; }), "transforms[].rotation.w", qw);
+        const auto& stamp = states.messages[m].stamp;
+        for (std::size_t b = 0; b < ts.size(); ++b) {
+          const std::string frame = (ns.empty() ? "" : ns + "/") + "body_" + std::to_string(b);
+          if (ts[b].frame_id != "world" || ts[b].child_frame_id != frame || ts[b].stamp.sec != stamp.sec ||
+              ts[b].stamp.nanosec != stamp.nanosec) {
+            tfs.fail(at + " transforms[" + std::to_string(b) + "]: " + ts[b].frame_id + " -> " +
+                     ts[b].child_frame_id + ", expected world -> " + frame + " at the body states' stamp");
+            break;
+          }
+        }
+      }
+      if (springs_marker) {
+        const msgs::MarkerMessage& mk = golden.springs_marker.messages[m];
+        std::vector<double> px, py, want_x, want_y, cr, want_cr;
+        for (const Vec2& p : mk.points) {
+          px.push_back(p.x());
+          py.push_back(p.y());
+        }
+        for (std::size_t k = 0; k < t.springs.size(); ++k) {
+          want_x.insert(want_x.end(), {t.springs[k].end_i.x(), t.springs[k].end_j.x()});
+          want_y.insert(want_y.end(), {t.springs[k].end_i.y(), t.springs[k].end_j.y()});
+          const Color c = k < desc.spring_colors.size() ? desc.spring_colors[k] : Color{};
+          for (int end = 0; end < 2; ++end) want_cr.insert(want_cr.end(), {c.r, c.g, c.b});
+        }
+        for (const auto& c : mk.colors) cr.insert(cr.end(), {c[0], c[1], c[2]});
+        each(spm, px, "points[].x", want_x);
+        each(spm, py, "points[].y", want_y);
+        each(spm, cr, "colors[].rgb", want_cr);
+        if (mk.type != msgs::kMarkerLineList || mk.frame_id != "world") {
+          spm.fail(at + ": springs marker of type " + std::to_string(mk.type) + " in frame " + mk.frame_id +
+                   ", expected a LINE_LIST in world");
+        }
+      }
     }
     const std::string tol = " (tolerance " + g3(rtol) + " x max(1, |value|))";
     r.line(e.ok(),
@@ -747,6 +847,116 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     r.line(sp.ok(), "spring states: endpoints, lengths and potentials recomputed from the recorded poses" +
                         tol + ": " + sp.summary());
     if (poses) r.line(po.ok(), "poses: positions and orientation quaternions" + tol + ": " + po.summary());
+    if (tf) {
+      r.line(tfs.ok(), "tf: world -> body frame transforms equal to the recorded body states" + tol + ": " +
+                           tfs.summary());
+    }
+    if (springs_marker) {
+      r.line(spm.ok(), "springs marker: line ends recomputed from the recorded states, scene colours" + tol +
+                           ": " + spm.summary());
+    }
+  }
+  // The latched markers: sent once, at step 0; per body its hull filled with counter-clockwise
+  // triangles that tile it (areas summing to the hull's, each centroid inside the hull) and its
+  // closed outline, in the body's frame and colour; the fixed spring anchors in world.
+  const bool old_markers = !golden.markers.messages.empty() && !golden.markers.messages[0].empty() &&
+                           !golden.markers.messages[0][0].frame_locked;
+  if (old_markers) {
+    r.info("markers: the per-step outlines of recordings made before the latched markers, not verified");
+  } else if (!golden.markers.messages.empty()) {
+    Tally tally;
+    std::string ns = states.topic.substr(0, states.topic.rfind('/'));
+    if (!ns.empty()) ns.erase(0, 1);
+    if (golden.markers.messages.size() != 1 || golden.markers.log_time[0] != 0) {
+      tally.fail("expected one MarkerArray at log time 0, found " +
+                 std::to_string(golden.markers.messages.size()));
+    }
+    const auto& ms = golden.markers.messages[0];
+    std::vector<Vec2> anchors;
+    for (const SpringDef& sp : model.springs) {
+      if (sp.body_i == kFixed) anchors.push_back(sp.anchor_i);
+      if (sp.body_j == kFixed) anchors.push_back(sp.anchor_j);
+    }
+    const std::size_t want = 2 * bodies + (anchors.empty() ? 0 : 1);
+    if (ms.size() != want) {
+      tally.fail(std::to_string(ms.size()) + " markers, expected " + std::to_string(want));
+    } else {
+      const auto cross = [](const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); };
+      for (std::size_t b = 0; b < bodies; ++b) {
+        const std::string id = "body " + std::to_string(b);
+        const std::vector<Vec2>& hull = model.body_hull[b];
+        const std::string frame = (ns.empty() ? "" : ns + "/") + "body_" + std::to_string(b);
+        const msgs::MarkerMessage& fill = ms[2 * b];
+        const msgs::MarkerMessage& line = ms[2 * b + 1];
+        const Color c = desc.bodies[b].color;
+        for (const msgs::MarkerMessage* mk : {&fill, &line}) {
+          if (mk->frame_id != frame || !mk->frame_locked || mk->lifetime.sec != 0 ||
+              mk->lifetime.nanosec != 0 || mk->color[0] != static_cast<float>(c.r) ||
+              mk->color[1] != static_cast<float>(c.g) || mk->color[2] != static_cast<float>(c.b)) {
+            tally.fail(id + ": marker in frame '" + mk->frame_id + "', expected '" + frame +
+                       "', frame-locked, lifetime 0, the body's colour");
+          }
+        }
+        double area = 0.0, tiles = 0.0;
+        for (std::size_t k = 0; k < hull.size(); ++k)
+          area += 0.5 * cross(hull[k], hull[(k + 1) % hull.size()]);
+        const auto inside = [&](const Vec2& q) {  // winding number of the hull around q
+          int wn = 0;
+          for (std::size_t k = 0; k < hull.size(); ++k) {
+            const Vec2& a = hull[k];
+            const Vec2& e = hull[(k + 1) % hull.size()];
+            const double side = cross(e - a, q - a);
+            if (a.y() <= q.y() && e.y() > q.y() && side > 0) ++wn;
+            if (a.y() > q.y() && e.y() <= q.y() && side < 0) --wn;
+          }
+          return wn != 0;
+        };
+        if (fill.type != msgs::kMarkerTriangleList || fill.points.size() % 3 != 0) {
+          tally.fail(id + ": hull marker is not a TRIANGLE_LIST");
+          continue;
+        }
+        for (std::size_t k = 0; k + 2 < fill.points.size(); k += 3) {
+          const Vec2 &p0 = fill.points[k], &p1 = fill.points[k + 1], &p2 = fill.points[k + 2];
+          const double a = 0.5 * cross(p1 - p0, p2 - p0);
+          if (a < 0.0) tally.fail(id + ": triangle " + std::to_string(k / 3) + " is clockwise");
+          if (!inside((p0 + p1 + p2) / 3.0))
+            tally.fail(id + ": triangle " + std::to_string(k / 3) + " lies outside the hull");
+          tiles += a;
+        }
+        tally.add(tiles, std::fabs(area), 1e-9 * std::max(1e-12, std::fabs(area)),
+                  [&] { return id + " filled area"; });
+        std::vector<Vec2> outline = hull;
+        if (!hull.empty()) outline.push_back(hull.front());
+        if (line.type != msgs::kMarkerLineStrip || line.points.size() != outline.size()) {
+          tally.fail(id + ": outline is not the closed hull as a LINE_STRIP");
+          continue;
+        }
+        for (std::size_t k = 0; k < outline.size(); ++k) {
+          const double tol = 1e-12 * std::max(1.0, outline[k].norm());
+          tally.add(line.points[k].x(), outline[k].x(), tol, [&] { return id + " outline x"; });
+          tally.add(line.points[k].y(), outline[k].y(), tol, [&] { return id + " outline y"; });
+        }
+        tally.add(line.scale_x, 2.0 * desc.bodies[b].radius, 0.0, [&] { return id + " outline width"; });
+      }
+      if (!anchors.empty()) {
+        const msgs::MarkerMessage& a = ms.back();
+        if (a.frame_id != "world" || a.points.size() != anchors.size()) {
+          tally.fail("spring anchors: " + std::to_string(a.points.size()) + " in '" + a.frame_id +
+                     "', expected " + std::to_string(anchors.size()) + " in world");
+        } else {
+          for (std::size_t k = 0; k < anchors.size(); ++k) {
+            tally.add(a.points[k].x(), anchors[k].x(), 0.0,
+                      [&] { return "anchor " + std::to_string(k) + " x"; });
+            tally.add(a.points[k].y(), anchors[k].y(), 0.0,
+                      [&] { return "anchor " + std::to_string(k) + " y"; });
+          }
+        }
+      }
+    }
+    r.line(tally.ok(), "markers: once at step 0, " + std::to_string(bodies) +
+                           " hulls tiled by counter-clockwise triangles inside them (areas summing to the "
+                           "hull's), closed outlines of width 2 r, body frames and colours, " +
+                           std::to_string(anchors.size()) + " fixed anchors: " + tally.summary());
   }
 
   // 4. The dynamics, re-integrated independently: from each recorded state, K steps of the

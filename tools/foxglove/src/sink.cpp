@@ -55,7 +55,7 @@ void FoxgloveSink::publish(const msgs::TopicSpec& spec, const World& world) {
 }
 
 Status FoxgloveSink::begin(const Scene& scene, const World& world) {
-  encoder_ = std::make_unique<msgs::Encoder>(scene);
+  encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
   start_ns_ = monotonic_ns();
   start_step_ = world.step_index();
   server_->new_session();

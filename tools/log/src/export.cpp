@@ -6,12 +6,13 @@
 //  - x..omega from BodyStates and px..T_spin from EnergyTerms.bodies: copies of the world's values;
 //  - T_point, T_spin, px, py, L: EnergyTerms totals, World::energy() and World::totals(), which
 //    the energy CSV prints too;
-//  - U_spring: the SPRING entries of EnergyTerms.forces summed from 0 in spring order, as
-//    World::energy() does;
-//  - U_gravity: World::energy() keeps one running sum over every gravity field, EnergyTerms one
-//    per field. With at most one field they are the same number; with more, U_gravity is
-//    recomputed from SceneDescription (masses, accelerations) and BodyStates (x, y) with
-//    World::energy()'s expression (the build never contracts to FMA: -ffp-contract=off);
+//  - U_gravity, U_spring: EnergyTerms.potential_gravity / potential_spring, World::energy()'s.
+//    Recordings made before those fields existed: U_spring is the SPRING entries of
+//    EnergyTerms.forces summed from 0 in spring order, as World::energy() does; U_gravity, where
+//    World::energy() keeps one running sum over every gravity field and EnergyTerms one per field,
+//    is the one field's entry, or with several recomputed from SceneDescription (masses,
+//    accelerations) and BodyStates (x, y) with World::energy()'s expression (bit-exact only
+//    because the build never contracts to FMA: -ffp-contract=off);
 //  - U = U_gravity + U_spring, T = T_point + T_spin, E = U + T: Energy's own formulas (the
 //    recorded potential and total associate differently, so they are not used).
 #include "rbsim/export.hpp"
@@ -59,7 +60,8 @@ class Exporter {
   // One step's rows; the reader has checked the messages against the scene description.
   Status write(const RecordedStep& d) {
     const msgs::SceneMessage& s = *scene_;
-    const bool need_states = csv_.is_open() || (energy_.is_open() && s.gravity.size() > 1);
+    const bool need_states = csv_.is_open() || (energy_.is_open() && s.gravity.size() > 1 &&
+                                                d.energy != nullptr && !d.energy->has_split);
     if ((need_states && d.body_states == nullptr) || d.energy == nullptr) {
       report_.warnings.push_back("step " + std::to_string(d.step) + ": no " +
                                  std::string(d.energy != nullptr ? "BodyStates" : "EnergyTerms") +
@@ -82,7 +84,9 @@ class Exporter {
     if (energy_.is_open()) {
       constexpr auto kGravity = static_cast<std::uint8_t>(msgs::EnergyTermsMessage::ForceKind::Gravity);
       double u_gravity = 0.0;
-      if (s.gravity.size() == 1) {
+      if (en.has_split) {
+        u_gravity = en.potential_gravity;
+      } else if (s.gravity.size() == 1) {
         for (const auto& f : en.forces) {
           if (f.kind == kGravity) {
             u_gravity = f.potential;
@@ -98,9 +102,11 @@ class Exporter {
           }
         }
       }
-      double u_spring = 0.0;
-      for (const auto& f : en.forces) {
-        if (f.kind != kGravity) u_spring += f.potential;
+      double u_spring = en.potential_spring;
+      if (!en.has_split) {
+        for (const auto& f : en.forces) {
+          if (f.kind != kGravity) u_spring += f.potential;
+        }
       }
       Energy e;
       e.u_gravity = u_gravity;

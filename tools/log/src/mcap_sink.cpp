@@ -18,23 +18,20 @@ Error fail(const std::string& path, const mcap::Status& st) {
 
 class McapSink final : public Sink {
  public:
-  McapSink(std::string path, RecordOptions options) : path_(std::move(path)), options_(std::move(options)) {
-    if (options_.topics.empty()) {
-      for (const auto& t : msgs::topics()) options_.topics.push_back(t.id);
-    }
-  }
+  McapSink(std::string path, RecordOptions options)
+      : path_(std::move(path)), options_(std::move(options)), ids_(msgs::topic_ids(options_.topics)) {}
 
   Status begin(const Scene& scene, const World& world) override {
     if (options_.every < 1) {
       return Error{path_ + ": record every " + std::to_string(options_.every) + " steps: must be at least 1"};
     }
-    encoder_ = std::make_unique<msgs::Encoder>(scene);
+    encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
     if (auto st = writer_.open(
             path_, writer_options(options_.compression, options_.chunk_size, options_.compression_level));
         !st.ok()) {
       return fail(path_, st);
     }
-    for (msgs::TopicId id : options_.topics) {
+    for (msgs::TopicId id : ids_) {
       auto channel = add_topic(writer_, msgs::topic(id), options_.ns);
       if (!channel.ok()) return fail(path_, channel.status());
       channels_[static_cast<std::size_t>(id)] = channel.value();
@@ -55,7 +52,7 @@ class McapSink final : public Sink {
  private:
   Status record(const World& world, bool first) {
     const mcap::Timestamp t = msgs::sim_time_ns(world);
-    for (msgs::TopicId id : options_.topics) {
+    for (msgs::TopicId id : ids_) {  // in topics() order: the latched ones first
       const msgs::TopicSpec& spec = msgs::topic(id);
       if (!spec.per_step && !first) continue;
       encoder_->encode(id, world, buffer_);
@@ -69,6 +66,7 @@ class McapSink final : public Sink {
 
   std::string path_;
   RecordOptions options_;
+  std::vector<msgs::TopicId> ids_;  // the selected topics
   mcap::Writer writer_;
   std::unique_ptr<msgs::Encoder> encoder_;
   std::array<std::uint16_t, msgs::kTopicCount> channels_{};
@@ -82,7 +80,7 @@ mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t 
                                    int compression_level) {
   mcap::WriterOptions o;
   o.profile = "ros2";
-  o.library = "rbsim 0.1.0";
+  o.library = std::string("rbsim ") + version();
   o.compression = compression;
   o.compression_level = compression_level;
   o.chunk_size = chunk_size;

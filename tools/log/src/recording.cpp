@@ -51,8 +51,14 @@ std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader
     const std::string type(spec->type);
     Result<std::string> ours = msgs::ros2msg_schema(type);
     const mcap::Bytes& theirs = schema->second.data;
+    const std::string_view text(reinterpret_cast<const char*>(theirs.data()), theirs.size());
+    const auto energy_version = spec->id == msgs::TopicId::Energy && schema->second.encoding == "ros2msg"
+                                    ? msgs::energy_terms_version(text)
+                                    : std::nullopt;
     if (channel.message_encoding != "cdr") {
       c.problem = "message encoding \"" + channel.message_encoding + "\", not cdr";
+    } else if (energy_version) {
+      c.energy_version = *energy_version;
     } else if (!ours || schema->second.encoding != "ros2msg" ||
                std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) !=
                    ours.value()) {
@@ -70,8 +76,9 @@ struct Recording::Impl {
   std::optional<msgs::SceneMessage> scene;
   std::array<std::string, msgs::kTopicCount> topics;
   std::map<std::uint16_t, msgs::TopicId> route;  // channel id -> the topic it carries
-  std::array<bool, kPerStep.size()> read{};      // decoded and joined
-  std::array<bool, kPerStep.size()> present{};   // read and in the file: a step waits for them
+  msgs::EnergyTermsVersion energy_version = msgs::EnergyTermsVersion::Current;
+  std::array<bool, kPerStep.size()> read{};     // decoded and joined
+  std::array<bool, kPerStep.size()> present{};  // read and in the file: a step waits for them
 
   // Steps not passed on yet, by increasing step; spare slots keep their storage for reuse.
   std::vector<std::unique_ptr<Slot>> pending, spare;
@@ -99,6 +106,7 @@ struct Recording::Impl {
       }
       topic = c.channel->topic;
       route.emplace(c.channel->id, id);
+      if (id == msgs::TopicId::Energy) energy_version = c.energy_version;
       if (i >= 0) present[static_cast<std::size_t>(i)] = true;
     }
     return Ok{};
@@ -172,7 +180,7 @@ struct Recording::Impl {
         step = scratch_springs.step;
         break;
       default:
-        decoded = msgs::decode_energy_terms(cdr, scratch_energy);
+        decoded = msgs::decode_energy_terms(cdr, scratch_energy, energy_version);
         step = scratch_energy.step;
         break;
     }

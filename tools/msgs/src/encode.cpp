@@ -1,5 +1,7 @@
 // World snapshot -> CDR messages (the adapters between sim_core and every output).
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "cdr.hpp"
 #include "rbsim/msgs.hpp"
@@ -10,6 +12,10 @@ using detail::CdrWriter;
 
 namespace {
 constexpr std::string_view kFrame = "world";
+// Springs are drawn as lines of this width (m) and their fixed anchors as spheres of this
+// diameter: scene units are metres and bodies are of the order of 0.1-1 m.
+constexpr double kSpringWidth = 0.05, kAnchorSize = 0.15;
+const Color kSpringGrey{0.25, 0.25, 0.25};
 
 void vector2(CdrWriter& w, const Vec2& v) {
   w.f64(v.x());
@@ -26,17 +32,129 @@ void point(CdrWriter& w, const Vec2& p) {
   w.f64(p.y());
   w.f64(0.0);
 }
+void quaternion(CdrWriter& w, double theta) {
+  const Quaternion q = quaternion_z(theta);
+  w.f64(q.x);
+  w.f64(q.y);
+  w.f64(q.z);
+  w.f64(q.w);
+}
 // geometry_msgs/Pose of a planar body: position (x, y, 0), rotation theta about +z.
 void pose(CdrWriter& w, double x, double y, double theta) {
   w.f64(x);
   w.f64(y);
   w.f64(0.0);
-  w.f64(0.0);
-  w.f64(0.0);
-  w.f64(std::sin(0.5 * theta));
-  w.f64(std::cos(0.5 * theta));
+  quaternion(w, theta);
+}
+
+// The fields of a visualization_msgs/Marker up to its points (action ADD, identity pose,
+// lifetime 0 = forever).
+struct MarkerHead {
+  Time stamp;
+  std::string_view frame, ns;
+  std::int32_t id = 0, type = 0;
+  double sx = 1.0, sy = 1.0, sz = 1.0;  // scale: line width in x for lines, diameter for spheres
+  Color color;
+  bool frame_locked = false;
+};
+void marker_head(CdrWriter& w, const MarkerHead& m) {
+  w.header(m.stamp, m.frame);
+  w.string(m.ns);
+  w.i32(m.id);
+  w.i32(m.type);
+  w.i32(0);  // ADD
+  pose(w, 0.0, 0.0, 0.0);
+  w.f64(m.sx);
+  w.f64(m.sy);
+  w.f64(m.sz);
+  color(w, m.color);
+  w.i32(0);  // lifetime: forever
+  w.u32(0);
+  w.boolean(m.frame_locked);
+}
+// The fields after the colours, all empty: no texture, text or mesh.
+void marker_rest(CdrWriter& w) {
+  w.string("");          // texture_resource
+  w.header(Time{}, "");  // texture: sensor_msgs/CompressedImage
+  w.string("");
+  w.sequence_length(0);
+  w.sequence_length(0);  // uv_coordinates
+  w.string("");          // text
+  w.string("");          // mesh_resource
+  w.string("");          // mesh_file.filename
+  w.sequence_length(0);  // mesh_file.data
+  w.boolean(false);      // mesh_use_embedded_materials
+}
+
+double cross(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
 }
 }  // namespace
+
+Quaternion quaternion_z(double theta) {
+  return Quaternion{0.0, 0.0, std::sin(0.5 * theta), std::cos(0.5 * theta)};
+}
+
+std::string body_frame(std::string_view ns, std::int32_t index) {
+  while (ns.starts_with('/')) ns.remove_prefix(1);
+  while (ns.ends_with('/')) ns.remove_suffix(1);
+  return (ns.empty() ? std::string() : std::string(ns) + "/") + "body_" + std::to_string(index);
+}
+
+// Ear clipping on the counter-clockwise vertex order: cut off a convex corner whose triangle
+// holds no other vertex, until a triangle is left. A simple polygon always has such an ear.
+std::vector<std::uint32_t> triangulate(std::span<const Vec2> p) {
+  std::vector<std::uint32_t> out;
+  const std::size_t n = p.size();
+  if (n < 3) return out;
+  double area2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) area2 += cross(p[i], p[(i + 1) % n]);
+  std::vector<std::uint32_t> v(n);
+  std::iota(v.begin(), v.end(), 0u);
+  if (area2 < 0.0) std::reverse(v.begin(), v.end());
+  const auto turn = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    return cross(p[b] - p[a], p[c] - p[a]);
+  };
+  // Inside or on the border of the CCW triangle abc (a vertex on a diagonal blocks it too).
+  const auto within = [&](const Vec2& q, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    return cross(p[b] - p[a], q - p[a]) >= 0.0 && cross(p[c] - p[b], q - p[b]) >= 0.0 &&
+           cross(p[a] - p[c], q - p[c]) >= 0.0;
+  };
+  while (v.size() > 3) {
+    const std::size_t m = v.size();
+    bool clipped = false;
+    for (std::size_t i = 0; i < m && !clipped; ++i) {
+      const std::uint32_t a = v[(i + m - 1) % m], b = v[i], c = v[(i + 1) % m];
+      if (turn(a, b, c) <= 0.0) continue;  // reflex or straight: not an ear
+      bool ear = true;
+      for (const std::uint32_t k : v) {
+        if (k == a || k == b || k == c || p[k] == p[a] || p[k] == p[b] || p[k] == p[c]) continue;
+        if (within(p[k], a, b, c)) {
+          ear = false;
+          break;
+        }
+      }
+      if (!ear) continue;
+      out.insert(out.end(), {a, b, c});
+      v.erase(v.begin() + static_cast<std::ptrdiff_t>(i));
+      clipped = true;
+    }
+    if (clipped) continue;
+    // No ear: drop a straight vertex (it adds no area), else (not a simple polygon) fan the rest.
+    bool dropped = false;
+    for (std::size_t i = 0; i < m && !dropped; ++i) {
+      if (turn(v[(i + m - 1) % m], v[i], v[(i + 1) % m]) == 0.0) {
+        v.erase(v.begin() + static_cast<std::ptrdiff_t>(i));
+        dropped = true;
+      }
+    }
+    if (dropped) continue;
+    for (std::size_t i = 1; i + 1 < m; ++i) out.insert(out.end(), {v[0], v[i], v[i + 1]});
+    return out;
+  }
+  if (turn(v[0], v[1], v[2]) > 0.0) out.insert(out.end(), {v[0], v[1], v[2]});
+  return out;
+}
 
 std::uint64_t sim_time_ns(const World& world) {
   const double ns = std::round(world.time() * 1e9);
@@ -48,7 +166,12 @@ Time sim_time(const World& world) {
   return Time{static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
 }
 
-Encoder::Encoder(const Scene& scene) : scene_(&scene) {}
+Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene) {
+  frames_.reserve(scene.world.bodies.size());
+  for (std::size_t b = 0; b < scene.world.bodies.size(); ++b) {
+    frames_.push_back(body_frame(ns, static_cast<std::int32_t>(b)));
+  }
+}
 
 void Encoder::scene(const World& world, Bytes& out) const {
   const Scene& s = *scene_;
@@ -173,6 +296,11 @@ void Encoder::energy(const World& world, Bytes& out) const {
   w.f64(t_point);
   w.f64(t_spin);
   w.f64(potential + t_point + t_spin);
+  // The split as the world sums it, so readers (log export) need not re-add the per-force terms,
+  // whose sum associates differently and, for several gravity fields, depends on FMA contraction.
+  const Energy e = world.energy();
+  w.f64(e.u_gravity);
+  w.f64(e.u_spring);
 }
 
 void Encoder::poses(const World& world, Bytes& out) const {
@@ -182,75 +310,85 @@ void Encoder::poses(const World& world, Bytes& out) const {
   for (std::int32_t b = 0; b < world.body_count(); ++b) pose(w, world.x()[b], world.y()[b], world.theta()[b]);
 }
 
-// One LINE_STRIP per body (its closed hull outline, in the body's frame via the marker pose)
-// and one LINE_LIST holding every spring, coloured per spring.
+void Encoder::tf(const World& world, Bytes& out) const {
+  const Time stamp = sim_time(world);
+  CdrWriter w(out);
+  w.sequence_length(static_cast<std::size_t>(world.body_count()));
+  for (std::int32_t b = 0; b < world.body_count(); ++b) {
+    w.header(stamp, kFrame);
+    w.string(frames_[static_cast<std::size_t>(b)]);
+    pose(w, world.x()[b], world.y()[b], world.theta()[b]);  // Transform: translation, rotation
+  }
+}
+
+// One LINE_LIST holding every spring in world coordinates, coloured per spring.
+void Encoder::springs(const World& world, Bytes& out) const {
+  const Scene& s = *scene_;
+  CdrWriter w(out);
+  marker_head(w, {sim_time(world), kFrame, "springs", 0, kMarkerLineList, kSpringWidth, 0.0, 0.0, kSpringGrey,
+                  false});
+  const std::size_t n = static_cast<std::size_t>(world.spring_count());
+  w.sequence_length(2 * n);
+  for (std::int32_t k = 0; k < world.spring_count(); ++k) {
+    const SpringState st = world.spring_state(SpringId{k});
+    point(w, st.end_i);
+    point(w, st.end_j);
+  }
+  w.sequence_length(2 * n);
+  for (std::int32_t k = 0; k < world.spring_count(); ++k) {
+    color(w, s.spring_colors[k]);
+    color(w, s.spring_colors[k]);
+  }
+  marker_rest(w);
+}
+
+// Per body, in its own frame (frame_locked: it moves with /tf): the hull filled (TRIANGLE_LIST,
+// ear-clipped so concave shapes fill right) and its closed outline (LINE_STRIP) of width 2 r in
+// the same colour, which together cover the hull grown by the radius r as tools/render draws it.
+// Then one SPHERE_LIST in "world" marking the springs' fixed anchors, in the springs' colours.
 void Encoder::markers(const World& world, Bytes& out) const {
   const Scene& s = *scene_;
   const Time stamp = sim_time(world);
+  std::vector<Vec2> anchors;
+  std::vector<Color> anchor_colors;
+  for (std::int32_t k = 0; k < world.spring_count(); ++k) {
+    const SpringDef& sp = world.spring(SpringId{k});
+    for (const auto& [body, anchor] :
+         {std::pair{sp.body_i, sp.anchor_i}, std::pair{sp.body_j, sp.anchor_j}}) {
+      if (body != kFixed) continue;
+      anchors.push_back(anchor);
+      anchor_colors.push_back(s.spring_colors[k]);
+    }
+  }
   CdrWriter w(out);
-  const std::size_t count = static_cast<std::size_t>(world.body_count()) + (world.spring_count() > 0 ? 1 : 0);
-  w.sequence_length(count);
-  auto marker_head = [&](std::string_view ns, std::int32_t id, std::int32_t type) {
-    w.header(stamp, kFrame);
-    w.string(ns);
-    w.i32(id);
-    w.i32(type);
-    w.i32(0);  // ADD
-  };
-  auto marker_tail = [&] {
-    w.i32(0);  // lifetime: forever
-    w.u32(0);
-    w.boolean(false);  // frame_locked
-  };
-  auto marker_rest = [&] {
-    w.string("");          // texture_resource
-    w.header(Time{}, "");  // texture: sensor_msgs/CompressedImage
-    w.string("");
-    w.sequence_length(0);
-    w.sequence_length(0);  // uv_coordinates
-    w.string("");          // text
-    w.string("");          // mesh_resource
-    w.string("");          // mesh_file.filename
-    w.sequence_length(0);  // mesh_file.data
-    w.boolean(false);      // mesh_use_embedded_materials
-  };
+  w.sequence_length(2 * static_cast<std::size_t>(world.body_count()) + (anchors.empty() ? 0 : 1));
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     const BodyId id{b};
-    marker_head("bodies", b, 4);  // LINE_STRIP
-    pose(w, world.x()[b], world.y()[b], world.theta()[b]);
-    const double width = 2.0 * world.radius(id);
-    w.f64(width);  // scale.x = line width
-    w.f64(0.0);
-    w.f64(0.0);
-    color(w, s.body_colors[b]);
-    marker_tail();
+    const std::string& frame = frames_[static_cast<std::size_t>(b)];
     const auto hull = world.hull(id);
+    const Color c = s.body_colors[b];
+    marker_head(w, {stamp, frame, "hulls", b, kMarkerTriangleList, 1.0, 1.0, 1.0, c, true});
+    const std::vector<std::uint32_t> triangles = triangulate(hull);
+    w.sequence_length(triangles.size());
+    for (const std::uint32_t i : triangles) point(w, hull[i]);
+    w.sequence_length(0);  // colors: the marker's
+    marker_rest(w);
+    marker_head(w,
+                {stamp, frame, "outlines", b, kMarkerLineStrip, 2.0 * world.radius(id), 0.0, 0.0, c, true});
     w.sequence_length(hull.size() + 1);
     for (const Vec2& v : hull) point(w, v);
     point(w, hull.front());
-    w.sequence_length(0);  // colors
-    marker_rest();
+    w.sequence_length(0);
+    marker_rest(w);
   }
-  if (world.spring_count() > 0) {
-    marker_head("springs", 0, 5);  // LINE_LIST
-    pose(w, 0.0, 0.0, 0.0);
-    w.f64(0.05);
-    w.f64(0.0);
-    w.f64(0.0);
-    color(w, Color{0.25, 0.25, 0.25});
-    marker_tail();
-    w.sequence_length(2 * static_cast<std::size_t>(world.spring_count()));
-    for (std::int32_t k = 0; k < world.spring_count(); ++k) {
-      const SpringState st = world.spring_state(SpringId{k});
-      point(w, st.end_i);
-      point(w, st.end_j);
-    }
-    w.sequence_length(2 * static_cast<std::size_t>(world.spring_count()));
-    for (std::int32_t k = 0; k < world.spring_count(); ++k) {
-      color(w, s.spring_colors[k]);
-      color(w, s.spring_colors[k]);
-    }
-    marker_rest();
+  if (!anchors.empty()) {
+    marker_head(w, {stamp, kFrame, "anchors", 0, kMarkerSphereList, kAnchorSize, kAnchorSize, kAnchorSize,
+                    kSpringGrey, false});
+    w.sequence_length(anchors.size());
+    for (const Vec2& a : anchors) point(w, a);
+    w.sequence_length(anchor_colors.size());
+    for (const Color& c : anchor_colors) color(w, c);
+    marker_rest(w);
   }
 }
 
@@ -271,6 +409,10 @@ void Encoder::encode(TopicId id, const World& world, Bytes& out) const {
       return energy(world, out);
     case TopicId::Poses:
       return poses(world, out);
+    case TopicId::Tf:
+      return tf(world, out);
+    case TopicId::Springs:
+      return springs(world, out);
     case TopicId::Markers:
       return markers(world, out);
     case TopicId::Clock:

@@ -12,13 +12,35 @@ namespace rbsim::msgs {
 namespace {
 constexpr TopicSpec kTopics[kTopicCount] = {
     {TopicId::Scene, "scene", "rbsim_msgs/msg/SceneDescription", true, false},
+    {TopicId::Markers, "markers", "visualization_msgs/msg/MarkerArray", true, false},
     {TopicId::BodyStates, "body_states", "rbsim_msgs/msg/BodyStates", false, true},
     {TopicId::SpringStates, "spring_states", "rbsim_msgs/msg/SpringStates", false, true},
     {TopicId::Energy, "energy", "rbsim_msgs/msg/EnergyTerms", false, true},
-    {TopicId::Poses, "poses", "geometry_msgs/msg/PoseArray", false, true},
-    {TopicId::Markers, "markers", "visualization_msgs/msg/MarkerArray", false, true},
+    {TopicId::Tf, "tf", "tf2_msgs/msg/TFMessage", false, true},
+    {TopicId::Springs, "springs", "visualization_msgs/msg/Marker", false, true},
     {TopicId::Clock, "clock", "rosgraph_msgs/msg/Clock", false, true},
+    {TopicId::Poses, "poses", "geometry_msgs/msg/PoseArray", false, true},
 };
+static_assert([] {
+  for (std::size_t i = 0; i < kTopicCount; ++i) {
+    if (static_cast<std::size_t>(kTopics[i].id) != i) return false;
+  }
+  return true;
+}());
+
+// EnergyTerms.msg as builds before the potential split recorded it (their recordings are still
+// read; the dependencies it names are unchanged).
+constexpr std::string_view kEnergyTermsWithoutSplit =
+    "std_msgs/Header header\n"
+    "uint64 step\n"
+    "BodyEnergy[] bodies\n"
+    "ForcePotential[] forces\n"
+    "Vector2 momentum            # totals over bodies\n"
+    "float64 angular_momentum    # sum of L_point + L_spin\n"
+    "float64 potential           # U = gravity + springs\n"
+    "float64 kinetic_point\n"
+    "float64 kinetic_spin\n"
+    "float64 total               # U + T\n";
 
 // "pkg/Name" or "pkg/msg/Name" -> "pkg/msg/Name"
 std::string canonical(std::string_view type) {
@@ -61,13 +83,6 @@ std::span<const TopicSpec> topics() {
 const TopicSpec& topic(TopicId id) {
   return kTopics[static_cast<std::size_t>(id)];
 }
-TopicSet default_topics() {
-  TopicSet set;
-  set.set();
-  set.reset(static_cast<std::size_t>(TopicId::Poses));
-  return set;
-}
-
 const TopicSpec* topic_for_type(std::string_view type) {
   const std::string t = canonical_type(type, "");
   for (const TopicSpec& spec : kTopics) {
@@ -82,8 +97,51 @@ bool names_topic(std::string_view requested, std::string_view topic) {
   return topic.ends_with(requested) && topic[topic.size() - requested.size() - 1] == '/';
 }
 
+TopicSet default_topics() {
+  TopicSet set;
+  set.set();
+  set.reset(static_cast<std::size_t>(TopicId::Poses));
+  return set;
+}
+
+Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns) {
+  TopicSet set;
+  set.set(static_cast<std::size_t>(TopicId::Scene));
+  bool any = false;
+  while (!list.empty()) {
+    const auto comma = list.find(',');
+    std::string_view name = list.substr(0, comma);
+    list = comma == std::string_view::npos ? std::string_view() : list.substr(comma + 1);
+    while (!name.empty() && name.front() == ' ') name.remove_prefix(1);
+    while (!name.empty() && name.back() == ' ') name.remove_suffix(1);
+    if (name.empty()) continue;
+    any = true;
+    const TopicSpec* found = nullptr;
+    for (const TopicSpec& spec : kTopics) {
+      if (names_topic(name, topic_name(spec, ns)) || name == spec.suffix) found = &spec;
+    }
+    if (found == nullptr) {
+      std::string known;
+      for (const TopicSpec& spec : kTopics) known += (known.empty() ? "" : ", ") + std::string(spec.suffix);
+      return Error{"unknown topic \"" + std::string(name) + "\" (topics: " + known + ")"};
+    }
+    set.set(static_cast<std::size_t>(found->id));
+  }
+  if (!any) return Error{"no topic given"};
+  return set;
+}
+
+std::vector<TopicId> topic_ids(const TopicSet& set) {
+  std::vector<TopicId> out;
+  for (const TopicSpec& spec : kTopics) {
+    if (set.test(static_cast<std::size_t>(spec.id))) out.push_back(spec.id);
+  }
+  return out;
+}
+
 std::string topic_name(const TopicSpec& spec, std::string_view ns) {
-  if (spec.id == TopicId::Clock || ns.empty()) return "/" + std::string(spec.suffix);
+  if (spec.id == TopicId::Clock || spec.id == TopicId::Tf || ns.empty())
+    return "/" + std::string(spec.suffix);
   std::string name = "/" + std::string(ns);
   while (name.size() > 1 && name.back() == '/') name.pop_back();
   if (name.size() > 1 && name[1] == '/') name.erase(0, 1);
@@ -136,11 +194,13 @@ std::vector<std::string_view> definition_types() {
   return out;
 }
 
-Result<std::string> ros2msg_schema(std::string_view root) {
+namespace {
+// The rosbag2 schema of `root` whose own text is `root_text` (its dependencies from definitions).
+Result<std::string> schema_of(std::string_view root, std::string_view root_text) {
   std::set<std::string> seen;
   std::string missing;
   std::function<std::string(std::string_view, int)> expand = [&](std::string_view type, int depth) {
-    const std::string_view text = definition(type);
+    const std::string_view text = depth == 0 ? root_text : definition(type);
     if (text.empty() || depth > 50) {
       missing = std::string(type);
       return std::string();
@@ -157,6 +217,22 @@ Result<std::string> ros2msg_schema(std::string_view root) {
   std::string schema = expand(root, 0);
   if (!missing.empty()) return Error{"no message definition for " + missing};
   return schema;
+}
+}  // namespace
+
+Result<std::string> ros2msg_schema(std::string_view root) {
+  return schema_of(root, definition(root));
+}
+
+std::optional<EnergyTermsVersion> energy_terms_version(std::string_view schema) {
+  const std::string_view type = topic(TopicId::Energy).type;
+  if (Result<std::string> now = ros2msg_schema(type); now && now.value() == schema) {
+    return EnergyTermsVersion::Current;
+  }
+  if (Result<std::string> old = schema_of(type, kEnergyTermsWithoutSplit); old && old.value() == schema) {
+    return EnergyTermsVersion::WithoutSplit;
+  }
+  return std::nullopt;
 }
 
 }  // namespace rbsim::msgs

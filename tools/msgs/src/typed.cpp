@@ -174,7 +174,8 @@ Status decode_spring_states(std::span<const std::byte> cdr, SpringStatesMessage&
   return Ok{};
 }
 
-Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out) {
+Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out,
+                           EnergyTermsVersion version) {
   Reader r(cdr);
   out.stamp = r.time();
   r.skip_string();  // frame_id
@@ -200,6 +201,9 @@ Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& o
   out.kinetic_point = r.get<double>();
   out.kinetic_spin = r.get<double>();
   out.total = r.get<double>();
+  out.has_split = version == EnergyTermsVersion::Current;
+  out.potential_gravity = out.has_split ? r.get<double>() : 0.0;
+  out.potential_spring = out.has_split ? r.get<double>() : 0.0;
   if (!r.ok()) return bad("EnergyTerms");
   return Ok{};
 }
@@ -222,10 +226,93 @@ Status decode_poses(std::span<const std::byte> cdr, PosesMessage& out) {
   return Ok{};
 }
 
+namespace {
+// One visualization_msgs/Marker as rbsim writes it: the trailing texture, text and mesh fields
+// are read past (they must be well-formed) but not kept.
+void read_marker(Reader& r, MarkerMessage& m) {
+  m.stamp = r.time();
+  m.frame_id = r.string();
+  m.ns = r.string();
+  m.id = r.get<std::int32_t>();
+  m.type = r.get<std::int32_t>();
+  m.action = r.get<std::int32_t>();
+  m.pose.x = r.get<double>();
+  m.pose.y = r.get<double>();
+  m.pose.z = r.get<double>();
+  m.pose.qx = r.get<double>();
+  m.pose.qy = r.get<double>();
+  m.pose.qz = r.get<double>();
+  m.pose.qw = r.get<double>();
+  m.scale_x = r.get<double>();
+  m.scale_y = r.get<double>();
+  m.scale_z = r.get<double>();
+  for (float& c : m.color) c = r.get<float>();
+  m.lifetime = r.time();
+  m.frame_locked = r.get<std::uint8_t>() != 0;
+  m.points.resize(r.length(24));
+  for (Vec2& p : m.points) {
+    p = r.vec2();
+    (void)r.get<double>();  // z
+  }
+  m.colors.resize(r.length(16));
+  for (auto& c : m.colors) {
+    for (float& x : c) x = r.get<float>();
+  }
+  r.skip_string();  // texture_resource
+  (void)r.time();   // texture.header
+  r.skip_string();
+  r.skip_string();                                                              // texture.format
+  for (std::uint32_t n = r.length(1); n > 0; --n) (void)r.get<std::uint8_t>();  // texture.data
+  for (std::uint32_t n = r.length(8); n > 0; --n) {                             // uv_coordinates
+    (void)r.get<float>();
+    (void)r.get<float>();
+  }
+  r.skip_string();                                                              // text
+  r.skip_string();                                                              // mesh_resource
+  r.skip_string();                                                              // mesh_file.filename
+  for (std::uint32_t n = r.length(1); n > 0; --n) (void)r.get<std::uint8_t>();  // mesh_file.data
+  (void)r.get<std::uint8_t>();                                                  // mesh_use_embedded_materials
+}
+}  // namespace
+
+Status decode_tf(std::span<const std::byte> cdr, TfMessage& out) {
+  Reader r(cdr);
+  out.transforms.resize(r.length(80));
+  for (auto& t : out.transforms) {
+    t.stamp = r.time();
+    t.frame_id = r.string();
+    t.child_frame_id = r.string();
+    t.x = r.get<double>();
+    t.y = r.get<double>();
+    t.z = r.get<double>();
+    t.qx = r.get<double>();
+    t.qy = r.get<double>();
+    t.qz = r.get<double>();
+    t.qw = r.get<double>();
+  }
+  if (!r.ok()) return bad("TFMessage");
+  return Ok{};
+}
+
+Status decode_marker(std::span<const std::byte> cdr, MarkerMessage& out) {
+  Reader r(cdr);
+  read_marker(r, out);
+  if (!r.ok()) return bad("Marker");
+  return Ok{};
+}
+
+Status decode_marker_array(std::span<const std::byte> cdr, std::vector<MarkerMessage>& out) {
+  Reader r(cdr);
+  out.resize(r.length(100));
+  for (MarkerMessage& m : out) read_marker(r, m);
+  if (!r.ok()) return bad("MarkerArray");
+  return Ok{};
+}
+
 std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr) {
   if (id == TopicId::Scene) return std::nullopt;
   Reader r(cdr);
-  if (id == TopicId::Markers && r.get<std::uint32_t>() == 0) return std::nullopt;
+  if ((id == TopicId::Markers || id == TopicId::Tf) && r.get<std::uint32_t>() == 0) return std::nullopt;
   const Time t = r.time();
   if (!r.ok()) return std::nullopt;
   return t;

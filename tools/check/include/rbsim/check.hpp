@@ -64,6 +64,9 @@ struct CheckReport {
   // extra"), with their ranges and a likely cause: "/rbsim/body_states: run lacks steps 0..999
   // (1,000 messages: recorder joined late?)", "... golden recorded every 10th step, run every 5th".
   std::vector<std::string> step_problems;
+  // Non-empty when the two files record different scenes (bodies, hull vertices, which bodies the
+  // springs join, force fields, integrator): why, in one line. Nothing else is then compared.
+  std::string scene_mismatch;
   std::vector<MetadataDifference> metadata;       // metadata differences (first per field)
   std::vector<FieldStats> fields;                 // topics by name, then fields in message order
   std::vector<std::string> topics;                // topics compared
@@ -82,5 +85,16 @@ struct CheckReport {
 // read (not MCAP, truncated, corrupted, bad CDR): a different outcome from a divergence.
 Result<CheckReport> check_logs(const std::string& run_path, const std::string& golden_path,
                                const CheckOptions& options = {});
+
+struct ReportFormat {
+  bool all_fields = false;             // list identical fields in the table too
+  std::optional<double> wall_seconds;  // how long the comparison took, printed with its MB/s
+};
+// The report `rbsim check` prints for `report`: the verdict, the first divergence (topic, step,
+// field, expected, actual, difference), topic and step problems, metadata, the per-field
+// max-error table and the totals. rbsim::testing::CheckLogs shows the same text.
+std::string format_report(const std::string& run_path, const std::string& golden_path,
+                          const CheckOptions& options, const CheckReport& report,
+                          const ReportFormat& format = {});
 
 }  // namespace rbsim::check

@@ -29,6 +29,9 @@ struct GoldenVerifyOptions {
   double quantity_tol = 1e-8;     // golden M, I, P, L, T, U vs the reference's (absolute)
   double recompute_rtol = 1e-9;   // recorded energy / spring / pose terms vs recomputed ones
   double integration_tol = 1e-9;  // K steps of the verifier's integrator vs the next recorded state
+  // The recording must end at the scene's last step (its duration); false accepts any length
+  // (rbsim::testing, whose users record as many steps as their test needs).
+  bool whole_run = true;
 };
 
 struct GoldenVerification {

@@ -253,6 +253,7 @@ Result<std::vector<ChannelSpec>> ros2_channels(const msgs::TopicSet& topics, std
 
 struct SinkOptions {
   msgs::TopicSet topics = msgs::default_topics();
+  std::string ns = "rbsim";        // the namespace of the frames in /tf and the markers
   std::int64_t publish_every = 1;  // every k-th step (as DdsSink)
   // Real-time factor to pace at; 0 leaves pacing to another sink (rbsim node's DdsSink paces, and
   // the driver calls the sinks one after the other, so the pace happens once).

@@ -20,10 +20,11 @@ struct RecordOptions {
   std::uint64_t chunk_size = 1 << 20;  // uncompressed bytes per chunk
   std::int64_t every = 1;              // record every k-th step (step 0 always); begin() refuses < 1
   std::string ns = "rbsim";            // ROS namespace of the topics
-  std::vector<msgs::TopicId> topics;   // empty: every topic
+  msgs::TopicSet topics = msgs::default_topics();
 };
 
-// A Sink that records a run: the scene description once at step 0, then every per-step topic.
+// A Sink that records a run: every selected latched topic (scene description, markers) once at
+// step 0, then every selected per-step topic at step 0 and every k-th step after it.
 // log_time = publish_time = simulated time in ns, so a recording is deterministic.
 std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options = {});
 

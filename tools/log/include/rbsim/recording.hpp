@@ -34,6 +34,8 @@ struct RecordedChannel {
   // schema whose text equals this build's); otherwise why not, e.g. "its rbsim_msgs/msg/BodyStates
   // schema differs from this build's (recorded by another version?)".
   std::string problem;
+  // The layout of an EnergyTerms channel: a recording made before the potential split is read too.
+  msgs::EnergyTermsVersion energy_version = msgs::EnergyTermsVersion::Current;
 };
 // The channels of `reader` (as far as it knows them) that carry one of our types, by channel id.
 std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader);

@@ -9,6 +9,7 @@
 // the pad count in the header's last byte (options), exactly as Cyclone DDS serialises it.
 #pragma once
 
+#include <array>
 #include <bitset>
 #include <cstddef>
 #include <cstdint>
@@ -28,8 +29,20 @@ namespace rbsim::msgs {
 // ---------------------------------------------------------------------------------------------
 // Topics
 
-enum class TopicId : std::uint8_t { Scene, BodyStates, SpringStates, Energy, Poses, Markers, Clock };
-inline constexpr std::size_t kTopicCount = 7;
+// In publishing order: the latched topics first, so every sink that walks topics() in order sends
+// the scene description and the body shapes before the first per-step message.
+enum class TopicId : std::uint8_t {
+  Scene,
+  Markers,
+  BodyStates,
+  SpringStates,
+  Energy,
+  Tf,
+  Springs,
+  Clock,
+  Poses
+};
+inline constexpr std::size_t kTopicCount = 9;
 
 struct TopicSpec {
   TopicId id;
@@ -40,18 +53,27 @@ struct TopicSpec {
 };
 std::span<const TopicSpec> topics();
 const TopicSpec& topic(TopicId id);
-// A selection of topics, indexed by TopicId.
-using TopicSet = std::bitset<kTopicCount>;
-// What is published and recorded unless a command line chooses: every topic but the PoseArray.
-TopicSet default_topics();
 // The topic of topics() whose type is `type` ("pkg/msg/Name", or "pkg/Name" as older tools write
 // it); null when it is none of ours.
 const TopicSpec* topic_for_type(std::string_view type);
 // Whether a topic name given on a command line names `topic`: the whole name
 // ("/rbsim/body_states") or its trailing part(s) after a '/' ("body_states", "rbsim/body_states").
 bool names_topic(std::string_view requested, std::string_view topic);
-// "/rbsim/body_states" for namespace "rbsim"; "/clock" always lives at the root.
+// "/rbsim/body_states" for namespace "rbsim"; "/clock" and "/tf" always live at the root.
 std::string topic_name(const TopicSpec& spec, std::string_view ns);
+
+// A selection of topics, indexed by TopicId.
+using TopicSet = std::bitset<kTopicCount>;
+// What a run publishes and records unless told otherwise: everything but the PoseArray (poses),
+// which /tf replaces for viewers.
+TopicSet default_topics();
+// A comma-separated --topics list: each name as names_topic() understands it against the topic's
+// name in namespace `ns`, or its bare suffix ("body_states", "/rbsim/body_states", "tf", "/tf",
+// "rbsim/markers"). The scene description is always included (every reader needs it).
+// Fails on an empty list or an unknown name, naming it and listing the valid ones.
+Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns = "rbsim");
+// The topics of a set in topics() order.
+std::vector<TopicId> topic_ids(const TopicSet& set);
 // DDS names per ROS 2 conventions: "rt/rbsim/body_states", "rbsim_msgs::msg::dds_::BodyStates_".
 std::string dds_topic_name(std::string_view ros_topic);
 std::string dds_type_name(std::string_view ros_type);
@@ -79,6 +101,12 @@ std::vector<std::string_view> definition_types();
 // The schema rosbag2 writes for a type with encoding "ros2msg": its .msg text followed by each
 // dependency, depth first, once, as "\n" + 80 '=' + "\nMSG: pkg/Name\n" + text.
 Result<std::string> ros2msg_schema(std::string_view type);
+// The EnergyTerms layouts this build reads: the current one, and the one before
+// potential_gravity / potential_spring were appended.
+enum class EnergyTermsVersion : std::uint8_t { Current, WithoutSplit };
+// The EnergyTerms layout a recorded schema text describes: this build's, or the one older builds
+// recorded (before the potential split). nullopt for any other text.
+std::optional<EnergyTermsVersion> energy_terms_version(std::string_view schema);
 
 // ---------------------------------------------------------------------------------------------
 // Encoding a world snapshot
@@ -93,23 +121,44 @@ std::uint64_t sim_time_ns(const World& world);
 
 using Bytes = std::vector<std::byte>;
 
+// The quaternion of a rotation by theta about +z (a planar body's orientation).
+struct Quaternion {
+  double x = 0.0, y = 0.0, z = 0.0, w = 1.0;
+};
+Quaternion quaternion_z(double theta);
+
+// Triangulates a simple polygon (convex or not, either winding) by ear clipping: index triples
+// into `polygon`, each triangle counter-clockwise, n - 2 of them for n vertices with no three
+// collinear (a collinear vertex adds no triangle). A polygon that is not simple (self-crossing,
+// which no scene body should be) is still covered by triangles, not necessarily exactly.
+std::vector<std::uint32_t> triangulate(std::span<const Vec2> polygon);
+
+// The TF frame of body `index` in namespace `ns`: "rbsim/body_3" (no leading slash, as tf2 wants).
+std::string body_frame(std::string_view ns, std::int32_t index);
+
 // Encodes the messages of one step into reused buffers: after the first step of a world, no
-// call allocates. The frame id of every header is "world".
+// per-step call allocates. The frame id of every header is "world", but for the body shapes,
+// which live in their body's TF frame (body_frame(ns, i)).
 class Encoder {
  public:
-  explicit Encoder(const Scene& scene);
+  explicit Encoder(const Scene& scene, std::string_view ns = "rbsim");
 
   void scene(const World& world, Bytes& out) const;  // rbsim_msgs/msg/SceneDescription
   void body_states(const World& world, Bytes& out) const;
   void spring_states(const World& world, Bytes& out) const;
   void energy(const World& world, Bytes& out) const;
+  void tf(const World& world, Bytes& out) const;       // tf2_msgs/msg/TFMessage: world -> each body
+  void springs(const World& world, Bytes& out) const;  // visualization_msgs/msg/Marker, LINE_LIST
   void poses(const World& world, Bytes& out) const;    // geometry_msgs/msg/PoseArray
-  void markers(const World& world, Bytes& out) const;  // visualization_msgs/msg/MarkerArray
-  void clock(const World& world, Bytes& out) const;    // rosgraph_msgs/msg/Clock
+  // visualization_msgs/msg/MarkerArray, latched: the body shapes in their frames (they move with
+  // /tf) and the fixed spring anchors in "world".
+  void markers(const World& world, Bytes& out) const;
+  void clock(const World& world, Bytes& out) const;  // rosgraph_msgs/msg/Clock
   void encode(TopicId id, const World& world, Bytes& out) const;
 
  private:
   const Scene* scene_;
+  std::vector<std::string> frames_;  // body_frame(ns, i) per body
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -172,6 +221,10 @@ struct EnergyTermsMessage {
   std::vector<Force> forces;
   Vec2 momentum{0.0, 0.0};  // totals over bodies
   double angular_momentum = 0.0, potential = 0.0, kinetic_point = 0.0, kinetic_spin = 0.0, total = 0.0;
+  // U_gravity and U_spring as World::energy() sums them; recordings made before they were added
+  // (EnergyTermsVersion::WithoutSplit) lack them: has_split is false and both are 0.
+  bool has_split = true;
+  double potential_gravity = 0.0, potential_spring = 0.0;
 };
 // geometry_msgs/msg/PoseArray, as rbsim publishes it (one pose per body, in body order).
 struct PosesMessage {
@@ -182,16 +235,47 @@ struct PosesMessage {
   };
   std::vector<Pose> poses;
 };
+// tf2_msgs/msg/TFMessage: one transform per body.
+struct TfMessage {
+  struct Transform {
+    Time stamp;
+    std::string frame_id, child_frame_id;
+    double x = 0.0, y = 0.0, z = 0.0;               // translation
+    double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;  // rotation
+  };
+  std::vector<Transform> transforms;
+};
+// visualization_msgs/msg/Marker, the fields rbsim sets (the springs' LINE_LIST and each marker of
+// the latched MarkerArray).
+struct MarkerMessage {
+  Time stamp;
+  std::string frame_id, ns;
+  std::int32_t id = 0, type = 0, action = 0;
+  PosesMessage::Pose pose;
+  double scale_x = 0.0, scale_y = 0.0, scale_z = 0.0;
+  std::array<float, 4> color{};  // r, g, b, a
+  Time lifetime;
+  bool frame_locked = false;
+  std::vector<Vec2> points;  // x, y (rbsim's markers are planar: every z is 0)
+  std::vector<std::array<float, 4>> colors;
+};
+// Marker types rbsim uses (visualization_msgs/msg/Marker constants).
+inline constexpr std::int32_t kMarkerLineStrip = 4, kMarkerLineList = 5, kMarkerSphereList = 7,
+                              kMarkerTriangleList = 11;
 Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
 // These reuse `out`'s storage: decoding a stream of messages does not allocate once warmed up.
 // They fail on truncated or malformed data (a sequence longer than the bytes left included).
 [[nodiscard]] Status decode_body_states(std::span<const std::byte> cdr, BodyStatesMessage& out);
 [[nodiscard]] Status decode_spring_states(std::span<const std::byte> cdr, SpringStatesMessage& out);
-[[nodiscard]] Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out);
+[[nodiscard]] Status decode_energy_terms(std::span<const std::byte> cdr, EnergyTermsMessage& out,
+                                         EnergyTermsVersion version = EnergyTermsVersion::Current);
 [[nodiscard]] Status decode_poses(std::span<const std::byte> cdr, PosesMessage& out);
-// The simulated time a per-step message carries: its header stamp, a Clock's clock, a
-// MarkerArray's first marker's stamp. nullopt for the scene description, an empty MarkerArray or
-// bytes too short to hold it.
+[[nodiscard]] Status decode_tf(std::span<const std::byte> cdr, TfMessage& out);
+[[nodiscard]] Status decode_marker(std::span<const std::byte> cdr, MarkerMessage& out);
+[[nodiscard]] Status decode_marker_array(std::span<const std::byte> cdr, std::vector<MarkerMessage>& out);
+// The simulated time a message carries: its header stamp, a Clock's clock, a MarkerArray's first
+// marker's stamp, a TFMessage's first transform's. nullopt for the scene description, an empty
+// MarkerArray or TFMessage, or bytes too short to hold it.
 std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr);
 
 // ---------------------------------------------------------------------------------------------

@@ -1,0 +1,122 @@
+// rbsim::testing: golden-log checks for GoogleTest suites, on the same code paths as the command
+// line (the run driver and MCAP sink of `rbsim run --record`, the comparer and report of
+// `rbsim check`, the verifier of `rbsim check --verify-golden`).
+#include "rbsim/testing.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "rbsim/check.hpp"
+#include "rbsim/golden.hpp"
+#include "rbsim/outputs.hpp"
+#include "rbsim/record.hpp"
+#include "rbsim/run.hpp"
+#include "rbsim/scene.hpp"
+
+namespace rbsim::testing {
+
+namespace {
+
+::testing::AssertionResult failure(const std::string& what, const std::string& message) {
+  return ::testing::AssertionFailure() << "rbsim::testing::" << what << ": " << message;
+}
+
+}  // namespace
+
+::testing::AssertionResult RecordScene(const std::string& scene_path, const std::string& out_mcap,
+                                       const RecordOptions& options) {
+  Result<Scene> loaded = load_scene(scene_path);
+  if (!loaded) return failure("RecordScene", loaded.error().message);
+  const Scene& scene = loaded.value();
+  std::int64_t steps = scene.step_count();
+  if (options.duration) {
+    if (!(*options.duration >= 0.0)) return failure("RecordScene", "duration must be >= 0");
+    steps = steps_for(*options.duration, scene.world.dt);
+  }
+  if (options.steps) steps = *options.steps;
+  if (steps < 0) return failure("RecordScene", "steps must be >= 0 (got " + std::to_string(steps) + ")");
+  if (options.record_every < 1) {
+    return failure("RecordScene",
+                   "record_every must be >= 1 (got " + std::to_string(options.record_every) + ")");
+  }
+  if (Status st = check_outputs({{out_mcap, "out_mcap"}}, {scene_path}, options.overwrite); !st) {
+    return failure("RecordScene",
+                   st.error().message + (options.overwrite ? "" : " (RecordOptions::overwrite)"));
+  }
+  log::RecordOptions ro;
+  ro.every = options.record_every;
+  ro.ns = options.ns;
+  if (!options.topics.empty()) {
+    std::string list;
+    for (const std::string& name : options.topics) list += (list.empty() ? "" : ",") + name;
+    Result<msgs::TopicSet> topics = msgs::parse_topic_set(list, options.ns);
+    if (!topics) return failure("RecordScene", topics.error().message);
+    ro.topics = topics.value();
+  }
+
+  Result<Driver> created = Driver::create(scene);
+  if (!created) return failure("RecordScene", scene.path + ": " + created.error().message);
+  std::unique_ptr<Sink> sink = log::make_mcap_sink(out_mcap, ro);
+  created->add(*sink);
+  DriverOptions run;
+  run.steps = steps;
+  if (Status st = created->run_pass(run); !st) return failure("RecordScene", st.error().message);
+  return ::testing::AssertionSuccess()
+         << "recorded " << steps << " steps of " << scene_path << " to " << out_mcap;
+}
+
+::testing::AssertionResult CheckLogs(const std::string& actual_mcap, const std::string& golden_mcap,
+                                     const Tolerance& tolerance) {
+  check::CheckOptions o;
+  o.atol = tolerance.atol;
+  o.rtol = tolerance.rtol;
+  o.topics = tolerance.topics;
+  Result<check::CheckReport> report = check::check_logs(actual_mcap, golden_mcap, o);
+  if (!report) return failure("CheckLogs", report.error().message);
+  const std::string text = check::format_report(actual_mcap, golden_mcap, o, report.value());
+  if (report->passed()) return ::testing::AssertionSuccess() << text;
+  return ::testing::AssertionFailure() << text;
+}
+
+bool GoldenUpdateRequested() {
+  const char* value = std::getenv(kUpdateGoldensVariable);
+  return value != nullptr && std::string_view(value) == "1";
+}
+
+::testing::AssertionResult UpdateGoldenIfRequested(const std::string& scene_path,
+                                                   const std::string& actual_mcap,
+                                                   const std::string& golden_mcap,
+                                                   const Tolerance& tolerance) {
+  const char* what = "UpdateGoldenIfRequested";
+  if (!GoldenUpdateRequested()) {
+    std::error_code ec;
+    if (!std::filesystem::exists(golden_mcap, ec)) {
+      return failure(what, "golden " + golden_mcap + " does not exist; run the test with " +
+                               kUpdateGoldensVariable + "=1 to create it from " + actual_mcap);
+    }
+    return CheckLogs(actual_mcap, golden_mcap, tolerance);
+  }
+  check::GoldenVerifyOptions verify;
+  verify.whole_run = false;  // a test records as many steps as it needs
+  Result<check::GoldenVerification> verified = check::verify_golden(scene_path, actual_mcap, verify);
+  if (!verified) return failure(what, verified.error().message);
+  if (!verified->passed) {
+    std::string lines;
+    for (const std::string& line : verified->lines) lines += "\n  " + line;
+    return failure(what, "refusing to write golden " + golden_mcap + ": " + actual_mcap +
+                             " fails verification against " + scene_path + lines);
+  }
+  std::ifstream in(actual_mcap, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (!in.good() && !in.eof()) return failure(what, "cannot read " + actual_mcap);
+  AtomicFile out;
+  if (Status st = out.open(golden_mcap); !st) return failure(what, st.error().message);
+  if (Status st = out.write(bytes.data(), bytes.size()); !st) return failure(what, st.error().message);
+  if (Status st = out.commit(); !st) return failure(what, st.error().message);
+  return ::testing::AssertionSuccess() << "golden " << golden_mcap << " updated from " << actual_mcap
+                                       << " (verified: " << verified->rule << ")";
+}
+
+}  // namespace rbsim::testing
