@@ -10,12 +10,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include <poll.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <map>
 #include <regex>
+#include <set>
 #include <thread>
 
 #include "rbsim/subprocess.hpp"
@@ -124,44 +127,103 @@ TEST(FoxgloveCli, PortZeroPrintsThePortTheLinkAndTheLayout) {
   EXPECT_NE(o.err.find("foxglove: 0 clients"), std::string::npos) << o;
 }
 
-// The node serves a client: subscribes to every advertised channel, gets the scene (latched) and
-// per-step messages at simulated times, and the node ends cleanly on SIGINT... here by --duration.
-TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
-  // Port 0 in a child: read its port from the listening line while it runs.
-  int pipe_fds[2];
-  ASSERT_EQ(::pipe(pipe_fds), 0);
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    ::dup2(pipe_fds[1], 2);
-    ::close(pipe_fds[0]);
-    ::close(pipe_fds[1]);
-    const std::string scene = scene_path();
-    ::execl(RBSIM_EXE, RBSIM_EXE, "node", scene.c_str(), "--foxglove", "0", "--domain", kDomain,
-            "--namespace", "fox_e2e", "--rate", "1", "--duration", "3", static_cast<char*>(nullptr));
-    ::_exit(127);
+// An rbsim command running in the background with --foxglove 0; its port is read from the
+// listening line. Stopped with SIGINT (as Ctrl-C) at the end of the scope; every wait is bounded.
+class Child {
+ public:
+  explicit Child(std::vector<std::string> args) {
+    int fds[2];
+    if (::pipe(fds) != 0) return;
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(fds[1], 2);
+      ::close(fds[0]);
+      ::close(fds[1]);
+      std::vector<char*> argv{const_cast<char*>(RBSIM_EXE)};
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      ::execv(RBSIM_EXE, argv.data());
+      ::_exit(127);
+    }
+    ::close(fds[1]);
+    err_fd_ = fds[0];
   }
-  ::close(pipe_fds[1]);
-  std::string err;
-  std::smatch m;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  const std::regex listening("listening on ws://127\\.0\\.0\\.1:(\\d+)");
-  while (!std::regex_search(err, m, listening) && std::chrono::steady_clock::now() < deadline) {
-    char buf[512];
-    const ssize_t n = ::read(pipe_fds[0], buf, sizeof buf);
-    if (n <= 0) break;
-    err.append(buf, static_cast<std::size_t>(n));
+  ~Child() {
+    (void)stop();
+    if (err_fd_ >= 0) ::close(err_fd_);
   }
-  ASSERT_TRUE(std::regex_search(err, m, listening)) << err;
-  const auto port = static_cast<std::uint16_t>(std::stoi(m[1]));
+  // The port of "listening on ws://127.0.0.1:PORT" (0 if it did not come within 30 s).
+  std::uint16_t port() {
+    const std::regex listening("listening on ws://127\\.0\\.0\\.1:(\\d+)");
+    std::smatch m;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!std::regex_search(err_, m, listening) && read_some(deadline)) {
+    }
+    return std::regex_search(err_, m, listening) ? static_cast<std::uint16_t>(std::stoi(m[1])) : 0;
+  }
+  // SIGINT, then the exit status (-1 if it had to be killed after 30 s) and everything it printed.
+  int stop() {
+    if (pid_ <= 0) return status_;
+    ::kill(pid_, SIGINT);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    int st = 0;
+    while (::waitpid(pid_, &st, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(pid_, SIGKILL);
+        ::waitpid(pid_, &st, 0);
+        st = -1;
+        break;
+      }
+      (void)read_some(std::chrono::steady_clock::now() + std::chrono::milliseconds(20));
+    }
+    while (read_some(std::chrono::steady_clock::now() + std::chrono::milliseconds(20))) {
+    }
+    pid_ = -1;
+    status_ = st == -1 ? -1 : (WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st));
+    return status_;
+  }
+  const std::string& err() const { return err_; }
 
+ private:
+  bool read_some(std::chrono::steady_clock::time_point deadline) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0 || err_fd_ < 0) return false;
+    pollfd p{err_fd_, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return false;
+    char buf[4096];
+    const ssize_t n = ::read(err_fd_, buf, sizeof buf);
+    if (n <= 0) return false;
+    err_.append(buf, static_cast<std::size_t>(n));
+    return true;
+  }
+  pid_t pid_ = -1;
+  int err_fd_ = -1;
+  int status_ = -1;
+  std::string err_;
+};
+
+// What a viewer that subscribes to every channel sees in up to `frames` frames.
+struct Seen {
+  std::map<std::string, int> counts;               // messages per topic
+  std::map<std::string, std::uint64_t> last_time;  // in the current session
+  std::map<std::string, std::uint64_t> max_time;   // over all
+  std::set<std::string> decreasing;                // topics whose log time went back within a session
+  int server_infos = 0;                            // after the first
+  std::set<std::string> sessions;
+  int statuses = 0;
+};
+Seen watch(std::uint16_t port, int frames, const std::string& stop_topic = "", int stop_count = 0) {
+  Seen seen;
   foxglove::test::WsClient c;
-  ASSERT_EQ(c.connect(port, {"foxglove.sdk.v1"}), 101);
+  EXPECT_EQ(c.connect(port, {"foxglove.sdk.v1"}), 101);
   auto info = c.read();
-  ASSERT_TRUE(info);
-  EXPECT_NE(info->data.find("\"serverInfo\""), std::string::npos);
+  EXPECT_TRUE(info);
+  if (!info) return seen;
+  seen.sessions.insert(nlohmann::json::parse(info->data).value("sessionId", ""));
   auto adv = c.read();
-  ASSERT_TRUE(adv);
+  EXPECT_TRUE(adv);
+  if (!adv) return seen;
   const auto channels = nlohmann::json::parse(adv->data).at("channels");
   std::string subscribe = R"({"op":"subscribe","subscriptions":[)";
   std::map<std::uint32_t, std::string> topic_of;
@@ -172,39 +234,99 @@ TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
     topic_of[id] = ch.at("topic").get<std::string>();
     EXPECT_EQ(ch.at("encoding"), "cdr");
     EXPECT_EQ(ch.at("schemaEncoding"), "ros2msg");
+    EXPECT_FALSE(ch.at("schema").get<std::string>().empty());
   }
   subscribe += "]}";
-  ASSERT_TRUE(c.send_text(subscribe));
-  std::map<std::string, int> counts;
-  std::uint64_t last_states_time = 0;
-  bool times_increase = true;
-  for (int i = 0; i < 400; ++i) {
+  EXPECT_TRUE(c.send_text(subscribe));
+  for (int i = 0; i < frames; ++i) {
     auto f = c.read();
     if (!f) break;
-    if (f->opcode != 2 || f->data.empty() || f->data[0] != '\x01') continue;
+    if (f->opcode == 1) {
+      const auto j = nlohmann::json::parse(f->data, nullptr, false);
+      if (j.value("op", "") == "serverInfo") {
+        ++seen.server_infos;
+        seen.sessions.insert(j.value("sessionId", ""));
+        seen.last_time.clear();
+      } else {
+        ++seen.statuses;
+      }
+      continue;
+    }
+    if (f->opcode != 2 || f->data.size() < 13 || f->data[0] != '\x01') continue;
     std::uint32_t sub = 0;
     std::uint64_t t = 0;
     std::memcpy(&sub, f->data.data() + 1, 4);
     std::memcpy(&t, f->data.data() + 5, 8);
-    ++counts[topic_of[sub]];
-    if (topic_of[sub] == "/fox_e2e/body_states") {
-      if (t < last_states_time) times_increase = false;
-      last_states_time = t;
-    }
+    const std::string& topic = topic_of[sub];
+    ++seen.counts[topic];
+    if (seen.last_time.count(topic) > 0 && t < seen.last_time[topic]) seen.decreasing.insert(topic);
+    seen.last_time[topic] = t;
+    seen.max_time[topic] = std::max(seen.max_time[topic], t);
+    if (!stop_topic.empty() && seen.counts[stop_topic] >= stop_count) break;
   }
-  c.close();
-  ::kill(pid, SIGINT);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  ::close(pipe_fds[0]);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
-  EXPECT_EQ(counts["/fox_e2e/scene"], 1);
-  EXPECT_GT(counts["/fox_e2e/body_states"], 10);
-  EXPECT_GT(counts["/clock"], 10);
-  EXPECT_EQ(counts.count("/fox_e2e/poses"), 0u) << "not a default topic";
-  EXPECT_TRUE(times_increase);
-  EXPECT_GT(last_states_time, 0u);
-  EXPECT_LT(last_states_time, 3'000'000'001ull) << "log time is simulated time";
+  return seen;
+}
+
+TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
+  Child node({"node", scene_path(), "--foxglove", "0", "--domain", kDomain, "--namespace", "fox_e2e",
+              "--rate", "1", "--duration", "3"});
+  const std::uint16_t port = node.port();
+  ASSERT_GT(port, 0) << node.err();
+  const Seen seen = watch(port, 400);
+  EXPECT_EQ(node.stop(), 0) << node.err();
+  EXPECT_EQ(seen.counts.at("/fox_e2e/scene"), 1);
+  EXPECT_GT(seen.counts.at("/fox_e2e/body_states"), 10);
+  EXPECT_GT(seen.counts.at("/clock"), 10);
+  EXPECT_EQ(seen.counts.count("/fox_e2e/poses"), 0u) << "not a default topic";
+  EXPECT_TRUE(seen.decreasing.empty()) << testing::PrintToString(seen.decreasing);
+  EXPECT_GT(seen.max_time.at("/fox_e2e/body_states"), 0u);
+  EXPECT_LE(seen.max_time.at("/fox_e2e/body_states"), 3'000'000'000ull) << "log time is simulated time";
+  EXPECT_NE(node.err().find("rbsim node: stopped after"), std::string::npos) << node.err();
+  EXPECT_NE(node.err().find("foxglove: 1 client,"), std::string::npos) << node.err();
+}
+
+TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {
+  test::TempDir dir;
+  const std::string log = (dir / "air.mcap").string();
+  const test::Outcome rec = rbsim({"run", scene_path(), "--duration", "0.1", "--record", log});
+  ASSERT_EQ(rec.exit_code, 0) << rec;
+  Child replay({"replay", log, "--foxglove", "0", "--domain", kDomain, "--namespace", "fox_rp", "--rate",
+                "0.5", "--loop"});
+  const std::uint16_t port = replay.port();
+  ASSERT_GT(port, 0) << replay.err();
+  // 0.1 s of log at half speed: a pass every 0.2 s; watch a few.
+  const Seen seen = watch(port, 3000, "/fox_rp/scene", 3);
+  EXPECT_EQ(replay.stop(), 0) << replay.err();
+  EXPECT_GE(seen.counts.at("/fox_rp/scene"), 3) << "the scene again in every pass";
+  EXPECT_GE(seen.server_infos, 2);
+  EXPECT_GE(seen.sessions.size(), 3u) << "a new sessionId every pass";
+  EXPECT_GT(seen.counts.at("/fox_rp/body_states"), 50);
+  EXPECT_TRUE(seen.decreasing.empty())
+      << "log times increase within a pass: " << testing::PrintToString(seen.decreasing);
+  EXPECT_LE(seen.max_time.at("/fox_rp/body_states"), 100'000'000ull) << "log time is simulated time";
+  EXPECT_NE(replay.err().find("rbsim replay: foxglove: open https://app.foxglove.dev/"), std::string::npos);
+}
+
+TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {
+  Child bridge({"bridge", "--foxglove", "0", "--domain", kDomain, "--namespace", "fox_br"});
+  const std::uint16_t port = bridge.port();
+  ASSERT_GT(port, 0) << bridge.err();
+  Child node({"node", scene_path(), "--domain", kDomain, "--namespace", "fox_br", "--rate", "1", "--duration",
+              "20"});
+  const Seen seen = watch(port, 2000, "/fox_br/body_states", 100);
+  EXPECT_EQ(node.stop(), 0) << node.err();
+  EXPECT_EQ(bridge.stop(), 0) << bridge.err();
+  EXPECT_GE(seen.counts.count("/fox_br/body_states") ? seen.counts.at("/fox_br/body_states") : 0, 100)
+      << bridge.err();
+  EXPECT_GE(seen.counts.count("/fox_br/scene") ? seen.counts.at("/fox_br/scene") : 0, 1)
+      << "latched, via DDS";
+  // Only the namespaced topics: /clock and /tf live at the root, where other nodes on the domain
+  // (other tests) publish too.
+  EXPECT_EQ(seen.decreasing.count("/fox_br/body_states"), 0u);
+  if (seen.max_time.count("/fox_br/body_states") > 0) {
+    EXPECT_LE(seen.max_time.at("/fox_br/body_states"), 20'000'000'000ull) << "log time is simulated time";
+  }
+  EXPECT_NE(bridge.err().find("rbsim bridge: stopped after"), std::string::npos) << bridge.err();
 }
 
 }  // namespace
