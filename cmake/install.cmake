@@ -41,6 +41,8 @@ if(RBSIM_INSTALL_TESTING)
 endif()
 install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# The Foxglove layout `rbsim node --foxglove` points to (tools/cli/foxglove.cpp looks here first).
+install(FILES ${PROJECT_SOURCE_DIR}/docs/foxglove-layout.json DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim)
 
 install(EXPORT rbsimTargets NAMESPACE rbsim:: DESTINATION ${RBSIM_CMAKE_DIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rbsimConfig.cmake.in

@@ -1,6 +1,8 @@
 // --foxglove [ADDR:]PORT, shared by rbsim node, replay and bridge: the option, and starting the
 // server with the lines that tell a person where to point Foxglove.
 #include <cstdio>
+#include <filesystem>
+#include <system_error>
 
 #include "commands.hpp"
 
@@ -9,6 +11,23 @@
 #endif
 
 namespace rbsim::cli {
+
+namespace {
+
+// Where the layout is: installed beside the binary (<prefix>/share/rbsim, cmake --install and the
+// Debian package), else in the source tree this binary was built from.
+std::string layout_path() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed =
+        exe.parent_path().parent_path() / "share/rbsim/foxglove-layout.json";
+    if (std::filesystem::exists(installed, ec)) return installed.string();
+  }
+  return RBSIM_FOXGLOVE_LAYOUT;
+}
+
+}  // namespace
 
 CLI::Option* add_foxglove_option(CLI::App* app, std::optional<std::string>& address, bool required) {
   CLI::Option* o = app->add_option(
@@ -44,7 +63,7 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
   std::fprintf(stderr, "%s: foxglove: open %s\n", command,
                foxglove::foxglove_app_link(foxglove::websocket_url(host, port)).c_str());
   std::fprintf(stderr, "%s: foxglove: layout %s (Foxglove: Layouts > Import from file)\n", command,
-               RBSIM_FOXGLOVE_LAYOUT);
+               layout_path().c_str());
   return server;
 }
 
