@@ -117,7 +117,7 @@ Subcommand add_check_command(CLI::App& parent) {
       "--golden-every", a->golden_every,
       "Print the --record-every K a golden of this scene is recorded with (about 500 steps) and exit");
   app->footer(
-      "Per-step messages (body and spring states, energy, poses, markers, clock) pair up per topic by "
+      "Per-step messages (body and spring states, energy, /tf, springs, poses, clock) pair up per topic by "
       "simulated step, round(stamp / dt) with each file's dt from its scene description; the scene "
       "description (and messages of other types) pair up in order. A step or message in only one file, a "
       "topic in only one file, a different schema or log time, or a physics value outside the tolerance is "

@@ -352,7 +352,8 @@ class Comparer {
     return Ok{};
   }
 
-  // The time step of the file's first scene description: steps are round(stamp / dt).
+  // The first scene description: its time step (steps are round(stamp / dt)) and, for the
+  // different-scene check, the scene itself.
   static Status read_dt(Side& s, mcap::IndexedReader& index) {
     std::vector<std::string> scene_topics;
     for (const auto& [id, channel] : index.channels()) {

@@ -1,8 +1,4 @@
 // A run published into the Foxglove server: the channels of rbsim's topics and the sink.
-#include <time.h>
-
-#include <cmath>
-
 #include "rbsim/foxglove.hpp"
 
 namespace rbsim::foxglove {
@@ -26,19 +22,6 @@ Result<std::vector<ChannelSpec>> ros2_channels(const msgs::TopicSet& topics, std
   return channels;
 }
 
-namespace {
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-void sleep_until(std::int64_t deadline_ns) {
-  const timespec ts{static_cast<time_t>(deadline_ns / 1'000'000'000),
-                    static_cast<long>(deadline_ns % 1'000'000'000)};
-  (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
-}
-}  // namespace
-
 FoxgloveSink::FoxgloveSink(Server& server, std::vector<ChannelId> ids, const SinkOptions& options)
     : server_(&server), ids_(std::move(ids)), options_(options) {
   ids_.resize(msgs::kTopicCount, 0);
@@ -56,8 +39,6 @@ void FoxgloveSink::publish(const msgs::TopicSpec& spec, const World& world) {
 
 Status FoxgloveSink::begin(const Scene& scene, const World& world) {
   encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
-  start_ns_ = monotonic_ns();
-  start_step_ = world.step_index();
   server_->new_session();
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (spec.transient_local) publish(spec, world);
@@ -67,10 +48,6 @@ Status FoxgloveSink::begin(const Scene& scene, const World& world) {
 
 Status FoxgloveSink::write(const World& world) {
   if (world.step_index() % options_.publish_every != 0) return Ok{};
-  if (options_.rate > 0.0) {
-    const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / options_.rate;
-    sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
-  }
   server_->time(msgs::sim_time_ns(world));
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (spec.per_step) publish(spec, world);

@@ -260,14 +260,12 @@ struct SinkOptions {
   msgs::TopicSet topics = msgs::default_topics();
   std::string ns = "rbsim";        // the namespace of the frames in /tf and the markers
   std::int64_t publish_every = 1;  // every k-th step (as DdsSink)
-  // Real-time factor to pace at; 0 leaves pacing to another sink (rbsim node's DdsSink paces, and
-  // the driver calls the sinks one after the other, so the pace happens once).
-  double rate = 0.0;
 };
 
 // Publishes a run into a Server started with ros2_channels(options.topics, ns): at begin() a new
 // session and every selected latched topic; at each published step the time and every selected
-// per-step topic that has a subscriber (nothing is encoded for a channel nobody watches).
+// per-step topic that has a subscriber (nothing is encoded for a channel nobody watches). It does
+// not pace: in rbsim node the DdsSink before it in the driver paces every step to --rate.
 class FoxgloveSink final : public Sink {
  public:
   FoxgloveSink(Server& server, std::vector<ChannelId> ids, const SinkOptions& options);
@@ -283,7 +281,6 @@ class FoxgloveSink final : public Sink {
   SinkOptions options_;
   std::unique_ptr<msgs::Encoder> encoder_;
   msgs::Bytes buffer_;
-  std::int64_t start_ns_ = 0, start_step_ = 0;
 };
 
 }  // namespace rbsim::foxglove
