@@ -211,17 +211,21 @@ def main():
         print(f"  {label}: {text}: {verdict(ok)}", flush=True)
 
     try:
+        # One binary for every process, even if the build is replaced while the benchmark runs.
+        rbsim = os.path.join(work, "rbsim")
+        shutil.copy2(a.rbsim, rbsim)
         scene = os.path.join(work, f"grid{BODIES}.xml")
         with open(scene, "w") as f:
             subprocess.run([sys.executable, os.path.join(a.root, "bench", "make_grid_scene.py"), str(BODIES), str(DT),
                             repr(seconds)], stdout=f, check=True, timeout=60)
         print(f"bench-record-live: {BODIES} bodies, dt = {DT * 1000:g} ms, {steps} steps ({seconds:g} s), default topics, "
               f"domain {domain}, namespace /{ns}, loopback ({env['CYCLONEDDS_URI']}); {os.cpu_count()} cores, "
-              f"load average {os.getloadavg()[0]:.2f} at the start", flush=True)
+              f"load average {os.getloadavg()[0]:.2f} at the start; {a.rbsim} (built "
+              f"{time.strftime('%Y-%m-%d %H:%M:%S', time.localtime(os.path.getmtime(a.rbsim)))})", flush=True)
 
         # 1. The baseline: rbsim run --record, same scene, steps, topics and namespace.
         run_mcap = os.path.join(work, "run.mcap")
-        run = Proc("run", [a.rbsim, "run", scene, "--record", run_mcap, "--namespace", ns, "--progress", "never"], env)
+        run = Proc("run", [rbsim, "run", scene, "--record", run_mcap, "--namespace", ns, "--progress", "never"], env)
         procs.append(run)
         if run.wait(node_bound_s) is None:
             run.stop(30)
@@ -242,7 +246,7 @@ def main():
         # 2. The node with its Foxglove server; the client subscribes before the recorder starts, and
         #    the node steps once the recorder's reader matched.
         live_mcap = os.path.join(work, "live.mcap")
-        node = Proc("node", [a.rbsim, "node", scene, "--rate", "1", "--domain", domain, "--namespace", ns,
+        node = Proc("node", [rbsim, "node", scene, "--rate", "1", "--domain", domain, "--namespace", ns,
                              "--foxglove", "127.0.0.1:0", "--wait-for-subscribers", "1"], env)
         procs.append(node)
         url = node.wait_for(r"foxglove: listening on (ws://127\.0\.0\.1:\d+)", 30).group(1)
@@ -251,7 +255,7 @@ def main():
                                  "--timeout-s", str(round(node_bound_s + 120))], env)
         procs.append(client)
         client.wait_for(r"READY \d+", 60)
-        rec = Proc("recorder", [a.rbsim, "record", live_mcap, "--domain", domain, "--namespace", ns,
+        rec = Proc("recorder", [rbsim, "record", live_mcap, "--domain", domain, "--namespace", ns,
                                 "--max-messages", str(expected_total),
                                 "--wall-duration", str(round(node_bound_s + 180))], env)
         procs.append(rec)
@@ -293,7 +297,7 @@ def main():
         rtf = node_rate * DT
         print(f"  node: {end.group(0)} ({node.wall_s():.1f} s wall from its start)", flush=True)
         print(f"  recorder: {rec_end.group(0)} ({rec.wall_s():.1f} s wall, stopped "
-              f"{'by SIGINT after a timeout' if rec_timed_out else 'at --max-messages'} "
+              f"{'at --max-messages' if rec_received >= expected_total and not rec_timed_out else 'by SIGINT or --wall-duration'} "
               f"{rec.ended - node_done:.1f} s after the node ended)", flush=True)
         print(f"(item 3) recording keeps up in real time, {BODIES} bodies, dt = 1 ms, --rate 1, rbsim record + "
               f"1 Foxglove client, {seconds:g} s:", flush=True)
@@ -338,7 +342,7 @@ def main():
                 report("rbsim check live.mcap run.mcap", False, "not run: the node did not publish every step")
             else:
                 t0 = time.monotonic()
-                chk = Proc("check", [a.rbsim, "check", live_mcap, run_mcap, "--ignore-log-time"], env)
+                chk = Proc("check", [rbsim, "check", live_mcap, run_mcap, "--ignore-log-time"], env)
                 procs.append(chk)
                 code = chk.wait(max(600.0, 20 * seconds))
                 if code is None:
