@@ -3,8 +3,10 @@
 // back on /bench/pong; `rbsim_bench_dds ping N` sends N samples one at a time and reports half
 // the round-trip times (median and p99, microseconds).
 // `rbsim_bench_dds listen TOPIC SECONDS` subscribes to a node's BodyStates topic (its QoS) and, for
-// every sample, prints "STEP SOURCE_NS DECODED_NS": the writer's source timestamp and the wall
-// clock once decoded (both CLOCK_REALTIME), the DDS side of scripts/bench-foxglove's latency.
+// every sample, prints "STEP SOURCE_NS DECODED_NS SOURCE_MONO_NS": the writer's source timestamp
+// and the wall clock once decoded (both CLOCK_REALTIME), and the source timestamp on
+// CLOCK_MONOTONIC, the clock of Node's process.hrtime (the two clocks' offset is read beside each
+// sample): the DDS side of scripts/bench-foxglove's latency.
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 
@@ -50,6 +52,10 @@ std::int64_t realtime_ns() {
       .count();
 }
 
+std::int64_t monotonic_ns() {  // steady_clock is CLOCK_MONOTONIC in libstdc++
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
 int listen(std::uint32_t domain, const std::string& topic, double seconds) {
   auto participant = rbsim::node::Participant::create(domain);
   if (!participant) return std::fprintf(stderr, "%s\n", participant.error().message.c_str()), 1;
@@ -60,7 +66,7 @@ int listen(std::uint32_t domain, const std::string& topic, double seconds) {
   dds_waitset_attach(waitset, dds_create_readcondition(sub->reader(), DDS_ANY_STATE), 0);
   std::printf("READY\n");
   std::fflush(stdout);
-  std::vector<std::array<std::int64_t, 3>> rows;
+  std::vector<std::array<std::int64_t, 4>> rows;
   rbsim::node::Received got;
   rbsim::msgs::BodyStatesMessage msg;
   const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
@@ -70,11 +76,14 @@ int listen(std::uint32_t domain, const std::string& topic, double seconds) {
       continue;
     }
     if (!rbsim::msgs::decode_body_states(got.cdr, msg)) continue;
-    rows.push_back({static_cast<std::int64_t>(msg.step), got.source_time_ns, realtime_ns()});
+    const std::int64_t real = realtime_ns();
+    const std::int64_t mono = monotonic_ns();
+    rows.push_back(
+        {static_cast<std::int64_t>(msg.step), got.source_time_ns, real, got.source_time_ns - (real - mono)});
   }
   for (const auto& r : rows)
-    std::printf("%lld %lld %lld\n", static_cast<long long>(r[0]), static_cast<long long>(r[1]),
-                static_cast<long long>(r[2]));
+    std::printf("%lld %lld %lld %lld\n", static_cast<long long>(r[0]), static_cast<long long>(r[1]),
+                static_cast<long long>(r[2]), static_cast<long long>(r[3]));
   return 0;
 }
 

@@ -54,12 +54,20 @@ void offered_by(const dds_qos_t* qos, msgs::OfferedQos& out) {
   }
 }
 
+// The topic `ros_topic` with the raw CDR sertype under the ROS 2 type name (raw_serdata.hpp):
+// rbsim's writers send the bytes rbsim_msgs encoded as they are, its readers take them as they
+// came. `sertype` is the one the topic uses (Cyclone may swap in an equal one it already has).
 Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec& spec,
-                                std::string_view ros_topic) {
-  const dds_topic_descriptor_t* desc = descriptor(spec.id);
+                                std::string_view ros_topic, const ddsi_sertype** sertype = nullptr) {
+  ddsi_sertype* type = make_raw_sertype(descriptor(spec.id)->m_typename);
   const std::string name = msgs::dds_topic_name(ros_topic);
-  const dds_entity_t topic = dds_create_topic(participant, desc, name.c_str(), nullptr, nullptr);
-  if (topic < 0) return dds_error("cannot create DDS topic " + name, topic);
+  const dds_entity_t topic =
+      dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
+  if (topic < 0) {
+    ddsi_sertype_unref(type);  // not taken over on failure
+    return dds_error("cannot create DDS topic " + name, topic);
+  }
+  if (sertype != nullptr) *sertype = type;
   return topic;
 }
 }  // namespace
@@ -105,7 +113,8 @@ Participant::~Participant() {
 // ---------------------------------------------------------------------------------------------
 Result<Publisher> Publisher::create(const Participant& participant, const msgs::TopicSpec& spec,
                                     std::string_view ros_topic, const QosSpec& q) {
-  auto topic = make_topic(participant.handle(), spec, ros_topic);
+  const ddsi_sertype* sertype = nullptr;
+  auto topic = make_topic(participant.handle(), spec, ros_topic, &sertype);
   if (!topic) return topic.error();
   dds_qos_t* qos = make_qos(q, false);
   const dds_entity_t writer = dds_create_writer(participant.handle(), topic.value(), qos, nullptr);
@@ -114,12 +123,13 @@ Result<Publisher> Publisher::create(const Participant& participant, const msgs::
   Publisher p;
   p.writer_ = writer;
   p.topic_ = topic.value();
+  p.sertype_ = sertype;
   p.ros_topic_ = std::string(ros_topic);
   return p;
 }
 
 Publisher::Publisher(Publisher&& o) noexcept
-    : writer_(o.writer_), topic_(o.topic_), ros_topic_(std::move(o.ros_topic_)) {
+    : writer_(o.writer_), topic_(o.topic_), sertype_(o.sertype_), ros_topic_(std::move(o.ros_topic_)) {
   o.writer_ = o.topic_ = 0;
 }
 Publisher::~Publisher() {
@@ -128,7 +138,7 @@ Publisher::~Publisher() {
 }
 
 Status Publisher::publish(std::span<const std::byte> cdr) {
-  ddsi_serdata* d = make_raw_serdata(cdr);
+  ddsi_serdata* d = make_raw_serdata(sertype_, cdr);
   const dds_return_t rc = dds_writecdr(writer_, d);  // takes the reference
   if (rc < 0) return dds_error("publishing on " + ros_topic_ + " failed", rc);
   return Ok{};

@@ -28,16 +28,14 @@ Result<std::unique_ptr<DdsSink>> DdsSink::create(const Participant& participant,
 }
 
 Status DdsSink::publish(msgs::TopicId id, const World& world) {
-  encoder_->encode(id, world, buffer_);
-  Status st = publishers_[static_cast<std::size_t>(id)]->publish(buffer_);
+  Status st = publishers_[static_cast<std::size_t>(id)]->publish(messages_->get(id, world));
   if (st) ++published_;
   return st;
 }
 
 Status DdsSink::begin(const Scene& scene, const World& world) {
-  encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
-  restart_clock();
-  start_step_ = world.step_index();
+  messages_ =
+      options_.messages ? options_.messages : std::make_shared<msgs::StepMessages>(scene, options_.ns);
   for (const msgs::TopicId id : ids_) {
     if (msgs::topic(id).per_step) continue;
     if (Status st = publish(id, world); !st) return st;
@@ -45,17 +43,8 @@ Status DdsSink::begin(const Scene& scene, const World& world) {
   return write(world);
 }
 
-void DdsSink::restart_clock() {
-  start_ns_ = monotonic_ns();
-}
-
 Status DdsSink::write(const World& world) {
   if (world.step_index() % options_.publish_every != 0) return Ok{};
-  if (options_.rate > 0.0) {
-    // Step n is due at start + (n - n0) dt / rate of wall time.
-    const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / options_.rate;
-    sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
-  }
   for (const msgs::TopicId id : ids_) {
     if (!msgs::topic(id).per_step) continue;
     if (Status st = publish(id, world); !st) return st;
@@ -81,6 +70,19 @@ bool DdsSink::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
     sleep_until(monotonic_ns() + 20'000'000);
   }
   return true;
+}
+
+Status Pacer::begin(const Scene&, const World& world) {
+  start_ns_ = monotonic_ns();
+  start_step_ = world.step_index();
+  return Ok{};
+}
+
+Status Pacer::write(const World& world) {
+  if (rate_ <= 0.0 || world.step_index() % every_ != 0) return Ok{};
+  const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / rate_;
+  sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
+  return Ok{};
 }
 
 }  // namespace rbsim::node

@@ -1,6 +1,7 @@
 #include "raw_serdata.hpp"
 
 #include <dds/ddsi/ddsi_sertype.h>
+#include <dds/ddsi/q_radmin.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -18,19 +19,54 @@ struct RawSerdata {
 const RawSerdata& raw(const ddsi_serdata* d) {
   return *reinterpret_cast<const RawSerdata*>(d);
 }
+void free_serdata(ddsi_serdata* d) {
+  auto* r = reinterpret_cast<RawSerdata*>(d);
+  delete[] r->bytes;
+  delete r;
+}
+
+RawSerdata* make(const ddsi_sertype* type, ddsi_serdata_kind kind, std::size_t size) {
+  auto* d = new RawSerdata{};
+  ddsi_serdata_init(&d->c, type, kind);
+  d->c.hash = type->serdata_basehash;  // keyless: every sample is the one instance
+  d->size = static_cast<std::uint32_t>(size);
+  const std::size_t padded = (size + 3) / 4 * 4;
+  d->bytes = new unsigned char[padded];
+  std::memset(d->bytes + size, 0, padded - size);
+  return d;
+}
+
+// A received sample: its fragments, in order, each covering [min, maxp1) of the payload and
+// possibly overlapping the one before (Cyclone's own serdata reads them the same way). The
+// bytes are kept as they came: rbsim's decoders check what they read.
+ddsi_serdata* from_ser(const ddsi_sertype* type, ddsi_serdata_kind kind, const nn_rdata* fragchain,
+                       std::size_t size) {
+  RawSerdata* d = make(type, kind, size);
+  std::size_t off = 0;
+  for (const nn_rdata* f = fragchain; f != nullptr && off < size; f = f->nextfrag) {
+    if (f->min > off || f->maxp1 > size) break;  // a gap or an overrun: never from Cyclone
+    if (f->maxp1 <= off) continue;
+    const unsigned char* payload = NN_RMSG_PAYLOADOFF(f->rmsg, NN_RDATA_PAYLOAD_OFF(f));
+    std::memcpy(d->bytes + off, payload + (off - f->min), f->maxp1 - off);
+    off = f->maxp1;
+  }
+  if (off < size) {
+    free_serdata(&d->c);
+    return nullptr;
+  }
+  return &d->c;
+}
 
 ddsi_serdata* from_ser_iov(const ddsi_sertype* type, ddsi_serdata_kind kind, ddsrt_msg_iovlen_t niov,
                            const ddsrt_iovec_t* iov, std::size_t size) {
-  auto* d = new RawSerdata{};
-  ddsi_serdata_init(&d->c, type, kind);
-  d->size = static_cast<std::uint32_t>(size);
-  d->bytes = new unsigned char[(size + 3) / 4 * 4]();
+  RawSerdata* d = make(type, kind, size);
   std::size_t at = 0;
   for (ddsrt_msg_iovlen_t i = 0; i < niov && at < size; ++i) {
     const std::size_t n = std::min<std::size_t>(iov[i].iov_len, size - at);
     std::memcpy(d->bytes + at, iov[i].iov_base, n);
     at += n;
   }
+  if (at < size) std::memset(d->bytes + at, 0, size - at);
   return &d->c;
 }
 std::uint32_t get_size(const ddsi_serdata* d) {
@@ -46,11 +82,6 @@ ddsi_serdata* to_ser_ref(const ddsi_serdata* d, std::size_t off, std::size_t sz,
 }
 void to_ser_unref(ddsi_serdata* d, const ddsrt_iovec_t*) {
   ddsi_serdata_unref(d);
-}
-void free_serdata(ddsi_serdata* d) {
-  auto* r = reinterpret_cast<RawSerdata*>(d);
-  delete[] r->bytes;
-  delete r;
 }
 bool eqkey(const ddsi_serdata*, const ddsi_serdata*) {
   return true;
@@ -76,6 +107,7 @@ const ddsi_serdata_ops kSerdataOps = [] {
   ddsi_serdata_ops ops{};
   ops.eqkey = eqkey;
   ops.get_size = get_size;
+  ops.from_ser = from_ser;
   ops.from_ser_iov = from_ser_iov;
   ops.to_ser = to_ser;
   ops.to_ser_ref = to_ser_ref;
@@ -89,12 +121,16 @@ const ddsi_serdata_ops kSerdataOps = [] {
   return ops;
 }();
 
-void sertype_free(ddsi_sertype*) {}
+void sertype_free(ddsi_sertype* t) {
+  ddsi_sertype_fini(t);
+  delete t;
+}
 void zero_samples(const ddsi_sertype*, void*, std::size_t) {}
 void realloc_samples(void** ptrs, const ddsi_sertype*, void*, std::size_t, std::size_t) {
   *ptrs = nullptr;
 }
 void free_samples(const ddsi_sertype*, void**, std::size_t, dds_free_op_t) {}
+// Cyclone compares the ops and type names before this: raw types of one name are one type.
 bool sertype_equal(const ddsi_sertype*, const ddsi_sertype*) {
   return true;
 }
@@ -114,23 +150,19 @@ const ddsi_sertype_ops kSertypeOps = [] {
   return ops;
 }();
 
-// One process-wide, never registered with a domain: it only tags serdata as raw bytes.
-const ddsi_sertype* raw_sertype() {
-  static ddsi_sertype type = [] {
-    ddsi_sertype t{};
-    ddsi_sertype_init(&t, "rbsim::raw_cdr", &kSertypeOps, &kSerdataOps, /*topickind_no_key=*/true);
-    return t;
-  }();
-  return &type;
-}
-
 }  // namespace
 
-ddsi_serdata* make_raw_serdata(std::span<const std::byte> cdr) {
+ddsi_sertype* make_raw_sertype(const char* type_name) {
+  auto* t = new ddsi_sertype{};
+  ddsi_sertype_init(t, type_name, &kSertypeOps, &kSerdataOps, /*topickind_no_key=*/true);
+  return t;
+}
+
+ddsi_serdata* make_raw_serdata(const ddsi_sertype* type, std::span<const std::byte> cdr) {
   ddsrt_iovec_t iov;
   iov.iov_base = const_cast<std::byte*>(cdr.data());
   iov.iov_len = static_cast<ddsrt_iov_len_t>(cdr.size());
-  return ddsi_serdata_from_ser_iov(raw_sertype(), SDK_DATA, 1, &iov, cdr.size());
+  return ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, cdr.size());
 }
 
 }  // namespace rbsim::node

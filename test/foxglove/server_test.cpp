@@ -427,20 +427,25 @@ TEST(FoxgloveSink, PublishesTheSceneLatchedAndSubscribedStepsAtSimulatedTime) {
   ASSERT_TRUE(end);
   ASSERT_TRUE(driver.value().finish());
 
-  // serverInfo of the new session, then steps 0, 2, 4 (time then body states each).
+  // serverInfo of the new session, then steps 0, 2, 4 (body states, then the step's time).
   EXPECT_EQ(next_json(c)["op"], "serverInfo");
   msgs::Encoder encoder(scene);
   for (std::int64_t step : {0, 2, 4}) {
     auto f = c.read();
-    ASSERT_TRUE(f);
-    ASSERT_EQ(f->data[0], '\x02') << "time first";
-    f = c.read();
     ASSERT_TRUE(f);
     auto data = as_data(*f);
     ASSERT_TRUE(data);
     EXPECT_EQ(data->subscription, 3u);
     const auto want_time = static_cast<std::uint64_t>(std::llround(static_cast<double>(step) * 0.01 * 1e9));
     EXPECT_EQ(data->log_time, want_time);
+    auto t = c.read();
+    ASSERT_TRUE(t);
+    ASSERT_EQ(t->data.size(), 9u);
+    ASSERT_EQ(t->data[0], '\x02') << "the step's time after its messages";
+    std::uint64_t time_ns = 0;
+    for (int i = 0; i < 8; ++i)
+      time_ns |= static_cast<std::uint64_t>(static_cast<unsigned char>(t->data[1 + i])) << (8 * i);
+    EXPECT_EQ(time_ns, want_time);
     msgs::BodyStatesMessage m;
     ASSERT_TRUE(msgs::decode_body_states(std::as_bytes(std::span(data->payload)), m));
     EXPECT_EQ(m.step, static_cast<std::uint64_t>(step));

@@ -38,10 +38,14 @@ int node_command(const NodeArgs& a) {
 
   auto participant = node::Participant::create(a.node.domain);
   if (!participant) return fail(participant.error().message);
-  auto sink = node::DdsSink::create(participant.value(), a.node);
+  // Each step is encoded once for DDS and the Foxglove server alike.
+  node::NodeOptions node_options = a.node;
+  node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
+  auto sink = node::DdsSink::create(participant.value(), node_options);
   if (!sink) return fail(sink.error().message);
-  // The Foxglove server serves beside DDS: the DDS sink paces the steps (it comes first in the
-  // driver), the Foxglove sink publishes each step right after it.
+  // The Foxglove server serves beside DDS. The pacer releases each step when it is due; the
+  // Foxglove sink's hand-off to the server's thread (a copy and a wake-up) goes first, so
+  // viewers do not wait for the DDS writes.
   std::unique_ptr<foxglove::Server> server;
   std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
   if (a.foxglove) {
@@ -49,6 +53,7 @@ int node_command(const NodeArgs& a) {
     fo.publish_every = a.node.publish_every;
     fo.topics = a.node.topics;
     fo.ns = a.node.ns;
+    fo.messages = node_options.messages;
     std::vector<foxglove::ChannelId> ids;
     auto channels = foxglove::ros2_channels(fo.topics, a.node.ns, &ids);
     if (!channels) return fail(channels.error().message);
@@ -73,8 +78,10 @@ int node_command(const NodeArgs& a) {
   Result<Driver> created = Driver::create(scene);
   if (!created) return fail(created.error().message);
   Driver& driver = created.value();
-  driver.add(*sink.value());
+  node::Pacer pacer(a.node.rate, a.node.publish_every);
+  driver.add(pacer);
   if (foxglove_sink) driver.add(*foxglove_sink);
+  driver.add(*sink.value());
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;

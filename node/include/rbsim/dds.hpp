@@ -17,6 +17,8 @@
 #include "rbsim/msgs.hpp"
 #include "rbsim/ros_env.hpp"
 
+struct ddsi_sertype;  // Cyclone DDS
+
 namespace rbsim::node {
 
 // Participant::create's domain argument for "ROS_DOMAIN_ID, else 0".
@@ -74,6 +76,7 @@ class Publisher {
  private:
   Publisher() = default;
   std::int32_t writer_ = 0, topic_ = 0;
+  const ddsi_sertype* sertype_ = nullptr;  // the writer's (raw CDR) type, owned by the topic
   std::string ros_topic_;
 };
 

@@ -1,4 +1,5 @@
-// The node: a Sink that publishes every topic of a step over DDS (rbsim node).
+// The node: a Sink that publishes every topic of a step over DDS (rbsim node), and the Pacer that
+// releases the steps at wall-clock time before any sink publishes them.
 #pragma once
 
 #include <cstdint>
@@ -15,13 +16,16 @@ namespace rbsim::node {
 struct NodeOptions {
   std::uint32_t domain = kDomainFromEnvironment;  // ROS_DOMAIN_ID, else 0 (Participant::create)
   std::string ns = "rbsim";
-  double rate = 1.0;               // real-time factor; 0: as fast as possible
+  double rate = 1.0;               // real-time factor (Pacer); 0: as fast as possible
   std::int64_t publish_every = 1;  // publish every k-th step; create() refuses < 1
   std::int32_t keep_last = 0;      // per-step writers keep last N instead of keep all (0)
   msgs::TopicSet topics = msgs::default_topics();
+  // Shared with the other sinks of a run (the Foxglove sink), so each step is encoded once; when
+  // null the sink encodes for itself.
+  std::shared_ptr<msgs::StepMessages> messages;
 };
 // Publishes the selected latched topics (scene description, markers: transient local) at begin()
-// and the selected per-step topics on every k-th step, pacing steps to wall time by `rate`.
+// and the selected per-step topics on every k-th step.
 class DdsSink final : public Sink {
  public:
   static Result<std::unique_ptr<DdsSink>> create(const Participant& participant, const NodeOptions& options);
@@ -33,8 +37,6 @@ class DdsSink final : public Sink {
   // Waits until `count` subscriptions match the first selected per-step topic (body states by
   // default); false when `stop` turned true.
   bool wait_for_subscribers(std::int32_t count, bool (*stop)());
-  // Restarts the pacing clock (e.g. when --loop starts the scene again).
-  void restart_clock();
   std::uint64_t published() const { return published_; }
 
  private:
@@ -43,11 +45,27 @@ class DdsSink final : public Sink {
   NodeOptions options_;
   std::vector<std::optional<Publisher>> publishers_;  // by TopicId; empty when not selected
   std::vector<msgs::TopicId> ids_;                    // the selected topics, latched first
-  std::unique_ptr<msgs::Encoder> encoder_;
-  msgs::Bytes buffer_;
-  std::int64_t start_ns_ = 0;  // monotonic clock at the paced step
-  std::int64_t start_step_ = 0;
+  std::shared_ptr<msgs::StepMessages> messages_;
   std::uint64_t published_ = 0;
+};
+
+// Paces a run to wall time: published step n (every k-th) is released at start + (n - n0) dt /
+// rate, with n0 and start taken at begin() (so each --loop pass starts afresh). Added to the
+// Driver before the sinks that publish, so they all send a step the moment it is due: the
+// Foxglove server's non-blocking hand-off first, then the DDS writes.
+class Pacer final : public Sink {
+ public:
+  Pacer(double rate, std::int64_t publish_every)
+      : rate_(rate), every_(publish_every < 1 ? 1 : publish_every) {}
+  Status begin(const Scene& scene, const World& world) override;
+  Status write(const World& world) override;
+  Status finish() override { return Ok{}; }
+
+ private:
+  double rate_;
+  std::int64_t every_;
+  std::int64_t start_ns_ = 0;  // monotonic clock at begin()
+  std::int64_t start_step_ = 0;
 };
 
 }  // namespace rbsim::node

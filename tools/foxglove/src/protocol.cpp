@@ -56,12 +56,11 @@ void append_le(std::string& out, std::uint64_t v, int bytes) {
 
 void append_message_data(std::string& out, SubscriptionId subscription, std::uint64_t log_time_ns,
                          std::span<const std::byte> payload) {
+  out.reserve(out.size() + kMessageDataHeader + payload.size());
   out.push_back('\x01');
   append_le(out, subscription, 4);
   append_le(out, log_time_ns, 8);
-  const std::size_t at = out.size();
-  out.resize(at + payload.size());
-  if (!payload.empty()) std::memcpy(out.data() + at, payload.data(), payload.size());
+  out.append(reinterpret_cast<const char*>(payload.data()), payload.size());  // no zero fill first
 }
 
 void append_time(std::string& out, std::uint64_t time_ns) {

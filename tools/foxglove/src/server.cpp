@@ -3,7 +3,8 @@
 // Threads: the producer (simulation, replay or DDS relay) calls publish()/time()/new_session(),
 // which copy into client queues under `mu` and wake the I/O thread; everything else (handshake,
 // client frames, sending, stall detection) runs on the I/O thread. The producer never waits on a
-// socket: the worst it waits for is `mu` while the I/O thread moves frames to websocketpp.
+// socket, nor on websocketpp: the I/O thread holds `mu` only to take frames out of the queues
+// (moves, no copies) and hands them to websocketpp after releasing it.
 #include <arpa/inet.h>
 
 #include <atomic>
@@ -33,6 +34,10 @@ struct Client {
   std::size_t in_flight = 0;          // websocketpp's buffered amount after the last pump
   std::int64_t last_progress_ns = 0;  // when the client last read something (or had nothing to read)
   bool dropping = false;              // disconnected for not reading; waiting for the close
+  // Frames taken from the queue under `mu` and sent without it (I/O thread). Their buffers go back
+  // to the queue's pool at the next take, or to websocketpp when sent.
+  std::vector<ClientQueue::Frame> outgoing;
+  std::size_t taken = 0;
   Client(detail::ConnectionId id, std::uint32_t channels, const QueueLimits& limits)
       : connection(id), protocol(channels), queue(limits) {}
 };
@@ -58,7 +63,6 @@ struct Server::Impl {
   std::unique_ptr<std::atomic<std::uint32_t>[]> subscribers;  // by channel - 1
 
   // I/O thread scratch, reused.
-  ClientQueue::Frame frame;
   ClientProtocol::Outcome outcome;
 
   Client* find(detail::ConnectionId id) {
@@ -78,15 +82,17 @@ struct Server::Impl {
   }
 
   void opened(detail::ConnectionId id) {
-    std::lock_guard lock(mu);
-    auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()), options.queue);
-    c->queue.push_text(server_info);
-    c->queue.push_text(advertise);
-    c->last_progress_ns = monotonic_ns();
-    ++totals.clients;
-    pump(*c, c->last_progress_ns);
-    clients.push_back(std::move(c));
-    client_count = clients.size();
+    {
+      std::lock_guard lock(mu);
+      auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()), options.queue);
+      c->queue.push_text(server_info);
+      c->queue.push_text(advertise);
+      c->last_progress_ns = monotonic_ns();
+      ++totals.clients;
+      clients.push_back(std::move(c));
+      client_count = clients.size();
+    }
+    pump_all();
   }
 
   void closed(detail::ConnectionId id) {
@@ -106,9 +112,16 @@ struct Server::Impl {
   }
 
   void message(detail::ConnectionId id, const std::string& payload, bool binary) {
-    std::lock_guard lock(mu);
+    {
+      std::lock_guard lock(mu);
+      if (!handle(id, payload, binary)) return;
+    }
+    pump_all();
+  }
+
+  bool handle(detail::ConnectionId id, const std::string& payload, bool binary) {
     Client* c = find(id);
-    if (c == nullptr) return;
+    if (c == nullptr) return false;
     if (binary) {
       c->protocol.handle_binary(payload.size(), outcome);
     } else {
@@ -124,22 +137,30 @@ struct Server::Impl {
       if (l.has) c->queue.push_message(ClientQueue::Kind::Latched, s.id, l.log_time, l.payload);
     }
     for (const std::string& r : outcome.replies) c->queue.push_text(r);
-    pump(*c, monotonic_ns());
+    return true;
   }
 
-  // Hands queued frames to websocketpp while less than max_in_flight_bytes is buffered there,
-  // and disconnects a client that has read nothing for stall_timeout_s.
-  void pump(Client& c, std::int64_t now) {
+  // Under `mu`: takes the frames websocketpp may have now (while less than max_in_flight_bytes is
+  // buffered there) and notes whether the client read anything since the last pump.
+  void take(Client& c, std::int64_t now) {
+    c.taken = 0;
     if (c.dropping) return;
     std::size_t buffered = transport->buffered(c.connection);
     if (buffered == 0 || buffered < c.in_flight) c.last_progress_ns = now;
     while (!c.queue.empty()) {
       const std::size_t next = c.queue.front_size();
       if (buffered > 0 && buffered + next > options.max_in_flight_bytes) break;
-      c.queue.pop(frame);
-      if (!transport->send(c.connection, frame.data, frame.binary)) break;
-      buffered = transport->buffered(c.connection);
+      if (c.taken == c.outgoing.size()) c.outgoing.emplace_back();
+      c.queue.pop(c.outgoing[c.taken++]);
+      buffered += next;
     }
+  }
+
+  // Under `mu`: records what websocketpp holds and disconnects a client that has read nothing for
+  // stall_timeout_s.
+  void settle(Client& c, std::int64_t now) {
+    if (c.dropping) return;
+    const std::size_t buffered = transport->buffered(c.connection);
     c.in_flight = buffered;
     const bool waiting = buffered > 0 || !c.queue.empty();
     if (waiting && static_cast<double>(now - c.last_progress_ns) > options.stall_timeout_s * 1e9) {
@@ -149,10 +170,22 @@ struct Server::Impl {
     }
   }
 
+  // I/O thread. Only it adds or removes clients, so the Client objects stay valid between the
+  // locked phases.
   void pump_all() {
-    std::lock_guard lock(mu);
     const std::int64_t now = monotonic_ns();
-    for (auto& c : clients) pump(*c, now);
+    {
+      std::lock_guard lock(mu);
+      for (auto& c : clients) take(*c, now);
+    }
+    for (auto& c : clients) {
+      for (std::size_t i = 0; i < c->taken; ++i) {
+        ClientQueue::Frame& f = c->outgoing[i];
+        if (!transport->send(c->connection, f.data, f.binary)) break;
+      }
+    }
+    std::lock_guard lock(mu);
+    for (auto& c : clients) settle(*c, now);
   }
 };
 

@@ -33,12 +33,12 @@ void FoxgloveSink::publish(const msgs::TopicSpec& spec, const World& world) {
   if (ch == 0 || !options_.topics.test(static_cast<std::size_t>(spec.id))) return;
   // Nothing is encoded for a channel nobody watches; a latched one is kept for later subscribers.
   if (!spec.transient_local && !server_->subscribed(ch)) return;
-  encoder_->encode(spec.id, world, buffer_);
-  server_->publish(ch, msgs::sim_time_ns(world), buffer_);
+  server_->publish(ch, msgs::sim_time_ns(world), messages_->get(spec.id, world));
 }
 
 Status FoxgloveSink::begin(const Scene& scene, const World& world) {
-  encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
+  messages_ =
+      options_.messages ? options_.messages : std::make_shared<msgs::StepMessages>(scene, options_.ns);
   server_->new_session();
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (spec.transient_local) publish(spec, world);
@@ -48,10 +48,12 @@ Status FoxgloveSink::begin(const Scene& scene, const World& world) {
 
 Status FoxgloveSink::write(const World& world) {
   if (world.step_index() % options_.publish_every != 0) return Ok{};
-  server_->time(msgs::sim_time_ns(world));
+  // The step's messages go before its time message: each publish wakes the server's thread, and
+  // a time message sent first would make the first wake-up (and the client's) carry 9 bytes.
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (spec.per_step) publish(spec, world);
   }
+  server_->time(msgs::sim_time_ns(world));
   return Ok{};
 }
 

@@ -40,6 +40,16 @@ class AsioTransport final : public Transport {
     ws_.set_reuse_addr(true);
     ws_.set_max_message_size(max_message_size);
     ws_.set_listen_backlog(64);
+    // Per-step messages are small and come every step: with Nagle on, the kernel holds each one
+    // until the previous segment is acknowledged, and the client's delayed ACK turns that into
+    // bursts many steps apart. Set on the accepted socket (the init handler runs before accept).
+    ws_.set_tcp_post_init_handler([this](Hdl h) {
+      websocketpp::lib::error_code hec;
+      WsServer::connection_ptr con = ws_.get_con_from_hdl(h, hec);
+      if (hec) return;
+      asio::error_code nec;
+      con->get_raw_socket().set_option(asio::ip::tcp::no_delay(true), nec);
+    });
     ws_.set_validate_handler([this](Hdl h) { return validate(h); });
     ws_.set_open_handler([this](Hdl h) { opened(h); });
     ws_.set_close_handler([this](Hdl h) { closed(h); });
@@ -114,13 +124,29 @@ class AsioTransport final : public Transport {
     }
   }
 
-  bool send(ConnectionId id, const std::string& data, bool binary) override {
+  bool send(ConnectionId id, std::string& data, bool binary) override {
     WsServer::connection_ptr con = find(id);
     if (!con) return false;
-    const websocketpp::lib::error_code ec =
-        con->send(data.data(), data.size(),
-                  binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
-    return !ec;
+    // A prepared message is written as it is: websocketpp's own preparation would copy the
+    // payload twice (into a message, then into a framed one). A server frame is unmasked and we
+    // negotiate no extension, so the frame is the RFC 6455 header followed by the payload.
+    // Once written, the message's buffer comes back to `spare_`, and from there to the caller:
+    // buffers circulate instead of being freed and faulted in again for every message.
+    std::shared_ptr<Message> msg(new Message(nullptr), [this](Message* m) {
+      if (spare_.size() < kSpareMax) spare_.push_back(std::move(m->get_raw_payload()));
+      delete m;
+    });
+    msg->set_opcode(binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
+    msg->set_header(frame_header(binary, data.size()));
+    msg->get_raw_payload().swap(data);
+    msg->set_prepared(true);
+    data.clear();
+    if (!spare_.empty()) {
+      data.swap(spare_.back());
+      spare_.pop_back();
+      data.clear();
+    }
+    return !con->send(msg);
   }
 
   std::size_t buffered(ConnectionId id) const override {
@@ -144,6 +170,23 @@ class AsioTransport final : public Transport {
     websocketpp::lib::error_code ec;
     WsServer::connection_ptr con = const_cast<WsServer&>(ws_).get_con_from_hdl(it->second, ec);
     return ec ? nullptr : con;
+  }
+
+  // The header of an unmasked, final frame of `size` payload bytes (RFC 6455 section 5.2).
+  static std::string frame_header(bool binary, std::size_t size) {
+    std::string h;
+    h.push_back(static_cast<char>(binary ? 0x82 : 0x81));
+    if (size < 126) {
+      h.push_back(static_cast<char>(size));
+    } else if (size <= 0xFFFF) {
+      h.push_back(static_cast<char>(126));
+      for (int shift = 8; shift >= 0; shift -= 8) h.push_back(static_cast<char>((size >> shift) & 0xFF));
+    } else {
+      h.push_back(static_cast<char>(127));
+      for (int shift = 56; shift >= 0; shift -= 8)
+        h.push_back(static_cast<char>((static_cast<std::uint64_t>(size) >> shift) & 0xFF));
+    }
+    return h;
   }
 
   // websocketpp reports a failed bind as "Underlying Transport Error"; a bind of our own says
@@ -241,6 +284,11 @@ class AsioTransport final : public Transport {
     });
   }
 
+  using Message = websocketpp::config::asio::message_type;
+  static constexpr std::size_t kSpareMax = 64;
+  // Buffers of written messages (I/O thread). Declared before ws_, whose connections may still
+  // hold messages when it is destroyed.
+  std::vector<std::string> spare_;
   asio::io_context io_;
   WsServer ws_;
   TransportHandlers handlers_;

@@ -42,8 +42,11 @@ class Transport {
   // Any thread: close every connection, stop listening, join the I/O thread.
   virtual void stop() = 0;
 
-  // I/O thread only. False when the connection is gone.
-  virtual bool send(ConnectionId id, const std::string& data, bool binary) = 0;
+  // I/O thread only. Sends `data` as one WebSocket message, taking its buffer (no copy: the
+  // frame header goes beside it in one gather write); `data` is left empty, holding the buffer of
+  // an earlier message that has been written, when there is one. False when the connection is
+  // gone.
+  virtual bool send(ConnectionId id, std::string& data, bool binary) = 0;
   // Bytes handed to the socket layer and not yet written for `id` (0 when gone).
   virtual std::size_t buffered(ConnectionId id) const = 0;
   // Drops the connection at once (no close handshake: for a peer that does not read).

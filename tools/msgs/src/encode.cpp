@@ -420,4 +420,18 @@ void Encoder::encode(TopicId id, const World& world, Bytes& out) const {
   }
 }
 
+StepMessages::StepMessages(const Scene& scene, std::string_view ns) : encoder_(scene, ns) {
+  step_.fill(-1);
+}
+
+const Bytes& StepMessages::get(TopicId id, const World& world) {
+  const auto i = static_cast<std::size_t>(id);
+  if (world_[i] != &world || step_[i] != world.step_index()) {
+    encoder_.encode(id, world, bytes_[i]);
+    world_[i] = &world;
+    step_[i] = world.step_index();
+  }
+  return bytes_[i];
+}
+
 }  // namespace rbsim::msgs

@@ -260,12 +260,15 @@ struct SinkOptions {
   msgs::TopicSet topics = msgs::default_topics();
   std::string ns = "rbsim";        // the namespace of the frames in /tf and the markers
   std::int64_t publish_every = 1;  // every k-th step (as DdsSink)
+  // Shared with the other sinks of a run (the node's DdsSink), so each step is encoded once; when
+  // null the sink encodes for itself.
+  std::shared_ptr<msgs::StepMessages> messages;
 };
 
 // Publishes a run into a Server started with ros2_channels(options.topics, ns): at begin() a new
 // session and every selected latched topic; at each published step the time and every selected
 // per-step topic that has a subscriber (nothing is encoded for a channel nobody watches). It does
-// not pace: in rbsim node the DdsSink before it in the driver paces every step to --rate.
+// not pace: in rbsim node the Pacer before it in the driver releases every step at --rate.
 class FoxgloveSink final : public Sink {
  public:
   FoxgloveSink(Server& server, std::vector<ChannelId> ids, const SinkOptions& options);
@@ -279,8 +282,7 @@ class FoxgloveSink final : public Sink {
   Server* server_;
   std::vector<ChannelId> ids_;  // by TopicId
   SinkOptions options_;
-  std::unique_ptr<msgs::Encoder> encoder_;
-  msgs::Bytes buffer_;
+  std::shared_ptr<msgs::StepMessages> messages_;
 };
 
 }  // namespace rbsim::foxglove

@@ -161,6 +161,21 @@ class Encoder {
   std::vector<std::string> frames_;  // body_frame(ns, i) per body
 };
 
+// The messages of the world's current step, each encoded once however many sinks send it (the
+// node's DDS and Foxglove sinks share one): get() encodes a topic at its first request in a step.
+// Encoding is deterministic, so a step seen again (a --loop pass) gives the same bytes.
+class StepMessages {
+ public:
+  explicit StepMessages(const Scene& scene, std::string_view ns = "rbsim");
+  const Bytes& get(TopicId id, const World& world);
+
+ private:
+  Encoder encoder_;
+  std::array<Bytes, kTopicCount> bytes_;
+  std::array<const World*, kTopicCount> world_{};
+  std::array<std::int64_t, kTopicCount> step_{};
+};
+
 // ---------------------------------------------------------------------------------------------
 // Typed decoding of our own messages (for tools that draw or export a recording). Colours come
 // back as the float32 the message carries.
