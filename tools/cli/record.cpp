@@ -15,11 +15,14 @@
 namespace rbsim::cli {
 
 namespace {
+constexpr int kLiveZstdLevel = -5;
+
 struct RecordArgs {
   node::RecorderOptions rec;
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   std::optional<double> duration;
   std::string compression = "zstd";
+  std::optional<int> compression_level;
   bool quiet = false;
   bool overwrite = false;
   std::optional<double> wrong_duration;
@@ -37,6 +40,10 @@ int record_command(RecordArgs a) {
                  "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.\n");
     return 2;
   }
+  // A live recorder must keep up with what arrives: zstd at a fast negative level by default, which
+  // costs much less CPU than level 1 for somewhat larger files (scripts/bench-record-live measures
+  // both). `rbsim run --record` writes offline and keeps level 1.
+  a.rec.compression_level = a.compression_level.value_or(a.compression == "zstd" ? kLiveZstdLevel : 0);
   const Result<mcap::Compression> codec = compression_option(a.compression, a.rec.compression_level);
   if (!codec) return fail(codec.error().message);
   a.rec.compression = codec.value();
@@ -126,9 +133,11 @@ Subcommand add_record_command(CLI::App& parent) {
   app->add_option("--compression", a->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->default_str("zstd");
-  app->add_option("--compression-level", a->rec.compression_level,
-                  "zstd -50..22 or lz4 0..12; 0: zstd 1, the MCAP C++ library's default")
-      ->default_str("0");
+  app->add_option("--compression-level", a->compression_level,
+                  "zstd -50..22 or lz4 0..12 (higher: smaller and slower); default zstd " +
+                      std::to_string(kLiveZstdLevel) +
+                      ", fast enough for a live stream (0: zstd 1, the MCAP C++ library's default, as rbsim "
+                      "run --record)");
   app->add_option(
          "--chunk-size", a->rec.chunk_size,
          "Uncompressed bytes per MCAP chunk: a killed recorder loses at most the chunk it was filling and "
