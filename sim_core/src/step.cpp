@@ -10,12 +10,14 @@ void World::step() {
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   std::fill(tau_.begin(), tau_.end(), 0.0);
-  if (!springs_.empty() || !winds_.empty()) update_rotations();
   // Order fixed by the reference: all gravity, then all springs, then all wind.
   accumulate_gravity();
   accumulate_springs();
   accumulate_wind();
   integrate();
+  // cos_/sin_ follow theta wherever springs or wind read them: the forces of the next step, and
+  // spring_state() on the state this step leaves (the encoders ask for it several times a step).
+  if (uses_rotations()) update_rotations();
   ++step_;
 }
 
@@ -57,7 +59,7 @@ SpringState World::spring_state(SpringId id) const {
   const SpringDef& sp = springs_[id.index];
   auto end = [&](std::int32_t body, const Vec2& anchor) -> Vec2 {
     if (body == kFixed) return anchor;
-    const double c = std::cos(theta_[body]), s = std::sin(theta_[body]);
+    const double c = cos_[body], s = sin_[body];  // current: a world with springs keeps them so
     return {c * anchor.x() - s * anchor.y() + x_[body], s * anchor.x() + c * anchor.y() + y_[body]};
   };
   SpringState st;

@@ -103,7 +103,7 @@ Result<World> World::create(const WorldDef& def) {
     column->assign(n, 0.0);
   }
   w.shape_.assign(n, 0);
-  std::fill(w.cos_.begin(), w.cos_.end(), 1.0);
+  std::fill(w.cos_.begin(), w.cos_.end(), 1.0);  // theta starts at 0
 
   std::unordered_map<HullKey, std::int32_t, HullKeyHash> shape_of;
   std::vector<Vec2> local;
@@ -260,6 +260,7 @@ void World::set_state(BodyId b, const BodyState& s) {
   x_[i] = s.position.x();
   y_[i] = s.position.y();
   theta_[i] = s.theta;
+  if (uses_rotations()) ::sincos(theta_[i], &sin_[i], &cos_[i]);  // as update_rotations()
   vx_[i] = s.velocity.x();
   vy_[i] = s.velocity.y();
   omega_[i] = s.omega;

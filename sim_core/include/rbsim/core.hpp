@@ -251,6 +251,7 @@ class World {
 
   double compute_finite_bound() const;
   void update_rotations();
+  bool uses_rotations() const { return !springs_.empty() || !winds_.empty(); }
   void accumulate_gravity();
   void accumulate_springs();
   void accumulate_wind();
@@ -264,7 +265,7 @@ class World {
   // Hot state, one entry per body.
   std::vector<double> x_, y_, theta_, vx_, vy_, omega_;
   std::vector<double> fx_, fy_, tau_;
-  std::vector<double> cos_, sin_;  // cos/sin of theta, refreshed once per step when needed
+  std::vector<double> cos_, sin_;  // cos/sin of theta, kept current while uses_rotations()
   // Per-body constants.
   std::vector<double> mass_, inertia_, radius_;
   std::vector<std::int32_t> shape_;  // index into shapes_
