@@ -56,7 +56,6 @@ struct Writer::Impl {
   ChunkMeta worker_meta;                // and its index data
 
   Bytes scratch;
-  Bytes compressed;
 
   Status check_open() const {
     if (!error.ok()) return error;
@@ -185,9 +184,8 @@ struct Writer::Impl {
     }
     // An uncompressed chunk is written straight from `chunk`, without a copy through the compressor.
     ByteView payload = chunk;
-    if (options.compression != Compression::None) {
-      if (!(s = compressor->compress(chunk, compressed)).ok()) return error = s;
-      payload = compressed;
+    if (options.compression != Compression::None && !(s = compressor->compress(chunk, payload)).ok()) {
+      return error = s;
     }
     const std::uint32_t crc = options.enable_crcs ? crc32(chunk) : 0;
     if (!(s = finish_pending()).ok()) return s;  // the worker's chunk first (none without a worker)
