@@ -1,6 +1,9 @@
 // Writer round trips through both readers, determinism, and crash-consistency of chunks.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -378,6 +381,107 @@ TEST(Crc32, LongInputsMatchTheBitwiseDefinition) {
   for (std::size_t split : {1u, 7u, 64u, 1000u, 65'537u}) {
     EXPECT_EQ(crc32(all.subspan(split), crc32(all.first(split))), whole) << split;
   }
+}
+
+TEST(Crc32, CombineEqualsTheCrcOfTheConcatenation) {
+  Bytes data(70'000);
+  std::uint32_t x = 777;
+  for (auto& b : data) b = static_cast<std::uint8_t>((x = x * 1103515245u + 12345u) >> 24);
+  const ByteView all(data);
+  for (std::size_t split : {0u, 1u, 3u, 64u, 4096u, 69'999u, 70'000u}) {
+    for (std::size_t end : {split, split + (70'000u - split) / 3, std::size_t{70'000u}}) {
+      const ByteView a = all.first(split), b = all.subspan(split, end - split);
+      EXPECT_EQ(crc32_combine(crc32(a), crc32(b), b.size()), crc32(all.first(end))) << split << " " << end;
+    }
+  }
+}
+
+// The records of `count` samples, all on channel 1, written to `path` or to memory.
+Bytes write_uncompressed(const std::string& path, std::uint64_t chunk_size, bool crcs) {
+  WriterOptions o;
+  o.compression = Compression::None;
+  o.chunk_size = chunk_size;
+  o.enable_crcs = crcs;
+  Writer w;
+  EXPECT_TRUE((path.empty() ? w.open_buffer(o) : w.open(path, o)).ok());
+  const Bytes schema_data = {'i', 'n', 't'};
+  const std::uint16_t schema = w.add_schema("Pose", "ros2msg", schema_data).value();
+  EXPECT_EQ(w.add_channel(schema, "/pose", "cdr").value(), 1);
+  EXPECT_EQ(w.add_channel(0, "/log", "json").value(), 2);
+  for (const Sample& s : samples()) {
+    EXPECT_TRUE(w.write_message(s.channel % 2 + 1, s.sequence, s.log_time, s.log_time, s.data).ok());
+  }
+  EXPECT_TRUE(w.close().ok());
+  return w.buffer();
+}
+
+// Uncompressed chunks are streamed to a file that can seek (and to memory), and built in memory
+// for one that cannot (a pipe): the same bytes either way, CRCs included.
+TEST(Writer, StreamedUncompressedChunksMatchBufferedOnes) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string fifo = (dir / ("rbsim_mcap_fifo_" + std::to_string(::getpid()))).string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (std::uint64_t chunk_size : {1u, 700u, 1u << 20}) {
+    for (bool crcs : {true, false}) {
+      const Bytes streamed = write_uncompressed("", chunk_size, crcs);
+      Bytes piped;
+      std::thread reader([&] {
+        std::FILE* f = std::fopen(fifo.c_str(), "rb");
+        ASSERT_NE(f, nullptr);
+        std::uint8_t buf[4096];
+        for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;)
+          piped.insert(piped.end(), buf, buf + n);
+        std::fclose(f);
+      });
+      write_uncompressed(fifo, chunk_size, crcs);
+      reader.join();
+      const auto diff = std::mismatch(streamed.begin(), streamed.end(), piped.begin(), piped.end());
+      EXPECT_TRUE(streamed == piped) << "chunk_size " << chunk_size << " crcs " << crcs << ": sizes "
+                                     << streamed.size() << " and " << piped.size() << ", first difference at "
+                                     << (diff.first - streamed.begin());
+      StreamReader r;  // every CRC checked
+      ASSERT_TRUE(r.open_buffer(streamed).ok());
+      RecordEntry e;
+      std::size_t messages = 0;
+      while (r.next(e)) messages += std::holds_alternative<Message>(e.record);
+      EXPECT_TRUE(r.status().ok()) << r.status().message;
+      EXPECT_EQ(messages, samples().size());
+    }
+  }
+  std::remove(fifo.c_str());
+}
+
+// While a streamed chunk is open the file ends in a Chunk record that claims more bytes than it
+// has: readers see the complete chunks before it and stop there, as after a cut-off write.
+TEST(Writer, OpenStreamedChunkReadsAsTruncated) {
+  const std::string path = (std::filesystem::temp_directory_path() / "rbsim_mcap_streamed.mcap").string();
+  WriterOptions o;
+  o.compression = Compression::None;
+  o.chunk_size = 1024;
+  Writer w;
+  ASSERT_TRUE(w.open(path, o).ok());
+  const std::uint16_t ch = w.add_channel(0, "/t", "raw").value();
+  const auto input = samples();
+  for (const Sample& s : input)
+    ASSERT_TRUE(w.write_message(ch, s.sequence, s.log_time, s.log_time, s.data).ok());
+  ASSERT_TRUE(w.flush_chunk().ok());
+  ASSERT_TRUE(w.write_message(ch, 0, 1, 1, input[0].data).ok());  // opens the next chunk
+  const Bytes partial = read_file(path);
+  StreamReader crashed;
+  ASSERT_TRUE(crashed.open_buffer(partial).ok());
+  std::size_t recovered = 0;
+  RecordEntry e;
+  while (crashed.next(e)) recovered += std::holds_alternative<Message>(e.record);
+  EXPECT_EQ(crashed.status().code, StatusCode::Truncated);
+  EXPECT_EQ(recovered, input.size());
+  ASSERT_TRUE(w.close().ok());
+  StreamReader whole;
+  ASSERT_TRUE(whole.open_buffer(read_file(path)).ok());
+  recovered = 0;
+  while (whole.next(e)) recovered += std::holds_alternative<Message>(e.record);
+  EXPECT_TRUE(whole.status().ok()) << whole.status().message;
+  EXPECT_EQ(recovered, input.size() + 1);
+  std::remove(path.c_str());
 }
 
 }  // namespace

@@ -13,6 +13,17 @@ struct Compressor::Impl {
   Compression compression = Compression::None;
   int level = 0;
   ZSTD_CCtx* zstd = nullptr;  // reused across chunks: creating one costs more than a small chunk
+  // Output buffer, grown when a bound exceeds it and never value-initialised (a std::vector
+  // resized up to the bound for every chunk would zero what the last one's shrink gave back).
+  std::unique_ptr<std::uint8_t[]> buffer;
+  std::size_t capacity = 0;
+  std::uint8_t* room(std::size_t n) {
+    if (n > capacity) {
+      buffer.reset(new std::uint8_t[n]);
+      capacity = n;
+    }
+    return buffer.get();
+  }
 };
 
 Compressor::Compressor(Compression compression, int level) : impl_(std::make_unique<Impl>()) {
@@ -25,34 +36,35 @@ Compressor::~Compressor() {
   ZSTD_freeCCtx(impl_->zstd);
 }
 
-Status Compressor::compress(ByteView in, Bytes& out) {
+Status Compressor::compress(ByteView in, ByteView& out) {
   switch (impl_->compression) {
     case Compression::None:
-      out.assign(in.begin(), in.end());
+      out = in;
       return Status::Ok();
     case Compression::Zstd: {
       if (impl_->zstd == nullptr) return Status::Error(StatusCode::IoError, "out of memory for zstd context");
-      out.resize(ZSTD_compressBound(in.size()));
+      const std::size_t bound = ZSTD_compressBound(in.size());
+      std::uint8_t* dst = impl_->room(bound);
       // Level 0 is the MCAP C++ library's default for zstd chunks, 1 (zstd's own default is 3).
       // scripts/bench-mcap prints what levels 3 and -3 cost and save against it.
       const int level = impl_->level == 0 ? 1 : impl_->level;
-      const std::size_t n =
-          ZSTD_compressCCtx(impl_->zstd, out.data(), out.size(), in.data(), in.size(), level);
+      const std::size_t n = ZSTD_compressCCtx(impl_->zstd, dst, bound, in.data(), in.size(), level);
       if (ZSTD_isError(n)) {
         return Status::Error(StatusCode::IoError, std::string("zstd: ") + ZSTD_getErrorName(n));
       }
-      out.resize(n);
+      out = ByteView(dst, n);
       return Status::Ok();
     }
     case Compression::Lz4: {
       LZ4F_preferences_t prefs{};
       prefs.compressionLevel = impl_->level;
-      out.resize(LZ4F_compressFrameBound(in.size(), &prefs));
-      const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), in.data(), in.size(), &prefs);
+      const std::size_t bound = LZ4F_compressFrameBound(in.size(), &prefs);
+      std::uint8_t* dst = impl_->room(bound);
+      const std::size_t n = LZ4F_compressFrame(dst, bound, in.data(), in.size(), &prefs);
       if (LZ4F_isError(n)) {
         return Status::Error(StatusCode::IoError, std::string("lz4: ") + LZ4F_getErrorName(n));
       }
-      out.resize(n);
+      out = ByteView(dst, n);
       return Status::Ok();
     }
   }
@@ -91,7 +103,7 @@ Status ChunkWorker::wait() {
 }
 
 ByteView ChunkWorker::payload() const {
-  return compression_ == Compression::None ? ByteView(records_) : ByteView(compressed_);
+  return compression_ == Compression::None ? ByteView(records_) : compressed_;
 }
 
 void ChunkWorker::release() {

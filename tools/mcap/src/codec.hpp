@@ -18,8 +18,9 @@ class Compressor {
   Compressor(const Compressor&) = delete;
   Compressor& operator=(const Compressor&) = delete;
 
-  // Replaces `out` with the compressed form of `in`.
-  Status compress(ByteView in, Bytes& out);
+  // Points `out` at the compressed form of `in` (for None: at `in`), valid until the next call.
+  // The compressor's buffer is reused without being cleared first.
+  Status compress(ByteView in, ByteView& out);
 
  private:
   struct Impl;
@@ -57,7 +58,7 @@ class ChunkWorker {
   const Compression compression_;
   const bool with_crc_;
   Bytes records_;
-  Bytes compressed_;
+  ByteView compressed_;
   std::uint32_t crc_ = 0;
   Status status_;
   bool pending_ = false;  // writer thread only

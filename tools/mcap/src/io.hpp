@@ -27,6 +27,11 @@ class Sink {
   virtual Status flush() = 0;  // hand buffered bytes to the OS
   virtual Status close() = 0;
   virtual const Bytes& buffer() const = 0;  // memory sinks only; empty otherwise
+  // Whether write_at() works: a regular file or memory (not a pipe or a device).
+  virtual bool seekable() const = 0;
+  // Overwrites bytes already written, at `offset` (< the bytes written so far); later write()s
+  // still append.
+  virtual Status write_at(std::uint64_t offset, ByteView data) = 0;
 };
 
 Result<std::unique_ptr<Sink>> open_file_sink(const std::string& path);

@@ -258,4 +258,39 @@ std::uint32_t crc32(ByteView data, std::uint32_t crc) {
   return libdeflate_crc32(crc, data.data(), data.size());
 }
 
+namespace {
+
+// CRC-32 arithmetic on polynomials over GF(2) modulo the CRC's polynomial, in its reflected bit
+// order: bit 31 holds the coefficient of x^0, bit 0 that of x^31.
+constexpr std::uint32_t kCrcPolynomial = 0xEDB88320u;  // x^32 + ... + 1 without the x^32 term
+constexpr std::uint32_t kCrcOne = 0x80000000u;         // the polynomial 1
+
+std::uint32_t multiply_mod(std::uint32_t a, std::uint32_t b) {
+  std::uint32_t product = 0;
+  for (int i = 0; i < 32; ++i) {  // a's coefficient of x^i times b x^i; b steps to b x^(i+1)
+    if ((a & (kCrcOne >> i)) != 0) product ^= b;
+    b = (b & 1u) != 0 ? (b >> 1) ^ kCrcPolynomial : b >> 1;
+  }
+  return product;
+}
+
+// x^(8 n) modulo the polynomial: appending n zero bytes multiplies a (pure) CRC by it.
+std::uint32_t x_pow_8n(std::uint64_t n) {
+  std::uint32_t result = kCrcOne;
+  std::uint32_t square = kCrcOne >> 8;  // x^8, then x^16, x^32, ...
+  for (int bit = 0; bit < 64 && n != 0; ++bit, n >>= 1) {
+    if ((n & 1u) != 0) result = multiply_mod(result, square);
+    square = multiply_mod(square, square);
+  }
+  return result;
+}
+
+}  // namespace
+
+std::uint32_t crc32_combine(std::uint32_t crc_a, std::uint32_t crc_b, std::uint64_t length_b) {
+  // zlib's CRC-32 pre- and post-inverts the register; those terms cancel between crc(a ++ b) and
+  // crc(b), leaving crc(a) shifted over b's length.
+  return multiply_mod(crc_a, x_pow_8n(length_b)) ^ crc_b;
+}
+
 }  // namespace rbsim::mcap

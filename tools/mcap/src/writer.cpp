@@ -1,4 +1,12 @@
 // Writer: <Magic><Header><Data section><DataEnd>[<Summary>][<Summary Offsets>]<Footer><Magic>.
+//
+// Uncompressed chunks written to a file that can seek (or to memory) are streamed: the Chunk
+// header goes out first with placeholder sizes (record length UINT64_MAX, so until the chunk is
+// complete a reader sees a truncated record, as it would a chunk cut off mid-write), each record
+// follows straight from the caller's bytes, and the header is overwritten once the chunk is full.
+// No copy of the records, and one CRC pass over them: the data section CRC is combined from the
+// chunk's (crc32_combine). Attachments and metadata, which never go inside a chunk, close it first.
+// Compressed chunks are built in memory, compressed whole and then written.
 #include <algorithm>
 
 #include "codec.hpp"
@@ -38,11 +46,16 @@ struct Writer::Impl {
   };
   Bytes chunk;  // the open chunk's uncompressed records
   ChunkMeta chunk_meta;
+  // Streamed uncompressed chunks: the open chunk's file offset, its records' size and CRC so far.
+  bool stream = false;
+  bool streaming = false;  // a streamed chunk is open
+  std::uint64_t stream_start = 0;
+  std::uint64_t stream_size = 0;
+  std::uint32_t stream_crc = 0;
   std::unique_ptr<ChunkWorker> worker;  // background_compression: the chunk being compressed
   ChunkMeta worker_meta;                // and its index data
 
   Bytes scratch;
-  Bytes compressed;
 
   Status check_open() const {
     if (!error.ok()) return error;
@@ -52,10 +65,9 @@ struct Writer::Impl {
 
   Status write(ByteView bytes) {
     if (!error.ok()) return error;
-    if (in_summary) {
-      summary_crc = crc32(bytes, summary_crc);
-    } else {
-      data_crc = crc32(bytes, data_crc);
+    if (options.enable_crcs) {
+      std::uint32_t& crc = in_summary ? summary_crc : data_crc;
+      crc = crc32(bytes, crc);
     }
     offset += bytes.size();
     Status s = sink->write(bytes);
@@ -65,6 +77,11 @@ struct Writer::Impl {
 
   // Serialises into the pending chunk when chunking (Schema/Channel/Message), else to the file.
   Status emit(const Record& record, bool into_chunk) {
+    if (into_chunk && stream) {
+      scratch.clear();
+      serialize_record(record, scratch);
+      return stream_records(scratch);
+    }
     if (into_chunk) {
       serialize_record(record, chunk);
       return Status::Ok();
@@ -78,24 +95,86 @@ struct Writer::Impl {
     *this = Impl{};
     options = opts;
     sink = std::move(s);
-    if (options.use_chunks && options.background_compression) {
+    stream = options.use_chunks && options.compression == Compression::None && sink->seekable();
+    if (stream) {
+      // Nothing to compress: no worker.
+    } else if (options.use_chunks && options.background_compression) {
       worker =
           std::make_unique<ChunkWorker>(options.compression, options.compression_level, options.enable_crcs);
-    } else {
-      compressor = std::make_unique<Compressor>(options.compression, options.compression_level);
     }
+    if (!stream) compressor = std::make_unique<Compressor>(options.compression, options.compression_level);
     open = true;
     Status st = write(ByteView(kMagic));
     if (!st.ok()) return st;
     return emit(Header{options.profile, options.library}, false);
   }
 
-  // Closes the open chunk: compressed here, or handed to the worker (which first finishes and
-  // writes the chunk before it, keeping file order).
+  // Chunk header of a chunk with `records` bytes of records and `payload` bytes of (compressed)
+  // payload, through the payload's length prefix.
+  void chunk_header(Bytes& out, std::uint64_t records, std::uint64_t payload, std::uint32_t crc,
+                    const ChunkMeta& meta) const {
+    const std::string_view compression = compression_name(options.compression);
+    put_u8(out, static_cast<std::uint8_t>(Opcode::Chunk));
+    put_u64(out, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + payload);
+    put_u64(out, meta.has_messages ? meta.start_time : 0);
+    put_u64(out, meta.has_messages ? meta.end_time : 0);
+    put_u64(out, records);
+    put_u32(out, crc);
+    put_string(out, compression);
+    put_u64(out, payload);
+  }
+
+  // Appends records to the streamed chunk, opening it (its header with placeholder sizes) first.
+  Status stream_records(ByteView bytes) {
+    if (!error.ok()) return error;
+    Status s;
+    if (!streaming) {
+      Bytes header;
+      chunk_header(header, 0, 0, 0, ChunkMeta{});
+      for (std::size_t i = 1; i < 9; ++i) header[i] = 0xFF;  // record length UINT64_MAX
+      stream_start = offset;                                 // stream_size and stream_crc are 0 here
+      streaming = true;
+      if (!(s = sink->write(header)).ok()) return error = s;
+      offset += header.size();  // its CRC is taken once its final bytes are known
+    }
+    if (options.enable_crcs) stream_crc = crc32(bytes, stream_crc);
+    stream_size += bytes.size();
+    offset += bytes.size();
+    if (!(s = sink->write(bytes)).ok()) error = s;
+    return s;
+  }
+
+  // Completes the streamed chunk: its header rewritten with the final sizes, CRCs and times.
+  Status finish_streamed_chunk() {
+    if (!streaming) return Status::Ok();
+    streaming = false;
+    scratch.clear();
+    chunk_header(scratch, stream_size, stream_size, options.enable_crcs ? stream_crc : 0, chunk_meta);
+    Status s = sink->write_at(stream_start, scratch);
+    if (!s.ok()) return error = s;
+    if (options.enable_crcs) data_crc = crc32_combine(crc32(scratch, data_crc), stream_crc, stream_size);
+    ChunkIndex index;
+    index.message_start_time = chunk_meta.has_messages ? chunk_meta.start_time : 0;
+    index.message_end_time = chunk_meta.has_messages ? chunk_meta.end_time : 0;
+    index.chunk_start_offset = stream_start;
+    index.chunk_length = offset - stream_start;
+    index.compressed_size = index.uncompressed_size = stream_size;
+    stream_size = 0;
+    stream_crc = 0;
+    s = finish_chunk(index, chunk_meta);
+    chunk_meta = ChunkMeta{};
+    return s;
+  }
+
+  // Closes the open chunk: streamed, compressed here, or handed to the worker (which first
+  // finishes and writes the chunk before it, keeping file order).
   Status flush_chunk() {
+    if (stream) return finish_streamed_chunk();
     if (chunk.empty()) return Status::Ok();
     Status s;
-    if (worker) {
+    // The worker takes the chunk when it is free. While it is still busy with the chunk before,
+    // this one is compressed here meanwhile (two cores at work), and both are written in order.
+    if (worker && (!worker->pending() || worker->finished())) {
       if (!(s = finish_pending()).ok()) return s;
       std::swap(chunk, worker->records());  // `chunk` gets the worker's emptied buffer back
       worker_meta = std::move(chunk_meta);
@@ -105,11 +184,12 @@ struct Writer::Impl {
     }
     // An uncompressed chunk is written straight from `chunk`, without a copy through the compressor.
     ByteView payload = chunk;
-    if (options.compression != Compression::None) {
-      if (!(s = compressor->compress(chunk, compressed)).ok()) return error = s;
-      payload = compressed;
+    if (options.compression != Compression::None && !(s = compressor->compress(chunk, payload)).ok()) {
+      return error = s;
     }
-    s = write_chunk(chunk, payload, options.enable_crcs ? crc32(chunk) : 0, chunk_meta);
+    const std::uint32_t crc = options.enable_crcs ? crc32(chunk) : 0;
+    if (!(s = finish_pending()).ok()) return s;  // the worker's chunk first (none without a worker)
+    s = write_chunk(chunk, payload, crc, chunk_meta);
     chunk.clear();
     chunk_meta = ChunkMeta{};
     return s;
@@ -135,28 +215,24 @@ struct Writer::Impl {
 
   Status write_chunk(ByteView records, ByteView payload, std::uint32_t crc, ChunkMeta& meta) {
     Status s;
-    const std::string_view compression = compression_name(options.compression);
-    const Timestamp start_time = meta.has_messages ? meta.start_time : 0;
-    const Timestamp end_time = meta.has_messages ? meta.end_time : 0;
     // Chunk header written by hand so the (possibly large) records are not copied again.
     scratch.clear();
-    put_u8(scratch, static_cast<std::uint8_t>(Opcode::Chunk));
-    put_u64(scratch, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + payload.size());
-    put_u64(scratch, start_time);
-    put_u64(scratch, end_time);
-    put_u64(scratch, records.size());
-    put_u32(scratch, crc);
-    put_string(scratch, compression);
-    put_u64(scratch, payload.size());
+    chunk_header(scratch, records.size(), payload.size(), crc, meta);
     ChunkIndex index;
-    index.message_start_time = start_time;
-    index.message_end_time = end_time;
+    index.message_start_time = meta.has_messages ? meta.start_time : 0;
+    index.message_end_time = meta.has_messages ? meta.end_time : 0;
     index.chunk_start_offset = offset;
-    index.compression = std::string(compression);
     index.compressed_size = payload.size();
     index.uncompressed_size = records.size();
     if (!(s = write(scratch)).ok() || !(s = write(payload)).ok()) return s;
     index.chunk_length = offset - index.chunk_start_offset;
+    return finish_chunk(index, meta);
+  }
+
+  // After a chunk record: its message indexes, its chunk index, and the bytes to the OS.
+  Status finish_chunk(ChunkIndex& index, ChunkMeta& meta) {
+    Status s;
+    index.compression = std::string(compression_name(options.compression));
     if (options.emit_message_indexes) {
       const std::uint64_t start = offset;
       for (auto& [channel_id, entries] : meta.message_index) {
@@ -333,16 +409,22 @@ Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, T
   ++st.message_count;
   ++st.channel_message_counts[channel_id];
   // Message layout by hand: its data is the rest of the record, so no copy into a Message.
-  Bytes& out = w.options.use_chunks ? w.chunk : w.scratch;
-  if (!w.options.use_chunks) out.clear();
-  const std::uint64_t record_offset = out.size();
+  Bytes& out = w.options.use_chunks && !w.stream ? w.chunk : w.scratch;
+  if (&out == &w.scratch) out.clear();
+  const std::uint64_t record_offset = w.stream ? w.stream_size : out.size();
   put_u8(out, static_cast<std::uint8_t>(Opcode::Message));
   put_u64(out, 2 + 4 + 8 + 8 + data.size());
   put_u16(out, channel_id);
   put_u32(out, sequence);
   put_u64(out, log_time);
   put_u64(out, publish_time);
-  put_raw(out, data);
+  if (w.stream) {
+    Status s = w.stream_records(out);
+    if (s.ok()) s = w.stream_records(data);
+    if (!s.ok()) return s;
+  } else {
+    put_raw(out, data);
+  }
   if (!w.options.use_chunks) return w.write(out);
   Impl::ChunkMeta& meta = w.chunk_meta;
   meta.message_index[channel_id].emplace_back(log_time, record_offset);
@@ -351,7 +433,7 @@ Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, T
   meta.has_messages = true;
   // A compressed chunk goes to the file as soon as it is ready, not only when the next one is full.
   if (Status s = w.write_compressed_chunk(); !s.ok()) return s;
-  if (w.chunk.size() >= w.options.chunk_size) return w.flush_chunk();
+  if ((w.stream ? w.stream_size : w.chunk.size()) >= w.options.chunk_size) return w.flush_chunk();
   return Status::Ok();
 }
 
@@ -360,6 +442,7 @@ Status Writer::add_attachment(Timestamp log_time, Timestamp create_time, std::st
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
   if (Status s = w.finish_pending(); !s.ok()) return s;
+  if (Status s = w.finish_streamed_chunk(); !s.ok()) return s;
   // Attachments never go inside chunks (spec: Attachment); the CRC covers every preceding field.
   Bytes& out = w.scratch;
   out.clear();
@@ -383,6 +466,7 @@ Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) 
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
   if (Status s = w.finish_pending(); !s.ok()) return s;
+  if (Status s = w.finish_streamed_chunk(); !s.ok()) return s;
   const std::uint64_t start = w.offset;
   if (Status s = w.emit(Metadata{std::string(name), metadata}, false); !s.ok()) return s;
   if (w.options.emit_metadata_indexes) {

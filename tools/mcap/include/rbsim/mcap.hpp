@@ -234,6 +234,8 @@ void serialize_record(const Record& record, Bytes& out);
 
 // CRC-32 as in zlib (polynomial 0xEDB88320); chainable: crc32(b, crc32(a)) == crc32(a ++ b).
 std::uint32_t crc32(ByteView data, std::uint32_t crc = 0);
+// The CRC-32 of a ++ b from crc32(a), crc32(b) and b's length, without reading either.
+std::uint32_t crc32_combine(std::uint32_t crc_a, std::uint32_t crc_b, std::uint64_t length_b);
 
 enum class Compression : std::uint8_t { None, Lz4, Zstd };
 std::string_view compression_name(Compression compression);  // "", "lz4", "zstd"
@@ -268,9 +270,11 @@ struct WriterOptions {
   bool repeat_schemas = true;   // copy Schema records into the summary
   bool repeat_channels = true;  // copy Channel records into the summary
   bool enable_crcs = true;      // chunk, attachment, data section and summary CRCs
-  // Compress each full chunk (and take its CRC) on a second thread while the next one fills. Same
+  // Compress each full chunk (and take its CRC) on a second thread while the next one fills; a
+  // chunk that fills while that thread is still busy is compressed on the caller's meanwhile. Same
   // bytes as without; a completed chunk reaches the file once compressed, or at the next write
-  // or flush after that, so a killed process may lose one more chunk than without.
+  // or flush after that, so a killed process may lose one more chunk than without. Uncompressed
+  // chunks written to a regular file (or memory) are streamed instead (see writer.cpp): no thread.
   bool background_compression = false;
 };
 
