@@ -25,10 +25,12 @@
 // (MCAP record framing and compression excluded), over wall-clock time (real_time, manual time for
 // BM_Record); Google Benchmark's CPU column is the thread's CPU time (user + system, so file
 // writes count), the whole process's for BM_Write, BM_Record (recordings compress on a second
-// thread) and BM_Check* (rbsim check reads each file on a thread of its own). scripts/bench-mcap judges on
-// CPU time like scripts/bench (this 2-core machine is shared with builds) and prints the wall-clock figures
-// beside it. Files go to $RBSIM_BENCH_TMP (default /tmp) and are removed afterwards.
+// thread) and BM_Check* (rbsim check reads each file on a thread of its own). scripts/bench-mcap judges
+// on wall-clock time, as a user sees it, and prints the CPU figures beside it. BM_Check* also count
+// the minor page faults per check ("faults": first touches of fresh memory, which the kernel
+// zeroes page by page). Files go to $RBSIM_BENCH_TMP (default /tmp) and are removed afterwards.
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -289,6 +291,9 @@ void bm_check(benchmark::State& state, Codec codec, bool differ) {
   msgs::Bytes buf;
   const std::uint64_t bytes = write_file(state, run, codec, snaps, encoder, count, buf);
   if (bytes == 0 || write_file(state, golden, codec, snaps, encoder, count, buf, differ ? 1 : 0) == 0) return;
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  const long faults_before = usage.ru_minflt;
   for (auto _ : state) {
     auto report = check::check_logs(run, golden);
     if (!report) {
@@ -300,6 +305,10 @@ void bm_check(benchmark::State& state, Codec codec, bool differ) {
       break;
     }
   }
+  ::getrusage(RUSAGE_SELF, &usage);
+  // Minor page faults per check (first touches of fresh memory: the kernel zeroes each page).
+  state.counters["faults"] = benchmark::Counter(static_cast<double>(usage.ru_minflt - faults_before),
+                                                benchmark::Counter::kAvgIterations);
   std::error_code ec;
   std::filesystem::remove(run, ec);
   std::filesystem::remove(golden, ec);

@@ -663,6 +663,8 @@ class Comparer {
       Pending& q = other.front();
       Status st = si == kRun ? compare(t, p, q) : compare(t, q, p);
       t.queued_bytes -= q.data.size();
+      side_[si].pump.recycle(std::move(p.data));
+      side_[1 - si].pump.recycle(std::move(q.data));
       other.pop_front();
       return st;
     }
@@ -785,10 +787,63 @@ class Comparer {
     static Scalar load(const std::byte* p, std::uint8_t size, Kind kind) {
       return msgs::load_scalar(p, size, kind);
     }
-    // One value pair at x (run) and y (golden).
+    // Bit-equal values (floats: equal as numbers, so 0 == -0), the common case and the only one
+    // that needs no more work than counting. Pairs that fail this go to mismatch().
+    static bool same(const std::byte* x, const std::byte* y, std::uint8_t size, Kind kind) {
+      if (kind == Kind::Float) {
+        if (size == 8) {
+          double va, vb;
+          std::memcpy(&va, x, 8);
+          std::memcpy(&vb, y, 8);
+          return va == vb;
+        }
+        float fa, fb;
+        std::memcpy(&fa, x, 4);
+        std::memcpy(&fb, y, 4);
+        return fa == fb;
+      }
+      switch (size) {
+        case 1:
+          return *x == *y;
+        case 2: {
+          std::uint16_t va, vb;
+          std::memcpy(&va, x, 2);
+          std::memcpy(&vb, y, 2);
+          return va == vb;
+        }
+        case 4:
+          return u32(x) == u32(y);
+        case 8: {
+          std::uint64_t va, vb;
+          std::memcpy(&va, x, 8);
+          std::memcpy(&vb, y, 8);
+          return va == vb;
+        }
+        default:
+          return std::memcmp(x, y, size) == 0;
+      }
+    }
+    // One value pair at x (run) and y (golden): counted, compared, `index` advanced.
     void value(const std::byte* x, const std::byte* y, std::uint8_t size, Kind kind, std::uint32_t group) {
+      ++t.stats[group].values;
+      if (!same(x, y, size, kind)) mismatch(x, y, size, kind, group);
+      ++index;
+    }
+    // mismatch() for float64 values va != vb at x and y, inline: the hot case of a check in which
+    // every value moved (another compiler or machine, compared with a tolerance).
+    void float_mismatch(const std::byte* x, const std::byte* y, double va, double vb, std::uint32_t group,
+                        std::uint64_t at) {
+      if (va != va && vb != vb) return;
+      index = at;
+      if (t.has_meta) return mismatch(x, y, 8, Kind::Float, group);
+      if (!c.differs_float(t.stats[group], va, vb) && first_bad == UINT64_MAX)
+        mark(float_scalar(va), float_scalar(vb));
+    }
+    // A value pair (value number `index`, already counted) that same() found not equal: NaN pairs
+    // match, metadata is reported apart, anything else is a difference (within the tolerance or not).
+    [[gnu::noinline]] void mismatch(const std::byte* x, const std::byte* y, std::uint8_t size, Kind kind,
+                                    std::uint32_t group) {
       Stat& st = t.stats[group];
-      ++st.values;
       if (kind == Kind::Float) {
         double va, vb;
         if (size == 8) {
@@ -806,10 +861,6 @@ class Comparer {
             !c.differs_float(st, va, vb) && first_bad == UINT64_MAX) {
           mark(float_scalar(va), float_scalar(vb));
         }
-        ++index;
-        return;
-      } else if (std::memcmp(x, y, size) == 0) {
-        ++index;
         return;
       }
       const Scalar sa = load(x, size, kind), sb = load(y, size, kind);
@@ -817,7 +868,6 @@ class Comparer {
           first_bad == UINT64_MAX) {
         mark(sa, sb);
       }
-      ++index;
     }
     static Scalar float_scalar(double v) {
       Scalar s;
@@ -860,8 +910,10 @@ class Comparer {
             has_step = true;
             step = step_value(load(b.data() + pb, f.size, f.kind));
           }
-          for (std::uint64_t k = 0; k < count; ++k, pa += f.size, pb += f.size) {
-            value(a.data() + pa, b.data() + pb, f.size, f.kind, f.group);
+          t.stats[f.group].values += count;
+          for (std::uint64_t k = 0; k < count; ++k, pa += f.size, pb += f.size, ++index) {
+            if (!same(a.data() + pa, b.data() + pb, f.size, f.kind))
+              mismatch(a.data() + pa, b.data() + pb, f.size, f.kind, f.group);
           }
         } else if (f.primitive) {  // strings
           for (std::uint64_t k = 0; k < count; ++k) {
@@ -889,18 +941,63 @@ class Comparer {
             pb += nb;
           }
         } else if (f.flat) {
-          for (std::uint64_t k = 0; k < count; ++k) {
+          // The hot loop of a large message (bodies[], springs[]): values are counted per element
+          // after the loop (flat_groups), each pair is tested for equality inline.
+          std::uint64_t k = 0;
+          Walk w = Walk::Ok;
+          std::uint64_t at = index;  // the value number, kept out of memory in the loop
+          // differs_float() spelled out for float64 pairs outside metadata: one NaN test on the
+          // difference (NaN only when either value is NaN, as va != vb), the tolerance in locals.
+          const bool plain = !t.has_meta;
+          const double atol = c.o_.atol, rtol = c.o_.rtol;
+          Stat* const stats = t.stats.data();
+          for (; k < count; ++k) {
             const std::size_t ra = (pa - 4) % 8, rb = (pb - 4) % 8;
-            if (f.flat_size[ra] > a.size() - pa || f.flat_size[rb] > b.size() - pb) return Walk::Malformed;
-            const auto& ops_a = f.flat_ops[ra];
-            const auto& ops_b = f.flat_ops[rb];
-            for (std::size_t o = 0; o < ops_b.size(); ++o) {
-              const Layout::Op& op = ops_b[o];
-              value(a.data() + pa + ops_a[o].offset, b.data() + pb + op.offset, op.size, op.kind, op.group);
+            if (f.flat_size[ra] > a.size() - pa || f.flat_size[rb] > b.size() - pb) {
+              w = Walk::Malformed;
+              break;
             }
+            const Layout::Op* ops_a = f.flat_ops[ra].data();
+            const Layout::Op* ops_b = f.flat_ops[rb].data();
+            const std::size_t n = f.flat_ops[rb].size();
+            const std::byte* xa = a.data() + pa;
+            const std::byte* yb = b.data() + pb;
+            for (std::size_t o = 0; o < n; ++o) {
+              const Layout::Op& op = ops_b[o];
+              const std::byte* x = xa + ops_a[o].offset;
+              const std::byte* y = yb + op.offset;
+              if (op.kind == Kind::Float && op.size == 8) {
+                double va, vb;
+                std::memcpy(&va, x, 8);
+                std::memcpy(&vb, y, 8);
+                if (va == vb) continue;
+                if (!plain) {
+                  float_mismatch(x, y, va, vb, op.group, at + o);
+                  continue;
+                }
+                double d = std::fabs(va - vb);
+                if (d != d) {
+                  if (va != va && vb != vb) continue;  // both NaN: a match
+                  d = std::numeric_limits<double>::infinity();
+                }
+                const double ab = std::fabs(vb);
+                const double rel = vb != 0.0 ? d / ab : std::numeric_limits<double>::infinity();
+                if (!c.record(stats[op.group], d, rel, d <= atol + rtol * ab) && first_bad == UINT64_MAX) {
+                  index = at + o;
+                  mark(float_scalar(va), float_scalar(vb));
+                }
+              } else if (!same(x, y, op.size, op.kind)) {
+                index = at + o;
+                mismatch(x, y, op.size, op.kind, op.group);
+              }
+            }
+            at += n;
             pa += f.flat_size[ra];
             pb += f.flat_size[rb];
           }
+          index = at;
+          for (const auto& [g, n] : f.flat_groups) t.stats[g].values += n * k;
+          if (w != Walk::Ok) return w;
         } else {
           for (std::uint64_t k = 0; k < count; ++k) {
             if (const Walk w = fields(f.children, false); w != Walk::Ok) return w;
@@ -1049,7 +1146,8 @@ class Comparer {
     return record(st, abs_diff, rel, abs_diff <= o_.atol + o_.rtol * std::fabs(b));
   }
 
-  bool record(Stat& st, double abs_diff, double rel, bool ok) {
+  // Inlined into the flat-element loop (GCC otherwise calls it there, at twice the cost).
+  [[gnu::always_inline]] bool record(Stat& st, double abs_diff, double rel, bool ok) {
     if (abs_diff > st.max_abs) {
       st.max_abs = abs_diff;
       if (step_known_) {

@@ -19,11 +19,15 @@ namespace rbsim::check {
 
 // Reads one file on its own thread (decompression and CRCs are most of the work), handing its
 // Schema, Channel and Message records over in batches; at most kPumpBytes ahead of the consumer.
+// Message buffers the consumer is done with come back through recycle() and are filled again:
+// a fresh buffer per message costs a page fault per 4 KiB of message data.
 class RecordPump {
  public:
-  static constexpr std::uint64_t kPumpBytes = 64u << 20;
+  static constexpr std::uint64_t kPumpBytes = 1u << 20;
   static constexpr std::size_t kBatchRecords = 256;
-  static constexpr std::uint64_t kBatchBytes = 4u << 20;
+  static constexpr std::uint64_t kBatchBytes = 256u << 10;
+  static constexpr std::size_t kSpareBuffers = 64;         // kept for reuse at most ...
+  static constexpr std::uint64_t kSpareBytes = 64u << 20;  // ... and their capacity at most
 
   ~RecordPump() { stop(); }
 
@@ -40,12 +44,24 @@ class RecordPump {
     cv_.notify_all();
     if (thread_.joinable()) thread_.join();
   }
+  // Gives a message buffer back for the reader thread to fill again (consumer side; handed over
+  // with the next batch).
+  void recycle(mcap::Bytes&& buffer) {
+    if (buffer.capacity() == 0 || returned_.size() >= kSpareBuffers) return;
+    returned_.push_back(std::move(buffer));
+  }
   // The next record, or null at the end (then status() says whether the file was read whole).
   mcap::Record* next() {
     if (pos_ < current_.size()) return &current_[pos_++];
     current_.clear();
     pos_ = 0;
     std::unique_lock<std::mutex> lock(mu_);
+    for (mcap::Bytes& b : returned_) {
+      if (spare_.size() >= kSpareBuffers || spare_bytes_ + b.capacity() > kSpareBytes) break;
+      spare_bytes_ += b.capacity();
+      spare_.push_back(std::move(b));
+    }
+    returned_.clear();
     cv_.wait(lock, [&] { return !batches_.empty() || finished_; });
     if (batches_.empty()) return nullptr;
     current_ = std::move(batches_.front().first);
@@ -62,7 +78,19 @@ class RecordPump {
     mcap::RecordEntry entry;
     std::vector<mcap::Record> batch;
     std::uint64_t bytes = 0;
+    std::vector<mcap::Bytes> spare;  // buffers to fill, taken from spare_
     for (;;) {
+      if (auto* m = std::get_if<mcap::Message>(&entry.record); m != nullptr && m->data.capacity() == 0) {
+        if (spare.empty()) {
+          std::lock_guard<std::mutex> lock(mu_);
+          spare.swap(spare_);
+          spare_bytes_ = 0;
+        }
+        if (!spare.empty()) {
+          m->data = std::move(spare.back());
+          spare.pop_back();
+        }
+      }
       const bool more = reader_.next(entry);
       if (more) {
         if (const auto* m = std::get_if<mcap::Message>(&entry.record)) {
@@ -101,8 +129,11 @@ class RecordPump {
   std::uint64_t queued_ = 0;
   bool stop_ = false, finished_ = false;
   mcap::Status status_;
+  std::vector<mcap::Bytes> spare_;     // guarded by mu_: recycled buffers for the reader thread
+  std::uint64_t spare_bytes_ = 0;      // their capacity
   std::vector<mcap::Record> current_;  // consumer side
   std::size_t pos_ = 0;
+  std::vector<mcap::Bytes> returned_;  // consumer side: recycled since the last batch
 };
 
 }  // namespace rbsim::check

@@ -170,9 +170,7 @@ class GrowingOutput {
   std::uint64_t limit_ = 0;
 };
 
-Status zstd_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
-  std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> ctx(ZSTD_createDCtx(), &ZSTD_freeDCtx);
-  if (!ctx) return decompress_error("zstd", "cannot allocate context");
+Status zstd_decompress(ZSTD_DCtx* ctx, ByteView in, std::uint64_t expected, Bytes& out) {
   GrowingOutput o(out, expected, in.size());
   ZSTD_inBuffer ib{in.data(), in.size(), 0};
   std::size_t hint = 1;
@@ -180,7 +178,7 @@ Status zstd_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
     if (!o.grow_if_full()) break;  // more output than declared: reported by the size check
     ZSTD_outBuffer ob{o.data(), o.room(), 0};
     const std::size_t before_in = ib.pos;
-    hint = ZSTD_decompressStream(ctx.get(), &ob, &ib);
+    hint = ZSTD_decompressStream(ctx, &ob, &ib);
     if (ZSTD_isError(hint)) return decompress_error("zstd", ZSTD_getErrorName(hint));
     o.produced += ob.pos;
     if (hint != 0 && ob.pos == 0 && ib.pos == before_in) return decompress_error("zstd", "truncated frame");
@@ -189,13 +187,7 @@ Status zstd_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
   return Status::Ok();
 }
 
-Status lz4_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
-  LZ4F_dctx* raw = nullptr;
-  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
-    return decompress_error("lz4", "cannot allocate context");
-  }
-  std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> ctx(raw,
-                                                                           &LZ4F_freeDecompressionContext);
+Status lz4_decompress(LZ4F_dctx* ctx, ByteView in, std::uint64_t expected, Bytes& out) {
   GrowingOutput o(out, expected, in.size());
   std::size_t consumed = 0;
   std::size_t hint = 1;
@@ -203,7 +195,7 @@ Status lz4_decompress(ByteView in, std::uint64_t expected, Bytes& out) {
     if (!o.grow_if_full()) break;
     std::size_t dst = o.room();
     std::size_t src = in.size() - consumed;
-    hint = LZ4F_decompress(ctx.get(), o.data(), &dst, in.data() + consumed, &src, nullptr);
+    hint = LZ4F_decompress(ctx, o.data(), &dst, in.data() + consumed, &src, nullptr);
     if (LZ4F_isError(hint)) return decompress_error("lz4", LZ4F_getErrorName(hint));
     o.produced += dst;
     consumed += src;
@@ -227,19 +219,47 @@ std::string_view compression_name(Compression compression) {
   return "";
 }
 
-Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
-  auto compression = detail::compression_from_name(chunk.compression);
+namespace detail {
+
+struct Decompressor::Impl {
+  ZSTD_DCtx* zstd = nullptr;  // created on first use, reset before each chunk
+  LZ4F_dctx* lz4 = nullptr;
+};
+
+Decompressor::Decompressor() : impl_(std::make_unique<Impl>()) {}
+
+Decompressor::~Decompressor() {
+  ZSTD_freeDCtx(impl_->zstd);
+  if (impl_->lz4 != nullptr) LZ4F_freeDecompressionContext(impl_->lz4);
+}
+
+Status Decompressor::decompress(const Chunk& chunk, ByteView records, Bytes& out, bool verify_crc) {
+  auto compression = compression_from_name(chunk.compression);
   if (!compression.ok()) return compression.status();
   Status status;
   switch (*compression) {
     case Compression::None:
-      out = chunk.records;
+      out.assign(records.begin(), records.end());
       break;
     case Compression::Zstd:
-      status = zstd_decompress(chunk.records, chunk.uncompressed_size, out);
+      if (impl_->zstd == nullptr) {
+        impl_->zstd = ZSTD_createDCtx();
+        if (impl_->zstd == nullptr) return decompress_error("zstd", "cannot allocate context");
+      } else {
+        ZSTD_DCtx_reset(impl_->zstd, ZSTD_reset_session_only);  // after an error, too
+      }
+      status = zstd_decompress(impl_->zstd, records, chunk.uncompressed_size, out);
       break;
     case Compression::Lz4:
-      status = lz4_decompress(chunk.records, chunk.uncompressed_size, out);
+      if (impl_->lz4 == nullptr) {
+        if (LZ4F_isError(LZ4F_createDecompressionContext(&impl_->lz4, LZ4F_VERSION))) {
+          impl_->lz4 = nullptr;
+          return decompress_error("lz4", "cannot allocate context");
+        }
+      } else {
+        LZ4F_resetDecompressionContext(impl_->lz4);
+      }
+      status = lz4_decompress(impl_->lz4, records, chunk.uncompressed_size, out);
       break;
   }
   if (!status.ok()) return status;
@@ -256,6 +276,13 @@ Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
     }
   }
   return Status::Ok();
+}
+
+}  // namespace detail
+
+Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
+  detail::Decompressor decompressor;
+  return decompressor.decompress(chunk, chunk.records, out, verify_crc);
 }
 
 bool parse_compression(std::string_view name, Compression& out) {

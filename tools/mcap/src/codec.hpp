@@ -72,4 +72,23 @@ class ChunkWorker {
 
 Result<Compression> compression_from_name(std::string_view name);
 
+// Decompresses chunks one after another (decompress_chunk's rules), keeping its zstd and lz4
+// contexts between them: a fresh context per chunk is a fresh allocation, whose pages fault in
+// again for every chunk of a file.
+class Decompressor {
+ public:
+  Decompressor();
+  ~Decompressor();
+  Decompressor(const Decompressor&) = delete;
+  Decompressor& operator=(const Decompressor&) = delete;
+
+  // `records` are a Chunk's compressed records, `chunk` gives its compression, sizes and CRC
+  // (its own records field is not read).
+  Status decompress(const Chunk& chunk, ByteView records, Bytes& out, bool verify_crc);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 }  // namespace rbsim::mcap::detail

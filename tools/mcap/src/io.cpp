@@ -27,19 +27,22 @@ class FileSource final : public Source {
   std::uint64_t size() const override { return size_; }
   Status read(std::uint64_t offset, std::uint64_t length, ByteView& out) override {
     if (offset > size_ || length > size_ - offset) return out_of_range(offset, length, size_);
-    buffer_.resize(static_cast<std::size_t>(length));
+    // The buffer only grows: resizing it down for a record prefix and up again for the next
+    // record would zero-fill it each time.
+    const std::size_t n = static_cast<std::size_t>(length);
+    if (buffer_.size() < n) buffer_.resize(n);
     // Sequential reads (the common case) skip the seek so stdio's read-ahead keeps working.
     if (offset != position_ && fseeko(file_.get(), static_cast<off_t>(offset), SEEK_SET) != 0) {
       position_ = UINT64_MAX;
       return Status::Error(StatusCode::IoError, std::string("seek failed: ") + std::strerror(errno));
     }
-    const std::size_t got = std::fread(buffer_.data(), 1, buffer_.size(), file_.get());
+    const std::size_t got = std::fread(buffer_.data(), 1, n, file_.get());
     position_ = offset + got;
-    if (got != buffer_.size()) {
+    if (got != n) {
       position_ = UINT64_MAX;
       return Status::Error(StatusCode::IoError, "short read at offset " + std::to_string(offset));
     }
-    out = buffer_;
+    out = ByteView(buffer_).first(n);
     return Status::Ok();
   }
 

@@ -79,6 +79,31 @@ Result<Record> parse_as(ByteView content, std::string_view name) {
   return Record(std::move(r));
 }
 
+}  // namespace
+
+namespace detail {
+
+Status parse_chunk_view(ByteView content, Chunk& r, ByteView& records) {
+  Cursor c(content);
+  std::uint64_t n = 0;
+  if (!(c.u64(r.message_start_time) && c.u64(r.message_end_time) && c.u64(r.uncompressed_size) &&
+        c.u32(r.uncompressed_crc) && c.string(r.compression) && c.u64(n) && c.view(n, records))) {
+    return malformed("Chunk");
+  }
+  r.records.clear();
+  return Status::Ok();
+}
+
+Status parse_message_into(ByteView content, Message& r) {
+  Cursor c(content);
+  if (!parse(c, r)) return malformed("Message");
+  return Status::Ok();
+}
+
+}  // namespace detail
+
+namespace {
+
 using namespace detail;
 
 void body(Bytes& o, const Header& r) {

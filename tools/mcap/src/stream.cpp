@@ -77,12 +77,21 @@ bool Streamer::next_in_chunk(RecordEntry& out) {
     return fail(Status::Error(StatusCode::Malformed, "record cut off at byte " + std::to_string(chunk_pos_) +
                                                          " of the chunk" + at(chunk_offset_)));
   }
-  auto record = parse_record(opcode, content);
-  if (!record.ok()) {
-    return fail(
-        Status::Error(record.status().code, record.status().message + " in chunk" + at(chunk_offset_)));
+  if (opcode == static_cast<std::uint8_t>(Opcode::Message)) {
+    // Into the caller's Message, reusing its buffer: a fresh one per message is fresh pages.
+    Message* message = std::get_if<Message>(&out.record);
+    if (message == nullptr) message = &out.record.emplace<Message>();
+    if (Status s = parse_message_into(content, *message); !s.ok()) {
+      return fail(Status::Error(s.code, s.message + " in chunk" + at(chunk_offset_)));
+    }
+  } else {
+    auto record = parse_record(opcode, content);
+    if (!record.ok()) {
+      return fail(
+          Status::Error(record.status().code, record.status().message + " in chunk" + at(chunk_offset_)));
+    }
+    out.record = std::move(record).value();
   }
-  out.record = std::move(record).value();
   out.offset = chunk_pos_;
   out.length = kRecordPrefix + length;
   out.chunk_offset = chunk_offset_;
@@ -129,7 +138,20 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
   const std::uint32_t data_crc = data_crc_;
   if (!is_data_end) update_crcs(opcode, prefix, content);
 
-  auto parsed = parse_record(opcode, content);
+  // A Chunk that is only descended into is decompressed straight from the file buffer.
+  const bool chunk_view = opcode == static_cast<std::uint8_t>(Opcode::Chunk) &&
+                          options_.descend_into_chunks && !options_.report_chunks;
+  ByteView chunk_records;
+  Result<Record> parsed = Record{};
+  if (chunk_view) {
+    Chunk chunk;
+    if (Status s = parse_chunk_view(content, chunk, chunk_records); !s.ok()) {
+      return fail(Status::Error(s.code, s.message + at(position_)));
+    }
+    parsed = Record(std::move(chunk));
+  } else {
+    parsed = parse_record(opcode, content);
+  }
   if (!parsed.ok()) return fail(Status::Error(parsed.status().code, parsed.status().message + at(position_)));
   Record& record = parsed.value();
   const std::uint64_t record_offset = position_;
@@ -152,7 +174,9 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
     }
     case Opcode::Chunk:
       if (options_.descend_into_chunks) {
-        chunk_error_ = decompress_chunk(std::get<Chunk>(record), chunk_data_, options_.verify_crcs);
+        const Chunk& chunk = std::get<Chunk>(record);
+        chunk_error_ = decompressor_.decompress(chunk, chunk_view ? chunk_records : ByteView(chunk.records),
+                                                chunk_data_, options_.verify_crcs);
         if (!chunk_error_.ok()) chunk_error_.message += " (chunk" + at(record_offset) + ")";
         chunk_pos_ = 0;
         chunk_offset_ = record_offset;

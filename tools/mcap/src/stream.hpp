@@ -1,6 +1,7 @@
 // Linear record walk shared by StreamReader and the IndexedReader's fallback scan.
 #pragma once
 
+#include "codec.hpp"
 #include "io.hpp"
 
 namespace rbsim::mcap::detail {
@@ -39,6 +40,7 @@ class Streamer {
   bool in_chunk_ = false;
   Status chunk_error_;  // decompression failure, reported after the Chunk record itself
   Bytes chunk_data_;
+  Decompressor decompressor_;
   std::size_t chunk_pos_ = 0;
   std::uint64_t chunk_offset_ = 0;
 };

@@ -179,4 +179,11 @@ inline bool is_magic(ByteView v) {
   return v.size() >= 8 && std::memcmp(v.data(), kMagic, 8) == 0;
 }
 
+// parse_record for a Chunk without copying its records: `chunk` gets every other field, `records`
+// views them in `content`. The same checks and error as parse_record.
+Status parse_chunk_view(ByteView content, Chunk& chunk, ByteView& records);
+// parse_record for a Message into `message`, whose data buffer is reused (no allocation once it is
+// large enough). The same checks and error as parse_record.
+Status parse_message_into(ByteView content, Message& message);
+
 }  // namespace rbsim::mcap::detail

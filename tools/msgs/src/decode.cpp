@@ -78,6 +78,9 @@ class Walker {
         if (f.array != MessageDecoder::Field::Array::None) visit.index(k);
         if (f.primitive >= 0 ? !primitive(kPrimitives[f.primitive], visit) : !type(f.nested, visit))
           return false;
+        if constexpr (requires { visit.done(); }) {
+          if (visit.done()) return true;  // the visitor has what it wanted: stop walking
+        }
         if (f.array != MessageDecoder::Field::Array::None) visit.unindex();
       }
       visit.leave(f);
@@ -134,21 +137,34 @@ struct Collect {
   void scalar(const Scalar& s, bool) { out->push_back(s); }
 };
 
-// Builds the path of scalar number `target` while walking.
+// Builds the path of scalar number `target` while walking; stops the walk there. The path is
+// kept as a stack of field names and indices and spelled out only for the target.
 struct PathOf {
+  struct Part {
+    const std::string* name = nullptr;  // null: an index
+    std::uint64_t index = 0;
+  };
   std::size_t target;
   std::size_t seen = 0;
-  std::vector<std::string> parts;
+  std::vector<Part> parts;
   std::string found;
+  bool done() const { return seen > target; }
   void begin_object() {}
   void end_object() {}
-  void enter(const MessageDecoder::Field& f) { parts.push_back((parts.empty() ? "" : ".") + f.name); }
+  void enter(const MessageDecoder::Field& f) { parts.push_back({&f.name, 0}); }
   void leave(const MessageDecoder::Field&) { parts.pop_back(); }
-  void index(std::uint64_t k) { parts.push_back("[" + std::to_string(k) + "]"); }
+  void index(std::uint64_t k) { parts.push_back({nullptr, k}); }
   void unindex() { parts.pop_back(); }
   void scalar(const Scalar&, bool is_length) {
-    if (seen++ != target || !found.empty()) return;
-    for (const std::string& p : parts) found += p;
+    if (seen++ != target) return;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      if (parts[i].name == nullptr) {
+        found += "[" + std::to_string(parts[i].index) + "]";
+      } else {
+        if (i > 0) found += '.';
+        found += *parts[i].name;
+      }
+    }
     if (is_length) found += ".length";
   }
 };
