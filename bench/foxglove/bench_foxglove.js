@@ -57,7 +57,12 @@ async function latency() {
     { env });
   const c = new Client(need, url, { name: "latency", subscribeAll: false });
   const fox = new Map(); // step -> received ns
-  c.onmessage = (m) => fox.set(Number(m.decoded.step), nowNs());
+  let size = 0;
+  c.onmessage = (m) => {
+    fox.set(Number(m.decoded.step), nowNs());
+    size = m.data.length;
+  };
+  c.messages = { push() {} }; // keep nothing: a growing heap would add collector pauses to the client's latency
   await c.ready();
   for (const ch of c.channels.values()) if (ch.topic.endsWith("/body_states")) c.subscribe(ch);
   await node.wait(seconds * 1000 + 30000);
@@ -70,13 +75,15 @@ async function latency() {
   const foxLat = both.map(([step, , , srcMono]) => fox.get(step) - srcMono);
   const [dm, d99, fm, f99] = [quantile(ddsLat, 0.5), quantile(ddsLat, 0.99), quantile(foxLat, 0.5), quantile(foxLat, 0.99)];
   const ratio = fm / dm;
-  console.log(`(a) latency, step published -> decoded, 100 bodies (BodyStates ${c.messages.at(-1)?.data.length} B), ` +
+  const ratio99 = f99 / d99;
+  const ok = ratio <= 2 && ratio99 <= 2;
+  console.log(`(a) latency, step published -> decoded, 100 bodies (BodyStates ${size} B), ` +
     `${both.length} steps at real time, clock resolution 1 ns:`);
   console.log(`    DDS (C++ subscriber) median ${us(dm)} us, p99 ${us(d99)} us; ` +
     `Foxglove WebSocket (Node client) median ${us(fm)} us, p99 ${us(f99)} us`);
-  console.log(`    ratio of medians ${ratio.toFixed(2)}x (target <= 2x), of p99 ${(f99 / d99).toFixed(2)}x` +
-    `: ${ratio <= 2 ? "met" : "MISSED"}`);
-  return ratio <= 2;
+  console.log(`    ratio of medians ${ratio.toFixed(2)}x, of p99 ${ratio99.toFixed(2)}x (target <= 2x both)` +
+    `: ${ok ? "met" : "MISSED"}`);
+  return ok;
 }
 
 async function fanOut() {
