@@ -21,6 +21,7 @@
 // Exit status 0 on success, 1 on an I/O or MCAP error, 2 on a usage error.
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -47,6 +48,16 @@ struct Capture {
   std::uint64_t payload_bytes = 0;
 };
 
+// Keeps the first record of each id, in order (schemas and channels).
+template <class Record>
+void keep_first_of_each_id(std::vector<Record>& records) {
+  std::vector<Record> kept;
+  for (auto& r : records) {
+    if (std::none_of(kept.begin(), kept.end(), [&](const Record& k) { return k.id == r.id; }))
+      kept.push_back(std::move(r));
+  }
+  records = std::move(kept);
+}
 bool load(const std::string& path, Capture& out) {
   mcap::StreamReader reader;
   if (auto st = reader.open(path); !st.ok()) {
@@ -69,20 +80,8 @@ bool load(const std::string& path, Capture& out) {
     return false;
   }
   // A capture written with a summary repeats its schemas and channels there: keep the first of each.
-  std::vector<mcap::Schema> schemas;
-  for (auto& s : out.schemas) {
-    bool seen = false;
-    for (const auto& k : schemas) seen = seen || k.id == s.id;
-    if (!seen) schemas.push_back(std::move(s));
-  }
-  out.schemas = std::move(schemas);
-  std::vector<mcap::Channel> channels;
-  for (auto& c : out.channels) {
-    bool seen = false;
-    for (const auto& k : channels) seen = seen || k.id == c.id;
-    if (!seen) channels.push_back(std::move(c));
-  }
-  out.channels = std::move(channels);
+  keep_first_of_each_id(out.schemas);
+  keep_first_of_each_id(out.channels);
   return true;
 }
 

@@ -138,9 +138,8 @@ class AsioTransport final : public Transport {
     });
     msg->set_opcode(binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
     msg->set_header(frame_header(binary, data.size()));
-    msg->get_raw_payload().swap(data);
+    msg->get_raw_payload().swap(data);  // `data` now holds the new message's empty payload
     msg->set_prepared(true);
-    data.clear();
     if (!spare_.empty()) {
       data.swap(spare_.back());
       spare_.pop_back();
