@@ -185,6 +185,10 @@ Subscription::~Subscription() {
   if (topic_ > 0) dds_delete(topic_);
 }
 
+void SerdataUnref::operator()(ddsi_serdata* d) const {
+  ddsi_serdata_unref(d);
+}
+
 bool Subscription::take(Received& out) {
   while (true) {
     ddsi_serdata* d = nullptr;
@@ -195,11 +199,14 @@ bool Subscription::take(Received& out) {
       ddsi_serdata_unref(d);
       continue;
     }
+    // Borrowed, not copied: to_ser_ref hands out a reference to the sample and its contiguous
+    // bytes (rbsim's raw CDR type keeps them in one buffer).
     const std::uint32_t size = ddsi_serdata_size(d);
-    out.cdr.resize(size);
-    ddsi_serdata_to_ser(d, 0, size, out.cdr.data());
-    out.source_time_ns = info.source_timestamp;
+    ddsrt_iovec_t bytes{};
+    out.held.reset(ddsi_serdata_to_ser_ref(d, 0, size, &bytes));
     ddsi_serdata_unref(d);
+    out.cdr = {static_cast<const std::byte*>(bytes.iov_base), bytes.iov_len};
+    out.source_time_ns = info.source_timestamp;
     auto known = std::find_if(writers_.begin(), writers_.end(),
                               [&](const Writer& w) { return w.handle == info.publication_handle; });
     if (known == writers_.end()) {

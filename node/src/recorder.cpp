@@ -16,7 +16,7 @@ std::uint64_t wall_ns() {
                                         std::chrono::system_clock::now().time_since_epoch())
                                         .count());
 }
-mcap::ByteView view(const std::vector<std::byte>& b) {
+mcap::ByteView view(std::span<const std::byte> b) {
   return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
 }
 }  // namespace

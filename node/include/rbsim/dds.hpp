@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -18,6 +19,7 @@
 #include "rbsim/ros_env.hpp"
 
 struct ddsi_sertype;  // Cyclone DDS
+struct ddsi_serdata;
 
 namespace rbsim::node {
 
@@ -81,8 +83,14 @@ class Publisher {
 };
 
 // Takes raw CDR samples from one topic.
+struct SerdataUnref {
+  void operator()(ddsi_serdata* d) const;
+};
 struct Received {
-  std::vector<std::byte> cdr;
+  // The sample's CDR bytes, borrowed from DDS without a copy: valid while `held` keeps them (a
+  // move keeps them valid; the next take into this Received replaces them).
+  std::span<const std::byte> cdr;
+  std::unique_ptr<ddsi_serdata, SerdataUnref> held;
   std::int64_t source_time_ns = 0;
   std::array<std::uint8_t, 16> writer{};  // the sending writer's GUID (stable when it is rediscovered)
   msgs::OfferedQos offered;               // what that writer offers (history, depth, durability)
