@@ -747,6 +747,30 @@ TEST(Verify, WrongWindFailsTheIndependentIntegration) {
   EXPECT_EQ(v->rule, "independent-integration");
 }
 
+// Springs of one colour travel as the springs marker's single color (no per-vertex colours), and
+// verification checks the colours against the scene file: a chain recorded with every spring red
+// is no golden of the chain (default spring colour), but is one of its own scene.
+TEST(Verify, OneSpringColourIsCheckedAgainstTheScene) {
+  TempDir tmp;
+  std::string red;
+  for (int k = 0; k < 5; ++k)
+    red += "  <rigidbodyspringcolor spring=\"" + std::to_string(k) + "\" r=\"1\" g=\"0\" b=\"0\"/>\n";
+  const fs::path scene = edited(tmp.path(), kChain, "</scene>", red + "</scene>");
+  const fs::path log_path = tmp / "chain.mcap";
+  record(scene, log_path, {"--record-every", kChainEvery});
+  check::GoldenVerifyOptions options;
+  options.fosssim_dir = kFosssim.string();
+  Result<check::GoldenVerification> v = check::verify_golden(kChain.string(), log_path.string(), options);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_FALSE(v->passed) << to_string(v.value());
+  EXPECT_TRUE(contains(to_string(v.value()), "FAIL scene description")) << to_string(v.value());
+  EXPECT_TRUE(contains(to_string(v.value()), "spring 0 colour r")) << to_string(v.value());
+  v = check::verify_golden(scene.string(), log_path.string(), options);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_TRUE(v->passed) << to_string(v.value());
+  EXPECT_TRUE(contains(to_string(v.value()), "PASS springs marker")) << to_string(v.value());
+}
+
 TEST(Verify, ErrorsOnBadInput) {
   TempDir tmp;
   write_text(tmp / "empty.mcap", "");

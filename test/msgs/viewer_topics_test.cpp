@@ -183,6 +183,32 @@ TEST(EncoderSprings, LineListOfTheSpringEndsInSceneColours) {
   }
 }
 
+// Springs that share one colour: it is the marker's color, with no per-vertex colours (32 bytes
+// less per spring); the points are as before.
+TEST(EncoderSprings, OneColourForEverySpringIsTheMarkersColor) {
+  rbsim::Scene scene = scene_with_anchor();
+  const rbsim::Color shared{0.2, 0.4, 0.6};
+  scene.spring_colors.assign(scene.world.springs.size(), shared);
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  for (int i = 0; i < 25; ++i) w->step();
+  rbsim::msgs::Bytes one, each;
+  rbsim::msgs::Encoder(scene).springs(w.value(), one);
+  rbsim::msgs::Encoder(scene_with_anchor()).springs(w.value(), each);
+  rbsim::msgs::MarkerMessage m, per_vertex;
+  ASSERT_TRUE(rbsim::msgs::decode_marker(one, m).ok());
+  ASSERT_TRUE(rbsim::msgs::decode_marker(each, per_vertex).ok());
+  const std::size_t n = static_cast<std::size_t>(w->spring_count());
+  ASSERT_GT(n, 1u);
+  EXPECT_TRUE(m.colors.empty());
+  EXPECT_EQ(m.color[0], static_cast<float>(shared.r));
+  EXPECT_EQ(m.color[1], static_cast<float>(shared.g));
+  EXPECT_EQ(m.color[2], static_cast<float>(shared.b));
+  EXPECT_EQ(m.color[3], 1.0f);
+  EXPECT_EQ(m.points, per_vertex.points);
+  EXPECT_EQ(each.size() - one.size(), 2 * n * 16);  // 2 n RGBA float colours
+}
+
 TEST(EncoderMarkers, FilledHullsOutlinesAndAnchorsInTheirFrames) {
   const rbsim::Scene scene = scene_with_anchor();
   auto w = rbsim::World::create(scene.world);

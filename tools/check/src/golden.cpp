@@ -568,6 +568,16 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
       exact(k[s], sp.stiffness, id + " stiffness");
       exact(l0[s], sp.rest_length, id + " rest_length");
     }
+    // Colours travel as float32 (std_msgs/ColorRGBA): the scene's, rounded so, exactly.
+    auto colour = [&](const Color& got, const Color& want, const std::string& id) {
+      exact(got.r, static_cast<float>(want.r), id + " colour r");
+      exact(got.g, static_cast<float>(want.g), id + " colour g");
+      exact(got.b, static_cast<float>(want.b), id + " colour b");
+    };
+    for (std::size_t b = 0; b < std::min(desc.bodies.size(), scene.body_colors.size()); ++b)
+      colour(desc.bodies[b].color, scene.body_colors[b], "body " + std::to_string(b));
+    for (std::size_t s = 0; s < std::min(desc.spring_colors.size(), scene.spring_colors.size()); ++s)
+      colour(desc.spring_colors[s], scene.spring_colors[s], "spring " + std::to_string(s));
     const auto gx = field(desc.gravity, [](const GravityDef& d) { return d.acceleration.x(); });
     const auto gy = field(desc.gravity, [](const GravityDef& d) { return d.acceleration.y(); });
     exact(static_cast<double>(gx.size()), static_cast<double>(model.gravity.size()), "gravity count");
@@ -590,7 +600,7 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
     r.line(tally.ok(), "scene description: " + std::to_string(bodies) +
                            " bodies (M, I and body-space hulls recomputed "
                            "from the vertices), " +
-                           std::to_string(model.springs.size()) + " springs, " +
+                           std::to_string(model.springs.size()) + " springs, colours, " +
                            std::to_string(model.gravity.size()) + " gravity, " +
                            std::to_string(scene.world.winds.size()) + " wind, dt " + g17(dt) + ", " +
                            to_string(scene.world.integrator) + ", " + std::to_string(v.steps) +
@@ -830,6 +840,10 @@ Result<GoldenVerification> verify_golden(const std::string& scene_path, const st
           for (int end = 0; end < 2; ++end) want_cr.insert(want_cr.end(), {c.r, c.g, c.b});
         }
         for (const auto& c : mk.colors) cr.insert(cr.end(), {c[0], c[1], c[2]});
+        if (mk.colors.empty()) {  // one colour for every spring: the marker's
+          for (std::size_t p = 0; p < mk.points.size(); ++p)
+            cr.insert(cr.end(), {mk.color[0], mk.color[1], mk.color[2]});
+        }
         each(spm, px, "points[].x", want_x);
         each(spm, py, "points[].y", want_y);
         each(spm, cr, "colors[].rgb", want_cr);

@@ -159,6 +159,8 @@ class Encoder {
  private:
   const Scene* scene_;
   std::vector<std::string> frames_;  // body_frame(ns, i) per body
+  // Every spring's colour when they all share one: the springs marker then carries it once.
+  std::optional<Color> spring_color_;
 };
 
 // The messages of the world's current step, each encoded once however many sinks send it (the
