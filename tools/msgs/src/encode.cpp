@@ -172,9 +172,8 @@ Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene) {
     frames_.push_back(body_frame(ns, static_cast<std::int32_t>(b)));
   }
   const auto& colors = scene.spring_colors;
-  if (!colors.empty() && std::all_of(colors.begin(), colors.end(), [&](const Color& c) {
-        return c.r == colors.front().r && c.g == colors.front().g && c.b == colors.front().b;
-      })) {
+  if (!colors.empty() &&
+      std::all_of(colors.begin(), colors.end(), [&](const Color& c) { return c == colors.front(); })) {
     spring_color_ = colors.front();
   }
 }

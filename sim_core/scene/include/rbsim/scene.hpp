@@ -14,6 +14,7 @@ namespace rbsim {
 
 struct Color {
   double r = 0.0, g = 0.0, b = 0.0;  // each in [0, 1]
+  bool operator==(const Color&) const = default;
 };
 
 struct Viewport {
