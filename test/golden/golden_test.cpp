@@ -691,16 +691,27 @@ TEST(CheckLibrary, FieldMaximaMatchAnIndependentDecode) {
 // ---------------------------------------------------------------------------------------------
 // Verification
 
+// A recording of `scene` (an edited copy of the chain) at the chain golden's stride, in `tmp`.
+fs::path record_chain_variant(const TempDir& tmp, const fs::path& scene) {
+  const fs::path log_path = tmp / "chain.mcap";
+  record(scene, log_path, {"--record-every", kChainEvery});
+  return log_path;
+}
+
+// `log_path` verified as a golden of `scene`, with the FOSSSim reference output at hand.
+Result<check::GoldenVerification> verify(const fs::path& scene, const fs::path& log_path) {
+  check::GoldenVerifyOptions options;
+  options.fosssim_dir = kFosssim.string();
+  return check::verify_golden(scene.string(), log_path.string(), options);
+}
+
 TEST(Verify, WrongPhysicsFailsVerification) {
   // A recording made with 5% more gravity, verified as a golden of the real scene: the scene
   // description, the recorded energies and energy conservation all give it away.
   TempDir tmp;
   const fs::path scene = edited(tmp.path(), kChain, "fy=\"-1.0\"", "fy=\"-1.05\"");
-  const fs::path log_path = tmp / "chain.mcap";
-  record(scene, log_path, {"--record-every", kChainEvery});
-  check::GoldenVerifyOptions options;
-  options.fosssim_dir = kFosssim.string();
-  Result<check::GoldenVerification> v = check::verify_golden(kChain.string(), log_path.string(), options);
+  const fs::path log_path = record_chain_variant(tmp, scene);
+  Result<check::GoldenVerification> v = verify(kChain, log_path);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_FALSE(v->passed) << to_string(v.value());
   auto line = [&](const std::string& prefix) {
@@ -714,7 +725,7 @@ TEST(Verify, WrongPhysicsFailsVerification) {
   EXPECT_TRUE(line("FAIL energy conservation")) << to_string(v.value());
   EXPECT_GT(v->energy_error, 10 * v->energy_bound);
   // The same recording is a fine golden of the scene it was made from.
-  v = check::verify_golden(scene.string(), log_path.string(), options);
+  v = verify(scene, log_path);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_TRUE(v->passed) << to_string(v.value());
   EXPECT_LT(v->energy_error, v->energy_bound);
@@ -756,16 +767,13 @@ TEST(Verify, OneSpringColourIsCheckedAgainstTheScene) {
   for (int k = 0; k < 5; ++k)
     red += "  <rigidbodyspringcolor spring=\"" + std::to_string(k) + "\" r=\"1\" g=\"0\" b=\"0\"/>\n";
   const fs::path scene = edited(tmp.path(), kChain, "</scene>", red + "</scene>");
-  const fs::path log_path = tmp / "chain.mcap";
-  record(scene, log_path, {"--record-every", kChainEvery});
-  check::GoldenVerifyOptions options;
-  options.fosssim_dir = kFosssim.string();
-  Result<check::GoldenVerification> v = check::verify_golden(kChain.string(), log_path.string(), options);
+  const fs::path log_path = record_chain_variant(tmp, scene);
+  Result<check::GoldenVerification> v = verify(kChain, log_path);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_FALSE(v->passed) << to_string(v.value());
   EXPECT_TRUE(contains(to_string(v.value()), "FAIL scene description")) << to_string(v.value());
   EXPECT_TRUE(contains(to_string(v.value()), "spring 0 colour r")) << to_string(v.value());
-  v = check::verify_golden(scene.string(), log_path.string(), options);
+  v = verify(scene, log_path);
   ASSERT_TRUE(v) << v.error().message;
   EXPECT_TRUE(v->passed) << to_string(v.value());
   EXPECT_TRUE(contains(to_string(v.value()), "PASS springs marker")) << to_string(v.value());
