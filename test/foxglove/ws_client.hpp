@@ -1,6 +1,7 @@
-// A minimal WebSocket client over a blocking POSIX socket, for the server tests: the opening
-// handshake with chosen subprotocols, masked client frames, unmasked server frames. Every read has
-// a timeout, so a test never hangs on a server that does not answer. 127.0.0.1 only.
+// A minimal WebSocket client over a blocking POSIX socket, for the server tests and the fan-out
+// benchmark's client (bench/foxglove/fanout_client.cpp): the opening handshake with chosen
+// subprotocols, masked client frames, unmasked server frames. Every read has a timeout, so a test
+// never hangs on a server that does not answer. 127.0.0.1 only.
 #pragma once
 
 #include <arpa/inet.h>
@@ -77,6 +78,8 @@ class WsClient {
 
   bool send_text(const std::string& text) { return send_frame(0x1, text); }
   bool send_binary(const std::string& data) { return send_frame(0x2, data); }
+  // A close frame with `payload` (a status code and reason, or nothing).
+  bool send_close(const std::string& payload) { return send_frame(0x8, payload); }
 
   struct Frame {
     int opcode = 0;  // 1 text, 2 binary, 8 close
@@ -84,32 +87,38 @@ class WsClient {
   };
   // The next data or close frame (pings are answered); nullopt on timeout, EOF or error.
   std::optional<Frame> read() {
+    Frame f;
+    if (!read(f)) return std::nullopt;
+    return f;
+  }
+  // The same into `f`, reusing its buffer (a reader of many frames allocates once); false on
+  // timeout, EOF or error.
+  bool read(Frame& f) {
     while (true) {
       unsigned char h[2];
-      if (!read_all(h, 2)) return std::nullopt;
+      if (!read_all(h, 2)) return false;
       const int opcode = h[0] & 0x0f;
       std::uint64_t len = h[1] & 0x7f;
       if (len == 126) {
         unsigned char e[2];
-        if (!read_all(e, 2)) return std::nullopt;
+        if (!read_all(e, 2)) return false;
         len = (std::uint64_t{e[0]} << 8) | e[1];
       } else if (len == 127) {
         unsigned char e[8];
-        if (!read_all(e, 8)) return std::nullopt;
+        if (!read_all(e, 8)) return false;
         len = 0;
         for (unsigned char b : e) len = (len << 8) | b;
       }
-      if (len > (64u << 20)) return std::nullopt;
-      Frame f;
+      if (len > (64u << 20)) return false;
       f.opcode = opcode;
       f.data.resize(len);
-      if (len > 0 && !read_all(f.data.data(), len)) return std::nullopt;
+      if (len > 0 && !read_all(f.data.data(), len)) return false;
       if (opcode == 0x9) {
         send_frame(0xA, f.data);
         continue;
       }
       if (opcode == 0xA) continue;
-      return f;
+      return true;
     }
   }
 
