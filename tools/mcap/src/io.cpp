@@ -91,24 +91,21 @@ class FileSink final : public Sink {
       buffer_.assign(data.begin(), data.end());
       return Status::Ok();
     }
-    const std::size_t total = buffer_.size() + data.size();
-    std::size_t done = 0;
-    while (done < total) {  // bounded: every pass writes at least one byte or returns
+    Status s = write_fully(buffer_.size() + data.size(), [&](std::size_t done) {
       const std::size_t skip = std::min(done, buffer_.size());
       iovec rest[2] = {{buffer_.data() + skip, buffer_.size() - skip},
                        {const_cast<std::uint8_t*>(data.data()) + (done - skip), data.size() - (done - skip)}};
       const int first = rest[0].iov_len == 0 ? 1 : 0;
-      const ssize_t n = ::writev(fd_, rest + first, 2 - first);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) return write_error();
-      done += static_cast<std::size_t>(n);
-    }
+      return ::writev(fd_, rest + first, 2 - first);
+    });
     buffer_.clear();
-    return Status::Ok();
+    return s;
   }
   Status flush() override {
     if (fd_ < 0) return Status::Ok();
-    Status s = write_all(buffer_.data(), buffer_.size());
+    Status s = write_fully(buffer_.size(), [&](std::size_t done) {
+      return ::write(fd_, buffer_.data() + done, buffer_.size() - done);
+    });
     buffer_.clear();
     return s;
   }
@@ -130,31 +127,27 @@ class FileSink final : public Sink {
     // The bytes may still sit in the buffer. pwrite() leaves the file position (where write()
     // appends next) where it is.
     if (Status s = flush(); !s.ok()) return s;
-    std::size_t done = 0;
-    while (done < data.size()) {  // bounded: every pass writes at least one byte or returns
-      const ssize_t n =
-          ::pwrite(fd_, data.data() + done, data.size() - done, static_cast<off_t>(offset + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) return write_error();
-      done += static_cast<std::size_t>(n);
-    }
-    return Status::Ok();
+    return write_fully(data.size(), [&](std::size_t done) {
+      return ::pwrite(fd_, data.data() + done, data.size() - done, static_cast<off_t>(offset + done));
+    });
   }
 
  private:
   static constexpr std::size_t kBuffer = 64 * 1024;
   static constexpr std::size_t kDirect = 16 * 1024;  // writes from this size bypass the buffer
 
-  static Status write_error() {
-    return Status::Error(StatusCode::IoError,
-                         std::string("write failed: ") + std::strerror(errno != 0 ? errno : EIO));
-  }
-  Status write_all(const std::uint8_t* p, std::size_t size) {
+  // Calls `put(done)` (a write, writev or pwrite of what remains after `done` bytes, returning its
+  // result) until `size` bytes are out, retrying on EINTR.
+  template <class Put>
+  static Status write_fully(std::size_t size, Put put) {
     std::size_t done = 0;
     while (done < size) {  // bounded: every pass writes at least one byte or returns
-      const ssize_t n = ::write(fd_, p + done, size - done);
+      const ssize_t n = put(done);
       if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) return write_error();
+      if (n <= 0) {
+        return Status::Error(StatusCode::IoError,
+                             std::string("write failed: ") + std::strerror(errno != 0 ? errno : EIO));
+      }
       done += static_cast<std::size_t>(n);
     }
     return Status::Ok();
