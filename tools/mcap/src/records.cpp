@@ -33,9 +33,13 @@ bool parse(Cursor& c, Message& r) {
   return c.u16(r.channel_id) && c.u32(r.sequence) && c.u64(r.log_time) && c.u64(r.publish_time) &&
          c.rest(r.data);
 }
-bool parse(Cursor& c, Chunk& r) {
+// A Chunk's fields before its records (parse and parse_chunk_view).
+bool parse_head(Cursor& c, Chunk& r) {
   return c.u64(r.message_start_time) && c.u64(r.message_end_time) && c.u64(r.uncompressed_size) &&
-         c.u32(r.uncompressed_crc) && c.string(r.compression) && c.bytes64(r.records);
+         c.u32(r.uncompressed_crc) && c.string(r.compression);
+}
+bool parse(Cursor& c, Chunk& r) {
+  return parse_head(c, r) && c.bytes64(r.records);
 }
 bool parse(Cursor& c, MessageIndex& r) {
   return c.u16(r.channel_id) && c.time_offsets(r.records);
@@ -86,8 +90,7 @@ namespace detail {
 Status parse_chunk_view(ByteView content, Chunk& r, ByteView& records) {
   Cursor c(content);
   std::uint64_t n = 0;
-  if (!(c.u64(r.message_start_time) && c.u64(r.message_end_time) && c.u64(r.uncompressed_size) &&
-        c.u32(r.uncompressed_crc) && c.string(r.compression) && c.u64(n) && c.view(n, records))) {
+  if (!(parse_head(c, r) && c.u64(n) && c.view(n, records))) {
     return malformed("Chunk");
   }
   r.records.clear();
