@@ -1,16 +1,27 @@
 #!/usr/bin/env python3
 """The module rules of docs/architecture.md, checked on the sources: each module includes only
 the public headers of the modules its row allows (its own internals stay in its src/), and every
-public header belongs to exactly one module.
+public header belongs to exactly one module; only the modules of READER_MODULES use the MCAP
+readers, and no module but mcap frames MCAP by hand (magic, record prefix, opcodes).
 
-    check_modules.py ROOT        # exit 1 listing every include that breaks a rule
+    check_modules.py ROOT [--allowlist FILE]   # exit 1 listing every break of a rule
+
+The allow-list (default ROOT/test/architecture_allowlist.txt) names the files that still break
+the reader or framing rule: a new one fails, and so does a listed one that no longer does.
 """
+import argparse
 import pathlib
 import re
 import sys
 
-# module: (folder, modules it may include). Mirrors docs/architecture.md's "Modules" table.
+import check_common
+
+# module: (folder, modules it may include). Mirrors docs/architecture.md's "Modules" table. A new
+# module is one row; the modules of BASE are the lowest layer: every module may include them, and
+# they include none of ours.
+BASE = {"base"}
 MODULES = {
+    "base": ("sim_core/base", set()),
     "core": ("sim_core", set()),
     "scene": ("sim_core/scene", {"core"}),
     "io": ("tools/io", {"core", "scene"}),
@@ -21,11 +32,34 @@ MODULES = {
     "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "node": ("node", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
-    "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check"}),
+    "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "log"}),
+    "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"rbsim/([A-Za-z0-9_]+\.hpp)"', re.M)
+SOURCE_SUFFIXES = (".cpp", ".hpp", ".h", ".in")
+
+# The reading side of rbsim/mcap.hpp (the Writer and the record types are for everyone): other
+# modules read recordings through log (rbsim/recording.hpp) or an mcap_tools tool.
+READER_MODULES = {"mcap", "mcap_tools", "log"}
+READER_API = re.compile(r"\bmcap\s*::\s*(StreamReader|IndexedReader|StreamOptions|IndexedOptions|"
+                        r"ReadMessagesOptions|MessageEntry|RecordEntry|parse_record|decompress_chunk)\b")
+# MCAP's framing by hand: the magic, the record prefix <opcode u8><length u64>, opcodes.
+FRAMING_MODULES = {"mcap"}
+FRAMING = [
+    (re.compile(r"\bkMagic\b"), "the magic (kMagic)"),
+    (re.compile(r"0x89\s*,\s*'M'\s*,\s*'C'\s*,\s*'A'\s*,\s*'P'|\\x89MCAP"), "a copy of the magic"),
+    (re.compile(r"\bk(?:Record)?Prefix\b"), "the record prefix (kPrefix)"),
+    (re.compile(r"\b(?:read_|load_)?le(?:16|32|64)\s*\("), "little-endian fields read by hand (le64)"),
+    (re.compile(r"\bmcap\s*::\s*Opcode\b"), "record opcodes (mcap::Opcode)"),
+]
+
+
+def allowed_includes(name):
+    """The modules `name` may include (None: any)."""
+    allowed = MODULES[name][1]
+    return None if allowed is None else allowed | (BASE - {name})
 
 
 def module_of(root, path):
@@ -38,8 +72,45 @@ def module_of(root, path):
     return best
 
 
+def check_includes(root, name, path, text, owner, problems):
+    allowed = allowed_includes(name)
+    if allowed is None:
+        return
+    for header in INCLUDE.findall(text):
+        target = owner.get(header)
+        if target is None and (path.parent / header).exists():
+            continue  # a private header beside it
+        if target is None:
+            problems.append(f"{path.relative_to(root)}: includes rbsim/{header}, which no module exports")
+        elif target != name and target not in allowed:
+            problems.append(f"{path.relative_to(root)}: module {name} includes rbsim/{header} of module "
+                            f"{target} (allowed: {', '.join(sorted(allowed)) or 'none'})")
+
+
+def reader_use(name, text):
+    """The first MCAP reader name `text` uses, if module `name` may not."""
+    if name in READER_MODULES:
+        return None
+    m = READER_API.search(check_common.strip(text))
+    return m and f"mcap::{m.group(1)}"
+
+
+def framing_use(name, text):
+    """What of MCAP's framing `text` spells out, if module `name` may not."""
+    if name in FRAMING_MODULES:
+        return None
+    code = check_common.strip(text, literals=False, directives=False)
+    return next((what for pattern, what in FRAMING if pattern.search(code)), None)
+
+
 def main():
-    root = pathlib.Path(sys.argv[1]).resolve()
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("root", type=pathlib.Path)
+    ap.add_argument("--allowlist", type=pathlib.Path, help="default: ROOT/test/architecture_allowlist.txt")
+    a = ap.parse_args()
+    root = a.root.resolve()
+    allowlist = a.allowlist or root / "test" / "architecture_allowlist.txt"
+    listed = check_common.read_allowlist(allowlist)
     owner, problems = {}, []
     for name, (folder, _) in MODULES.items():
         for header in (root / folder / "include" / "rbsim").glob("*.hpp"):
@@ -50,21 +121,28 @@ def main():
             owner[header.name] = name
     if not owner:
         problems.append("no public headers found: wrong ROOT?")
-    for name, (folder, allowed) in MODULES.items():
-        if allowed is None:
-            continue
+    readers, framers = set(), set()
+    for name, (folder, _) in MODULES.items():
         for path in sorted((root / folder).rglob("*")):
-            if path.suffix not in (".cpp", ".hpp", ".h", ".in") or module_of(root, path) != name:
+            if path.suffix not in SOURCE_SUFFIXES or module_of(root, path) != name:
                 continue
-            for header in INCLUDE.findall(path.read_text(encoding="utf-8", errors="replace")):
-                target = owner.get(header)
-                if target is None and (path.parent / header).exists():
-                    continue  # a private header beside it
-                if target is None:
-                    problems.append(f"{path.relative_to(root)}: includes rbsim/{header}, which no module exports")
-                elif target != name and target not in allowed:
-                    problems.append(f"{path.relative_to(root)}: module {name} includes rbsim/{header} of module "
-                                    f"{target} (allowed: {', '.join(sorted(allowed)) or 'none'})")
+            text = path.read_text(encoding="utf-8", errors="replace")
+            rel = path.relative_to(root).as_posix()
+            check_includes(root, name, path, text, owner, problems)
+            used = reader_use(name, text)
+            if used:
+                readers.add(rel)
+                if rel not in listed["mcap-reader"]:
+                    problems.append(f"{rel}: module {name} uses the MCAP readers ({used}); only "
+                                    f"{', '.join(sorted(READER_MODULES))} may")
+            framed = framing_use(name, text)
+            if framed:
+                framers.add(rel)
+                if rel not in listed["mcap-framing"]:
+                    problems.append(f"{rel}: module {name} frames MCAP by hand ({framed}); only tools/mcap may")
+    for kind, found in (("mcap-reader", readers), ("mcap-framing", framers)):
+        for rel in sorted(set(listed[kind]) - found):
+            problems.append(f"{allowlist}: {kind} {rel} no longer breaks the rule: its entry can be removed")
     for p in problems:
         print(p)
     print(f"{len(owner)} public headers in {len(MODULES)} modules, {len(problems)} problems")

@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""check_modules.py and check_sizes.py on small source trees made here: a clean tree passes, each
+deliberate break of a rule fails with its message, and the allow-list ratchets.
+
+    check_rules_test.py   # unittest; exit 1 on a failure
+"""
+import pathlib
+import subprocess
+import sys
+import tempfile
+import textwrap
+import unittest
+
+HERE = pathlib.Path(__file__).resolve().parent
+
+
+def function(name, lines):
+    """A clang-formatted C++ function of exactly `lines` lines, with a lambda, a string holding a
+    brace and a comment holding one (none of which may end it early)."""
+    body = ["  int n = 0;", '  const char* s = "}";', "  // }", "  auto f = [&](int k) {", "    return k + 1;", "  };"]
+    body += ["  n = f(n);"] * (lines - len(body) - 3)
+    return "\n".join([f"int {name}(int x) {{"] + body + ["  return n + x + (s[0] == '}');", "}"]) + "\n"
+
+
+class Tree:
+    """A temporary source tree: the modules core (sim_core), mcap, log, check and node, each with a
+    public header, and whatever files a test adds."""
+
+    def __init__(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.root = pathlib.Path(self.tmp.name)
+        for folder, header in [("sim_core", "core"), ("tools/mcap", "mcap"), ("tools/log", "recording"),
+                               ("tools/check", "check"), ("node", "replay")]:
+            self.write(f"{folder}/include/rbsim/{header}.hpp", "#pragma once\n")
+        self.write("sim_core/src/world.cpp", '#include "rbsim/core.hpp"\n' + function("step", 20))
+        self.write("tools/log/src/recording.cpp",
+                   '#include "rbsim/mcap.hpp"\n#include "rbsim/recording.hpp"\n'
+                   "void read() { rbsim::mcap::IndexedReader reader; }\n")
+        self.write("node/src/replay.cpp",
+                   '#include "rbsim/recording.hpp"\n#include "rbsim/replay.hpp"\n'
+                   "// not mcap::IndexedReader, which log wraps\n" + function("play", 150))
+
+    def write(self, rel, text):
+        path = self.root / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+
+    def run(self, script):
+        p = subprocess.run([sys.executable, str(HERE / script), str(self.root)], capture_output=True, text=True)
+        return p.returncode, p.stdout + p.stderr
+
+
+class CheckModulesTest(unittest.TestCase):
+    def setUp(self):
+        self.tree = Tree()
+        self.addCleanup(self.tree.tmp.cleanup)
+
+    def assertFails(self, message):
+        rc, out = self.tree.run("check_modules.py")
+        self.assertEqual(rc, 1, out)
+        self.assertIn(message, out)
+
+    def test_clean_tree_passes(self):
+        rc, out = self.tree.run("check_modules.py")
+        self.assertEqual(rc, 0, out)
+        self.assertIn("0 problems", out)
+
+    def test_include_of_a_module_not_allowed_fails(self):
+        self.tree.write("sim_core/src/bad.cpp", '#include "rbsim/recording.hpp"\n')
+        self.assertFails("sim_core/src/bad.cpp: module core includes rbsim/recording.hpp of module log "
+                         "(allowed: base)")
+
+    def test_base_is_for_everyone_and_includes_nothing(self):
+        self.tree.write("sim_core/base/include/rbsim/base.hpp", "#pragma once\n")
+        self.tree.write("tools/mcap/src/use.cpp", '#include "rbsim/base.hpp"\n')
+        self.assertEqual(self.tree.run("check_modules.py")[0], 0)
+        self.tree.write("sim_core/base/src/bad.cpp", '#include "rbsim/core.hpp"\n')
+        self.assertFails("sim_core/base/src/bad.cpp: module base includes rbsim/core.hpp of module core")
+
+    def test_reader_outside_mcap_log_and_mcap_tools_fails(self):
+        self.tree.write("tools/check/src/compare.cpp", "void f() { rbsim::mcap::StreamReader r; }\n")
+        self.assertFails("tools/check/src/compare.cpp: module check uses the MCAP readers (mcap::StreamReader); "
+                         "only log, mcap, mcap_tools may")
+
+    def test_framing_outside_mcap_fails(self):
+        self.tree.write("tools/log/src/sniff.cpp",
+                        "const unsigned char kHead[] = {0x89, 'M', 'C', 'A', 'P', 0x30, '\\r', '\\n'};\n")
+        self.assertFails("tools/log/src/sniff.cpp: module log frames MCAP by hand (a copy of the magic)")
+        self.tree.write("tools/log/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
+        self.assertFails("(little-endian fields read by hand (le64))")
+
+    def test_allowlist_ratchets(self):
+        self.tree.write("tools/check/src/compare.cpp", "rbsim::mcap::IndexedReader r;\n")
+        self.tree.write("test/architecture_allowlist.txt", "mcap-reader tools/check/src/compare.cpp\n")
+        self.assertEqual(self.tree.run("check_modules.py")[0], 0)
+        self.tree.write("tools/check/src/compare.cpp", "int r;  // mcap::IndexedReader gone\n")
+        self.assertFails("mcap-reader tools/check/src/compare.cpp no longer breaks the rule: its entry can be removed")
+
+
+class CheckSizesTest(unittest.TestCase):
+    def setUp(self):
+        self.tree = Tree()
+        self.addCleanup(self.tree.tmp.cleanup)
+
+    def assertFails(self, message):
+        rc, out = self.tree.run("check_sizes.py")
+        self.assertEqual(rc, 1, out)
+        self.assertIn(message, out)
+
+    def test_clean_tree_passes(self):  # replay.cpp's play is 150 lines: at the limit
+        rc, out = self.tree.run("check_sizes.py")
+        self.assertEqual(rc, 0, out)
+        self.assertIn("0 problems", out)
+
+    def test_file_over_700_lines_fails(self):
+        self.tree.write("tools/log/src/big.py", "x = 1\n" * 700)
+        self.assertEqual(self.tree.run("check_sizes.py")[0], 0)
+        self.tree.write("tools/log/src/big.py", "x = 1\n" * 701)
+        self.assertFails("tools/log/src/big.py:1: file is 701 lines (limit 700)")
+
+    def test_tests_are_exempt(self):
+        self.tree.write("test/log/big_test.cpp", "int x;\n" * 900)
+        self.tree.write("examples/demo/demo_test.cpp", "int x;\n" * 900)
+        self.assertEqual(self.tree.run("check_sizes.py")[0], 0)
+
+    def test_function_over_150_lines_fails(self):
+        self.tree.write("node/src/replay.cpp", "namespace rbsim {\n\n" + function("play", 151) + "\n}  // namespace rbsim\n")
+        self.assertFails("node/src/replay.cpp:3: function play is 151 lines (limit 150)")
+
+    def test_member_functions_and_constructors_are_measured(self):
+        body = "\n".join(["    ++n_;"] * 150)
+        self.tree.write("tools/log/src/sink.hpp", textwrap.dedent("""\
+            struct Sink {
+             public:
+              explicit Sink(int n) : n_{n}, f_([this] { return n_; }) {
+            BODY
+              }
+              int n_{0};
+            };
+            """).replace("BODY", body))
+        self.assertFails("tools/log/src/sink.hpp:3: function Sink is 152 lines (limit 150)")
+
+    def test_allowlist_ratchets(self):
+        self.tree.write("node/src/replay.cpp", function("play", 160))
+        self.tree.write("test/architecture_allowlist.txt", "function 160 node/src/replay.cpp play\n")
+        self.assertEqual(self.tree.run("check_sizes.py")[0], 0)
+        self.tree.write("node/src/replay.cpp", function("play", 155))  # shrinking is fine
+        self.assertEqual(self.tree.run("check_sizes.py")[0], 0)
+        self.tree.write("node/src/replay.cpp", function("play", 161))
+        self.assertFails("function play is 161 lines (limit 150; allow-listed at 160, which may only shrink)")
+        self.tree.write("node/src/replay.cpp", function("play", 150))
+        self.assertFails("function play of node/src/replay.cpp is 150 lines (limit 150): its entry can be removed")
+
+
+if __name__ == "__main__":
+    unittest.main()
