@@ -30,9 +30,9 @@ MODULES = {
     "mcap_tools": ("tools/mcap_tools", {"mcap", "core"}),
     "log": ("tools/log", {"io", "msgs", "mcap", "mcap_tools", "core", "scene"}),
     "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
+    "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "node": ("node", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
-    "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module

@@ -9,7 +9,6 @@
 
 #include "rbsim/check.hpp"
 #include "rbsim/export.hpp"
-#include "rbsim/golden.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/mcap_tools.hpp"
 #include "rbsim/record.hpp"
