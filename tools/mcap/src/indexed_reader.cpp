@@ -33,7 +33,7 @@ bool later(const Pending& a, const Pending& b) {
 }  // namespace
 
 struct IndexedReader::Impl {
-  std::unique_ptr<Source> source;
+  std::unique_ptr<ByteSource> source;
   IndexedOptions options;
   bool open = false;
   Header header;
@@ -59,54 +59,51 @@ struct IndexedReader::Impl {
   }
 
   Status read_section(std::uint64_t begin, std::uint64_t end, const std::function<void(Record&)>& visit) {
-    for (std::uint64_t pos = begin; pos < end;) {
-      std::uint8_t opcode = 0;
-      ByteView content;
-      if (Status s = read_record_at(*source, pos, opcode, content); !s.ok()) return s;
-      if (pos + kRecordPrefix + content.size() > end) {
-        return Status::Error(StatusCode::Malformed,
-                             "summary record at offset " + std::to_string(pos) + " overruns its section");
+    // Framed to the end of the file (a length past it is a truncation), bounded by the section.
+    RecordReader records(*source, begin);
+    RecordView rec;
+    while (records.position() < end) {
+      if (!records.next(rec)) return records.status();
+      if (rec.offset + rec.length > end) {
+        return Status::Error(StatusCode::Malformed, "summary record at offset " + std::to_string(rec.offset) +
+                                                        " overruns its section");
       }
-      auto record = parse_record(opcode, content);
-      if (!record.ok()) return with_context(record.status(), "summary offset " + std::to_string(pos));
+      auto record = parse_record(rec.opcode, rec.content);
+      if (!record.ok()) return with_context(record.status(), "summary offset " + std::to_string(rec.offset));
       visit(record.value());
-      pos += kRecordPrefix + content.size();
     }
     return Status::Ok();
   }
 
-  Status load(std::unique_ptr<Source> s, const IndexedOptions& opts) {
-    *this = Impl{};
-    source = std::move(s);
-    options = opts;
-    const std::uint64_t size = source->size();
-    ByteView view;
-    if (Status st = source->read(0, std::min<std::uint64_t>(size, 8), view); !st.ok()) return st;
-    if (size == 0) return Status::Error(StatusCode::Truncated, "empty file");
-    if (std::memcmp(view.data(), kMagic, view.size()) != 0) {
-      return Status::Error(StatusCode::BadMagic, "not an MCAP file (bad magic)");
+  Status read_header() {
+    if (source->size() == 0) return Status::Error(StatusCode::Truncated, "empty file");
+    // A file shorter than the magic whose bytes match is cut off: the Header read below says so.
+    if (Status st = check_magic(*source, 0); !st.ok() && st.code != StatusCode::Truncated) {
+      if (st.code == StatusCode::BadMagic)
+        return Status::Error(StatusCode::BadMagic, "not an MCAP file (bad magic)");
+      return st;
     }
-    std::uint8_t opcode = 0;
-    if (Status st = read_record_at(*source, 8, opcode, view); !st.ok()) return st;
-    auto parsed = parse_record(opcode, view);
-    if (!parsed.ok() || opcode != static_cast<std::uint8_t>(Opcode::Header)) {
+    RecordView rec;
+    if (Status st = read_record(*source, sizeof kMagic, rec); !st.ok()) return st;
+    auto parsed = parse_record(rec.opcode, rec.content);
+    if (!parsed.ok() || rec.opcode != static_cast<std::uint8_t>(Opcode::Header)) {
       return Status::Error(StatusCode::Malformed, "first record is not a valid Header");
     }
     header = std::get<Header>(std::move(parsed).value());
+    return Status::Ok();
+  }
 
+  Status load(std::unique_ptr<ByteSource> s, const IndexedOptions& opts) {
+    *this = Impl{};
+    source = std::move(s);
+    options = opts;
+    if (Status st = read_header(); !st.ok()) return st;
     // Footer and trailing magic sit at fixed distances from the end (spec: Footer).
-    const std::uint64_t min_size = 8 + kRecordPrefix + kFooterRecord + 8;
-    if (size < min_size) return Status::Error(StatusCode::Truncated, "file too short for a Footer");
-    if (Status st = source->read(size - 8, 8, view); !st.ok()) return st;
-    if (!is_magic(view)) {
-      return Status::Error(StatusCode::Truncated, "no trailing magic: file truncated or never closed");
-    }
-    const std::uint64_t footer_offset = size - 8 - kFooterRecord;
-    if (Status st = read_record_at(*source, footer_offset, opcode, view); !st.ok()) return st;
-    if (opcode != static_cast<std::uint8_t>(Opcode::Footer) || view.size() != kFooterContent) {
-      return Status::Error(StatusCode::Malformed, "no Footer before the trailing magic");
-    }
-    footer = std::get<Footer>(parse_record(opcode, view).value());
+    auto read = read_footer(*source);
+    if (!read.ok()) return read.status();
+    footer = read.value();
+    const std::uint64_t footer_offset = mcap::footer_offset(source->size());
+    ByteView view;
 
     const std::uint64_t summary_end =
         footer.summary_offset_start != 0 ? footer.summary_offset_start : footer_offset;
@@ -175,13 +172,11 @@ struct IndexedReader::Impl {
 
   Status load_chunk(const ChunkIndex& index, const std::function<void(Message&, std::uint64_t)>& on_message) {
     const std::string where = "chunk at offset " + std::to_string(index.chunk_start_offset);
-    std::uint8_t opcode = 0;
-    ByteView content;
-    if (Status s = read_record_at(*source, index.chunk_start_offset, opcode, content); !s.ok()) {
+    RecordView rec;
+    if (Status s = read_record(*source, index.chunk_start_offset, rec); !s.ok())
       return with_context(s, where);
-    }
-    auto record = parse_record(opcode, content);
-    if (!record.ok() || opcode != static_cast<std::uint8_t>(Opcode::Chunk)) {
+    auto record = parse_record(rec.opcode, rec.content);
+    if (!record.ok() || rec.opcode != static_cast<std::uint8_t>(Opcode::Chunk)) {
       return Status::Error(StatusCode::Malformed, "chunk index points at no Chunk (" + where + ")");
     }
     Bytes data;
@@ -189,23 +184,18 @@ struct IndexedReader::Impl {
         !s.ok()) {
       return with_context(s, where);
     }
-    Cursor c(data);
-    while (c.remaining() > 0) {
-      const std::uint64_t offset = c.position();
-      std::uint8_t op = 0;
-      std::uint64_t length = 0;
-      ByteView body;
-      if (!c.u8(op) || !c.u64(length) || !c.view(length, body)) {
-        return Status::Error(StatusCode::Malformed, "record cut off inside " + where);
-      }
-      auto inner = parse_record(op, body);
+    ViewSource chunk_source(data);
+    RecordReader records(chunk_source);
+    while (records.next(rec)) {
+      auto inner = parse_record(rec.opcode, rec.content);
       if (!inner.ok()) return with_context(inner.status(), where);
       if (auto* m = std::get_if<Message>(&inner.value())) {
-        on_message(*m, offset);
+        on_message(*m, rec.offset);
       } else {
         learn(inner.value());
       }
     }
+    if (!records.status().ok()) return Status::Error(StatusCode::Malformed, "record cut off inside " + where);
     return Status::Ok();
   }
 };
@@ -316,27 +306,25 @@ Result<std::vector<Message>> IndexedReader::read_all_messages(const ReadMessages
 
 Result<Attachment> IndexedReader::read_attachment(const AttachmentIndex& index) {
   if (Status s = impl_->check_open(); !s.ok()) return s;
-  std::uint8_t opcode = 0;
-  ByteView content;
-  if (Status s = read_record_at(*impl_->source, index.offset, opcode, content); !s.ok()) return s;
-  auto record = parse_record(opcode, content);
+  RecordView rec;
+  if (Status s = read_record(*impl_->source, index.offset, rec); !s.ok()) return s;
+  auto record = parse_record(rec.opcode, rec.content);
   if (!record.ok()) return record.status();
-  if (opcode != static_cast<std::uint8_t>(Opcode::Attachment)) {
+  if (rec.opcode != static_cast<std::uint8_t>(Opcode::Attachment)) {
     return Status::Error(StatusCode::Malformed, "attachment index points at no Attachment");
   }
   Attachment a = std::get<Attachment>(std::move(record).value());
-  if (Status s = check_attachment_crc(content, a); !s.ok()) return s;
+  if (Status s = check_attachment_crc(rec.content, a); !s.ok()) return s;
   return a;
 }
 
 Result<Metadata> IndexedReader::read_metadata(const MetadataIndex& index) {
   if (Status s = impl_->check_open(); !s.ok()) return s;
-  std::uint8_t opcode = 0;
-  ByteView content;
-  if (Status s = read_record_at(*impl_->source, index.offset, opcode, content); !s.ok()) return s;
-  auto record = parse_record(opcode, content);
+  RecordView rec;
+  if (Status s = read_record(*impl_->source, index.offset, rec); !s.ok()) return s;
+  auto record = parse_record(rec.opcode, rec.content);
   if (!record.ok()) return record.status();
-  if (opcode != static_cast<std::uint8_t>(Opcode::Metadata)) {
+  if (rec.opcode != static_cast<std::uint8_t>(Opcode::Metadata)) {
     return Status::Error(StatusCode::Malformed, "metadata index points at no Metadata");
   }
   return std::get<Metadata>(std::move(record).value());

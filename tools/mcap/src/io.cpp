@@ -9,7 +9,8 @@
 #include <cerrno>
 #include <cstring>
 
-namespace rbsim::mcap::detail {
+namespace rbsim::mcap {
+namespace detail {
 namespace {
 
 Status io_error(const std::string& what, const std::string& path) {
@@ -21,7 +22,7 @@ struct FileCloser {
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
-class FileSource final : public Source {
+class FileSource final : public ByteSource {
  public:
   FileSource(FilePtr file, std::uint64_t size) : file_(std::move(file)), size_(size) {}
   std::uint64_t size() const override { return size_; }
@@ -53,7 +54,7 @@ class FileSource final : public Source {
   Bytes buffer_;
 };
 
-class BufferSource final : public Source {
+class BufferSource final : public ByteSource {
  public:
   explicit BufferSource(Bytes data) : data_(std::move(data)) {}
   std::uint64_t size() const override { return data_.size(); }
@@ -182,20 +183,31 @@ class BufferSink final : public Sink {
 };
 
 }  // namespace
+}  // namespace detail
 
-Result<std::unique_ptr<Source>> open_file_source(const std::string& path) {
-  FilePtr file(std::fopen(path.c_str(), "rb"));
-  if (!file) return io_error("cannot open", path);
-  if (fseeko(file.get(), 0, SEEK_END) != 0) return io_error("cannot seek", path);
+Result<std::unique_ptr<ByteSource>> open_file_source(const std::string& path) {
+  detail::FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) return detail::io_error("cannot open", path);
+  if (fseeko(file.get(), 0, SEEK_END) != 0) return detail::io_error("cannot seek", path);
   const off_t size = ftello(file.get());
-  if (size < 0 || fseeko(file.get(), 0, SEEK_SET) != 0) return io_error("cannot size", path);
-  return std::unique_ptr<Source>(
-      std::make_unique<FileSource>(std::move(file), static_cast<std::uint64_t>(size)));
+  if (size < 0 || fseeko(file.get(), 0, SEEK_SET) != 0) return detail::io_error("cannot size", path);
+  return std::unique_ptr<ByteSource>(
+      std::make_unique<detail::FileSource>(std::move(file), static_cast<std::uint64_t>(size)));
 }
 
-std::unique_ptr<Source> make_buffer_source(Bytes data) {
-  return std::make_unique<BufferSource>(std::move(data));
+std::unique_ptr<ByteSource> make_buffer_source(Bytes data) {
+  return std::make_unique<detail::BufferSource>(std::move(data));
 }
+
+Status ViewSource::read(std::uint64_t offset, std::uint64_t length, ByteView& out) {
+  if (offset > data_.size() || length > data_.size() - offset) {
+    return detail::out_of_range(offset, length, size());
+  }
+  out = data_.subspan(static_cast<std::size_t>(offset), static_cast<std::size_t>(length));
+  return Status::Ok();
+}
+
+namespace detail {
 
 Result<std::unique_ptr<Sink>> open_file_sink(const std::string& path) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);  // as fopen "wb"
@@ -207,4 +219,5 @@ std::unique_ptr<Sink> make_buffer_sink() {
   return std::make_unique<BufferSink>();
 }
 
-}  // namespace rbsim::mcap::detail
+}  // namespace detail
+}  // namespace rbsim::mcap

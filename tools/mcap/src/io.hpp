@@ -1,24 +1,13 @@
-// Random-access byte sources for the readers and byte sinks for the writer.
+// Byte sinks for the writer (the readers' byte sources are public: rbsim/mcap_records.hpp).
 #pragma once
 
 #include <cstdio>
 #include <memory>
 
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_records.hpp"
 
 namespace rbsim::mcap::detail {
-
-class Source {
- public:
-  virtual ~Source() = default;
-  virtual std::uint64_t size() const = 0;
-  // Views `length` bytes at `offset`; the view stays valid until the next read. Fails (never
-  // allocates) when the range lies outside the source.
-  virtual Status read(std::uint64_t offset, std::uint64_t length, ByteView& out) = 0;
-};
-
-Result<std::unique_ptr<Source>> open_file_source(const std::string& path);
-std::unique_ptr<Source> make_buffer_source(Bytes data);
 
 class Sink {
  public:

@@ -2,6 +2,9 @@
 #include <libdeflate.h>
 
 #include <array>
+#include <cstdio>
+
+#include "rbsim/mcap_records.hpp"
 
 #include "wire.hpp"
 
@@ -230,6 +233,13 @@ std::uint8_t opcode_of(const Record& record) {
 std::string_view record_type_name(const Record& record) {
   const std::uint8_t op = opcode_of(record);
   return std::holds_alternative<UnknownRecord>(record) || op >= kNames.size() ? kNames[0] : kNames[op];
+}
+
+std::string opcode_name(std::uint8_t opcode) {
+  if (opcode >= 1 && opcode < kNames.size()) return std::string(kNames[opcode]);
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "opcode 0x%02x", opcode);
+  return buf;
 }
 
 Result<Record> parse_record(std::uint8_t opcode, ByteView content) {

@@ -1,6 +1,7 @@
 #include "stream.hpp"
 
 #include <array>
+#include <cstring>
 
 #include "wire.hpp"
 
@@ -8,35 +9,15 @@ namespace rbsim::mcap {
 namespace detail {
 namespace {
 
-std::uint64_t le64(ByteView v) {
-  std::uint64_t n = 0;
-  for (std::size_t i = 0; i < 8; ++i) n |= std::uint64_t{v[i]} << (8 * i);
-  return n;
-}
-
 std::string at(std::uint64_t offset) {
   return " at offset " + std::to_string(offset);
 }
 
-}  // namespace
-
-Status read_record_at(Source& source, std::uint64_t offset, std::uint8_t& opcode, ByteView& content) {
-  const std::uint64_t size = source.size();
-  if (offset > size || size - offset < kRecordPrefix) {
-    return Status::Error(StatusCode::Truncated, "record header cut off" + at(offset));
-  }
-  ByteView prefix;
-  if (Status s = source.read(offset, kRecordPrefix, prefix); !s.ok()) return s;
-  opcode = prefix[0];
-  const std::uint64_t length = le64(prefix.subspan(1));
-  if (length > size - offset - kRecordPrefix) {
-    return Status::Error(StatusCode::Truncated,
-                         "record (opcode " + std::to_string(opcode) + ")" + at(offset) + " claims " +
-                             std::to_string(length) + " bytes, only " +
-                             std::to_string(size - offset - kRecordPrefix) + " remain");
-  }
-  return source.read(offset + kRecordPrefix, length, content);
+constexpr std::uint8_t op(Opcode o) {
+  return static_cast<std::uint8_t>(o);
 }
+
+}  // namespace
 
 Status check_attachment_crc(ByteView content, const Attachment& a) {
   if (a.crc == 0) return Status::Ok();
@@ -58,7 +39,7 @@ bool Streamer::next(RecordEntry& out) {
   while (state_ != State::Done) {
     if (in_chunk_) {
       if (!chunk_error_.ok()) return fail(std::move(chunk_error_));
-      if (chunk_pos_ < chunk_data_.size()) return next_in_chunk(out);
+      if (!chunk_records_.at_end()) return next_in_chunk(out);
       in_chunk_ = false;
     }
     bool yield = false;
@@ -69,78 +50,110 @@ bool Streamer::next(RecordEntry& out) {
 }
 
 bool Streamer::next_in_chunk(RecordEntry& out) {
-  Cursor c(ByteView(chunk_data_).subspan(chunk_pos_));
-  std::uint8_t opcode = 0;
-  std::uint64_t length = 0;
-  ByteView content;
-  if (!c.u8(opcode) || !c.u64(length) || !c.view(length, content)) {
-    return fail(Status::Error(StatusCode::Malformed, "record cut off at byte " + std::to_string(chunk_pos_) +
+  RecordView rec;
+  if (!chunk_records_.next(rec)) {
+    return fail(Status::Error(StatusCode::Malformed, "record cut off at byte " +
+                                                         std::to_string(chunk_records_.position()) +
                                                          " of the chunk" + at(chunk_offset_)));
   }
-  if (opcode == static_cast<std::uint8_t>(Opcode::Message)) {
+  if (rec.opcode == op(Opcode::Message)) {
     // Into the caller's Message, reusing its buffer: a fresh one per message is fresh pages.
     Message* message = std::get_if<Message>(&out.record);
     if (message == nullptr) message = &out.record.emplace<Message>();
-    if (Status s = parse_message_into(content, *message); !s.ok()) {
+    if (Status s = parse_message_into(rec.content, *message); !s.ok()) {
       return fail(Status::Error(s.code, s.message + " in chunk" + at(chunk_offset_)));
     }
   } else {
-    auto record = parse_record(opcode, content);
+    auto record = parse_record(rec.opcode, rec.content);
     if (!record.ok()) {
       return fail(
           Status::Error(record.status().code, record.status().message + " in chunk" + at(chunk_offset_)));
     }
     out.record = std::move(record).value();
   }
-  out.offset = chunk_pos_;
-  out.length = kRecordPrefix + length;
+  out.offset = rec.offset;
+  out.length = rec.length;
   out.chunk_offset = chunk_offset_;
-  chunk_pos_ += static_cast<std::size_t>(out.length);
   return true;
 }
 
-void Streamer::update_crcs(std::uint8_t opcode, ByteView prefix, ByteView content) {
+void Streamer::update_crcs(const RecordView& record) {
   if (!options_.verify_crcs) return;
   if (!seen_data_end_) {
-    data_crc_ = crc32(content, crc32(prefix, data_crc_));
-  } else if (opcode != static_cast<std::uint8_t>(Opcode::Footer)) {
-    summary_crc_ = crc32(content, crc32(prefix, summary_crc_));
+    data_crc_ = crc32(record.content, crc32(record.prefix_bytes(), data_crc_));
+  } else if (record.opcode != op(Opcode::Footer)) {
+    summary_crc_ = crc32(record.content, crc32(record.prefix_bytes(), summary_crc_));
   }
 }
 
-bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
-  const std::uint64_t size = source_.size();
-  ByteView view;
-  if (state_ == State::Start) {
-    const std::uint64_t n = std::min<std::uint64_t>(size, 8);
-    if (Status s = source_.read(0, n, view); !s.ok()) return fail(s);
-    if (n == 0) return fail(Status::Error(StatusCode::Truncated, "empty file"));
-    if (std::memcmp(view.data(), kMagic, view.size()) != 0) {
+// The leading magic; the records follow it.
+bool Streamer::start() {
+  if (source_.size() == 0) return fail(Status::Error(StatusCode::Truncated, "empty file"));
+  if (Status s = check_magic(source_, 0); !s.ok()) {
+    if (s.code == StatusCode::BadMagic) {
       return fail(Status::Error(StatusCode::BadMagic, "not an MCAP file (bad magic)"));
     }
-    if (n < 8) return fail(Status::Error(StatusCode::Truncated, "file ends inside the magic"));
-    if (options_.verify_crcs) data_crc_ = crc32(view);
-    position_ = 8;
-    state_ = State::Records;
+    if (s.code == StatusCode::Truncated) {
+      return fail(Status::Error(StatusCode::Truncated, "file ends inside the magic"));
+    }
+    return fail(s);
   }
-  if (position_ == size) return fail(Status::Error(StatusCode::Truncated, "file ends without a Footer"));
-  std::uint8_t opcode = 0;
-  ByteView content;
-  if (Status s = read_record_at(source_, position_, opcode, content); !s.ok()) return fail(s);
-  const std::uint64_t length = content.size();
-  std::array<std::uint8_t, kRecordPrefix> prefix{opcode};
-  for (std::size_t i = 0; i < 8; ++i) prefix[1 + i] = static_cast<std::uint8_t>(length >> (8 * i));
-  if (first_record_ && opcode != static_cast<std::uint8_t>(Opcode::Header)) {
+  if (options_.verify_crcs) data_crc_ = crc32(ByteView(kMagic, sizeof kMagic));
+  position_ = sizeof kMagic;
+  records_.reset(position_);
+  state_ = State::Records;
+  return true;
+}
+
+// The summary CRC, then the trailing magic and nothing after it.
+bool Streamer::check_footer(const RecordView& footer_record, const Footer& footer) {
+  // Spec: "The last record in the data section MUST be the Data End record".
+  if (!seen_data_end_) return fail(Status::Error(StatusCode::Malformed, "Footer without a DataEnd record"));
+  // The summary CRC runs from the end of DataEnd through Footer.summary_offset_start.
+  const std::uint32_t stored = footer.summary_crc;
+  const std::uint32_t computed =
+      crc32(footer_record.content.subspan(0, 16), crc32(footer_record.prefix_bytes(), summary_crc_));
+  if (options_.verify_crcs && stored != 0 && stored != computed) {
+    return fail(Status::Error(
+        StatusCode::CrcMismatch,
+        "summary CRC mismatch: computed " + std::to_string(computed) + ", stored " + std::to_string(stored)));
+  }
+  const std::uint64_t size = source_.size();
+  if (size - position_ < sizeof kMagic) {
+    return fail(Status::Error(StatusCode::Truncated, "file ends inside the trailing magic"));
+  }
+  if (Status s = check_magic(source_, position_); !s.ok()) {
+    if (s.code != StatusCode::BadMagic) return fail(s);
+    return fail(Status::Error(StatusCode::BadMagic, "bad trailing magic" + at(position_)));
+  }
+  if (size - position_ > sizeof kMagic) {
+    return fail(Status::Error(StatusCode::Malformed, "unexpected bytes after the trailing magic"));
+  }
+  position_ = size;
+  state_ = State::Done;
+  return true;
+}
+
+bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
+  if (state_ == State::Start && !start()) return false;
+  RecordView rec;
+  if (!records_.next(rec)) {
+    if (!records_.status().ok()) return fail(records_.status());
+    return fail(Status::Error(StatusCode::Truncated, "file ends without a Footer"));
+  }
+  const std::uint8_t opcode = rec.opcode;
+  const ByteView content = rec.content;
+  if (first_record_ && opcode != op(Opcode::Header)) {
     return fail(Status::Error(StatusCode::Malformed, "first record is not a Header" + at(position_)));
   }
   first_record_ = false;
-  const bool is_data_end = opcode == static_cast<std::uint8_t>(Opcode::DataEnd);
+  const bool is_data_end = opcode == op(Opcode::DataEnd);
   const std::uint32_t data_crc = data_crc_;
-  if (!is_data_end) update_crcs(opcode, prefix, content);
+  if (!is_data_end) update_crcs(rec);
 
   // A Chunk that is only descended into is decompressed straight from the file buffer.
-  const bool chunk_view = opcode == static_cast<std::uint8_t>(Opcode::Chunk) &&
-                          options_.descend_into_chunks && !options_.report_chunks;
+  const bool chunk_view =
+      opcode == op(Opcode::Chunk) && options_.descend_into_chunks && !options_.report_chunks;
   ByteView chunk_records;
   Result<Record> parsed = Record{};
   if (chunk_view) {
@@ -156,9 +169,9 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
   Record& record = parsed.value();
   const std::uint64_t record_offset = position_;
   out.offset = record_offset;
-  out.length = kRecordPrefix + length;
+  out.length = rec.length;
   out.chunk_offset.reset();
-  position_ += out.length;
+  position_ = records_.position();
   yield = true;
 
   switch (static_cast<Opcode>(opcode)) {
@@ -178,7 +191,8 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
         chunk_error_ = decompressor_.decompress(chunk, chunk_view ? chunk_records : ByteView(chunk.records),
                                                 chunk_data_, options_.verify_crcs);
         if (!chunk_error_.ok()) chunk_error_.message += " (chunk" + at(record_offset) + ")";
-        chunk_pos_ = 0;
+        chunk_source_.reset(chunk_data_);
+        chunk_records_.reset(0);
         chunk_offset_ = record_offset;
         in_chunk_ = true;
       }
@@ -192,33 +206,9 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
         if (Status s = check_attachment_crc(content, std::get<Attachment>(record)); !s.ok()) return fail(s);
       }
       break;
-    case Opcode::Footer: {
-      // Spec: "The last record in the data section MUST be the Data End record".
-      if (!seen_data_end_) {
-        return fail(Status::Error(StatusCode::Malformed, "Footer without a DataEnd record"));
-      }
-      // The summary CRC runs from the end of DataEnd through Footer.summary_offset_start.
-      const std::uint32_t stored = std::get<Footer>(record).summary_crc;
-      const std::uint32_t computed = crc32(content.subspan(0, 16), crc32(prefix, summary_crc_));
-      if (options_.verify_crcs && stored != 0 && stored != computed) {
-        return fail(Status::Error(StatusCode::CrcMismatch, "summary CRC mismatch: computed " +
-                                                               std::to_string(computed) + ", stored " +
-                                                               std::to_string(stored)));
-      }
-      if (size - position_ < 8) {
-        return fail(Status::Error(StatusCode::Truncated, "file ends inside the trailing magic"));
-      }
-      if (Status s = source_.read(position_, 8, view); !s.ok()) return fail(s);
-      if (!is_magic(view)) {
-        return fail(Status::Error(StatusCode::BadMagic, "bad trailing magic" + at(position_)));
-      }
-      if (size - position_ > 8) {
-        return fail(Status::Error(StatusCode::Malformed, "unexpected bytes after the trailing magic"));
-      }
-      position_ = size;
-      state_ = State::Done;
+    case Opcode::Footer:
+      if (!check_footer(rec, std::get<Footer>(record))) return false;
       break;
-    }
     default:
       break;
   }
@@ -229,11 +219,11 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
 }  // namespace detail
 
 struct StreamReader::Impl {
-  std::unique_ptr<detail::Source> source;
+  std::unique_ptr<ByteSource> source;
   std::unique_ptr<detail::Streamer> streamer;
   Status not_open = Status::Error(StatusCode::NotOpen, "stream reader is not open");
 
-  Status start(std::unique_ptr<detail::Source> s, const StreamOptions& options) {
+  Status start(std::unique_ptr<ByteSource> s, const StreamOptions& options) {
     source = std::move(s);
     streamer = std::make_unique<detail::Streamer>(*source, options);
     return Status::Ok();
@@ -244,13 +234,13 @@ StreamReader::StreamReader() : impl_(std::make_unique<Impl>()) {}
 StreamReader::~StreamReader() = default;
 
 Status StreamReader::open(const std::string& path, const StreamOptions& options) {
-  auto source = detail::open_file_source(path);
+  auto source = open_file_source(path);
   if (!source.ok()) return source.status();
   return impl_->start(std::move(source).value(), options);
 }
 
 Status StreamReader::open_buffer(Bytes data, const StreamOptions& options) {
-  return impl_->start(detail::make_buffer_source(std::move(data)), options);
+  return impl_->start(make_buffer_source(std::move(data)), options);
 }
 
 bool StreamReader::next(RecordEntry& out) {

@@ -3,17 +3,17 @@
 
 #include "codec.hpp"
 #include "io.hpp"
+#include "rbsim/mcap_records.hpp"
 
 namespace rbsim::mcap::detail {
 
-// Reads <opcode><length><content> at `offset`, bounding `length` by the bytes left in the source.
-Status read_record_at(Source& source, std::uint64_t offset, std::uint8_t& opcode, ByteView& content);
 // Checks Attachment.crc (when non-zero) against the content bytes it covers.
 Status check_attachment_crc(ByteView content, const Attachment& attachment);
 
 class Streamer {
  public:
-  Streamer(Source& source, const StreamOptions& options) : source_(source), options_(options) {}
+  Streamer(ByteSource& source, const StreamOptions& options)
+      : source_(source), options_(options), records_(source), chunk_records_(chunk_source_) {}
 
   bool next(RecordEntry& out);
   const Status& status() const { return status_; }
@@ -25,12 +25,15 @@ class Streamer {
   bool fail(Status status);
   bool next_in_chunk(RecordEntry& out);
   bool read_top_level(RecordEntry& out, bool& yield);
-  void update_crcs(std::uint8_t opcode, ByteView prefix, ByteView content);
+  bool start();
+  bool check_footer(const RecordView& footer_record, const Footer& footer);
+  void update_crcs(const RecordView& record);
 
-  Source& source_;
+  ByteSource& source_;
   StreamOptions options_;
   Status status_;
   State state_ = State::Start;
+  RecordReader records_;  // the top-level records, after the leading magic
   std::uint64_t position_ = 0;
   bool first_record_ = true;
   bool seen_data_end_ = false;
@@ -41,7 +44,8 @@ class Streamer {
   Status chunk_error_;  // decompression failure, reported after the Chunk record itself
   Bytes chunk_data_;
   Decompressor decompressor_;
-  std::size_t chunk_pos_ = 0;
+  ViewSource chunk_source_;     // views chunk_data_
+  RecordReader chunk_records_;  // the records of the chunk being reported
   std::uint64_t chunk_offset_ = 0;
 };
 

@@ -175,10 +175,6 @@ inline constexpr std::size_t kRecordPrefix = 9;  // opcode u8 + content length u
 inline constexpr std::size_t kFooterContent = 20;
 inline constexpr std::size_t kFooterRecord = kRecordPrefix + kFooterContent;
 
-inline bool is_magic(ByteView v) {
-  return v.size() >= 8 && std::memcmp(v.data(), kMagic, 8) == 0;
-}
-
 // parse_record for a Chunk without copying its records: `chunk` gets every other field, `records`
 // views them in `content`. The same checks and error as parse_record.
 Status parse_chunk_view(ByteView content, Chunk& chunk, ByteView& records);

@@ -1,0 +1,120 @@
+// Record framing (spec: Records): the one place that reads opcodes, length prefixes and magic.
+#include <cstring>
+
+#include "rbsim/mcap_records.hpp"
+#include "wire.hpp"
+
+namespace rbsim::mcap {
+namespace {
+
+std::string at(std::uint64_t offset) {
+  return " at offset " + std::to_string(offset);
+}
+
+}  // namespace
+
+Status check_magic(ByteSource& source, std::uint64_t offset) {
+  const std::uint64_t size = source.size();
+  const std::uint64_t n = offset > size ? 0 : std::min<std::uint64_t>(size - offset, sizeof kMagic);
+  ByteView view;
+  if (n > 0) {
+    if (Status s = source.read(offset, n, view); !s.ok()) return s;
+    if (std::memcmp(view.data(), kMagic, view.size()) != 0) {
+      return Status::Error(StatusCode::BadMagic, "bad magic" + at(offset));
+    }
+  }
+  if (n < sizeof kMagic)
+    return Status::Error(StatusCode::Truncated, "file ends inside the magic" + at(offset));
+  return Status::Ok();
+}
+
+void RecordReader::reset(std::uint64_t begin, std::uint64_t end) {
+  const std::uint64_t size = source_->size();
+  end_ = std::min(end, size);
+  position_ = begin;
+  problem_ = RecordProblem{};
+}
+
+void RecordReader::seek(std::uint64_t offset) {
+  position_ = offset;
+  problem_ = RecordProblem{};
+}
+
+bool RecordReader::fail(RecordProblem problem) {
+  problem_ = std::move(problem);
+  if (on_problem_) on_problem_(problem_);
+  return false;
+}
+
+bool RecordReader::next(RecordView& out) {
+  if (!problem_.status.ok() || position_ >= end_) return false;
+  const std::uint64_t offset = position_;
+  const std::uint64_t available = end_ - offset;
+  RecordProblem problem{offset, available, std::nullopt, std::nullopt, Status::Ok()};
+  ByteView prefix;
+  if (available < kPrefixSize) {
+    if (Status s = source_->read(offset, available, prefix); !s.ok())
+      return fail({offset, available, {}, {}, s});
+    problem.opcode = prefix[0];
+    problem.status = Status::Error(StatusCode::Truncated, "record header cut off" + at(offset));
+    return fail(std::move(problem));
+  }
+  if (Status s = source_->read(offset, kPrefixSize, prefix); !s.ok())
+    return fail({offset, available, {}, {}, s});
+  std::memcpy(out.prefix, prefix.data(), kPrefixSize);
+  const std::uint8_t opcode = prefix[0];
+  std::uint64_t length = 0;
+  for (std::size_t i = 0; i < 8; ++i) length |= std::uint64_t{prefix[1 + i]} << (8 * i);
+  problem.opcode = opcode;
+  problem.content_length = length;
+  if (length > available - kPrefixSize) {
+    problem.status =
+        Status::Error(StatusCode::Truncated, "record (opcode " + std::to_string(opcode) + ")" + at(offset) +
+                                                 " claims " + std::to_string(length) + " bytes, only " +
+                                                 std::to_string(available - kPrefixSize) + " remain");
+    return fail(std::move(problem));
+  }
+  if (Status s = source_->read(offset + kPrefixSize, length, out.content); !s.ok()) {
+    problem.status = std::move(s);
+    return fail(std::move(problem));
+  }
+  out.opcode = opcode;
+  out.offset = offset;
+  out.length = kPrefixSize + length;
+  position_ = offset + out.length;
+  return true;
+}
+
+Status read_record(ByteSource& source, std::uint64_t offset, RecordView& out) {
+  RecordReader reader(source, offset);
+  if (reader.next(out)) return Status::Ok();
+  if (!reader.status().ok()) return reader.status();
+  // An offset at (or past) the end: no bytes of a header at all.
+  return Status::Error(StatusCode::Truncated, "record header cut off" + at(offset));
+}
+
+std::uint64_t footer_offset(std::uint64_t size) {
+  return size - sizeof kMagic - detail::kFooterRecord;
+}
+
+Result<Footer> read_footer(ByteSource& source) {
+  const std::uint64_t size = source.size();
+  const std::uint64_t min_size =
+      sizeof kMagic + detail::kRecordPrefix + detail::kFooterRecord + sizeof kMagic;
+  if (size < min_size) return Status::Error(StatusCode::Truncated, "file too short for a Footer");
+  if (Status s = check_magic(source, size - sizeof kMagic); !s.ok()) {
+    if (s.code == StatusCode::IoError) return s;
+    return Status::Error(StatusCode::Truncated, "no trailing magic: file truncated or never closed");
+  }
+  RecordView record;
+  if (Status s = read_record(source, footer_offset(size), record); !s.ok()) return s;
+  if (record.opcode != static_cast<std::uint8_t>(Opcode::Footer) ||
+      record.content.size() != detail::kFooterContent) {
+    return Status::Error(StatusCode::Malformed, "no Footer before the trailing magic");
+  }
+  auto parsed = parse_record(record.opcode, record.content);
+  if (!parsed.ok()) return parsed.status();
+  return std::get<Footer>(std::move(parsed).value());
+}
+
+}  // namespace rbsim::mcap
