@@ -140,76 +140,70 @@ void StepValues::each(const std::vector<double>& got, const char* path, const st
   for (std::size_t i = 0; i < got.size(); ++i) near(got[i], want[i], path, i);
 }
 
-void verify_energy_terms(const StageContext& c, const RecordedRun& run,
-                         const std::vector<msgs::EnergyTermsMessage>& energy) {
+namespace {
+// The loop every recomputing stage shares: `compare(at, m)` for each recorded step m of `run`,
+// within the recompute tolerance, then one report line: `what`, the tolerance and the tally.
+template <class Compare>
+void verify_each_step(const StageContext& c, const RecordedRun& run, const std::string& what,
+                      Compare compare) {
   const double rtol = c.options.recompute_rtol;
   Tally tally;
   for (std::size_t m = 0; m < run.states.size(); ++m) {
     StepValues at(tally, rtol, run.steps[m]);
-    compare_energy(at, energy[m], run.terms[m], c.model.gravity.size());
+    compare(at, m);
   }
-  c.report.line(tally.ok(),
-                "energy terms: P, L_point, L_spin, T_point, T_spin per body, U per force and the totals of " +
-                    std::to_string(run.states.size()) + " steps recomputed from the recorded states" +
-                    tolerance_text(rtol) + ": " + tally.summary());
+  c.report.line(tally.ok(), what + tolerance_text(rtol) + ": " + tally.summary());
+}
+}  // namespace
+
+void verify_energy_terms(const StageContext& c, const RecordedRun& run,
+                         const std::vector<msgs::EnergyTermsMessage>& energy) {
+  verify_each_step(
+      c, run,
+      "energy terms: P, L_point, L_spin, T_point, T_spin per body, U per force and the totals of " +
+          std::to_string(run.states.size()) + " steps recomputed from the recorded states",
+      [&](StepValues& at, std::size_t m) {
+        compare_energy(at, energy[m], run.terms[m], c.model.gravity.size());
+      });
 }
 
 void verify_spring_states(const StageContext& c, const RecordedRun& run,
                           const std::vector<msgs::SpringStatesMessage>& springs) {
-  const double rtol = c.options.recompute_rtol;
-  Tally tally;
-  for (std::size_t m = 0; m < run.states.size(); ++m) {
-    StepValues at(tally, rtol, run.steps[m]);
-    compare_springs(at, springs[m], run.terms[m], c.model.springs);
-  }
-  c.report.line(tally.ok(),
-                "spring states: endpoints, lengths and potentials recomputed from the recorded poses" +
-                    tolerance_text(rtol) + ": " + tally.summary());
+  verify_each_step(
+      c, run, "spring states: endpoints, lengths and potentials recomputed from the recorded poses",
+      [&](StepValues& at, std::size_t m) { compare_springs(at, springs[m], run.terms[m], c.model.springs); });
 }
 
 void verify_poses(const StageContext& c, const RecordedRun& run,
                   const std::vector<msgs::PosesMessage>& poses) {
-  const double rtol = c.options.recompute_rtol;
-  Tally tally;
   using Pose = msgs::PosesMessage::Pose;
-  for (std::size_t m = 0; m < run.states.size(); ++m) {
-    StepValues at(tally, rtol, run.steps[m]);
-    const State& s = run.states[m];
-    const auto& ps = poses[m].poses;
-    std::vector<double> qz, qw;
-    quaternions(s, qz, qw);
-    at.each(field(ps, [](const Pose& p) { return p.x; }), "poses[].position.x", s.x);
-    at.each(field(ps, [](const Pose& p) { return p.y; }), "poses[].position.y", s.y);
-    at.each(field(ps, [](const Pose& p) { return p.qz; }), "poses[].orientation.z", qz);
-    at.each(field(ps, [](const Pose& p) { return p.qw; }), "poses[].orientation.w", qw);
-  }
-  c.report.line(tally.ok(), "poses: positions and orientation quaternions" + tolerance_text(rtol) + ": " +
-                                tally.summary());
+  verify_each_step(c, run, "poses: positions and orientation quaternions",
+                   [&](StepValues& at, std::size_t m) {
+                     const State& s = run.states[m];
+                     const auto& ps = poses[m].poses;
+                     std::vector<double> qz, qw;
+                     quaternions(s, qz, qw);
+                     at.each(field(ps, [](const Pose& p) { return p.x; }), "poses[].position.x", s.x);
+                     at.each(field(ps, [](const Pose& p) { return p.y; }), "poses[].position.y", s.y);
+                     at.each(field(ps, [](const Pose& p) { return p.qz; }), "poses[].orientation.z", qz);
+                     at.each(field(ps, [](const Pose& p) { return p.qw; }), "poses[].orientation.w", qw);
+                   });
 }
 
 void verify_tf(const StageContext& c, const RecordedRun& run, const TopicMessages<msgs::TfMessage>& tf,
                const TopicMessages<msgs::BodyStatesMessage>& states) {
-  const double rtol = c.options.recompute_rtol;
   const std::string frame_prefix = body_frame_prefix(states.topic);
-  Tally tally;
-  for (std::size_t m = 0; m < run.states.size(); ++m) {
-    StepValues at(tally, rtol, run.steps[m]);
-    compare_transforms(at, tf.messages[m], run.states[m], states.messages[m], frame_prefix);
-  }
-  c.report.line(tally.ok(), "tf: world -> body frame transforms equal to the recorded body states" +
-                                tolerance_text(rtol) + ": " + tally.summary());
+  verify_each_step(c, run, "tf: world -> body frame transforms equal to the recorded body states",
+                   [&](StepValues& at, std::size_t m) {
+                     compare_transforms(at, tf.messages[m], run.states[m], states.messages[m], frame_prefix);
+                   });
 }
 
 void verify_springs_marker(const StageContext& c, const RecordedRun& run,
                            const std::vector<msgs::MarkerMessage>& marker, const msgs::SceneMessage& desc) {
-  const double rtol = c.options.recompute_rtol;
-  Tally tally;
-  for (std::size_t m = 0; m < run.states.size(); ++m) {
-    StepValues at(tally, rtol, run.steps[m]);
-    compare_springs_marker(at, marker[m], run.terms[m], desc);
-  }
-  c.report.line(tally.ok(), "springs marker: line ends recomputed from the recorded states, scene colours" +
-                                tolerance_text(rtol) + ": " + tally.summary());
+  verify_each_step(
+      c, run, "springs marker: line ends recomputed from the recorded states, scene colours",
+      [&](StepValues& at, std::size_t m) { compare_springs_marker(at, marker[m], run.terms[m], desc); });
 }
 
 }  // namespace rbsim::check
