@@ -5,13 +5,8 @@
 #include "wire.hpp"
 
 namespace rbsim::mcap {
-namespace {
 
-std::string at(std::uint64_t offset) {
-  return " at offset " + std::to_string(offset);
-}
-
-}  // namespace
+using detail::at;
 
 Status check_magic(ByteSource& source, std::uint64_t offset) {
   const std::uint64_t size = source.size();
@@ -64,7 +59,7 @@ bool RecordReader::next(RecordView& out) {
   std::memcpy(out.prefix, prefix.data(), kPrefixSize);
   const std::uint8_t opcode = prefix[0];
   std::uint64_t length = 0;
-  for (std::size_t i = 0; i < 8; ++i) length |= std::uint64_t{prefix[1 + i]} << (8 * i);
+  detail::Cursor(prefix.subspan(1)).u64(length);  // the prefix holds all 8 bytes: cannot fail
   problem.opcode = opcode;
   problem.content_length = length;
   if (length > available - kPrefixSize) {

@@ -9,10 +9,6 @@ namespace rbsim::mcap {
 namespace detail {
 namespace {
 
-std::string at(std::uint64_t offset) {
-  return " at offset " + std::to_string(offset);
-}
-
 constexpr std::uint8_t op(Opcode o) {
   return static_cast<std::uint8_t>(o);
 }

@@ -5,8 +5,14 @@
 #include <limits>
 
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_records.hpp"
 
 namespace rbsim::mcap::detail {
+
+// " at offset N", the place of every read error.
+inline std::string at(std::uint64_t offset) {
+  return " at offset " + std::to_string(offset);
+}
 
 // Bounds-checked reader over one record's content. Every length prefix is checked against the
 // bytes that remain, so a corrupt length can neither overrun nor cause a large allocation.
@@ -171,7 +177,7 @@ inline void put_id_map(Bytes& out, const std::map<std::uint16_t, std::uint64_t>&
   }
 }
 
-inline constexpr std::size_t kRecordPrefix = 9;  // opcode u8 + content length u64
+inline constexpr std::size_t kRecordPrefix = RecordReader::kPrefixSize;
 inline constexpr std::size_t kFooterContent = 20;
 inline constexpr std::size_t kFooterRecord = kRecordPrefix + kFooterContent;
 
