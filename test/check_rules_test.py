@@ -50,20 +50,30 @@ class Tree:
         return p.returncode, p.stdout + p.stderr
 
 
-class CheckModulesTest(unittest.TestCase):
+class CheckerTest(unittest.TestCase):
+    """A fresh tree per test, checked by the subclass's SCRIPT."""
+    SCRIPT = None
+
     def setUp(self):
         self.tree = Tree()
         self.addCleanup(self.tree.tmp.cleanup)
 
     def assertFails(self, message):
-        rc, out = self.tree.run("check_modules.py")
+        rc, out = self.tree.run(self.SCRIPT)
         self.assertEqual(rc, 1, out)
         self.assertIn(message, out)
 
-    def test_clean_tree_passes(self):
-        rc, out = self.tree.run("check_modules.py")
+    def assertPasses(self):
+        rc, out = self.tree.run(self.SCRIPT)
         self.assertEqual(rc, 0, out)
         self.assertIn("0 problems", out)
+
+
+class CheckModulesTest(CheckerTest):
+    SCRIPT = "check_modules.py"
+
+    def test_clean_tree_passes(self):
+        self.assertPasses()
 
     def test_include_of_a_module_not_allowed_fails(self):
         self.tree.write("sim_core/src/bad.cpp", '#include "rbsim/recording.hpp"\n')
@@ -97,20 +107,11 @@ class CheckModulesTest(unittest.TestCase):
         self.assertFails("mcap-reader tools/check/src/compare.cpp no longer breaks the rule: its entry can be removed")
 
 
-class CheckSizesTest(unittest.TestCase):
-    def setUp(self):
-        self.tree = Tree()
-        self.addCleanup(self.tree.tmp.cleanup)
-
-    def assertFails(self, message):
-        rc, out = self.tree.run("check_sizes.py")
-        self.assertEqual(rc, 1, out)
-        self.assertIn(message, out)
+class CheckSizesTest(CheckerTest):
+    SCRIPT = "check_sizes.py"
 
     def test_clean_tree_passes(self):  # replay.cpp's play is 150 lines: at the limit
-        rc, out = self.tree.run("check_sizes.py")
-        self.assertEqual(rc, 0, out)
-        self.assertIn("0 problems", out)
+        self.assertPasses()
 
     def test_file_over_700_lines_fails(self):
         self.tree.write("tools/log/src/big.py", "x = 1\n" * 700)
