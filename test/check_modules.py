@@ -27,7 +27,7 @@ MODULES = {
     "io": ("tools/io", {"core", "scene"}),
     "msgs": ("tools/msgs", {"core", "scene"}),
     "mcap": ("tools/mcap", set()),
-    "mcap_tools": ("tools/mcap_tools", {"mcap", "core"}),
+    "mcap_tools": ("tools/mcap_tools", {"mcap"}),
     "log": ("tools/log", {"io", "msgs", "mcap", "mcap_tools", "core", "scene"}),
     "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),

@@ -46,11 +46,11 @@
 #include "rbsim/builders.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/core.hpp"
-#include "rbsim/io.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/msgs.hpp"
-#include "rbsim/record.hpp"
 #include "rbsim/scene.hpp"
+#include "rbsim/sink.hpp"
 
 namespace {
 

@@ -33,7 +33,7 @@
 #include <vector>
 
 #include "rbsim/mcap.hpp"
-#include "rbsim/record.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/scene.hpp"
 

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "rbsim/record.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/recorder.hpp"
 
 namespace rbsim::node {

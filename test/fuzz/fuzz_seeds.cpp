@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/msgs.hpp"
-#include "rbsim/record.hpp"
 #include "rbsim/scene.hpp"
 
 namespace {

@@ -14,7 +14,7 @@
 
 #include "rbsim/check.hpp"
 #include "rbsim/golden.hpp"
-#include "rbsim/record.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/subprocess.hpp"
 
 namespace {

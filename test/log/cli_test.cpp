@@ -466,6 +466,34 @@ TEST(LogCli, RecoverTruncatedRecording) {
   EXPECT_NE(info.out.find("messages:    " + std::to_string(kept)), std::string::npos) << info.out;
 }
 
+// `run --record` writes RUN.mcap.tmp.PID and renames it at the end: a finished run leaves only
+// RUN.mcap; a killed one leaves no RUN.mcap, only its temporary, which recover saves.
+TEST(RecordCli, KilledRunLeavesItsTemporaryForRecover) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/chain.xml");
+  Outcome done = rbsim({"run", scene, "--steps", "10", "--record", (dir / "done.mcap").string()});
+  ASSERT_EQ(done.exit_code, 0) << describe(done);
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir.path())) names.push_back(e.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"done.mcap"});
+
+  // Killed (SIGKILL, by the time limit) long before its 50 million steps are done.
+  Outcome killed = rbsim({"run", scene, "--steps", "50000000", "--record", (dir / "run.mcap").string()},
+                         std::chrono::milliseconds(3000));
+  ASSERT_TRUE(killed.timed_out) << describe(killed);
+  EXPECT_FALSE(fs::exists(dir / "run.mcap"));
+  std::vector<fs::path> temps;
+  for (const auto& e : fs::directory_iterator(dir.path())) {
+    if (e.path().filename().string().rfind("run.mcap.tmp.", 0) == 0) temps.push_back(e.path());
+  }
+  ASSERT_EQ(temps.size(), 1u);
+  Outcome o = rbsim({"log", "recover", temps[0].string(), (dir / "run.mcap").string()});
+  EXPECT_EQ(o.exit_code, 0) << describe(o);
+  EXPECT_NE(o.err.find("truncated"), std::string::npos) << o.err;
+  Outcome doctor = rbsim({"log", "doctor", (dir / "run.mcap").string()});
+  EXPECT_EQ(doctor.exit_code, 0) << describe(doctor);
+}
+
 // A file cut inside its first chunk holds no complete message: recover says so, exits 1 and
 // writes nothing (an empty recording would only pass the damage on).
 TEST(LogCli, RecoverWritesNothingWhenNoMessageIsComplete) {

@@ -10,8 +10,8 @@
 #include "rbsim/check.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/mcap_tools.hpp"
-#include "rbsim/record.hpp"
 
 namespace rbsim::test {
 

@@ -8,7 +8,8 @@
 
 #include <unistd.h>
 
-#include "rbsim/io.hpp"
+#include "rbsim/fosssim.hpp"
+#include "rbsim/sink.hpp"
 
 namespace fs = std::filesystem;
 

@@ -19,11 +19,6 @@ struct BridgeArgs {
   bool quiet = false;
 };
 
-int fail(const std::string& m) {
-  std::fprintf(stderr, "rbsim bridge: error: %s\n", m.c_str());
-  return 1;
-}
-
 // The simulated time a sample carries (ns): the scene description's stamp, a per-step message's
 // header stamp or clock; nullopt when it has none.
 std::optional<std::uint64_t> sim_time(const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
@@ -39,16 +34,16 @@ std::optional<std::uint64_t> sim_time(const msgs::TopicSpec& spec, std::span<con
 
 int bridge_command(const BridgeArgs& a) {
   auto participant = node::Participant::create(a.domain);
-  if (!participant) return fail(participant.error().message);
+  if (!participant) return fail("bridge", participant.error().message);
   std::vector<foxglove::ChannelId> ids;
   msgs::TopicSet all;
   all.set();  // every topic a node may publish: the viewer chooses what to subscribe to
   auto channels = foxglove::ros2_channels(all, a.ns, &ids);
-  if (!channels) return fail(channels.error().message);
+  if (!channels) return fail("bridge", channels.error().message);
   auto relay = node::Relay::create(participant.value(), a.ns);
-  if (!relay) return fail(relay.error().message);
+  if (!relay) return fail("bridge", relay.error().message);
   auto started = start_foxglove("rbsim bridge", *a.foxglove, std::move(channels.value()));
-  if (!started) return fail(started.error().message);
+  if (!started) return fail("bridge", started.error().message);
   foxglove::Server& server = *started.value();
   install_stop_handlers();
   if (!a.quiet) {
@@ -71,7 +66,7 @@ int bridge_command(const BridgeArgs& a) {
   };
   while (!stop_requested()) {
     auto polled = relay.value()->poll(100'000'000, on_sample);
-    if (!polled) return fail(polled.error().message);
+    if (!polled) return fail("bridge", polled.error().message);
   }
   if (!a.quiet) {
     std::fprintf(

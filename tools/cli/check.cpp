@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/golden.hpp"
@@ -24,18 +25,13 @@ struct CheckArgs {
 
 constexpr int kMatch = 0, kDiverged = 1, kError = 2;
 
-int fail(const std::string& message) {
-  std::fprintf(stderr, "rbsim check: error: %s\n", message.c_str());
-  return kError;
-}
-
 int compare(const CheckArgs& a) {
   const std::string& run = a.files[0];
   const std::string& golden = a.files[1];
   const auto start = std::chrono::steady_clock::now();
   Result<check::CheckReport> result = check::check_logs(run, golden, a.options);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!result) return fail(result.error().message);
+  if (!result) return fail("check", result.error().message, kError);
   check::ReportFormat format;
   format.all_fields = a.all_fields;
   format.wall_seconds = wall;
@@ -49,7 +45,7 @@ int verify(const CheckArgs& a) {
   check::GoldenVerifyOptions o;
   o.fosssim_dir = a.fosssim_dir;
   Result<check::GoldenVerification> result = check::verify_golden(scene, golden, o);
-  if (!result) return fail(result.error().message);
+  if (!result) return fail("check", result.error().message, kError);
   const check::GoldenVerification& v = result.value();
   std::printf("rbsim check --verify-golden %s %s: rule %s\n", scene.c_str(), golden.c_str(),
               v.rule.empty() ? "(none applies)" : v.rule.c_str());
@@ -60,19 +56,22 @@ int verify(const CheckArgs& a) {
 
 int golden_every(const CheckArgs& a) {
   Result<Scene> scene = load_scene(a.golden_every);
-  if (!scene) return fail(scene.error().message);
+  if (!scene) return fail("check", scene.error().message, kError);
   std::printf("%lld\n", static_cast<long long>(check::golden_record_every(scene->step_count())));
   return kMatch;
 }
 
 int check_command(const CheckArgs& a) {
   if (!a.golden_every.empty()) {
-    if (!a.files.empty() || a.verify_golden) return fail("--golden-every takes no other arguments");
+    if (!a.files.empty() || a.verify_golden)
+      return fail("check", "--golden-every takes no other arguments", kError);
     return golden_every(a);
   }
   if (a.files.size() != 2) {
-    return fail(a.verify_golden ? "--verify-golden needs SCENE and GOLDEN"
-                                : "expected two files: RUN.mcap GOLDEN.mcap");
+    return fail("check",
+                a.verify_golden ? "--verify-golden needs SCENE and GOLDEN"
+                                : "expected two files: RUN.mcap GOLDEN.mcap",
+                kError);
   }
   return a.verify_golden ? verify(a) : compare(a);
 }

@@ -92,4 +92,9 @@ Result<mcap::Compression> compression_option(const std::string& name, int level)
   return codec;
 }
 
+int fail(const char* command, const std::string& message, int exit_status) {
+  std::fprintf(stderr, "rbsim %s: error: %s\n", command, message.c_str());
+  return exit_status;
+}
+
 }  // namespace rbsim::cli

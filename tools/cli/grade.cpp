@@ -2,8 +2,9 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli_util.hpp"
 #include "commands.hpp"
-#include "rbsim/io.hpp"
+#include "rbsim/fosssim.hpp"
 
 namespace rbsim::cli {
 
@@ -13,19 +14,15 @@ struct GradeArgs {
 };
 
 int grade_command(const GradeArgs& a) {
-  auto fail = [](const std::string& m) {
-    std::fprintf(stderr, "rbsim grade: error: %s\n", m.c_str());
-    return 2;
-  };
   Result<Scene> scene = load_scene(a.scene);
-  if (!scene) return fail(scene.error().message);
+  if (!scene) return fail("grade", scene.error().message, 2);
   Result<std::vector<std::byte>> bytes = read_file(a.reference);
-  if (!bytes) return fail(bytes.error().message);
+  if (!bytes) return fail("grade", bytes.error().message, 2);
   Result<FosssimLog> log =
       parse_fosssim(bytes.value(), static_cast<std::int32_t>(scene->world.bodies.size()));
-  if (!log) return fail(a.reference + ": " + log.error().message);
+  if (!log) return fail("grade", a.reference + ": " + log.error().message, 2);
   Result<GradeReport> report = grade(scene.value(), log.value());
-  if (!report) return fail(report.error().message);
+  if (!report) return fail("grade", report.error().message, 2);
   const GradeReport& r = report.value();
   std::printf(
       "%s: %s  steps %lld  max step diff %.3g (step %lld)  summed %.3g  max quantity diff %.3g (%s)\n",

@@ -28,14 +28,9 @@ struct LogOptions {
   std::optional<double> start, end;
 };
 
-int fail(const char* command, const std::string& message) {
-  std::fprintf(stderr, "rbsim log %s: error: %s\n", command, message.c_str());
-  return 1;
-}
-
 int info_command(const LogOptions& o) {
   auto info = mcap_tools::info(o.file);
-  if (!info) return fail("info", o.file + ": " + info.error().message);
+  if (!info) return fail("log info", o.file + ": " + info.error().message);
   std::fputs(mcap_tools::format_info(info.value()).c_str(), stdout);
   return 0;
 }
@@ -55,7 +50,7 @@ int doctor_command(const LogOptions& o) {
     const std::string more =
         report.errors > 1 ? " (and " + std::to_string(report.errors - 1) + " more errors, listed on stdout)"
                           : "";
-    return fail("doctor", o.file + ": " + report.first_error() + more);
+    return fail("log doctor", o.file + ": " + report.first_error() + more);
   }
   return 0;
 }
@@ -63,12 +58,12 @@ int doctor_command(const LogOptions& o) {
 int recover_command(const LogOptions& o) {
   mcap_tools::RecoverOptions options;
   if (Status st = check_outputs({{o.out, "OUT"}}, {o.file}, o.overwrite); !st)
-    return fail("recover", st.error().message);
+    return fail("log recover", st.error().message);
   const Result<mcap::Compression> codec = compression_option(o.compression);
-  if (!codec) return fail("recover", codec.error().message);
+  if (!codec) return fail("log recover", codec.error().message);
   options.compression = codec.value();
   auto report = mcap_tools::recover(o.file, o.out, options);
-  if (!report) return fail("recover", report.error().message);
+  if (!report) return fail("log recover", report.error().message);
   const mcap_tools::RecoverReport& r = report.value();
   if (!o.quiet) std::fputs(r.summary().c_str(), stdout);
   std::fflush(stdout);
@@ -86,12 +81,12 @@ int export_command(const LogOptions& o) {
   log::ExportOptions options;
   if (Status st = check_outputs({{o.csv, "--csv"}, {o.energy_csv, "--energy-csv"}}, {o.file}, o.overwrite);
       !st)
-    return fail("export", st.error().message);
+    return fail("log export", st.error().message);
   options.csv = o.csv;
   options.energy_csv = o.energy_csv;
   options.ns = o.ns;
   auto report = log::export_csv(o.file, options);
-  if (!report) return fail("export", report.error().message);
+  if (!report) return fail("log export", report.error().message);
   for (const std::string& w : report.value().warnings) {
     std::fprintf(stderr, "rbsim log export: warning: %s: %s\n", o.file.c_str(), w.c_str());
   }
@@ -116,7 +111,7 @@ int cat_command(const LogOptions& o) {
     std::fputc('\n', stdout);
   });
   std::fflush(stdout);
-  if (!st) return fail("cat", st.error().message);
+  if (!st) return fail("log cat", st.error().message);
   return 0;
 }
 

@@ -24,25 +24,20 @@ struct NodeArgs {
   std::optional<std::string> foxglove;  // [ADDR:]PORT
 };
 
-int fail(const std::string& m) {
-  std::fprintf(stderr, "rbsim node: error: %s\n", m.c_str());
-  return 1;
-}
-
 int node_command(const NodeArgs& a) {
   Result<Scene> loaded = load_scene(a.scene);
-  if (!loaded) return fail(loaded.error().message);
+  if (!loaded) return fail("node", loaded.error().message);
   const Scene& scene = loaded.value();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
   const std::int64_t steps = steps_for(a.duration.value_or(scene.duration), scene.world.dt);
 
   auto participant = node::Participant::create(a.node.domain);
-  if (!participant) return fail(participant.error().message);
+  if (!participant) return fail("node", participant.error().message);
   // Each step is encoded once for DDS and the Foxglove server alike.
   node::NodeOptions node_options = a.node;
   node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
   auto sink = node::DdsSink::create(participant.value(), node_options);
-  if (!sink) return fail(sink.error().message);
+  if (!sink) return fail("node", sink.error().message);
   // The Foxglove server serves beside DDS. The pacer releases each step when it is due; the
   // Foxglove sink's hand-off to the server's thread (a copy and a wake-up) goes first, so
   // viewers do not wait for the DDS writes.
@@ -56,9 +51,9 @@ int node_command(const NodeArgs& a) {
     fo.messages = node_options.messages;
     std::vector<foxglove::ChannelId> ids;
     auto channels = foxglove::ros2_channels(fo.topics, a.node.ns, &ids);
-    if (!channels) return fail(channels.error().message);
+    if (!channels) return fail("node", channels.error().message);
     auto started = start_foxglove("rbsim node", *a.foxglove, std::move(channels.value()));
-    if (!started) return fail(started.error().message);
+    if (!started) return fail("node", started.error().message);
     server = std::move(started.value());
     foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);
   }
@@ -76,7 +71,7 @@ int node_command(const NodeArgs& a) {
   }
   const auto start = std::chrono::steady_clock::now();
   Result<Driver> created = Driver::create(scene);
-  if (!created) return fail(created.error().message);
+  if (!created) return fail("node", created.error().message);
   Driver& driver = created.value();
   node::Pacer pacer(a.node.rate, a.node.publish_every);
   driver.add(pacer);
@@ -87,19 +82,19 @@ int node_command(const NodeArgs& a) {
   options.allow_nonfinite = a.allow_nonfinite;
   options.stop = stop_requested;
   do {
-    if (Status st = driver.begin(); !st) return fail(st.error().message);
+    if (Status st = driver.begin(); !st) return fail("node", st.error().message);
     const Result<PassEnd> end = driver.run(options);
-    if (!end) return fail(end.error().message);
+    if (!end) return fail("node", end.error().message);
     if (end.value() == PassEnd::Diverged) {
       // Subscribers still get every step before it (bounded wait for their acknowledgements).
       const Status flushed = driver.finish();
-      return fail(describe_divergence(driver.divergence()) + ". Published steps up to " +
-                  std::to_string(driver.world().step_index() - 1) +
-                  (flushed ? "" : " (" + flushed.error().message + ")") +
-                  " (--allow-nonfinite keeps going).");
+      return fail("node", describe_divergence(driver.divergence()) + ". Published steps up to " +
+                              std::to_string(driver.world().step_index() - 1) +
+                              (flushed ? "" : " (" + flushed.error().message + ")") +
+                              " (--allow-nonfinite keeps going).");
     }
   } while (a.loop && !stop_requested());
-  if (Status st = driver.finish(); !st) return fail(st.error().message);
+  if (Status st = driver.finish(); !st) return fail("node", st.error().message);
   if (!a.quiet) {
     const std::int64_t total_steps = driver.steps_done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -7,8 +7,8 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
-#include "rbsim/record.hpp"
 #include "rbsim/recorder.hpp"
 #include "validators.hpp"
 
@@ -28,11 +28,6 @@ struct RecordArgs {
   std::optional<double> wrong_duration;
 };
 
-int fail(const std::string& m) {
-  std::fprintf(stderr, "rbsim record: error: %s\n", m.c_str());
-  return 1;
-}
-
 int record_command(RecordArgs a) {
   if (a.wrong_duration) {
     std::fprintf(stderr,
@@ -45,16 +40,17 @@ int record_command(RecordArgs a) {
   // both). `rbsim run --record` writes offline and keeps level 1.
   a.rec.compression_level = a.compression_level.value_or(a.compression == "zstd" ? kLiveZstdLevel : 0);
   const Result<mcap::Compression> codec = compression_option(a.compression, a.rec.compression_level);
-  if (!codec) return fail(codec.error().message);
+  if (!codec) return fail("record", codec.error().message);
   a.rec.compression = codec.value();
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
   // error, leaving a recoverable file, instead of SIGXFSZ killing it.
   std::signal(SIGXFSZ, SIG_IGN);
-  if (Status st = check_outputs({{a.rec.path, "OUT"}}, {}, a.overwrite); !st) return fail(st.error().message);
+  if (Status st = check_outputs({{a.rec.path, "OUT"}}, {}, a.overwrite); !st)
+    return fail("record", st.error().message);
   auto participant = node::Participant::create(a.domain);
-  if (!participant) return fail(participant.error().message);
+  if (!participant) return fail("record", participant.error().message);
   auto recorder = node::Recorder::create(participant.value(), a.rec);
-  if (!recorder) return fail(recorder.error().message);
+  if (!recorder) return fail("record", recorder.error().message);
   install_stop_handlers();
   if (!a.quiet) {
     std::fprintf(stderr, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",
@@ -77,7 +73,7 @@ int record_command(RecordArgs a) {
   }
   // Whatever stopped us, finish a valid indexed file.
   if (Status st = recorder.value()->close(); !st)
-    return fail(st.error().message + " (the file can be repaired with rbsim log recover)");
+    return fail("record", st.error().message + " (the file can be repaired with rbsim log recover)");
   if (!a.quiet || failure) {
     std::uint64_t lost = 0, duplicates = 0;
     for (const auto& c : recorder.value()->counts()) {
@@ -97,11 +93,11 @@ int record_command(RecordArgs a) {
                  static_cast<unsigned long long>(recorder.value()->received()),
                  static_cast<unsigned long long>(lost), a.rec.path.c_str());
   }
-  if (failure) return fail(*failure + " (the file was finished up to that point)");
+  if (failure) return fail("record", *failure + " (the file was finished up to that point)");
   if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
     std::remove(a.rec.path.c_str());
-    return fail("nothing received on " + participant.value().description() + " under /" + a.rec.ns +
-                "; nothing written (is a node running with the same domain and namespace?)");
+    return fail("record", "nothing received on " + participant.value().description() + " under /" + a.rec.ns +
+                              "; nothing written (is a node running with the same domain and namespace?)");
   }
   return 0;
 }

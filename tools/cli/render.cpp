@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/render.hpp"
@@ -18,30 +19,26 @@ struct RenderArgs {
 };
 
 int render_command(const RenderArgs& a) {
-  auto fail = [](const std::string& m) {
-    std::fprintf(stderr, "rbsim render: error: %s\n", m.c_str());
-    return 1;
-  };
   render::RenderOptions o;
   if (!render::parse_size(a.size, o.width, o.height)) {
-    return fail("invalid --size \"" + a.size + "\" (expected WxH, e.g. 1280x720, each 16..16384)");
+    return fail("render", "invalid --size \"" + a.size + "\" (expected WxH, e.g. 1280x720, each 16..16384)");
   }
-  if (!(a.fps > 0.0 && a.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
+  if (!(a.fps > 0.0 && a.fps <= 1000.0)) return fail("render", "--fps must be in (0, 1000]");
   o.out_dir = a.out;
   o.fps = a.fps;
   o.duration = a.duration;
   o.overwrite = a.overwrite;
   // Before any frame is drawn: the movie must not replace a file unasked, nor an input.
   if (Status st = check_outputs({{a.out, "--out", true}, {a.mp4, "--mp4"}}, {a.input}, a.overwrite); !st)
-    return fail(st.error().message);
+    return fail("render", st.error().message);
   Result<std::int64_t> frames = render::render(a.input, o);
-  if (!frames) return fail(frames.error().message);
+  if (!frames) return fail("render", frames.error().message);
   std::fprintf(stderr, "rbsim render: %lld %s (%dx%d at %g fps) in %s\n",
                static_cast<long long>(frames.value()), frames.value() == 1 ? "frame" : "frames", o.width,
                o.height, o.fps, a.out.c_str());
   if (!a.mp4.empty()) {
     if (Status st = render::make_movie(a.out, a.fps, frames.value(), a.mp4); !st)
-      return fail(st.error().message);
+      return fail("render", st.error().message);
     std::fprintf(stderr, "rbsim render: movie %s\n", a.mp4.c_str());
   }
   return 0;

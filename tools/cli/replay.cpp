@@ -21,17 +21,12 @@ struct ReplayArgs {
   std::optional<std::string> foxglove;  // [ADDR:]PORT
 };
 
-int fail(const std::string& m) {
-  std::fprintf(stderr, "rbsim replay: error: %s\n", m.c_str());
-  return 1;
-}
-
 int replay_command(ReplayArgs a) {
   if (!a.ns.empty()) a.replay.ns = a.ns;
   auto participant = node::Participant::create(a.domain);
-  if (!participant) return fail(participant.error().message);
+  if (!participant) return fail("replay", participant.error().message);
   auto opened = node::Replay::open(participant.value(), a.replay);
-  if (!opened) return fail(opened.error().message);
+  if (!opened) return fail("replay", opened.error().message);
   node::Replay& replay = *opened.value();
   for (const std::string& w : replay.warnings())
     std::fprintf(stderr, "rbsim replay: warning: %s\n", w.c_str());
@@ -51,7 +46,7 @@ int replay_command(ReplayArgs a) {
       channels.push_back(std::move(c));
     }
     auto started = start_foxglove("rbsim replay", *a.foxglove, std::move(channels));
-    if (!started) return fail(started.error().message);
+    if (!started) return fail("replay", started.error().message);
     server = std::move(started.value());
     foxglove::Server* srv = server.get();
     tap.pass = [srv, &last_time] {
@@ -97,12 +92,12 @@ int replay_command(ReplayArgs a) {
   bool complete = true;
   do {
     auto played = replay.play(stop_requested, server ? &tap : nullptr);
-    if (!played) return fail(played.error().message);
+    if (!played) return fail("replay", played.error().message);
     complete = played.value();
     if (complete) ++passes;
   } while (a.loop && complete && !stop_requested());
   if (complete) {
-    if (Status st = replay.finish(); !st) return fail(st.error().message);
+    if (Status st = replay.finish(); !st) return fail("replay", st.error().message);
   }
   if (server) (void)server->flush(2.0);  // viewers that keep up get the end of the log
   if (!a.quiet) {

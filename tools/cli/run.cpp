@@ -7,11 +7,11 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/csv.hpp"
-#include "rbsim/io.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
-#include "rbsim/record.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
+#include "rbsim/sink.hpp"
 #include "validators.hpp"
 
 namespace rbsim::cli {
@@ -37,14 +37,9 @@ struct RunOptions {
   bool overwrite = false;
 };
 
-int fail(const std::string& message) {
-  std::fprintf(stderr, "rbsim run: error: %s\n", message.c_str());
-  return 1;
-}
-
 int run(const RunOptions& o) {
   Result<Scene> loaded = load_scene(o.scene);
-  if (!loaded) return fail(loaded.error().message);
+  if (!loaded) return fail("run", loaded.error().message);
   const Scene& scene = loaded.value();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
 
@@ -60,10 +55,10 @@ int run(const RunOptions& o) {
                                  {o.frames, "--frames", true}},
                                 {o.scene}, o.overwrite);
       !st)
-    return fail(st.error().message);
+    return fail("run", st.error().message);
 
   Result<Driver> created = Driver::create(scene);
-  if (!created) return fail(scene.path + ": " + created.error().message);
+  if (!created) return fail("run", scene.path + ": " + created.error().message);
   Driver& driver = created.value();
 
   std::vector<std::unique_ptr<Sink>> sinks;
@@ -76,7 +71,7 @@ int run(const RunOptions& o) {
     ro.ns = o.ns;
     ro.topics = o.topic_set;
     const Result<mcap::Compression> codec = compression_option(o.compression, o.compression_level);
-    if (!codec) return fail(codec.error().message);
+    if (!codec) return fail("run", codec.error().message);
     ro.compression = codec.value();
     ro.compression_level = o.compression_level;
     sinks.push_back(log::make_mcap_sink(o.record, ro));
@@ -84,14 +79,14 @@ int run(const RunOptions& o) {
   if (!o.frames.empty()) {
     int width = 0, height = 0;
     if (!render::parse_size(o.size, width, height))
-      return fail("invalid --size \"" + o.size + "\" (expected WxH)");
-    if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("--fps must be in (0, 1000]");
+      return fail("run", "invalid --size \"" + o.size + "\" (expected WxH)");
+    if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("run", "--fps must be in (0, 1000]");
     sinks.push_back(render::make_frame_sink(
         o.frames, width, height, o.fps,
         render::run_duration(steps, scene.world.dt, scene.duration, scene.step_count()), o.overwrite));
   }
   for (auto& sink : sinks) driver.add(*sink);
-  if (Status st = driver.begin(); !st) return fail(st.error().message);
+  if (Status st = driver.begin(); !st) return fail("run", st.error().message);
 
   install_stop_handlers();
   Progress progress(steps, o.progress == "always"  ? Progress::Mode::Always
@@ -104,14 +99,14 @@ int run(const RunOptions& o) {
   options.progress = [&progress](std::int64_t step) { progress.update(step); };
   const auto start = std::chrono::steady_clock::now();
   const Result<PassEnd> end = driver.run(options);
-  if (!end) return fail(end.error().message);
+  if (!end) return fail("run", end.error().message);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.finish();
-  if (Status st = driver.finish(); !st) return fail(st.error().message);
+  if (Status st = driver.finish(); !st) return fail("run", st.error().message);
   const World& world = driver.world();
   if (end.value() == PassEnd::Diverged) {
-    return fail(describe_divergence(driver.divergence()) + ". Outputs hold steps 0.." +
-                std::to_string(world.step_index() - 1) + " (--allow-nonfinite keeps going).");
+    return fail("run", describe_divergence(driver.divergence()) + ". Outputs hold steps 0.." +
+                           std::to_string(world.step_index() - 1) + " (--allow-nonfinite keeps going).");
   }
 
   const std::int64_t done = world.step_index();

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "rbsim/dds.hpp"
-#include "rbsim/io.hpp"
+#include "rbsim/sink.hpp"
 
 namespace rbsim::node {
 

@@ -15,8 +15,9 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <variant>
 #include <vector>
+
+#include "rbsim/status.hpp"
 
 namespace rbsim {
 
@@ -25,33 +26,6 @@ namespace rbsim {
 const char* version();
 
 using Vec2 = Eigen::Vector2d;
-
-// ---------------------------------------------------------------------------------------------
-// Errors: an expected-style value. The core reports invalid definitions through it; the I/O
-// layers (scene loader, sinks) use the same type.
-struct Error {
-  std::string message;
-};
-
-template <class T>
-class [[nodiscard]] Result {
- public:
-  Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
-  Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
-  bool ok() const { return v_.index() == 0; }
-  explicit operator bool() const { return ok(); }
-  T& value() { return std::get<0>(v_); }
-  const T& value() const { return std::get<0>(v_); }
-  T& operator*() { return value(); }
-  T* operator->() { return &value(); }
-  const Error& error() const { return std::get<1>(v_); }
-
- private:
-  std::variant<T, Error> v_;
-};
-
-struct Ok {};
-using Status = Result<Ok>;
 
 // ---------------------------------------------------------------------------------------------
 // Definitions (what a scene describes). Plain structs with defaults.

@@ -25,6 +25,7 @@
 #include <utility>
 
 #include "layout.hpp"
+#include "rbsim/assert.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/mcap.hpp"
 #include "record_pump.hpp"
@@ -292,7 +293,7 @@ class Comparer {
       report_.metadata.push_back(
           {std::string("MCAP header, ") + what, "\"" + *golden + "\"", "\"" + *run + "\""});
       if (o_.strict_metadata) {
-        Divergence d;
+        FirstDifference d;
         d.topic_level = true;
         d.field = "(" + report_.metadata.back().line() + ")";
         consider(Key{0, problem_ordinal_++}, std::move(d));
@@ -305,7 +306,7 @@ class Comparer {
         report_.scene_mismatch = "the run and the golden record different scenes (golden " +
                                  quoted(side_[kGolden].scene->name) + ", run " +
                                  quoted(side_[kRun].scene->name) + "): " + why;
-        Divergence d;
+        FirstDifference d;
         d.topic_level = true;
         d.field = "(" + report_.scene_mismatch + ")";
         consider(Key{0, problem_ordinal_++}, std::move(d));
@@ -531,7 +532,7 @@ class Comparer {
 
   void topic_problem(const Topic& t, const std::string& what) {
     report_.topic_problems.push_back(t.name + ": " + what);
-    Divergence d;
+    FirstDifference d;
     d.topic = t.name;
     d.topic_level = true;
     d.field = "(" + what + ")";
@@ -539,7 +540,7 @@ class Comparer {
   }
 
   // True when `d` became the first divergence.
-  bool consider(Key key, Divergence d) {
+  bool consider(Key key, FirstDifference d) {
     if (!report_.first || key < first_key_) {
       first_key_ = key;
       report_.first = std::move(d);
@@ -568,7 +569,7 @@ class Comparer {
     t.only[si].add(p.step);
     ++report_.diverging_messages;
     ++report_.one_file_messages;
-    Divergence d{
+    FirstDifference d{
         t.name, true, p.step, si == kGolden ? "(message missing from the run)" : "(extra message in the run)",
         "",     "",   ""};
     if (consider(Key{p.log_time, p.ordinal}, std::move(d))) {
@@ -698,13 +699,13 @@ class Comparer {
           st.step_at_max = g.index;
         }
         if (!report_.first || key < first_key_) {
-          Divergence d{t.name,
-                       false,
-                       g.index,
-                       "(message bytes)",
-                       std::to_string(g.data.size()) + " bytes",
-                       std::to_string(r.data.size()) + " bytes",
-                       "bytes differ"};
+          FirstDifference d{t.name,
+                            false,
+                            g.index,
+                            "(message bytes)",
+                            std::to_string(g.data.size()) + " bytes",
+                            std::to_string(r.data.size()) + " bytes",
+                            "bytes differ"};
           consider(key, std::move(d));
         }
       }
@@ -734,13 +735,13 @@ class Comparer {
     if (!t.diverged_message) {
       t.diverged_message = true;
       if (!report_.first || key < first_key_) {
-        Divergence d{t.name,
-                     last_has_step_,
-                     last_step_,
-                     "(log_time)",
-                     std::to_string(g.log_time) + " ns",
-                     std::to_string(r.log_time) + " ns",
-                     fmt_short(diff) + " ns"};
+        FirstDifference d{t.name,
+                          last_has_step_,
+                          last_step_,
+                          "(log_time)",
+                          std::to_string(g.log_time) + " ns",
+                          std::to_string(r.log_time) + " ns",
+                          fmt_short(diff) + " ns"};
         consider(key, std::move(d));
       }
     }
@@ -1055,12 +1056,11 @@ class Comparer {
       t.diverged_message = true;
       if (!report_.first || key < first_key_) {
         // The walk kept the values it found first; a decoded pair has them by index.
-        if (decoded && (first_bad >= golden_.size() || first_bad_run >= run_.size())) {
-          return Error{"internal: value " + std::to_string(first_bad) + " of " + t.name + " out of range"};
-        }
+        RBSIM_ASSERT(!decoded || (first_bad < golden_.size() && first_bad_run < run_.size()),
+                     "a decoded pair's first difference indexes its values");
         const Scalar& a = decoded ? run_[first_bad_run] : ls.bad_a;
         const Scalar& b = decoded ? golden_[first_bad] : ls.bad_b;
-        Divergence d{
+        FirstDifference d{
             t.name,  has_step,        step, t.decoder[kGolden]->path(cdr(g.data), first_bad), text(b),
             text(a), difference(a, b)};
         consider(key, std::move(d));
@@ -1219,7 +1219,7 @@ class Comparer {
                       " messages on this topic, the run " + std::to_string(t.count[kRun])
                 : "extra message in the run: the run has " + std::to_string(t.count[kRun]) +
                       " messages on this topic, the golden " + std::to_string(t.count[kGolden]);
-        Divergence d{t.name, has_step, step, "(" + what + ")", "", "", ""};
+        FirstDifference d{t.name, has_step, step, "(" + what + ")", "", "", ""};
         consider(Key{p.log_time, p.ordinal}, std::move(d));
         report_.diverging_messages += t.queue[si].size();
       }
@@ -1285,7 +1285,7 @@ std::string MetadataDifference::line() const {
   return where + ": expected " + expected + ", actual " + actual;
 }
 
-std::string Divergence::line() const {
+std::string FirstDifference::line() const {
   if (topic_level && topic.empty()) return field.substr(1, field.size() - 2);
   if (topic_level) return "topic " + topic + ": " + field.substr(1, field.size() - 2);
   std::string out = "topic " + topic + ", " + (has_step ? "step " : "message ") + std::to_string(step);

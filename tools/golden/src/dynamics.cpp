@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rbsim/io.hpp"
+#include "rbsim/fosssim.hpp"
 #include "stages.hpp"
 
 namespace rbsim::check {

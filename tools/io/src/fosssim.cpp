@@ -8,7 +8,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "rbsim/io.hpp"
+#include "rbsim/fosssim.hpp"
 
 namespace rbsim {
 

@@ -2,8 +2,10 @@
 #include <bit>
 #include <cstring>
 
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/csv.hpp"
-#include "rbsim/io.hpp"
+#include "rbsim/fosssim.hpp"
+#include "rbsim/sink.hpp"
 
 namespace rbsim {
 

@@ -2,7 +2,8 @@
 #include <array>
 #include <string>
 
-#include "rbsim/record.hpp"
+#include "rbsim/atomic_file.hpp"
+#include "rbsim/mcap_sink.hpp"
 
 namespace rbsim::log {
 
@@ -26,8 +27,11 @@ class McapSink final : public Sink {
       return Error{path_ + ": record every " + std::to_string(options_.every) + " steps: must be at least 1"};
     }
     encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
-    if (auto st = writer_.open(
-            path_, writer_options(options_.compression, options_.chunk_size, options_.compression_level));
+    // Written under a temporary name and renamed into place by finish(): a killed run leaves the
+    // temporary (`<path>.tmp.<pid>`), which `rbsim log recover` turns into a recording.
+    file_.open_external(path_);
+    if (auto st = writer_.open(file_.temp_path(), writer_options(options_.compression, options_.chunk_size,
+                                                                 options_.compression_level));
         !st.ok()) {
       return fail(path_, st);
     }
@@ -46,7 +50,7 @@ class McapSink final : public Sink {
 
   Status finish() override {
     if (auto st = writer_.close(); !st.ok()) return fail(path_, st);
-    return Ok{};
+    return file_.commit();
   }
 
  private:
@@ -67,6 +71,7 @@ class McapSink final : public Sink {
   std::string path_;
   RecordOptions options_;
   std::vector<msgs::TopicId> ids_;  // the selected topics
+  AtomicFile file_;  // declared before writer_: the writer closes before the temporary is removed
   mcap::Writer writer_;
   std::unique_ptr<msgs::Encoder> encoder_;
   std::array<std::uint16_t, msgs::kTopicCount> channels_{};

@@ -28,16 +28,6 @@ std::span<const std::byte> bytes_of(const mcap::Message& m) {
   return {reinterpret_cast<const std::byte*>(m.data.data()), m.data.size()};
 }
 
-// The messages recorded for one step, as far as they have arrived.
-struct Slot {
-  std::uint64_t step = 0;
-  std::array<bool, kPerStep.size()> has{};
-  msgs::BodyStatesMessage states;
-  msgs::SpringStatesMessage springs;
-  msgs::EnergyTermsMessage energy;
-  RecordedStep::LogTimes log_time;
-};
-
 }  // namespace
 
 std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader) {
@@ -70,6 +60,16 @@ std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader
 }
 
 struct Recording::Impl {
+  // The messages recorded for one step, as far as they have arrived.
+  struct Slot {
+    std::uint64_t step = 0;
+    std::array<bool, kPerStep.size()> has{};
+    msgs::BodyStatesMessage states;
+    msgs::SpringStatesMessage springs;
+    msgs::EnergyTermsMessage energy;
+    RecordedStep::LogTimes log_time;
+  };
+
   std::string path;
   RecordingOptions options;
   mcap::IndexedReader reader;

@@ -1,8 +1,8 @@
 // Linear record walk shared by StreamReader and the IndexedReader's fallback scan.
 #pragma once
 
+#include "byte_sink.hpp"
 #include "codec.hpp"
-#include "io.hpp"
 #include "rbsim/mcap_records.hpp"
 
 namespace rbsim::mcap::detail {

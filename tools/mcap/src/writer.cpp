@@ -9,8 +9,8 @@
 // Compressed chunks are built in memory, compressed whole and then written.
 #include <algorithm>
 
+#include "byte_sink.hpp"
 #include "codec.hpp"
-#include "io.hpp"
 #include "wire.hpp"
 
 namespace rbsim::mcap {
@@ -19,7 +19,7 @@ using namespace detail;
 
 struct Writer::Impl {
   WriterOptions options;
-  std::unique_ptr<Sink> sink;
+  std::unique_ptr<ByteSink> sink;
   std::unique_ptr<Compressor> compressor;
   Status error;  // sticky: the first failure is returned by every later call
   bool open = false;
@@ -91,7 +91,7 @@ struct Writer::Impl {
     return write(scratch);
   }
 
-  Status begin(std::unique_ptr<Sink> s, const WriterOptions& opts) {
+  Status begin(std::unique_ptr<ByteSink> s, const WriterOptions& opts) {
     *this = Impl{};
     options = opts;
     sink = std::move(s);

@@ -17,6 +17,7 @@
 
 namespace rbsim::mcap_tools {
 
+using detail::kPrefix;
 using detail::opcode_name;
 
 std::string DoctorReport::first_error() const {
@@ -28,7 +29,6 @@ std::string DoctorReport::first_error() const {
 
 namespace {
 
-constexpr std::size_t kPrefix = 9;
 constexpr std::size_t kMaxFindings = 1000;  // further findings are counted, not stored
 
 template <class... A>

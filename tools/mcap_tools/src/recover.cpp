@@ -4,14 +4,13 @@
 // cannot frame: the end of a truncated file). Chunks are the unit of recovery: each complete
 // chunk is decompressed and CRC-checked here, so one corrupt chunk is skipped and the chunks after
 // it are still kept; a chunk cut off by the end of the file is lost with its messages.
-#include <fcntl.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap_tools.hpp"
 #include "tools_util.hpp"
 
@@ -20,8 +19,7 @@ namespace rbsim::mcap_tools {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr std::size_t kPrefix = 9;
+using detail::kPrefix;
 
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
@@ -221,7 +219,8 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   }
   const mcap::Header header = std::get<mcap::Header>(entry.record);
 
-  const std::string temp = out + ".tmp." + std::to_string(::getpid());
+  AtomicFile output;  // the MCAP writer creates the temporary; commit() moves it into place
+  output.open_external(out);
   Recoverer rec(report);
   if (has_summary(file)) {
     mcap::IndexedReader summary;
@@ -233,11 +232,11 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   wo.background_compression = true;
   wo.profile = header.profile;
   wo.library = header.library;
-  if (mcap::Status s = rec.writer().open(temp, wo); !s.ok()) return Error{out + ": " + s.message};
+  if (mcap::Status s = rec.writer().open(output.temp_path(), wo); !s.ok())
+    return Error{out + ": " + s.message};
   auto abandon = [&](const std::string& why) -> Result<RecoverReport> {
     (void)rec.writer().close();
-    std::remove(temp.c_str());
-    return Error{out + ": " + why};
+    return Error{out + ": " + why};  // output's destructor removes the temporary
   };
 
   bool in_summary = false;
@@ -292,21 +291,8 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     return abandon("nothing to recover from " + in + " (" + report.problem +
                    "): it holds no complete message; nothing written");
   }
-  if (mcap::Status s = rec.writer().close(); !s.ok()) {
-    std::remove(temp.c_str());
-    return Error{out + ": " + s.message};
-  }
-  // Durable before it replaces anything (as AtomicFile does).
-  if (const int fd = ::open(temp.c_str(), O_RDONLY); fd >= 0) {
-    (void)::fsync(fd);
-    ::close(fd);
-  }
-  std::error_code ec;
-  fs::rename(temp, out, ec);
-  if (ec) {
-    std::remove(temp.c_str());
-    return Error{out + ": cannot move the output into place: " + ec.message()};
-  }
+  if (mcap::Status s = rec.writer().close(); !s.ok()) return Error{out + ": " + s.message};
+  if (Status st = output.commit(); !st) return st.error();
   return report;
 }
 

@@ -8,8 +8,12 @@
 #include <string_view>
 
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_records.hpp"
 
 namespace rbsim::mcap_tools::detail {
+
+// Opcode and content length in front of every record.
+inline constexpr std::size_t kPrefix = mcap::RecordReader::kPrefixSize;
 
 // Bounded random access to a file: every read is checked against the size found at open.
 class FileBytes {

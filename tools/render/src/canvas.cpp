@@ -2,7 +2,6 @@
 #include <cairo.h>
 #include <png.h>
 
-#include <cerrno>
 #include <csetjmp>
 
 #include <algorithm>
@@ -10,8 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/render.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -237,22 +236,16 @@ Status Canvas::write_png(const std::string& path) const {
   cairo_surface_flush(impl_->surface);
   const unsigned char* data = cairo_image_surface_get_data(impl_->surface);
   const int stride = cairo_image_surface_get_stride(impl_->surface);
-  const std::string temp = path + ".tmp";
-  std::FILE* f = std::fopen(temp.c_str(), "wb");
-  if (f == nullptr) return Error{path + ": cannot write PNG: " + std::strerror(errno)};
+  AtomicFile file;
+  if (Status st = file.open(path); !st) return st;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   std::vector<unsigned char> row(static_cast<std::size_t>(width_) * 3);
-  bool ok = info != nullptr && encode_png(png, info, f, data, stride, width_, height_, row.data());
+  const bool ok =
+      info != nullptr && encode_png(png, info, file.stream(), data, stride, width_, height_, row.data());
   png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
-  ok = std::fclose(f) == 0 && ok;
-  if (!ok) {
-    std::remove(temp.c_str());
-    return Error{path + ": cannot write PNG"};
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) return Error{path + ": cannot move PNG into place: " + ec.message()};
+  if (!ok) return Error{path + ": cannot write PNG"};  // file's destructor removes the temporary
+  if (Status st = file.commit(); !st) return st;
   return Ok{};
 }
 

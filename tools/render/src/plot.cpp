@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "process.hpp"
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
@@ -90,7 +91,9 @@ Status plot(const std::string& input, const PlotOptions& o) {
       is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
   if (!samples) return samples.error();
 
-  const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp", temp = o.out_png + ".tmp";
+  AtomicFile png;  // gnuplot writes it; data and script are scratch files beside it
+  png.open_external(o.out_png);
+  const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp";
   {
     std::ofstream f(data);
     for (const Sample& s : samples.value()) {
@@ -104,7 +107,7 @@ Status plot(const std::string& input, const PlotOptions& o) {
   {
     std::ofstream f(script);
     f << "set terminal pngcairo size " << o.width << "," << o.height << " enhanced font 'DejaVu Sans,11'\n"
-      << "set output '" << temp << "'\n"
+      << "set output '" << png.temp_path() << "'\n"
       << "set datafile separator ','\nset grid\nset key outside right top\nset xlabel 'time (s)'\n"
       << "set multiplot layout 2,1 title '" << fs::path(input).filename().string() << "'\n"
       << "set title 'Energy'\nset ylabel 'energy'\n"
@@ -122,14 +125,8 @@ Status plot(const std::string& input, const PlotOptions& o) {
   std::remove(data.c_str());
   std::remove(script.c_str());
   if (!code) return Error{"gnuplot: " + code.error().message};
-  if (code.value() != 0) {
-    std::remove(temp.c_str());
-    return Error{"gnuplot failed drawing " + o.out_png};
-  }
-  std::error_code ec;
-  fs::rename(temp, o.out_png, ec);
-  if (ec) return Error{o.out_png + ": " + ec.message()};
-  return Ok{};
+  if (code.value() != 0) return Error{"gnuplot failed drawing " + o.out_png};
+  return png.commit();
 }
 
 }  // namespace rbsim::render

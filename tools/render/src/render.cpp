@@ -15,6 +15,7 @@
 
 #include "process.hpp"
 
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
@@ -228,22 +229,24 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
 }
 
 Status make_movie(const std::string& frames_dir, double fps, std::int64_t frames, const std::string& mp4) {
-  const std::string temp = mp4 + ".tmp.mp4";
+  AtomicFile movie;
+  movie.open_external(mp4);
   char rate[32];
   std::snprintf(rate, sizeof rate, "%g", fps);
-  Result<int> code = detail::run_process({"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i",
-                                          (fs::path(frames_dir) / "frame%05d.png").string(), "-frames:v",
-                                          std::to_string(frames), "-c:v", "libx264", "-pix_fmt", "yuv420p",
-                                          "-crf", "20", "-movflags", "+faststart", temp});
+  // -f mp4: the temporary's name does not end in .mp4, so ffmpeg is told the container.
+  const std::string input = (fs::path(frames_dir) / "frame%05d.png").string();
+  const std::string& output = movie.temp_path();
+  Result<int> code =
+      detail::run_process({"ffmpeg", "-y",        "-loglevel",  "error",     "-framerate",
+                           rate,     "-i",        input,        "-frames:v", std::to_string(frames),
+                           "-c:v",   "libx264",   "-pix_fmt",   "yuv420p",   "-crf",
+                           "20",     "-movflags", "+faststart", "-f",        "mp4",
+                           output});
   if (!code) return Error{"ffmpeg: " + code.error().message};
   if (code.value() != 0) {
-    std::remove(temp.c_str());
     return Error{"ffmpeg failed (exit " + std::to_string(code.value()) + ") making " + mp4};
   }
-  std::error_code ec;
-  fs::rename(temp, mp4, ec);
-  if (ec) return Error{mp4 + ": " + ec.message()};
-  return Ok{};
+  return movie.commit();
 }
 
 }  // namespace rbsim::render

@@ -8,10 +8,11 @@
 #include <fstream>
 #include <iterator>
 
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/golden.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
-#include "rbsim/record.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/scene.hpp"
 

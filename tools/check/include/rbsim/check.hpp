@@ -25,7 +25,7 @@ struct CheckOptions {
 
 // Where two recordings first differ. `field` is the full path ("bodies[3].x"), or for a message-
 // or topic-level difference a description in parentheses ("(message missing from the run)").
-struct Divergence {
+struct FirstDifference {
   std::string topic;
   bool has_step = false;  // true: `step` is the simulated step; false: the message's index on its topic
   std::uint64_t step = 0;
@@ -55,7 +55,7 @@ struct MetadataDifference {
 };
 
 struct CheckReport {
-  std::optional<Divergence> first;          // none: the recordings match
+  std::optional<FirstDifference> first;     // none: the recordings match
   std::uint64_t diverging_values = 0;       // values outside the tolerance
   std::uint64_t diverging_messages = 0;     // messages with such a value, plus missing and extra ones
   std::uint64_t one_file_messages = 0;      // of those: per-step messages whose step one file lacks

@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
-#include "rbsim/io.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/sink.hpp"
 
 namespace rbsim::foxglove {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/core.hpp"
-#include "rbsim/io.hpp"
 
 namespace rbsim {
 

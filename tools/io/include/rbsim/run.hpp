@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
-#include "rbsim/io.hpp"
 #include "rbsim/scene.hpp"
+#include "rbsim/sink.hpp"
 
 namespace rbsim {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "rbsim/core.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/status.hpp"
 
 namespace rbsim::mcap_tools {
 

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
-#include "rbsim/io.hpp"
 #include "rbsim/msgs.hpp"
 #include "rbsim/scene.hpp"
+#include "rbsim/sink.hpp"
 
 namespace rbsim::render {
 

@@ -1,4 +1,5 @@
-// Recording a run: the MCAP sink and the conventions every rbsim recording follows, the rosbag2
+// Recording a run to MCAP: the MCAP sink of `rbsim run --record` (the DDS recorder of `rbsim
+// record` is node/'s recorder) and the conventions every rbsim recording follows, the rosbag2
 // layout (profile "ros2", "ros2msg" schemas, "cdr" messages, "offered_qos_profiles" channel
 // metadata), so Foxglove and `ros2 bag` open them.
 #pragma once
@@ -8,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "rbsim/io.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/sink.hpp"
 
 namespace rbsim::log {
 

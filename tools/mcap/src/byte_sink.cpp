@@ -1,4 +1,4 @@
-#include "io.hpp"
+#include "byte_sink.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -71,7 +71,7 @@ class BufferSource final : public ByteSource {
 // Appends to a file descriptor through a buffer of its own. Small writes (record headers, indexes,
 // small messages) gather in the buffer; a large one goes to the kernel straight from the caller's
 // bytes, in one writev() with what the buffer holds: no copy, one system call.
-class FileSink final : public Sink {
+class FileSink final : public ByteSink {
  public:
   explicit FileSink(int fd) : fd_(fd) {
     struct stat st {};
@@ -160,7 +160,7 @@ class FileSink final : public Sink {
   Bytes empty_;
 };
 
-class BufferSink final : public Sink {
+class BufferSink final : public ByteSink {
  public:
   Status write(ByteView data) override {
     data_.insert(data_.end(), data.begin(), data.end());
@@ -209,13 +209,13 @@ Status ViewSource::read(std::uint64_t offset, std::uint64_t length, ByteView& ou
 
 namespace detail {
 
-Result<std::unique_ptr<Sink>> open_file_sink(const std::string& path) {
+Result<std::unique_ptr<ByteSink>> open_file_sink(const std::string& path) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);  // as fopen "wb"
   if (fd < 0) return io_error("cannot create", path);
-  return std::unique_ptr<Sink>(std::make_unique<FileSink>(fd));
+  return std::unique_ptr<ByteSink>(std::make_unique<FileSink>(fd));
 }
 
-std::unique_ptr<Sink> make_buffer_sink() {
+std::unique_ptr<ByteSink> make_buffer_sink() {
   return std::make_unique<BufferSink>();
 }
 

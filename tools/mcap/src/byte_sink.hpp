@@ -9,9 +9,9 @@
 
 namespace rbsim::mcap::detail {
 
-class Sink {
+class ByteSink {
  public:
-  virtual ~Sink() = default;
+  virtual ~ByteSink() = default;
   virtual Status write(ByteView data) = 0;
   virtual Status flush() = 0;  // hand buffered bytes to the OS
   virtual Status close() = 0;
@@ -23,8 +23,8 @@ class Sink {
   virtual Status write_at(std::uint64_t offset, ByteView data) = 0;
 };
 
-Result<std::unique_ptr<Sink>> open_file_sink(const std::string& path);
-std::unique_ptr<Sink> make_buffer_sink();
+Result<std::unique_ptr<ByteSink>> open_file_sink(const std::string& path);
+std::unique_ptr<ByteSink> make_buffer_sink();
 
 inline Status out_of_range(std::uint64_t offset, std::uint64_t length, std::uint64_t size) {
   return Status::Error(StatusCode::Truncated, "read of " + std::to_string(length) + " bytes at offset " +

@@ -1,0 +1,46 @@
+// The one way rbsim writes an output file: under a temporary name beside its final path, renamed
+// into place by commit() after an fsync, so a reader never sees a half-written output and a run
+// that fails leaves the old file as it was. Destroying an uncommitted AtomicFile removes the
+// temporary; a process that is killed leaves it, named temp_path(): `<path>.tmp.<pid>`.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "rbsim/status.hpp"
+
+namespace rbsim {
+
+class AtomicFile {
+ public:
+  AtomicFile() = default;
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile();
+
+  // Creates the temporary and opens it for write() and stream().
+  [[nodiscard]] Status open(const std::string& path);
+  // Only names the temporary, for a writer that creates the file itself (the MCAP writer,
+  // ffmpeg, gnuplot): it writes temp_path(), commit() moves that into place.
+  void open_external(const std::string& path);
+
+  [[nodiscard]] Status write(const void* data, std::size_t size);
+  // The open temporary, for a library that writes through a FILE* (libpng); nullptr for an
+  // external writer's file.
+  std::FILE* stream() { return file_; }
+  [[nodiscard]] Status commit();  // flush, fsync, rename over path()
+  void discard();                 // removes the temporary; path() is left as it was
+
+  const std::string& path() const { return path_; }
+  const std::string& temp_path() const { return temp_path_; }
+  std::uint64_t bytes_written() const { return bytes_; }
+
+ private:
+  std::string path_, temp_path_;
+  std::FILE* file_ = nullptr;
+  bool pending_ = false;  // a temporary may exist and is ours to remove
+  std::uint64_t bytes_ = 0;
+};
+
+}  // namespace rbsim
