@@ -123,7 +123,9 @@ TEST(RecordReader, ReportsATruncatedRecordWithItsOffset) {
     ASSERT_TRUE(p.opcode.has_value());
     EXPECT_EQ(*p.opcode, cut.opcode);
     EXPECT_EQ(p.content_length.has_value(), keep >= RecordReader::kPrefixSize);
-    if (p.content_length) EXPECT_EQ(*p.content_length, cut.length - RecordReader::kPrefixSize);
+    if (p.content_length) {
+      EXPECT_EQ(*p.content_length, cut.length - RecordReader::kPrefixSize);
+    }
     EXPECT_EQ(reader.position(), cut.offset);
     EXPECT_EQ(reader.problem().offset, cut.offset);
     EXPECT_EQ(reader.status().code, StatusCode::Truncated);
@@ -202,9 +204,9 @@ TEST(ByteSource, FileAndBufferSourcesGiveTheSameRecords) {
   auto from_buffer = make_buffer_source(file);
   ViewSource from_view(file);
   std::vector<Bytes> file_contents, buffer_contents, view_contents;
-  const auto a = all_records(*from_file.value(), kMagicSize, RecordReader::kToEnd, &file_contents);
-  const auto b = all_records(*from_buffer, kMagicSize, RecordReader::kToEnd, &buffer_contents);
-  const auto c = all_records(from_view, kMagicSize, RecordReader::kToEnd, &view_contents);
+  const auto a = all_records(*from_file.value(), kMagicSize, file.size() - kMagicSize, &file_contents);
+  const auto b = all_records(*from_buffer, kMagicSize, file.size() - kMagicSize, &buffer_contents);
+  const auto c = all_records(from_view, kMagicSize, file.size() - kMagicSize, &view_contents);
   ASSERT_FALSE(a.empty());
   ASSERT_EQ(a.size(), b.size());
   ASSERT_EQ(a.size(), c.size());

@@ -1,8 +1,9 @@
 // rbsim log doctor's stages and the state they share (private to mcap_tools). Doctor::run calls
 // them in order, each in its own file: the structure walk (doctor_structure.cpp, one pass over
-// the file record by record), the chunk examination (doctor_chunks.cpp, as each chunk's message
-// indexes end), then the summary and index checks (doctor_summary.cpp) and the statistics
-// (doctor_statistics.cpp) over what the walk collected.
+// the file record by record, each record to its handler in doctor_records.cpp), the chunk
+// examination (doctor_chunks.cpp, as each chunk's message indexes end), then the summary and
+// index checks (doctor_summary.cpp) and the statistics (doctor_statistics.cpp) over what the walk
+// collected.
 #pragma once
 
 #include <map>
