@@ -110,9 +110,9 @@ std::string human_bytes(std::uint64_t n) {
 Result<LogInfo> info(const std::string& path) {
   LogInfo info;
   {
-    detail::FileBytes f;
-    if (std::string e = f.open(path); !e.empty()) return Error{e};
-    info.file_size = f.size();
+    auto source = detail::open_input(path);
+    if (!source) return source.error();
+    info.file_size = source.value()->size();
     if (info.file_size == 0) return Error{"empty file (0 bytes): not an MCAP file"};
   }
   mcap::IndexedReader reader;

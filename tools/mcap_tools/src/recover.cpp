@@ -19,7 +19,6 @@ namespace rbsim::mcap_tools {
 namespace {
 
 namespace fs = std::filesystem;
-using detail::kPrefix;
 
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
@@ -32,12 +31,30 @@ bool same_file(const std::string& a, const std::string& b) {
 
 // Whether the file ends in a Footer that points at a summary (checked before opening an
 // IndexedReader, which would scan a whole file without one).
-bool has_summary(detail::FileBytes& file) {
-  constexpr std::uint64_t kTail = kPrefix + 20 + 8;  // Footer record + trailing magic
-  mcap::Bytes tail;
-  if (file.size() < 8 + kTail || !file.read(file.size() - kTail, kTail, tail)) return false;
-  return tail[0] == static_cast<std::uint8_t>(mcap::Opcode::Footer) && detail::le64(&tail[kPrefix]) != 0 &&
-         std::equal(tail.end() - 8, tail.end(), std::begin(mcap::kMagic));
+bool has_summary(mcap::ByteSource& file) {
+  const auto footer = mcap::read_footer(file);
+  return footer.ok() && footer.value().summary_start != 0;
+}
+
+// The record the input ends in, as far as the bytes at `offset` tell: its opcode and, when its
+// prefix is whole, the content length it claims. Nothing when no byte is left (or readable).
+struct CutRecord {
+  std::uint8_t opcode = 0;
+  std::optional<std::uint64_t> content_length;
+};
+std::optional<CutRecord> record_at(mcap::ByteSource& file, std::uint64_t offset) {
+  mcap::RecordReader reader(file, offset);
+  mcap::RecordView record;
+  if (reader.next(record)) return CutRecord{record.opcode, record.content.size()};
+  const mcap::RecordProblem& problem = reader.problem();
+  if (!problem.opcode) return std::nullopt;
+  return CutRecord{*problem.opcode, problem.content_length};
+}
+
+// Whether `byte` could start the trailing magic (whose cut-off the read status already words).
+bool starts_magic(std::uint8_t byte) {
+  mcap::ViewSource first(mcap::ByteView(&byte, 1));
+  return mcap::check_magic(first, 0).code != mcap::StatusCode::BadMagic;
 }
 
 class Recoverer {
@@ -85,15 +102,14 @@ class Recoverer {
       note("chunk at offset " + std::to_string(offset) + " skipped: " + s.message);
       return mcap::Status::Ok();
     }
-    for (std::size_t at = 0; at < data.size();) {
-      const std::size_t left = data.size() - at;
-      const std::uint64_t length = left < kPrefix ? 0 : detail::le64(data.data() + at + 1);
-      if (left < kPrefix || length > left - kPrefix) {
-        note("chunk at offset " + std::to_string(offset) + ": records cut off at byte " + std::to_string(at));
-        break;
-      }
-      auto record = mcap::parse_record(data[at], mcap::ByteView(data).subspan(at + kPrefix, length));
-      at += kPrefix + static_cast<std::size_t>(length);
+    mcap::ViewSource records(data);
+    mcap::RecordReader reader(records);
+    reader.on_problem([&](const mcap::RecordProblem& problem) {
+      note("chunk at offset " + std::to_string(offset) + ": records cut off at byte " +
+           std::to_string(problem.offset));
+    });
+    for (mcap::RecordView view; reader.next(view);) {
+      auto record = mcap::parse_record(view.opcode, view.content);
       if (!record.ok()) {
         note("chunk at offset " + std::to_string(offset) +
              ": unreadable record skipped: " + record.status().message);
@@ -198,8 +214,9 @@ std::string RecoverReport::summary() const {
 
 Result<RecoverReport> recover(const std::string& in, const std::string& out, const RecoverOptions& options) {
   RecoverReport report;
-  detail::FileBytes file;
-  if (std::string e = file.open(in); !e.empty()) return Error{in + ": " + e};
+  auto input = detail::open_input(in);
+  if (!input) return Error{in + ": " + input.error().message};
+  mcap::ByteSource& file = *input.value();
   report.input_size = file.size();
   if (report.input_size == 0) return Error{in + ": empty file (0 bytes): not an MCAP file; nothing written"};
   if (same_file(in, out)) return Error{out + ": the output must not be the input file"};
@@ -264,18 +281,17 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     if (status.code == mcap::StatusCode::Truncated) {
       report.problem = "truncated: " + status.message;
       // Which record does the file end in? A chunk loses its messages.
-      mcap::Bytes prefix;
       const std::uint64_t left = report.input_size - std::min(report.stopped_at, report.input_size);
-      if (left > 0 && file.read(report.stopped_at, std::min<std::uint64_t>(left, kPrefix), prefix) &&
-          prefix[0] != mcap::kMagic[0]) {  // (not the trailing magic: the status says what is wrong with it)
-        const std::string name = detail::opcode_name(prefix[0]);
+      const std::optional<CutRecord> cut = record_at(file, report.stopped_at);
+      if (cut && !starts_magic(cut->opcode)) {
+        const std::string name = mcap::opcode_name(cut->opcode);
         report.problem = "truncated: the file ends inside a " + name + " record at offset " +
                          std::to_string(report.stopped_at);
-        if (prefix.size() == kPrefix) {
-          report.problem += " (it claims " + std::to_string(detail::le64(&prefix[1])) + " bytes, " +
-                            std::to_string(left - kPrefix) + " remain)";
+        if (cut->content_length) {
+          report.problem += " (it claims " + std::to_string(*cut->content_length) + " bytes, " +
+                            std::to_string(left - mcap::RecordReader::kPrefixSize) + " remain)";
         }
-        if (prefix[0] == static_cast<std::uint8_t>(mcap::Opcode::Chunk)) report.incomplete_chunks = 1;
+        if (cut->opcode == mcap::opcode_of<mcap::Chunk>()) report.incomplete_chunks = 1;
       }
     }
     if (in_summary) report.problem += " (in the summary section, after every data record was read)";

@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include "rbsim/mcap.hpp"
 
@@ -46,9 +47,45 @@ class ViewSource final : public ByteSource {
 // the bytes there differ from kMagic, Truncated when the source ends before all 8 (the ones
 // present being right), IoError when the read fails.
 Status check_magic(ByteSource& source, std::uint64_t offset);
+// The magic's length: where a file's first record starts, and what follows its Footer.
+inline constexpr std::uint64_t kMagicSize = sizeof kMagic;
 
 // "Chunk", "Message", ... for an opcode; "opcode 0x42" for one this library does not know.
 std::string opcode_name(std::uint8_t opcode);
+
+// Opcodes (spec: Opcodes): 0x01-0x0F are the spec's records, 0x80-0xFF private ones (readers skip
+// them), the rest reserved.
+constexpr bool is_known_opcode(std::uint8_t opcode) {
+  return opcode >= static_cast<std::uint8_t>(Opcode::Header) &&
+         opcode <= static_cast<std::uint8_t>(Opcode::DataEnd);
+}
+constexpr bool is_private_opcode(std::uint8_t opcode) {
+  return opcode >= 0x80;
+}
+
+// The opcode of record type T (opcode_of<Chunk>() == 0x06): for code that tells framed records
+// (RecordView::opcode) apart before, or without, parsing them.
+template <class T>
+constexpr std::uint8_t opcode_of() {
+  constexpr Opcode opcode = std::is_same_v<T, Header>            ? Opcode::Header
+                            : std::is_same_v<T, Footer>          ? Opcode::Footer
+                            : std::is_same_v<T, Schema>          ? Opcode::Schema
+                            : std::is_same_v<T, Channel>         ? Opcode::Channel
+                            : std::is_same_v<T, Message>         ? Opcode::Message
+                            : std::is_same_v<T, Chunk>           ? Opcode::Chunk
+                            : std::is_same_v<T, MessageIndex>    ? Opcode::MessageIndex
+                            : std::is_same_v<T, ChunkIndex>      ? Opcode::ChunkIndex
+                            : std::is_same_v<T, Attachment>      ? Opcode::Attachment
+                            : std::is_same_v<T, AttachmentIndex> ? Opcode::AttachmentIndex
+                            : std::is_same_v<T, Statistics>      ? Opcode::Statistics
+                            : std::is_same_v<T, Metadata>        ? Opcode::Metadata
+                            : std::is_same_v<T, MetadataIndex>   ? Opcode::MetadataIndex
+                            : std::is_same_v<T, SummaryOffset>   ? Opcode::SummaryOffset
+                            : std::is_same_v<T, DataEnd>         ? Opcode::DataEnd
+                                                                 : Opcode{0};
+  static_assert(opcode != Opcode{0}, "opcode_of<T>: T is not a record type of the spec");
+  return static_cast<std::uint8_t>(opcode);
+}
 
 // One framed record; `content` views the source (valid until its next read).
 struct RecordView {
