@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string_view>
 
@@ -17,6 +16,7 @@
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_records.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
@@ -153,10 +153,8 @@ class FrameSink final : public Sink {
 }  // namespace
 
 bool is_recording(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[8] = {};
-  in.read(magic, 8);
-  return in.gcount() == 8 && std::memcmp(magic, mcap::kMagic, 8) == 0;
+  mcap::Result<std::unique_ptr<mcap::ByteSource>> source = mcap::open_file_source(path);
+  return source.ok() && mcap::check_magic(*source.value(), 0).ok();
 }
 
 namespace detail {
