@@ -58,6 +58,17 @@ TEST_F(AtomicFileTest, CommitMovesTheWholeFileIntoPlace) {
   EXPECT_EQ(read(path("out.csv")), "a,b\n1,2\n");
 }
 
+TEST_F(AtomicFileTest, RenameOnlyCommitAlsoMovesTheWholeFileIntoPlace) {
+  write_text(path("frame00001.png"), "old");
+  AtomicFile f;
+  ASSERT_TRUE(f.open(path("frame00001.png")).ok());
+  ASSERT_TRUE(f.write("new frame", 9).ok());
+  EXPECT_EQ(read(path("frame00001.png")), "old");
+  ASSERT_TRUE(f.commit(AtomicFile::Durability::RenameOnly).ok());
+  EXPECT_EQ(names(), std::vector<std::string>{"frame00001.png"});
+  EXPECT_EQ(read(path("frame00001.png")), "new frame");
+}
+
 TEST_F(AtomicFileTest, DestroyedUncommittedKeepsTheOldFileAndRemovesTheTemporary) {
   write_text(path("out.csv"), "old");
   {

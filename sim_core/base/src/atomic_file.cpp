@@ -58,18 +58,19 @@ Status AtomicFile::write(const void* data, std::size_t size) {
   return Ok{};
 }
 
-Status AtomicFile::commit() {
+Status AtomicFile::commit(Durability durability) {
   if (!pending_) return Error{path_ + ": commit of a file that is not open"};
+  const bool sync = durability == Durability::Fsync;
   bool written = true;
   int error = 0;
   if (file_ != nullptr) {
-    const bool flushed = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
+    const bool flushed = std::fflush(file_) == 0 && (!sync || ::fsync(::fileno(file_)) == 0);
     error = errno;  // the flush's, if it failed; else the close's
     const bool closed = std::fclose(file_) == 0;
     if (flushed) error = errno;
     written = flushed && closed;
     file_ = nullptr;
-  } else {
+  } else if (sync) {
     written = sync_path(temp_path_);
     error = errno;
   }

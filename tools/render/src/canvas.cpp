@@ -245,7 +245,8 @@ Status Canvas::write_png(const std::string& path) const {
       info != nullptr && encode_png(png, info, file.stream(), data, stride, width_, height_, row.data());
   png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
   if (!ok) return Error{path + ": cannot write PNG"};  // file's destructor removes the temporary
-  if (Status st = file.commit(); !st) return st;
+  // One frame of hundreds, made again by rerunning the render: renamed into place, not fsynced.
+  if (Status st = file.commit(AtomicFile::Durability::RenameOnly); !st) return st;
   return Ok{};
 }
 

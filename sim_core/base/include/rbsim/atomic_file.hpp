@@ -1,5 +1,5 @@
 // The one way rbsim writes an output file: under a temporary name beside its final path, renamed
-// into place by commit() after an fsync, so a reader never sees a half-written output and a run
+// into place by commit() (after an fsync, by default), so a reader never sees a half-written output and a run
 // that fails leaves the old file as it was. Destroying an uncommitted AtomicFile removes the
 // temporary; a process that is killed leaves it, named temp_path(): `<path>.tmp.<pid>`.
 #pragma once
@@ -14,6 +14,12 @@ namespace rbsim {
 
 class AtomicFile {
  public:
+  // Fsync: the data is on disk before the rename (an output that must survive a power cut).
+  // RenameOnly: the rename alone, which still keeps readers and a killed process from a half-written
+  // file; for outputs made by the hundred (a render's frames), where an fsync each costs more
+  // than the drawing.
+  enum class Durability { Fsync, RenameOnly };
+
   AtomicFile() = default;
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -29,8 +35,8 @@ class AtomicFile {
   // The open temporary, for a library that writes through a FILE* (libpng); nullptr for an
   // external writer's file.
   std::FILE* stream() { return file_; }
-  [[nodiscard]] Status commit();  // flush, fsync, rename over path()
-  void discard();                 // removes the temporary; path() is left as it was
+  [[nodiscard]] Status commit(Durability durability = Durability::Fsync);  // flush, rename over path()
+  void discard();  // removes the temporary; path() is left as it was
 
   const std::string& path() const { return path_; }
   const std::string& temp_path() const { return temp_path_; }
