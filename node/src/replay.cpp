@@ -7,8 +7,6 @@
 #include <set>
 
 #include "clock.hpp"
-#include "rbsim/mcap.hpp"
-#include "rbsim/mcap_tools.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/replay.hpp"
 
@@ -25,11 +23,6 @@ bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
     if (now >= deadline_ns) return true;
     sleep_until(std::min(deadline_ns, now + kSlice));
   }
-}
-
-std::string last_component(std::string_view topic) {
-  const auto slash = topic.rfind('/');
-  return std::string(slash == std::string_view::npos ? topic : topic.substr(slash + 1));
 }
 
 std::span<const std::byte> bytes(const mcap::Bytes& b) {
@@ -50,7 +43,7 @@ std::array<std::byte, 12> clock_cdr(std::uint64_t t_ns) {
 
 struct Replay::Impl {
   ReplayOptions options;
-  mcap::IndexedReader reader;
+  std::unique_ptr<log::Recording> recording;
   std::vector<Publisher> publishers;
   std::map<std::uint16_t, std::size_t> route;       // replayed channel id -> publisher index
   std::set<std::uint16_t> latched_channels;         // replayed channels of latched topics (scene, markers)
@@ -69,28 +62,24 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   Impl& im = *r->impl_;
   im.options = options;
   const std::string& path = options.path;
-  // An empty or unreadable file is said to be so (recover cannot help it).
-  if (const std::string bad = mcap_tools::unreadable(path); !bad.empty())
-    return Error{"cannot read " + path + ": " + bad};
-  if (auto st = im.reader.open(path); !st.ok()) {
-    std::string hint;
-    if (st.code == mcap::StatusCode::Truncated)
-      hint = " (an unfinished recording: 'rbsim log recover' saves its complete messages, if it holds any)";
-    return Error{"cannot read " + path + ": " + st.message + hint};
-  }
+  // Raw messages only: every channel of our types is replayed as recorded, whatever it holds.
+  log::RecordingOptions ro;
+  ro.steps = false;
+  ro.scene = false;
+  auto opened = log::Recording::open(path, ro);
+  if (!opened) return Error{"cannot read " + opened.error().message};
+  im.recording = std::move(opened.value());
 
   // Channels that carry one of our types as CDR (found by type), by id (file order).
-  struct Candidate {
-    const mcap::Channel* channel;
-    const msgs::TopicSpec* spec;
-  };
+  using Candidate = const log::RecordedChannel*;
   std::vector<Candidate> candidates;
-  for (const log::RecordedChannel& c : log::recorded_channels(im.reader)) {
+  for (const log::RecordedChannel& c : im.recording->channels()) {
+    if (c.spec == nullptr) continue;
     if (!c.problem.empty()) {
       r->warnings_.push_back("skipping " + c.channel->topic + ": " + c.problem);
       continue;
     }
-    candidates.push_back({c.channel, c.spec});
+    candidates.push_back(&c);
   }
   if (candidates.empty()) {
     std::string why = "none of its channels carries an rbsim message type as CDR";
@@ -103,27 +92,26 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     std::vector<Candidate> chosen;
     for (const std::string& name : options.topics) {
       bool found = false;
-      for (const Candidate& c : candidates) {
-        if (name == c.channel->topic || name == last_component(c.channel->topic) || name == c.spec->suffix) {
+      for (const Candidate c : candidates) {
+        if (msgs::names_topic(name, c->channel->topic) || name == c->spec->suffix) {
           found = true;
-          if (std::none_of(chosen.begin(), chosen.end(),
-                           [&](const Candidate& x) { return x.channel == c.channel; })) {
+          if (std::none_of(chosen.begin(), chosen.end(), [&](const Candidate x) { return x == c; })) {
             chosen.push_back(c);
           }
         }
       }
       if (!found) {
         std::string known;
-        for (const Candidate& c : candidates) known += (known.empty() ? "" : ", ") + c.channel->topic;
+        for (const Candidate c : candidates) known += (known.empty() ? "" : ", ") + c->channel->topic;
         return Error{"unknown topic \"" + name + "\": " + path + " has " + known};
       }
     }
     std::sort(chosen.begin(), chosen.end(),
-              [](const Candidate& a, const Candidate& b) { return a.channel->id < b.channel->id; });
+              [](const Candidate a, const Candidate b) { return a->channel->id < b->channel->id; });
     candidates = std::move(chosen);
   }
   if (options.clock) {
-    std::erase_if(candidates, [](const Candidate& c) { return c.spec->id == msgs::TopicId::Clock; });
+    std::erase_if(candidates, [](const Candidate c) { return c->spec->id == msgs::TopicId::Clock; });
     if (candidates.empty())
       return Error{"nothing to replay: --topics selects only /clock, which --clock replaces"};
   }
@@ -144,30 +132,19 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     by_topic.emplace(topic, std::make_pair(im.publishers.size() - 1, &spec));
     return im.publishers.size() - 1;
   };
-  const auto& stats = im.reader.statistics();
   std::optional<std::size_t> states_publisher;
-  for (const Candidate& c : candidates) {
-    const std::string topic = options.ns ? msgs::topic_name(*c.spec, *options.ns) : c.channel->topic;
-    auto index = publisher_for(*c.spec, topic);
+  for (const Candidate c : candidates) {
+    const std::string topic = options.ns ? msgs::topic_name(*c->spec, *options.ns) : c->channel->topic;
+    auto index = publisher_for(*c->spec, topic);
     if (!index) return index.error();
-    im.route.emplace(c.channel->id, index.value());
-    if (c.spec->transient_local) im.latched_channels.insert(c.channel->id);
-    if (c.spec->id == msgs::TopicId::BodyStates && !states_publisher) states_publisher = index.value();
-    im.topics.push_back(c.channel->topic);
-    std::uint64_t count = 0;
-    if (stats) {
-      if (auto it = stats->channel_message_counts.find(c.channel->id);
-          it != stats->channel_message_counts.end()) {
-        count = it->second;
-      }
-    }
-    std::string schema;
-    if (const auto s = im.reader.schemas().find(c.channel->schema_id); s != im.reader.schemas().end())
-      schema.assign(reinterpret_cast<const char*>(s->second.data.data()), s->second.data.size());
-    im.output_of.emplace(c.channel->id, r->outputs_.size());
-    im.topic_of.emplace(c.channel->id, c.spec->id);
-    r->outputs_.push_back({c.channel->topic, topic, count, std::string(c.spec->type), std::move(schema),
-                           c.spec->transient_local});
+    im.route.emplace(c->channel->id, index.value());
+    if (c->spec->transient_local) im.latched_channels.insert(c->channel->id);
+    if (c->spec->id == msgs::TopicId::BodyStates && !states_publisher) states_publisher = index.value();
+    im.topics.push_back(c->channel->topic);
+    im.output_of.emplace(c->channel->id, r->outputs_.size());
+    im.topic_of.emplace(c->channel->id, c->spec->id);
+    r->outputs_.push_back({c->channel->topic, topic, c->message_count.value_or(0), std::string(c->spec->type),
+                           std::string(c->schema_text()), c->spec->transient_local});
   }
   if (options.clock) {
     const msgs::TopicSpec& spec = msgs::topic(msgs::TopicId::Clock);
@@ -184,19 +161,14 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   // The log-time range of the replayed channels: the first message is where pacing and
   // --start-offset count from.
   bool any = false;
-  mcap::ReadMessagesOptions first;
-  first.topics = im.topics;
-  auto st = im.reader.read_messages(first, [&](const mcap::MessageEntry& e) {
-    r->first_log_time_ = e.message.log_time;
+  Status st = im.recording->read_messages({im.topics}, [&](const log::RecordedMessage& m) {
+    r->first_log_time_ = m.message->log_time;
     any = true;
     return false;
   });
-  if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
+  if (!st) return Error{"cannot read " + st.error().message};
   if (!any) return Error{path + ": the log has rbsim topics but no messages on them"};
-  r->last_log_time_ = r->first_log_time_;
-  for (const mcap::ChunkIndex& ci : im.reader.chunk_indexes())
-    r->last_log_time_ = std::max(r->last_log_time_, ci.message_end_time);
-  if (stats) r->last_log_time_ = std::max(r->last_log_time_, stats->message_end_time);
+  r->last_log_time_ = std::max(r->first_log_time_, im.recording->last_log_time().value_or(0));
   return r;
 }
 
@@ -239,7 +211,6 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     }
     tap->message(im.output_of.at(channel), t, cdr);
   };
-  const std::string& path = im.options.path;
   const double offset_ns = std::max(0.0, im.options.start_offset) * 1e9;
   const std::uint64_t start = offset_ns >= static_cast<double>(mcap::kMaxTime - first_log_time_)
                                   ? mcap::kMaxTime
@@ -250,18 +221,19 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
   std::map<std::uint16_t, mcap::Message> latched;
   std::set<std::uint16_t> sent_early;
   if (!im.latched_channels.empty()) {
-    mcap::ReadMessagesOptions o;
-    for (const auto& [id, channel] : im.reader.channels()) {
-      if (im.latched_channels.count(id) > 0) o.topics.push_back(channel.topic);
+    log::MessageFilter latched_topics;
+    for (const log::RecordedChannel& c : im.recording->channels()) {
+      if (im.latched_channels.count(c.channel->id) > 0) latched_topics.topics.push_back(c.channel->topic);
     }
-    auto st = im.reader.read_messages(o, [&](const mcap::MessageEntry& e) {
-      const std::uint16_t ch = e.message.channel_id;
+    Status st = im.recording->read_messages(latched_topics, [&](const log::RecordedMessage& rm) {
+      const mcap::Message& m = *rm.message;
+      const std::uint16_t ch = m.channel_id;
       if (im.latched_channels.count(ch) == 0) return true;
-      if (e.message.log_time < start || latched.count(ch) == 0) latched[ch] = e.message;
+      if (m.log_time < start || latched.count(ch) == 0) latched[ch] = m;
       // Past the start with one per channel: the rest of the log cannot change the choice.
-      return e.message.log_time < start || latched.size() < im.latched_channels.size();
+      return m.log_time < start || latched.size() < im.latched_channels.size();
     });
-    if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
+    if (!st) return Error{"cannot read " + st.error().message};
     for (const auto& [ch, m] : latched) {
       if (stop()) return false;
       if (Status s = im.publishers[im.route.at(ch)].publish(bytes(m.data)); !s) return s.error();
@@ -278,11 +250,9 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
   std::uint64_t t0 = 0;
   std::optional<std::uint64_t> last_clock;
   const double rate = im.options.rate;
-  mcap::ReadMessagesOptions o;
-  o.topics = im.topics;
-  o.start_time = start;
-  auto st = im.reader.read_messages(o, [&](const mcap::MessageEntry& e) {
-    const mcap::Message& m = e.message;
+  log::MessageFilter played{im.topics, start};
+  Status st = im.recording->read_messages(played, [&](const log::RecordedMessage& rm) {
+    const mcap::Message& m = *rm.message;
     const auto route = im.route.find(m.channel_id);
     if (route == im.route.end()) return true;  // a channel of the same name we do not replay
     if (sent_early.count(m.channel_id) > 0 && latched.at(m.channel_id).log_time == m.log_time &&
@@ -323,7 +293,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     ++published_;
     return true;
   });
-  if (!st.ok()) return Error{"reading " + path + " failed: " + st.message};
+  if (!st) return Error{"cannot read " + st.error().message};
   if (failure) return *failure;
   return !stopped;
 }

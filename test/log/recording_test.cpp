@@ -316,5 +316,133 @@ TEST(Recording, OpenNamesTheFileOfAnUnreadableInput) {
   EXPECT_NE(missing.error().message.find("missing.mcap"), std::string::npos);
 }
 
+// Raw reading: every topic's messages as recorded, in log-time order whatever the file order,
+// picked by topic and log-time window.
+TEST(Recording, ReadMessagesGivesRawMessagesInLogTimeOrder) {
+  TempDir dir;
+  const fs::path file = dir / "shuffled.mcap";
+  write_recording(file, {{TopicId::BodyStates, 0, 30},
+                         {TopicId::Scene, 0, 10},
+                         {TopicId::SpringStates, 0, 20},
+                         {TopicId::Energy, 0, 50},
+                         {TopicId::BodyStates, 1, 40}});
+  log::RecordingOptions raw;
+  raw.steps = false;
+  raw.scene = false;
+  auto opened = log::Recording::open(file.string(), raw);
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  log::Recording& r = *opened.value();
+  EXPECT_EQ(r.scene(), nullptr);
+  std::vector<std::pair<mcap::Timestamp, std::string>> seen;
+  const auto collect = [&](const log::RecordedMessage& m) {
+    EXPECT_NE(m.channel->spec, nullptr);
+    EXPECT_GE(m.cdr().size(), 4u);
+    seen.emplace_back(m.message->log_time, m.topic());
+    return true;
+  };
+  ASSERT_TRUE(r.read_messages({}, collect).ok());
+  const std::vector<std::pair<mcap::Timestamp, std::string>> all = {{10, "/rbsim/scene"},
+                                                                    {20, "/rbsim/spring_states"},
+                                                                    {30, "/rbsim/body_states"},
+                                                                    {40, "/rbsim/body_states"},
+                                                                    {50, "/rbsim/energy"}};
+  EXPECT_EQ(seen, all);
+  seen.clear();
+  ASSERT_TRUE(r.read_messages({{"/rbsim/body_states", "/rbsim/energy"}, 31, 60}, collect).ok());
+  EXPECT_EQ(seen, (std::vector<std::pair<mcap::Timestamp, std::string>>{{40, "/rbsim/body_states"},
+                                                                        {50, "/rbsim/energy"}}));
+  seen.clear();
+  ASSERT_TRUE(r.read_messages({}, [&](const log::RecordedMessage& m) {
+                 seen.emplace_back(m.message->log_time, m.topic());
+                 return seen.size() < 2;  // false stops the read, without an error
+               }).ok());
+  EXPECT_EQ(seen.size(), 2u);
+  EXPECT_EQ(r.last_log_time(), std::optional<mcap::Timestamp>(50));
+}
+
+// channels() lists channels of any type; a raw reader opens a file of none of ours, which a
+// reader of steps refuses.
+TEST(Recording, ChannelsListsTopicsOfOtherTypes) {
+  TempDir dir;
+  const fs::path file = dir / "foreign.mcap";
+  {
+    mcap::Writer w;
+    ASSERT_TRUE(w.open(file.string(), log::writer_options(mcap::Compression::None)).ok());
+    const std::string text = "int32 x\n";
+    ASSERT_TRUE(
+        w.add_schema({1, "other_msgs/msg/Thing", "ros2msg", mcap::Bytes(text.begin(), text.end())}).ok());
+    ASSERT_TRUE(w.add_channel({1, 1, "/thing", "cdr", {}}).ok());
+    const mcap::Bytes cdr = {0, 1, 0, 0, 7, 0, 0, 0};
+    for (std::uint32_t k = 0; k < 3; ++k)
+      ASSERT_TRUE(w.write_message(1, k, 100 + k, 100 + k, mcap::ByteView{cdr.data(), cdr.size()}).ok());
+    ASSERT_TRUE(w.close().ok());
+  }
+  auto steps = log::Recording::open(file.string(), {});
+  ASSERT_FALSE(steps.ok());
+  EXPECT_NE(steps.error().message.find("no rbsim_msgs/msg/SceneDescription topic"), std::string::npos)
+      << steps.error().message;
+  log::RecordingOptions raw;
+  raw.steps = false;
+  raw.scene = false;
+  auto opened = log::Recording::open(file.string(), raw);
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  const auto& channels = opened.value()->channels();
+  ASSERT_EQ(channels.size(), 1u);
+  EXPECT_EQ(channels[0].spec, nullptr);
+  EXPECT_EQ(channels[0].channel->topic, "/thing");
+  EXPECT_EQ(channels[0].schema_text(), "int32 x\n");
+  EXPECT_EQ(channels[0].message_count, std::optional<std::uint64_t>(3));
+  EXPECT_TRUE(opened.value()->lists_every_channel());
+  int messages = 0;
+  ASSERT_TRUE(opened.value()
+                  ->read_messages({},
+                                  [&](const log::RecordedMessage& m) {
+                                    EXPECT_EQ(m.cdr()[4], std::byte{7});
+                                    ++messages;
+                                    return true;
+                                  })
+                  .ok());
+  EXPECT_EQ(messages, 3);
+}
+
+// read_steps() with other topics beside: one pass gives the joined steps and those topics' raw
+// messages, each in its order.
+TEST(Recording, ReadStepsPassesOtherTopicsInTheSamePass) {
+  TempDir dir;
+  const fs::path file = dir / "chain.mcap";
+  record_scene(source_path("scenes/chain.xml"), file, 5);
+  auto opened = log::Recording::open(file.string(), {});
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  log::Recording& r = *opened.value();
+  std::vector<std::uint64_t> steps;
+  std::vector<std::string> raw;
+  const log::MessageFilter also{{"/tf", r.topic(TopicId::Scene)}};
+  const Status st = r.read_steps(
+      [&](const log::RecordedStep& s) -> Status {
+        steps.push_back(s.step);
+        return Ok{};
+      },
+      also,
+      [&](const log::RecordedMessage& m) {
+        EXPECT_EQ(m.channel->spec, &msgs::topic(m.topic() == "/tf" ? TopicId::Tf : TopicId::Scene));
+        raw.push_back(m.topic());
+        return true;
+      });
+  ASSERT_TRUE(st.ok()) << st.error().message;
+  EXPECT_EQ(steps, (std::vector<std::uint64_t>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(std::count(raw.begin(), raw.end(), "/tf"), 6);
+  EXPECT_EQ(std::count(raw.begin(), raw.end(), "/rbsim/scene"), 1);
+  // Stopping from the raw side ends the pass without an error and passes no more steps.
+  steps.clear();
+  ASSERT_TRUE(r.read_steps(
+                   [&](const log::RecordedStep& s) -> Status {
+                     steps.push_back(s.step);
+                     return Ok{};
+                   },
+                   also, [](const log::RecordedMessage&) { return false; })
+                  .ok());
+  EXPECT_LT(steps.size(), 6u);
+}
+
 }  // namespace
 }  // namespace rbsim::test

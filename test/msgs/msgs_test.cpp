@@ -484,4 +484,37 @@ TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {
   EXPECT_FALSE(rbsim::msgs::decode_stamp(TopicId::Markers, empty).has_value());
 }
 
+// The one step rule: the step field where a type has one (even against its stamp), else
+// round(stamp / dt); nothing without either, or with a dt that cannot divide.
+TEST(MessageStep, UsesTheStepFieldElseTheStampOverDt) {
+  rbsim::Scene scene = spring_wind_scene();
+  auto w = rbsim::World::create(scene.world);
+  ASSERT_TRUE(w.ok());
+  for (int i = 0; i < 1234; ++i) w->step();
+  const double dt = scene.world.dt;
+  const rbsim::msgs::Encoder encoder(scene);
+  rbsim::msgs::Bytes out;
+  for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
+    encoder.encode(spec.id, w.value(), out);
+    const auto step = rbsim::msgs::message_step(spec.id, out, dt);
+    if (spec.id == TopicId::Scene) {
+      EXPECT_FALSE(step.has_value());
+      continue;
+    }
+    ASSERT_TRUE(step.has_value()) << spec.suffix;
+    EXPECT_EQ(*step, 1234u) << spec.suffix;
+    const bool has_field =
+        spec.id == TopicId::BodyStates || spec.id == TopicId::SpringStates || spec.id == TopicId::Energy;
+    // A dt that cannot divide: only the types that carry their step still have one.
+    EXPECT_EQ(rbsim::msgs::message_step(spec.id, out, 0.0).has_value(), has_field) << spec.suffix;
+    EXPECT_EQ(rbsim::msgs::message_step(spec.id, out, std::nan("")).has_value(), has_field) << spec.suffix;
+    // Twice the dt halves a stamp's step, never a step field's.
+    EXPECT_EQ(rbsim::msgs::message_step(spec.id, out, 2 * dt), has_field ? 1234u : 617u) << spec.suffix;
+    EXPECT_FALSE(rbsim::msgs::message_step(spec.id, std::span(out).first(8), dt).has_value()) << spec.suffix;
+  }
+  const std::byte empty[] = {std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0},
+                             std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0}};
+  EXPECT_FALSE(rbsim::msgs::message_step(TopicId::Markers, empty, dt).has_value());
+}
+
 }  // namespace

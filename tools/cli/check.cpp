@@ -117,7 +117,8 @@ Subcommand add_check_command(CLI::App& parent) {
       "Print the --record-every K a golden of this scene is recorded with (about 500 steps) and exit");
   app->footer(
       "Per-step messages (body and spring states, energy, /tf, springs, poses, clock) pair up per topic by "
-      "simulated step, round(stamp / dt) with each file's dt from its scene description; the scene "
+      "simulated step (the step body and spring states and energy carry, round(stamp / dt) for the others "
+      "with each file's dt from its scene description); the scene "
       "description (and messages of other types) pair up in order. A step or message in only one file, a "
       "topic in only one file, a different schema or log time, or a physics value outside the tolerance is "
       "a divergence; steps in one file only are listed per topic with their ranges and likely cause (a "

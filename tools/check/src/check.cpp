@@ -28,7 +28,8 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/mcap.hpp"
-#include "record_pump.hpp"
+#include "rbsim/record_stream.hpp"
+#include "rbsim/recording.hpp"
 
 namespace rbsim::check {
 
@@ -216,7 +217,7 @@ struct Topic {
 
 struct Side {
   std::string path, role;  // role: "run" or "golden"
-  RecordPump pump;
+  log::RecordStream pump;
   std::map<std::uint16_t, mcap::Schema> schemas;
   std::map<std::uint16_t, std::size_t> channel_topic;
   std::set<std::string> summary_topics;
@@ -329,71 +330,43 @@ class Comparer {
   Status open(Side& s) {
     // The summary first: a clear error for a truncated or non-MCAP file before any comparing, and
     // the file's whole topic list (so messages of a topic the other file lacks are not queued).
-    std::error_code ec;
-    const auto status = std::filesystem::status(s.path, ec);
-    if (std::filesystem::is_directory(status)) return Error{with_path(s, "is a directory, not an MCAP file")};
-    if (std::filesystem::is_regular_file(status) && std::filesystem::file_size(s.path, ec) == 0 && !ec) {
-      return Error{with_path(s, "empty file, not an MCAP file")};
-    }
-    mcap::IndexedReader index;
-    if (auto st = index.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
-    s.header = index.header();
-    for (const auto& [id, channel] : index.channels()) s.summary_topics.insert(channel.topic);
-    if (Status st = read_dt(s, index); !st) return st;
+    log::RecordingOptions raw;  // any file, whatever types it carries: no topic is required
+    raw.steps = false;
+    raw.scene = false;
+    auto recording = log::Recording::open(s.path, raw);
+    if (!recording) return Error{s.role + " log " + recording.error().message};
+    const log::Recording& r = *recording.value();
+    s.header = r.header();
+    for (const log::RecordedChannel& c : r.channels()) s.summary_topics.insert(c.channel->topic);
     // The summary's channels are known to be complete when every chunk's message index names
     // only channels it lists (rbsim writes indexes and repeats channels; other writers may not).
-    s.summary_known = index.indexed();
-    for (const mcap::ChunkIndex& ci : index.chunk_indexes()) {
-      if (ci.message_index_offsets.empty()) s.summary_known = false;
-      for (const auto& [channel_id, offset] : ci.message_index_offsets) {
-        if (index.channels().count(channel_id) == 0) s.summary_known = false;
-      }
-    }
-    if (auto st = s.pump.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
+    s.summary_known = r.lists_every_channel();
+    if (Status st = read_dt(s, *recording.value()); !st) return st;
+    if (Status st = s.pump.open(s.path); !st) return Error{s.role + " log " + st.error().message};
     return Ok{};
   }
 
-  // The first scene description: its time step (steps are round(stamp / dt)) and, for the
+  // The first scene description: its time step (the step of a message that carries only a stamp is
+  // round(stamp / dt)) and, for the
   // different-scene check, the scene itself.
-  static Status read_dt(Side& s, mcap::IndexedReader& index) {
-    std::vector<std::string> scene_topics;
-    for (const auto& [id, channel] : index.channels()) {
-      const auto schema = index.schemas().find(channel.schema_id);
-      if (schema != index.schemas().end() && is_type(schema->second.name, msgs::TopicId::Scene))
-        scene_topics.push_back(channel.topic);
+  static Status read_dt(Side& s, log::Recording& recording) {
+    log::MessageFilter scenes;
+    for (const log::RecordedChannel& c : recording.channels()) {
+      if (c.spec != nullptr && c.spec->id == msgs::TopicId::Scene) scenes.topics.push_back(c.channel->topic);
     }
-    if (scene_topics.empty()) return Ok{};
-    mcap::ReadMessagesOptions options;
-    options.topics = scene_topics;
-    const mcap::Status st = index.read_messages(options, [&](const mcap::MessageEntry& e) {
-      Result<msgs::SceneMessage> scene = msgs::decode_scene(cdr(e.message.data));
+    if (scenes.topics.empty()) return Ok{};
+    const Status st = recording.read_messages(scenes, [&](const log::RecordedMessage& m) {
+      Result<msgs::SceneMessage> scene = msgs::decode_scene(m.cdr());
       if (scene && std::isfinite(scene->dt) && scene->dt > 0.0) s.dt = scene->dt;
       if (scene) s.scene = std::move(scene.value());
       return false;
     });
-    if (!st.ok()) return Error{with_path(s, describe(st))};
+    if (!st) return Error{s.role + " log " + st.error().message};
     return Ok{};
   }
 
   static bool is_type(const std::string& schema_name, msgs::TopicId id) {
     return msgs::topic_for_type(schema_name) == &msgs::topic(id);
-  }
-
-  static std::string describe(const mcap::Status& st) {
-    switch (st.code) {
-      case mcap::StatusCode::BadMagic:
-        return st.message.starts_with("not an MCAP file") ? st.message
-                                                          : "not an MCAP file (" + st.message + ")";
-      case mcap::StatusCode::Truncated:
-        return "truncated or incomplete MCAP file (" + st.message + ")";
-      case mcap::StatusCode::CrcMismatch:
-        return "corrupted MCAP file (" + st.message + ")";
-      case mcap::StatusCode::Malformed:
-      case mcap::StatusCode::DecompressionFailed:
-        return "corrupted MCAP file (" + st.message + ")";
-      default:
-        return st.message;
-    }
   }
 
   static bool any_names(const std::vector<std::string>& list, const std::string& topic) {
@@ -409,7 +382,7 @@ class Comparer {
     Side& s = side_[si];
     mcap::Record* next = s.pump.next();
     if (next == nullptr) {
-      if (!s.pump.status().ok()) return Error{with_path(s, describe(s.pump.status()))};
+      if (Status st = s.pump.status(); !st) return Error{s.role + " log " + st.error().message};
       s.done = true;
       return Ok{};
     }
@@ -550,16 +523,12 @@ class Comparer {
     return false;
   }
 
-  // The simulated step of a per-step message: round(stamp / dt) with the file's own dt (a message
-  // without a stamp, an empty MarkerArray, follows the previous one).
+  // The simulated step of a per-step message, msgs::message_step with the file's own dt; a message
+  // without one (an empty MarkerArray) follows the previous one.
   std::uint64_t step_of_message(Topic& t, int si, const mcap::Bytes& data) {
     StepTrack& tr = t.track[si];
-    std::uint64_t step = tr.any ? tr.last + std::max<std::uint64_t>(tr.stride, 1) : 0;
-    if (const auto stamp = msgs::decode_stamp(*t.step_id, cdr(data))) {
-      const double ns = static_cast<double>(stamp->sec) * 1e9 + static_cast<double>(stamp->nanosec);
-      const double k = std::round(ns / (side_[si].dt * 1e9));
-      step = !(k > 0.0) ? 0 : k >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(k);
-    }
+    const std::uint64_t step = msgs::message_step(*t.step_id, cdr(data), side_[si].dt)
+                                   .value_or(tr.any ? tr.last + std::max<std::uint64_t>(tr.stride, 1) : 0);
     tr.add(step);
     return step;
   }

@@ -5,9 +5,8 @@
 #include <map>
 #include <set>
 
-#include "rbsim/mcap.hpp"
-#include "rbsim/mcap_tools.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/recording.hpp"
 
 namespace rbsim::log {
 
@@ -29,15 +28,19 @@ struct ChannelDecoder {
 
 Status cat(const std::string& path, const CatOptions& options,
            const std::function<void(std::string_view line)>& on_line) {
-  mcap::IndexedReader reader;
-  if (mcap::Status st = reader.open(path); !st.ok()) return Error{path + ": " + mcap_tools::read_error(st)};
+  RecordingOptions raw;  // every topic as recorded, whatever its type
+  raw.steps = false;
+  raw.scene = false;
+  auto opened = Recording::open(path, raw);
+  if (!opened) return opened.error();
+  Recording& recording = *opened.value();
 
-  mcap::ReadMessagesOptions ro;
-  if (const auto start = to_ns(options.start)) ro.start_time = *start;
-  if (const auto end = to_ns(options.end)) ro.end_time = *end;
+  MessageFilter filter;
+  if (const auto start = to_ns(options.start)) filter.start = *start;
+  if (const auto end = to_ns(options.end)) filter.end = *end;
   if (!options.topics.empty()) {
     std::set<std::string> known;
-    for (const auto& [id, channel] : reader.channels()) known.insert(channel.topic);
+    for (const RecordedChannel& c : recording.channels()) known.insert(c.channel->topic);
     std::set<std::string> chosen;
     for (const std::string& requested : options.topics) {
       bool found = false;
@@ -53,37 +56,36 @@ Status cat(const std::string& path, const CatOptions& options,
         return Error{path + ": no topic " + requested + " (topics: " + (list.empty() ? "none" : list) + ")"};
       }
     }
-    ro.topics.assign(chosen.begin(), chosen.end());
+    filter.topics.assign(chosen.begin(), chosen.end());
   }
 
   std::map<std::uint16_t, ChannelDecoder> decoders;
   std::string line;
   Status failure = Ok{};
-  mcap::Status read = reader.read_messages(ro, [&](const mcap::MessageEntry& e) -> bool {
-    const mcap::Message& m = e.message;
+  const Status read = recording.read_messages(filter, [&](const RecordedMessage& rm) -> bool {
+    const mcap::Message& m = *rm.message;
+    const mcap::Schema* schema = rm.channel->schema;
     auto [it, fresh] = decoders.try_emplace(m.channel_id);
-    if (fresh && e.channel != nullptr && e.schema != nullptr && e.schema->encoding == "ros2msg" &&
-        e.channel->message_encoding == "cdr") {
-      const std::string_view text(reinterpret_cast<const char*>(e.schema->data.data()),
-                                  e.schema->data.size());
-      auto decoder = msgs::MessageDecoder::create(e.schema->name, text);
+    if (fresh && schema != nullptr && schema->encoding == "ros2msg" &&
+        rm.channel->channel->message_encoding == "cdr") {
+      auto decoder = msgs::MessageDecoder::create(schema->name, rm.channel->schema_text());
       if (!decoder) {
-        failure = Error{path + ": schema " + e.schema->name + ": " + decoder.error().message};
+        failure = Error{path + ": schema " + schema->name + ": " + decoder.error().message};
         return false;
       }
       it->second.decoder = std::move(decoder.value());
     }
     line.clear();
     line += "{\"topic\":";
-    msgs::append_json_string(line, e.channel != nullptr ? e.channel->topic : std::string());
+    msgs::append_json_string(line, rm.topic());
     line += ",\"sequence\":" + std::to_string(m.sequence);
     line += ",\"log_time\":" + std::to_string(m.log_time);
     line += ",\"publish_time\":" + std::to_string(m.publish_time);
     line += ",\"data\":";
     if (it->second.decoder) {
-      if (Status st = it->second.decoder->to_json(std::as_bytes(std::span(m.data)), line); !st) {
-        failure = Error{path + ": " + (e.channel != nullptr ? e.channel->topic : "?") +
-                        " message at log time " + std::to_string(m.log_time) + " ns: " + st.error().message};
+      if (Status st = it->second.decoder->to_json(rm.cdr(), line); !st) {
+        failure = Error{path + ": " + rm.topic() + " message at log time " + std::to_string(m.log_time) +
+                        " ns: " + st.error().message};
         return false;
       }
     } else {
@@ -93,7 +95,7 @@ Status cat(const std::string& path, const CatOptions& options,
     on_line(line);
     return true;
   });
-  if (!read.ok()) return Error{path + ": " + mcap_tools::read_error(read)};
+  if (!read) return read;
   return failure;
 }
 

@@ -2,10 +2,13 @@
 // their step.
 #include "rbsim/recording.hpp"
 
+#include <algorithm>
 #include <array>
+#include <deque>
 #include <map>
 #include <optional>
 
+#include "rbsim/assert.hpp"
 #include "rbsim/mcap_tools.hpp"
 
 namespace rbsim::log {
@@ -30,34 +33,44 @@ std::span<const std::byte> bytes_of(const mcap::Message& m) {
 
 }  // namespace
 
-std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader) {
-  std::vector<RecordedChannel> out;
-  for (const auto& [id, channel] : reader.channels()) {
-    const auto schema = reader.schemas().find(channel.schema_id);
-    if (schema == reader.schemas().end()) continue;
-    const msgs::TopicSpec* spec = msgs::topic_for_type(schema->second.name);
-    if (spec == nullptr) continue;
-    RecordedChannel c{&channel, spec, {}};
-    const std::string type(spec->type);
-    Result<std::string> ours = msgs::ros2msg_schema(type);
-    const mcap::Bytes& theirs = schema->second.data;
-    const std::string_view text(reinterpret_cast<const char*>(theirs.data()), theirs.size());
-    const auto energy_version = spec->id == msgs::TopicId::Energy && schema->second.encoding == "ros2msg"
-                                    ? msgs::energy_terms_version(text)
-                                    : std::nullopt;
-    if (channel.message_encoding != "cdr") {
-      c.problem = "message encoding \"" + channel.message_encoding + "\", not cdr";
-    } else if (energy_version) {
-      c.energy_version = *energy_version;
-    } else if (!ours || schema->second.encoding != "ros2msg" ||
-               std::string_view(reinterpret_cast<const char*>(theirs.data()), theirs.size()) !=
-                   ours.value()) {
-      c.problem = "its " + type + " schema differs from this build's (recorded by another version?)";
-    }
-    out.push_back(std::move(c));
-  }
-  return out;
+std::string_view RecordedChannel::schema_text() const {
+  if (schema == nullptr) return {};
+  return {reinterpret_cast<const char*>(schema->data.data()), schema->data.size()};
 }
+
+namespace {
+
+// What this build makes of a channel: its rbsim topic (by schema name), whether it can decode it.
+RecordedChannel describe_channel(const mcap::IndexedReader& reader, const mcap::Channel& channel) {
+  RecordedChannel c;
+  c.channel = &channel;
+  if (const auto schema = reader.schemas().find(channel.schema_id); schema != reader.schemas().end())
+    c.schema = &schema->second;
+  if (const auto& stats = reader.statistics()) {
+    if (const auto n = stats->channel_message_counts.find(channel.id);
+        n != stats->channel_message_counts.end())
+      c.message_count = n->second;
+  }
+  if (c.schema == nullptr) return c;
+  c.spec = msgs::topic_for_type(c.schema->name);
+  if (c.spec == nullptr) return c;
+  const std::string type(c.spec->type);
+  Result<std::string> ours = msgs::ros2msg_schema(type);
+  const std::string_view text = c.schema_text();
+  const auto energy_version = c.spec->id == msgs::TopicId::Energy && c.schema->encoding == "ros2msg"
+                                  ? msgs::energy_terms_version(text)
+                                  : std::nullopt;
+  if (channel.message_encoding != "cdr") {
+    c.problem = "message encoding \"" + channel.message_encoding + "\", not cdr";
+  } else if (energy_version) {
+    c.energy_version = *energy_version;
+  } else if (!ours || c.schema->encoding != "ros2msg" || text != ours.value()) {
+    c.problem = "its " + type + " schema differs from this build's (recorded by another version?)";
+  }
+  return c;
+}
+
+}  // namespace
 
 struct Recording::Impl {
   // The messages recorded for one step, as far as they have arrived.
@@ -73,6 +86,10 @@ struct Recording::Impl {
   std::string path;
   RecordingOptions options;
   mcap::IndexedReader reader;
+  // Every channel, in the order they became known (the summary's by id, then any a read found);
+  // a deque, so the pointers handed out in RecordedMessage stay valid as channels are added.
+  std::deque<RecordedChannel> channels;
+  std::map<std::uint16_t, std::size_t> channel_at;  // channel id -> index in channels
   std::optional<msgs::SceneMessage> scene;
   std::array<std::string, msgs::kTopicCount> topics;
   std::map<std::uint16_t, msgs::TopicId> route;  // channel id -> the topic it carries
@@ -89,11 +106,30 @@ struct Recording::Impl {
 
   Error fail(const std::string& what) const { return Error{path + ": " + what}; }
 
+  // The channel a message arrived on (one the summary did not list is described now).
+  const RecordedChannel* channel_of(const mcap::MessageEntry& e) {
+    const std::uint16_t id = e.message.channel_id;
+    if (const auto it = channel_at.find(id); it != channel_at.end()) return &channels[it->second];
+    if (e.channel == nullptr) return nullptr;
+    channel_at.emplace(id, channels.size());
+    return &channels.emplace_back(describe_channel(reader, *e.channel));
+  }
+
+  void learn_channels() {
+    for (const auto& [id, channel] : reader.channels()) {
+      if (channel_at.count(id) != 0) continue;
+      channel_at.emplace(id, channels.size());
+      channels.push_back(describe_channel(reader, channel));
+    }
+  }
+
   Status classify() {
-    for (const RecordedChannel& c : recorded_channels(reader)) {
+    for (const RecordedChannel& c : channels) {
+      if (c.spec == nullptr) continue;
       const msgs::TopicId id = c.spec->id;
       const int i = per_step_index(id);
-      if (id != msgs::TopicId::Scene && (i < 0 || !read[static_cast<std::size_t>(i)])) continue;
+      if (id == msgs::TopicId::Scene ? !options.scene : (i < 0 || !read[static_cast<std::size_t>(i)]))
+        continue;
       if (!options.ns.empty() && c.channel->topic != msgs::topic_name(*c.spec, options.ns)) continue;
       std::string& topic = topics[static_cast<std::size_t>(id)];
       if (!topic.empty() && topic != c.channel->topic) {
@@ -169,22 +205,22 @@ struct Recording::Impl {
   Status message(const mcap::MessageEntry& e, std::size_t i) {
     const auto cdr = bytes_of(e.message);
     Status decoded = Ok{};
-    std::uint64_t step = 0;
     switch (i) {
       case kStates:
         decoded = msgs::decode_body_states(cdr, scratch_states);
-        step = scratch_states.step;
         break;
       case kSprings:
         decoded = msgs::decode_spring_states(cdr, scratch_springs);
-        step = scratch_springs.step;
         break;
       default:
         decoded = msgs::decode_energy_terms(cdr, scratch_energy, energy_version);
-        step = scratch_energy.step;
         break;
     }
     if (!decoded) return fail(where(e) + ": " + decoded.error().message);
+    // The step these types carry; decoding checked that the message holds it.
+    const std::optional<std::uint64_t> at = msgs::message_step(kPerStep[i], cdr, scene ? scene->dt : 0.0);
+    RBSIM_ASSERT(at.has_value(), "a decoded per-step message carries its step");
+    const std::uint64_t step = *at;
     if (last[i] && step <= *last[i]) {
       const std::string type(msgs::topic(kPerStep[i]).type);
       if (step == *last[i])
@@ -288,7 +324,7 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
     if (i < 0) return im.fail("cannot read " + std::string(msgs::topic(id).type) + " messages as steps");
     im.read[static_cast<std::size_t>(i)] = true;
   }
-  if (options.read.empty()) im.read.fill(true);
+  if (options.read.empty() && options.steps) im.read.fill(true);
   for (msgs::TopicId id : options.require) {
     const int i = per_step_index(id);
     if (i < 0 || !im.read[static_cast<std::size_t>(i)]) {
@@ -307,8 +343,10 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
     const mcap::Status s = im.reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
     if (!s.ok()) return im.fail(mcap_tools::read_error(s));
   }
+  im.learn_channels();
   if (Status st = im.classify(); !st) return st.error();
-  if (options.require_scene && im.topics[static_cast<std::size_t>(msgs::TopicId::Scene)].empty()) {
+  if (options.scene && options.require_scene &&
+      im.topics[static_cast<std::size_t>(msgs::TopicId::Scene)].empty()) {
     return im.missing(msgs::TopicId::Scene);
   }
   for (msgs::TopicId id : options.require) {
@@ -330,7 +368,49 @@ const std::string& Recording::topic(msgs::TopicId id) const {
   return impl_->topics[static_cast<std::size_t>(id)];
 }
 
-Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& on_step) {
+const std::deque<RecordedChannel>& Recording::channels() const {
+  return impl_->channels;
+}
+
+const mcap::Header& Recording::header() const {
+  return impl_->reader.header();
+}
+
+bool Recording::lists_every_channel() const {
+  const mcap::IndexedReader& reader = impl_->reader;
+  if (!reader.indexed()) return false;
+  for (const mcap::ChunkIndex& ci : reader.chunk_indexes()) {
+    if (ci.message_index_offsets.empty()) return false;
+    for (const auto& [channel_id, offset] : ci.message_index_offsets) {
+      if (reader.channels().count(channel_id) == 0) return false;
+    }
+  }
+  return true;
+}
+
+std::optional<mcap::Timestamp> Recording::last_log_time() const {
+  const mcap::IndexedReader& reader = impl_->reader;
+  std::optional<mcap::Timestamp> last;
+  for (const mcap::ChunkIndex& ci : reader.chunk_indexes())
+    last = std::max(last.value_or(0), ci.message_end_time);
+  if (const auto& stats = reader.statistics()) last = std::max(last.value_or(0), stats->message_end_time);
+  return last;
+}
+
+Status Recording::read_messages(const MessageFilter& filter, const MessageCallback& on_message) {
+  Impl& im = *impl_;
+  const mcap::ReadMessagesOptions ro{filter.topics, filter.start, filter.end};
+  const mcap::Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+    const RecordedChannel* channel = im.channel_of(e);
+    if (channel == nullptr) return true;  // a message on a channel the file never defines
+    return on_message(RecordedMessage{channel, &e.message});
+  });
+  if (!st.ok()) return im.fail(mcap_tools::read_error(st));
+  return Ok{};
+}
+
+Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& on_step,
+                             const MessageFilter& also, const MessageCallback& on_message) {
   Impl& im = *impl_;
   im.pending.clear();
   im.last = {};
@@ -338,19 +418,34 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   for (std::size_t i = 0; i < kPerStep.size(); ++i) {
     if (im.present[i]) ro.topics.push_back(im.topics[static_cast<std::size_t>(kPerStep[i])]);
   }
+  const std::size_t step_topics = ro.topics.size();
+  if (on_message) ro.topics.insert(ro.topics.end(), also.topics.begin(), also.topics.end());
   if (ro.topics.empty()) return Ok{};
+  const auto is_also = [&](const mcap::MessageEntry& e) {
+    if (!on_message || e.channel == nullptr || e.message.log_time < also.start ||
+        e.message.log_time >= also.end)
+      return false;
+    return std::find(ro.topics.begin() + static_cast<std::ptrdiff_t>(step_topics), ro.topics.end(),
+                     e.channel->topic) != ro.topics.end();
+  };
   Status failure = Ok{};
+  bool stopped = false;
   const mcap::Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
     const auto r = im.route.find(e.message.channel_id);
-    if (r == im.route.end()) return true;  // another channel of the same name
-    const int i = per_step_index(r->second);
-    if (i < 0) return true;
+    const int i = r == im.route.end() ? -1 : per_step_index(r->second);
+    if (i < 0) {
+      // Not a joined topic: a raw message of `also`, or another channel of a joined topic's name.
+      if (!is_also(e)) return true;
+      const RecordedChannel* channel = im.channel_of(e);
+      stopped = channel != nullptr && !on_message(RecordedMessage{channel, &e.message});
+      return !stopped;
+    }
     failure = im.message(e, static_cast<std::size_t>(i));
     if (failure) failure = im.drain(false, on_step);
     return static_cast<bool>(failure);
   });
   if (!st.ok()) return im.fail(mcap_tools::read_error(st));
-  if (!failure) return failure;
+  if (!failure || stopped) return failure;
   return im.drain(true, on_step);
 }
 

@@ -1,4 +1,5 @@
 // Typed decoding of rbsim's own messages (for tools that draw or export a recording).
+#include <cmath>
 #include <cstring>
 
 #include "rbsim/msgs.hpp"
@@ -316,6 +317,24 @@ std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr) {
   const Time t = r.time();
   if (!r.ok()) return std::nullopt;
   return t;
+}
+
+std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte> cdr, double dt) {
+  if (id == TopicId::BodyStates || id == TopicId::SpringStates || id == TopicId::Energy) {
+    Reader r(cdr);
+    r.time();
+    r.skip_string();  // header.frame_id
+    const auto step = r.get<std::uint64_t>();
+    if (!r.ok()) return std::nullopt;
+    return step;
+  }
+  const std::optional<Time> stamp = decode_stamp(id, cdr);
+  if (!stamp || !std::isfinite(dt) || !(dt > 0.0)) return std::nullopt;
+  // Stamps are written as sec + nanosec of step * dt; rounding undoes the nanosecond truncation.
+  const double ns = static_cast<double>(stamp->sec) * 1e9 + static_cast<double>(stamp->nanosec);
+  const double k = std::round(ns / (dt * 1e9));
+  if (!(k > 0.0)) return 0;
+  return k >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(k);
 }
 
 }  // namespace rbsim::msgs

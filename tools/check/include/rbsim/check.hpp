@@ -76,8 +76,9 @@ struct CheckReport {
 };
 
 // Compares a recording with a golden one. Per-step messages (rbsim's body states, spring states,
-// energy terms, /tf, springs, poses and clock) pair up per topic by simulated step, round(stamp / dt)
-// with each file's dt from its scene description; other messages (the latched scene description and markers,
+// energy terms, /tf, springs, poses and clock) pair up per topic by simulated step, msgs::message_step
+// (the step a message carries, else round(stamp / dt) with each file's dt from its scene
+// description); other messages (the latched scene description and markers,
 // topics of other types, a file without a scene description) pair up per topic in file order.
 // A step (or message) in only one file, a topic in only one file, a different schema, log time or
 // any physics field value outside the tolerance is a divergence; metadata is reported apart. Integers,

@@ -1,7 +1,11 @@
-// Reading a recording back: the one reader of rbsim's MCAP recordings (render, plot, export,
-// golden verification and replay use it). Topics are found by type from msgs::topics(), never by
-// name; messages are decoded by this build's typed decoders, so a channel whose schema text differs
-// from this build's is refused rather than misread.
+// Reading a recording back: the one reader of rbsim's MCAP recordings. Render, plot, export, the
+// golden verifier, replay and rbsim check read through it (with RecordStream, record_stream.hpp,
+// for check's file-order stream); no other module uses the MCAP readers. It serves every topic:
+// rbsim's per-step topics decoded and joined by step (read_steps), and any topic as raw messages
+// in log-time order (read_messages). Topics are found by type from msgs::topics(), never by name;
+// messages are decoded by this build's typed decoders, so a channel whose schema text differs from
+// this build's is refused rather than misread. A message's step is msgs::message_step's, the one
+// step rule.
 //
 // A recording's messages may arrive in any log-time order: a live recording (rbsim record, DDS)
 // stamps each message with its arrival time, so the latched scene description can come after the
@@ -11,8 +15,11 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,38 +31,61 @@
 namespace rbsim::log {
 
 // ---------------------------------------------------------------------------------------------
-// Channels by type
+// Channels and messages
 
-// A channel of a recording that carries one of our types.
+// A channel of a recording: rbsim's types (found by schema name) and any other.
 struct RecordedChannel {
-  const mcap::Channel* channel = nullptr;  // points into the reader's channels()
-  const msgs::TopicSpec* spec = nullptr;
-  // Empty when the channel can be decoded by this build (message encoding "cdr", a "ros2msg"
-  // schema whose text equals this build's); otherwise why not, e.g. "its rbsim_msgs/msg/BodyStates
-  // schema differs from this build's (recorded by another version?)".
+  const mcap::Channel* channel = nullptr;  // points into the recording's channels
+  const mcap::Schema* schema = nullptr;    // its schema; null when it has none (or the file lacks it)
+  const msgs::TopicSpec* spec = nullptr;   // the rbsim topic whose type it carries; null: another type
+  // For one of our types: empty when the channel can be decoded by this build (message encoding
+  // "cdr", a "ros2msg" schema whose text equals this build's); otherwise why not, e.g. "its
+  // rbsim_msgs/msg/BodyStates schema differs from this build's (recorded by another version?)".
   std::string problem;
   // The layout of an EnergyTerms channel: a recording made before the potential split is read too.
   msgs::EnergyTermsVersion energy_version = msgs::EnergyTermsVersion::Current;
+  std::optional<std::uint64_t> message_count;  // from the summary's statistics, when it has them
+  std::string_view schema_text() const;        // the schema's data as text ("" without one)
 };
-// The channels of `reader` (as far as it knows them) that carry one of our types, by channel id.
-std::vector<RecordedChannel> recorded_channels(const mcap::IndexedReader& reader);
+
+// One message as recorded (CDR for rbsim's types). Valid during the callback only.
+struct RecordedMessage {
+  const RecordedChannel* channel = nullptr;
+  const mcap::Message* message = nullptr;  // log and publish time, sequence, data
+  const std::string& topic() const { return channel->channel->topic; }
+  std::span<const std::byte> cdr() const { return std::as_bytes(std::span(message->data)); }
+};
+
+// Which messages read_messages() passes on: by topic name (empty: every topic) and log time.
+struct MessageFilter {
+  std::vector<std::string> topics;
+  mcap::Timestamp start = 0;             // log time >= start
+  mcap::Timestamp end = mcap::kMaxTime;  // log time < end
+};
+
+// Called for each message in log-time order; returns false to stop reading (not an error).
+using MessageCallback = std::function<bool(const RecordedMessage&)>;
 
 // ---------------------------------------------------------------------------------------------
 // Steps
 
 struct RecordingOptions {
   std::string ns;  // ROS namespace of the topics; empty: the only one of each type in the file
-  // The per-step topics read (BodyStates, SpringStates, Energy; others are refused). Empty: all
-  // three. Topics not read are not decoded.
+  // The per-step topics read_steps() joins (BodyStates, SpringStates, Energy; others are refused).
+  // Empty: all three. Topics not read are not decoded.
   std::vector<msgs::TopicId> read;
+  // false: no per-step topic is looked for (read_steps() passes nothing): the recording is read as
+  // raw messages only, whatever types its channels carry.
+  bool steps = true;
   // Per-step topics that must be in the file (a channel of the type, in the namespace).
   std::vector<msgs::TopicId> require;
+  // false: the scene description is not looked for, and scene() is null.
+  bool scene = true;
   // false: a recording without a scene description (or with one this build cannot decode) is
   // read too, and scene() is null.
   bool require_scene = true;
   bool verify_crc = false;  // check the data section CRC on open (reads the whole file once)
 };
-
 // One recorded step. A message pointer is null when the topic is not read, not recorded, or has
 // no message for this step (lost by a live recorder, or a recording cut short). The messages are
 // checked against the scene description when there is one: as many bodies, springs, and gravity
@@ -96,8 +126,24 @@ class Recording {
   // message's log time) on a malformed message, a step that does not increase on its topic (a
   // repeat included), or a message that does not match the scene description. Decoding and
   // joining reuse their storage: once warm, they do not allocate for a recording whose topics
-  // interleave no more than they did so far.
-  [[nodiscard]] Status read_steps(const std::function<Status(const RecordedStep&)>& on_step);
+  // interleave no more than they did so far. `also` names other topics whose raw messages go to
+  // `on_message` in the same pass (log-time order), so a reader of both reads the file once.
+  [[nodiscard]] Status read_steps(const std::function<Status(const RecordedStep&)>& on_step,
+                                  const MessageFilter& also = {}, const MessageCallback& on_message = {});
+
+  // Every channel of the file, rbsim's and others', in the order they became known: the summary's
+  // by id, then any that a read found in the data section (pointers to them stay valid).
+  const std::deque<RecordedChannel>& channels() const;
+  const mcap::Header& header() const;
+  // True when the summary lists every channel that has messages (every chunk's message index
+  // names only channels it lists, as rbsim writes them): a topic not listed has no messages.
+  bool lists_every_channel() const;
+  // The log time of the last message, from the summary (statistics, chunk indexes), if it says.
+  std::optional<mcap::Timestamp> last_log_time() const;
+
+  // The raw messages `filter` picks, in log-time order, until `on_message` returns false. Fails
+  // on an unreadable or corrupt file (naming it and what is wrong).
+  [[nodiscard]] Status read_messages(const MessageFilter& filter, const MessageCallback& on_message);
 
  private:
   Recording();

@@ -294,6 +294,13 @@ Result<SceneMessage> decode_scene(std::span<const std::byte> cdr);
 // marker's stamp, a TFMessage's first transform's. nullopt for the scene description, an empty
 // MarkerArray or TFMessage, or bytes too short to hold it.
 std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr);
+// The one step rule: the simulated step a per-step message belongs to, for every reader (the
+// recording reader, rbsim check, the golden verifier). Body states, spring states and energy terms
+// carry their step (`uint64 step` after the header); the other per-step topics carry only the
+// stamp of their step, t = step * dt, so their step is round(stamp / dt) with the recording's dt
+// (from its scene description). nullopt for a message without either (the scene description, an
+// empty MarkerArray or TFMessage, bytes too short) or, for a stamp, a dt that is not finite and > 0.
+std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte> cdr, double dt);
 
 // ---------------------------------------------------------------------------------------------
 // Schema-driven decoding: any CDR message whose ros2msg schema is known (e.g. read from an MCAP

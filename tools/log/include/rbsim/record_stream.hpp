@@ -1,5 +1,6 @@
-// rbsim check's reader thread: one MCAP file streamed on its own thread (decompression and CRCs
-// are most of the work of a check), its records handed over in batches.
+// A recording streamed in file order on a reader thread of its own: for a consumer that takes
+// records as the file holds them (rbsim check, two files side by side), while
+// rbsim/recording.hpp serves topics in log-time or step order.
 #pragma once
 
 #include <condition_variable>
@@ -14,14 +15,16 @@
 #include <vector>
 
 #include "rbsim/mcap.hpp"
+#include "rbsim/status.hpp"
 
-namespace rbsim::check {
+namespace rbsim::log {
 
-// Reads one file on its own thread (decompression and CRCs are most of the work), handing its
-// Schema, Channel and Message records over in batches; at most kPumpBytes ahead of the consumer.
+// Reads one file on its own thread (decompression and CRCs are most of the work), every CRC
+// verified, handing its Schema, Channel and Message records over in batches; at most kPumpBytes
+// ahead of the consumer.
 // Message buffers the consumer is done with come back through recycle() and are filled again:
 // a fresh buffer per message costs a page fault per 4 KiB of message data.
-class RecordPump {
+class RecordStream {
  public:
   static constexpr std::uint64_t kPumpBytes = 1u << 20;
   static constexpr std::size_t kBatchRecords = 256;
@@ -29,13 +32,10 @@ class RecordPump {
   static constexpr std::size_t kSpareBuffers = 64;         // kept for reuse at most ...
   static constexpr std::uint64_t kSpareBytes = 64u << 20;  // ... and their capacity at most
 
-  ~RecordPump() { stop(); }
+  ~RecordStream() { stop(); }
 
-  mcap::Status open(const std::string& path) {
-    mcap::Status st = reader_.open(path);
-    if (st.ok()) thread_ = std::thread([this] { run(); });
-    return st;
-  }
+  // Opens `path` and starts the reader thread; errors name the file and what is wrong with it.
+  [[nodiscard]] Status open(const std::string& path);
   void stop() {
     {
       std::lock_guard<std::mutex> lock(mu_);
@@ -71,56 +71,13 @@ class RecordPump {
     cv_.notify_all();
     return current_.empty() ? next() : &current_[pos_++];
   }
-  const mcap::Status& status() const { return status_; }  // valid once next() returned null
+  // Once next() returned null: Ok when the file was read whole, else the file and what is wrong.
+  Status status() const;
 
  private:
-  void run() {
-    mcap::RecordEntry entry;
-    std::vector<mcap::Record> batch;
-    std::uint64_t bytes = 0;
-    std::vector<mcap::Bytes> spare;  // buffers to fill, taken from spare_
-    for (;;) {
-      if (auto* m = std::get_if<mcap::Message>(&entry.record); m != nullptr && m->data.capacity() == 0) {
-        if (spare.empty()) {
-          std::lock_guard<std::mutex> lock(mu_);
-          spare.swap(spare_);
-          spare_bytes_ = 0;
-        }
-        if (!spare.empty()) {
-          m->data = std::move(spare.back());
-          spare.pop_back();
-        }
-      }
-      const bool more = reader_.next(entry);
-      if (more) {
-        if (const auto* m = std::get_if<mcap::Message>(&entry.record)) {
-          bytes += m->data.size() + 64;
-          batch.push_back(std::move(entry.record));
-        } else if (std::holds_alternative<mcap::Schema>(entry.record) ||
-                   std::holds_alternative<mcap::Channel>(entry.record)) {
-          bytes += 64;
-          batch.push_back(std::move(entry.record));
-        }
-      }
-      if (!more || batch.size() >= kBatchRecords || bytes >= kBatchBytes) {
-        std::unique_lock<std::mutex> lock(mu_);
-        cv_.wait(lock, [&] { return stop_ || queued_ < kPumpBytes; });
-        if (stop_) return;
-        queued_ += bytes;
-        batches_.emplace_back(std::move(batch), bytes);
-        batch = {};
-        bytes = 0;
-        if (!more) {
-          status_ = reader_.status();
-          finished_ = true;
-        }
-        lock.unlock();
-        cv_.notify_all();
-        if (!more) return;
-      }
-    }
-  }
+  void run();
 
+  std::string path_;
   mcap::StreamReader reader_;
   std::thread thread_;
   std::mutex mu_;
@@ -136,4 +93,4 @@ class RecordPump {
   std::vector<mcap::Bytes> returned_;  // consumer side: recycled since the last batch
 };
 
-}  // namespace rbsim::check
+}  // namespace rbsim::log
