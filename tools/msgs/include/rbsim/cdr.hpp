@@ -39,16 +39,16 @@ class CdrCursor {
   // Moves to the next multiple of `size` (a primitive's size) when `count` values of `size` bytes
   // follow there; false, the cursor unmoved, when they do not fit in the data.
   bool align(std::size_t size, std::uint64_t count = 1) {
-    const std::size_t pad = (size - offset() % size) % size;
-    const std::size_t left = remaining();
-    if (pad > left || count > (left - pad) / size) return false;
+    std::size_t pad = 0;
+    if (!fits(size, count, pad)) return false;
     pos_ += pad;
     return true;
   }
   // align(size, count) and past the values; false, the cursor unmoved, when they do not fit.
   bool skip(std::size_t size, std::uint64_t count) {
-    if (!align(size, count)) return false;
-    pos_ += static_cast<std::size_t>(count) * size;
+    std::size_t pad = 0;
+    if (!fits(size, count, pad)) return false;
+    pos_ += pad + static_cast<std::size_t>(count) * size;
     return true;
   }
   // Past `n` bytes the caller has checked are there (n <= remaining()).
@@ -57,9 +57,10 @@ class CdrCursor {
   // One primitive of `size` bytes, aligned, copied to `out`; false, the cursor unmoved, when it
   // does not fit.
   bool read(std::size_t size, void* out) {
-    if (!align(size, 1)) return false;
-    std::memcpy(out, here(), size);
-    pos_ += size;
+    std::size_t pad = 0;
+    if (!fits(size, 1, pad)) return false;
+    std::memcpy(out, here() + pad, size);
+    pos_ += pad + size;
     return true;
   }
   template <class T>
@@ -87,6 +88,14 @@ class CdrCursor {
   }
 
  private:
+  // The padding to the next multiple of `size`, and whether `count` values of `size` bytes fit
+  // after it. One position update per read or skip, as the hot loops need.
+  bool fits(std::size_t size, std::uint64_t count, std::size_t& pad) const {
+    pad = (size - offset() % size) % size;
+    const std::size_t left = remaining();
+    return pad <= left && count <= (left - pad) / size;
+  }
+
   const std::byte* data_;
   std::size_t size_;
   std::size_t pos_;
