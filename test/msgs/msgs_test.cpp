@@ -7,6 +7,7 @@
 
 #include "decoder_for.hpp"
 #include "rbsim/builders.hpp"
+#include "rbsim/cdr.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace {
@@ -251,6 +252,68 @@ struct Cdr {
     return *this;
   }
 };
+
+// The one CDR cursor (rbsim/cdr.hpp) that every CDR reader walks with.
+TEST(CdrCursor, AlignsFromTheEndOfTheHeaderAndNeverReadsPastTheData) {
+  using rbsim::msgs::CdrCursor;
+  Cdr c;
+  c.put<std::uint8_t>(7).put(2.5).put<std::uint16_t>(3);  // 1 byte, 7 of padding, 8, 2
+  ASSERT_EQ(c.bytes.size(), 22u);
+  EXPECT_TRUE(CdrCursor::plain_header(c.bytes));
+  CdrCursor at(c.bytes);
+  EXPECT_EQ(at.pos(), 4u);
+  std::uint8_t u8 = 0;
+  ASSERT_TRUE(at.read(u8));
+  EXPECT_EQ(u8, 7u);
+  EXPECT_EQ(at.offset(), 1u);
+  EXPECT_FALSE(at.align(8, 2));  // one double fits, two do not: the cursor stays
+  EXPECT_EQ(at.offset(), 1u);
+  double d = 0;
+  ASSERT_TRUE(at.read(d));
+  EXPECT_EQ(d, 2.5);
+  EXPECT_EQ(at.pos(), 20u);
+  std::uint16_t u16 = 0;
+  ASSERT_TRUE(at.read(u16));
+  EXPECT_EQ(u16, 3u);
+  EXPECT_EQ(at.remaining(), 0u);
+  std::uint32_t more = 0;
+  EXPECT_FALSE(at.u32(more));
+  EXPECT_TRUE(at.align(2, 0));   // no values, no padding: fits at the end
+  EXPECT_FALSE(at.align(4, 0));  // the padding alone runs past the end
+  EXPECT_EQ(at.pos(), 22u);
+
+  CdrCursor skip(c.bytes);
+  EXPECT_TRUE(skip.skip(1, 1));
+  EXPECT_FALSE(skip.skip(8, 2));
+  EXPECT_TRUE(skip.skip(8, 1));
+  EXPECT_EQ(skip.pos(), 20u);
+  EXPECT_FALSE(skip.skip(2, 2));
+  EXPECT_TRUE(skip.skip(2, 1));
+}
+
+TEST(CdrCursor, StringsCarryTheirNulAndFitTheData) {
+  using rbsim::msgs::CdrCursor;
+  Cdr c;
+  c.str("abc").str("");
+  CdrCursor at(c.bytes);
+  std::string_view s;
+  ASSERT_TRUE(at.string(s));
+  EXPECT_EQ(s, "abc");
+  ASSERT_TRUE(at.string(s));
+  EXPECT_EQ(s, "");
+  EXPECT_EQ(at.remaining(), 0u);
+  Cdr zero;  // a length of 0 (no NUL) and a length past the data are both malformed
+  zero.put<std::uint32_t>(0);
+  CdrCursor z(zero.bytes);
+  EXPECT_FALSE(z.string(s));
+  Cdr past;
+  past.put<std::uint32_t>(5).put<std::uint8_t>('a');
+  CdrCursor p(past.bytes);
+  EXPECT_FALSE(p.string(s));
+  const rbsim::msgs::Bytes big_endian{std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0}};
+  EXPECT_FALSE(CdrCursor::plain_header(big_endian));
+  EXPECT_FALSE(CdrCursor::plain_header(std::span(c.bytes).first(3)));
+}
 
 TEST(MessageDecoder, ToJsonNestsObjectsAndArraysAndWritesNoNaN) {
   const char* schema =

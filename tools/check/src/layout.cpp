@@ -1,25 +1,12 @@
 // The layout walker of rbsim check: a ros2msg schema expanded into field groups, and CDR messages
 // walked against it (values counted or paired without decoding them all).
 #include <algorithm>
-#include <charconv>
-#include <cmath>
-#include <condition_variable>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <deque>
-#include <filesystem>
-#include <limits>
 #include <map>
-#include <mutex>
-#include <optional>
-#include <set>
-#include <sstream>
-#include <thread>
-#include <tuple>
+#include <string_view>
 #include <utility>
 
 #include "layout.hpp"
+#include "rbsim/cdr.hpp"
 
 namespace rbsim::check {
 
@@ -226,34 +213,19 @@ struct Pairer {
   }
 };
 
-// Walks CDR bytes by the decoder's rules (XCDR1, little endian, alignment relative to the end of
-// the 4-byte encapsulation header), reading only lengths.
+// Walks CDR bytes through the one CDR cursor (the decoders' rules), reading only lengths.
 struct ByteCounter {
-  std::span<const std::byte> d;
-  std::size_t pos = 4;
+  msgs::CdrCursor at;
   std::vector<std::uint64_t>& counts;
   std::uint64_t budget;
 
-  bool skip(std::size_t size, std::uint64_t n) {
-    const std::size_t pad = (size - (pos - 4) % size) % size;
-    const std::size_t left = d.size() - pos;
-    if (pad > left || n > (left - pad) / size) return false;
-    pos += pad + static_cast<std::size_t>(n) * size;
-    return true;
-  }
-  bool u32(std::uint32_t& v) {
-    const std::size_t at = pos + (4 - (pos - 4) % 4) % 4;
-    if (!skip(4, 1)) return false;
-    std::memcpy(&v, d.data() + at, 4);
-    return true;
-  }
   bool fields(const std::vector<Layout::Field>& fs) {
     using Array = Layout::Field::Array;
     for (const Layout::Field& f : fs) {
       std::uint64_t count = 1;
       if (f.array == Array::Sequence) {
         std::uint32_t n = 0;
-        if (!u32(n) || n > d.size() - pos) return false;
+        if (!at.u32(n) || n > at.remaining()) return false;
         ++counts[f.length_group];
         count = n;
       } else if (f.array == Array::Fixed) {
@@ -264,19 +236,18 @@ struct ByteCounter {
       if (f.primitive) {
         counts[f.group] += count;
         if (f.size > 0) {
-          if (count > 0 && !skip(f.size, count)) return false;
+          if (count > 0 && !at.skip(f.size, count)) return false;
         } else {
+          std::string_view s;
           for (std::uint64_t k = 0; k < count; ++k) {
-            std::uint32_t n = 0;
-            if (!u32(n) || n == 0 || n > d.size() - pos) return false;
-            pos += n;
+            if (!at.string(s)) return false;
           }
         }
       } else if (f.flat) {
         for (std::uint64_t k = 0; k < count; ++k) {
-          const std::size_t bytes = f.flat_size[(pos - 4) % 8];
-          if (bytes > d.size() - pos) return false;
-          pos += bytes;
+          const std::size_t bytes = f.flat_size[at.offset() % 8];
+          if (bytes > at.remaining()) return false;
+          at.advance(bytes);
         }
         for (const auto& [g, n] : f.flat_groups) counts[g] += n * count;
       } else {
@@ -292,9 +263,9 @@ struct ByteCounter {
 }  // namespace
 
 bool Layout::count(std::span<const std::byte> cdr, std::vector<std::uint64_t>& counts) const {
-  if (cdr.size() < 4 || cdr[0] != std::byte{0} || cdr[1] != std::byte{1}) return false;
+  if (!msgs::CdrCursor::plain_header(cdr)) return false;
   if (counts.size() < groups_.size()) counts.resize(groups_.size(), 0);
-  ByteCounter c{cdr, 4, counts, 4 * static_cast<std::uint64_t>(cdr.size()) + 1024};
+  ByteCounter c{msgs::CdrCursor(cdr), counts, 4 * static_cast<std::uint64_t>(cdr.size()) + 1024};
   return c.fields(root_);
 }
 

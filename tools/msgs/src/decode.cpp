@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <map>
 #include <sstream>
 
+#include "rbsim/cdr.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
@@ -37,20 +37,20 @@ int primitive_index(std::string_view t) {
   return -1;
 }
 
-// Walks one message; `Visit` is called with each scalar. Returns false on malformed data.
+// Walks one message through the CDR cursor; `Visit` is called with each scalar. Returns false on
+// malformed data.
 class Walker {
  public:
   Walker(const std::vector<MessageDecoder::Type>& types, std::span<const std::byte> cdr)
-      : types_(types), cdr_(cdr) {}
+      : types_(types), cdr_(cdr), at_(cdr) {}
   std::string error;
 
   template <class Visit>
   bool message(Visit&& visit) {
-    if (cdr_.size() < 4) return fail("shorter than the 4-byte encapsulation header");
-    if (cdr_[0] != std::byte{0} || cdr_[1] != std::byte{1}) {
+    if (cdr_.size() < CdrCursor::kHeader) return fail("shorter than the 4-byte encapsulation header");
+    if (!CdrCursor::plain_header(cdr_)) {
       return fail("unsupported CDR encapsulation (only plain little-endian CDR, 00 01, is read)");
     }
-    pos_ = 4;
     return type(0, visit);
   }
 
@@ -65,7 +65,7 @@ class Walker {
       if (f.array == MessageDecoder::Field::Array::Sequence) {
         std::uint32_t n = 0;
         if (!read(4, &n)) return false;
-        if (n > cdr_.size() - pos_) return fail("sequence length " + std::to_string(n) + " exceeds the data");
+        if (n > at_.remaining()) return fail("sequence length " + std::to_string(n) + " exceeds the data");
         Scalar len;
         len.kind = Scalar::Kind::Length;
         len.u = n;
@@ -96,9 +96,9 @@ class Walker {
     if (p.size == 0) {
       std::uint32_t n = 0;
       if (!read(4, &n)) return false;
-      if (n == 0 || n > cdr_.size() - pos_) return fail("string length " + std::to_string(n) + " invalid");
-      s.s = std::string_view(reinterpret_cast<const char*>(cdr_.data() + pos_), n - 1);
-      pos_ += n;
+      if (n == 0 || n > at_.remaining()) return fail("string length " + std::to_string(n) + " invalid");
+      s.s = std::string_view(reinterpret_cast<const char*>(at_.here()), n - 1);
+      at_.advance(n);
     } else {
       std::byte raw[8] = {};
       if (!read(p.size, raw)) return false;
@@ -108,12 +108,7 @@ class Walker {
     return true;
   }
   bool read(std::size_t size, void* out) {
-    const std::size_t offset = pos_ - 4;
-    const std::size_t pad = (size - offset % size) % size;
-    if (pad + size > cdr_.size() - pos_) return fail("truncated at byte " + std::to_string(pos_));
-    pos_ += pad;
-    std::memcpy(out, cdr_.data() + pos_, size);
-    pos_ += size;
+    if (!at_.read(size, out)) return fail("truncated at byte " + std::to_string(at_.pos()));
     return true;
   }
   bool fail(std::string why) {
@@ -122,7 +117,7 @@ class Walker {
   }
   const std::vector<MessageDecoder::Type>& types_;
   std::span<const std::byte> cdr_;
-  std::size_t pos_ = 0;
+  CdrCursor at_;  // after the header, used once message() has checked it
   int depth_ = 0;
 };
 

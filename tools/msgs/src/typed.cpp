@@ -1,55 +1,31 @@
 // Typed decoding of rbsim's own messages (for tools that draw or export a recording).
 #include <cmath>
-#include <cstring>
 
+#include "rbsim/cdr.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
 
 namespace {
 
-// Bounds-checked XCDR1 little-endian reader; the first failure sticks.
+// The typed decoders' reader: the CDR cursor with a sticky failure (the first one stops every
+// later read, which then return zeros).
 class Reader {
  public:
-  explicit Reader(std::span<const std::byte> data) : d_(data) {
-    ok_ = d_.size() >= 4 && d_[0] == std::byte{0} && d_[1] == std::byte{1};
-  }
+  explicit Reader(std::span<const std::byte> data) : ok_(CdrCursor::plain_header(data)), at_(data) {}
   bool ok() const { return ok_; }
   template <class T>
   T get() {
     T v{};
-    const std::size_t offset = pos_ - 4;
-    const std::size_t pad = (sizeof(T) - offset % sizeof(T)) % sizeof(T);
-    if (!ok_ || pad + sizeof(T) > d_.size() - pos_) {
-      ok_ = false;
-      return v;
-    }
-    std::memcpy(&v, d_.data() + pos_ + pad, sizeof(T));
-    pos_ += pad + sizeof(T);
+    if (ok_ && !at_.read(v)) ok_ = false;
     return v;
   }
-  std::string string() {
-    const auto n = get<std::uint32_t>();
-    if (!ok_ || n == 0 || n > d_.size() - pos_) {
-      ok_ = false;
-      return {};
-    }
-    std::string s(reinterpret_cast<const char*>(d_.data() + pos_), n - 1);
-    pos_ += n;
-    return s;
-  }
-  void skip_string() {
-    const auto n = get<std::uint32_t>();
-    if (!ok_ || n == 0 || n > d_.size() - pos_) {
-      ok_ = false;
-      return;
-    }
-    pos_ += n;
-  }
+  std::string string() { return std::string(string_view()); }
+  void skip_string() { (void)string_view(); }
   // A sequence length, bounded by the bytes left (every element takes at least `min_size`).
   std::uint32_t length(std::size_t min_size) {
     const auto n = get<std::uint32_t>();
-    if (ok_ && static_cast<std::uint64_t>(n) * min_size > d_.size() - pos_) ok_ = false;
+    if (ok_ && static_cast<std::uint64_t>(n) * min_size > at_.remaining()) ok_ = false;
     return ok_ ? n : 0;
   }
   Vec2 vec2() {
@@ -72,9 +48,13 @@ class Reader {
   }
 
  private:
-  std::span<const std::byte> d_;
-  std::size_t pos_ = 4;
-  bool ok_ = true;
+  std::string_view string_view() {
+    std::string_view s;
+    if (!ok_ || !at_.string(s)) ok_ = false;
+    return s;
+  }
+  bool ok_;
+  CdrCursor at_;  // used only while ok_ (the header checked)
 };
 
 Error bad(const char* type) {
