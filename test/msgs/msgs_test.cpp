@@ -580,4 +580,15 @@ TEST(MessageStep, UsesTheStepFieldElseTheStampOverDt) {
   EXPECT_FALSE(rbsim::msgs::message_step(TopicId::Markers, empty, dt).has_value());
 }
 
+// Metadata is what a scene description says about itself, not its physics: every field of the
+// schema is one or the other, and rbsim check reports only the metadata apart.
+TEST(IsSceneMetadata, TellsTheDescriptiveFieldsFromThePhysics) {
+  for (const char* meta : {"name", "description", "has_viewport", "viewport_cx", "viewport_cy",
+                           "viewport_size", "background.r", "background.a"})
+    EXPECT_TRUE(rbsim::msgs::is_scene_metadata(meta)) << meta;
+  for (const char* physics : {"dt", "duration", "step_count", "integrator", "bodies[].mass", "springs[].k",
+                              "gravity[].gx", "header.stamp.sec", "names", "background"})
+    EXPECT_FALSE(rbsim::msgs::is_scene_metadata(physics)) << physics;
+}
+
 }  // namespace

@@ -292,8 +292,7 @@ class Comparer {
         t.tally.meta_reported.assign(groups.size(), 0);
         for (std::size_t gi = 0; gi < groups.size(); ++gi) {
           const std::string& path = groups[gi].path;
-          if (path == "name" || path == "description" || path == "has_viewport" ||
-              path.starts_with("viewport_") || path.starts_with("background.")) {
+          if (msgs::is_scene_metadata(path)) {
             t.tally.meta[gi] = 1;
             t.tally.has_meta = true;
           }

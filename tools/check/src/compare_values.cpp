@@ -126,7 +126,7 @@ struct Lockstep {
       if (f.primitive && f.size > 0) {
         if (count == 0) continue;
         if (!a.align(f.size, count) || !b.align(f.size, count)) return Walk::Malformed;
-        if (root && f.array == Array::None && f.name == "step") {
+        if (root && f.array == Array::None && f.name == msgs::kStepField) {
           has_step = true;
           step = step_value(load(b.here(), f.size, f.kind));
         }

@@ -151,7 +151,7 @@ bool walk(const std::vector<Layout::Field>& fields, std::span<const msgs::Scalar
       for (std::uint64_t k = 0; k < count; ++k, ++pos) {
         if (s[pos].kind != f.kind) return false;
         if (plan != nullptr) {
-          if (root && f.array == Array::None && f.name == "step")
+          if (root && f.array == Array::None && f.name == msgs::kStepField)
             plan->step = static_cast<std::ptrdiff_t>(pos);
           plan->group.push_back(f.group);
         }
@@ -277,7 +277,7 @@ Result<Layout> Layout::create(std::string_view type, std::string_view schema) {
   if (!fields) return fields.error();
   layout.root_ = std::move(fields.value());
   for (const Field& f : layout.root_) {
-    if (f.name == "step" && f.primitive && f.array == Field::Array::None &&
+    if (f.name == msgs::kStepField && f.primitive && f.array == Field::Array::None &&
         (f.kind == msgs::Scalar::Kind::UInt || f.kind == msgs::Scalar::Kind::Int)) {
       layout.has_step_ = true;
     }

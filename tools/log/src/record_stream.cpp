@@ -7,7 +7,8 @@ namespace rbsim::log {
 
 Status RecordStream::open(const std::string& path) {
   path_ = path;
-  if (const mcap::Status st = reader_.open(path); !st.ok()) return Error{path + ": " + mcap_tools::read_error(st)};
+  if (const mcap::Status st = reader_.open(path); !st.ok())
+    return Error{path + ": " + mcap_tools::read_error(st)};
   thread_ = std::thread([this] { run(); });
   return Ok{};
 }

@@ -317,4 +317,10 @@ std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte>
   return k >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(k);
 }
 
+bool is_scene_metadata(std::string_view field_path) {
+  // SceneDescription.msg's fields that do not change the simulation.
+  return field_path == "name" || field_path == "description" || field_path == "has_viewport" ||
+         field_path.starts_with("viewport_") || field_path.starts_with("background.");
+}
+
 }  // namespace rbsim::msgs

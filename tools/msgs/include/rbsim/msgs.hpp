@@ -301,6 +301,11 @@ std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr);
 // (from its scene description). nullopt for a message without either (the scene description, an
 // empty MarkerArray or TFMessage, bytes too short) or, for a stamp, a dt that is not finite and > 0.
 std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte> cdr, double dt);
+// The name of that field: schema-driven readers (rbsim check) find a message's step by it.
+inline constexpr std::string_view kStepField = "step";
+// Whether a field of the scene description (its path, "background.r") is metadata rather than
+// physics: the scene's name, description, viewport and background, which rbsim check reports apart.
+bool is_scene_metadata(std::string_view field_path);
 
 // ---------------------------------------------------------------------------------------------
 // Schema-driven decoding: any CDR message whose ros2msg schema is known (e.g. read from an MCAP
