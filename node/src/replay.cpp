@@ -74,9 +74,9 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     return Error{"cannot read " + path + ": " + bad};
   if (auto st = im.reader.open(path); !st.ok()) {
     std::string hint;
-    if (st.code == mcap::StatusCode::Truncated)
+    if (st.code() == ErrorCode::Truncated)
       hint = " (an unfinished recording: 'rbsim log recover' saves its complete messages, if it holds any)";
-    return Error{"cannot read " + path + ": " + st.message + hint};
+    return Error{"cannot read " + path + ": " + st.error().message + hint};
   }
 
   // Channels that carry one of our types as CDR (found by type), by id (file order).
@@ -191,7 +191,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     any = true;
     return false;
   });
-  if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
+  if (!st.ok()) return Error{"cannot read " + path + ": " + st.error().message};
   if (!any) return Error{path + ": the log has rbsim topics but no messages on them"};
   r->last_log_time_ = r->first_log_time_;
   for (const mcap::ChunkIndex& ci : im.reader.chunk_indexes())
@@ -261,7 +261,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
       // Past the start with one per channel: the rest of the log cannot change the choice.
       return e.message.log_time < start || latched.size() < im.latched_channels.size();
     });
-    if (!st.ok()) return Error{"cannot read " + path + ": " + st.message};
+    if (!st.ok()) return Error{"cannot read " + path + ": " + st.error().message};
     for (const auto& [ch, m] : latched) {
       if (stop()) return false;
       if (Status s = im.publishers[im.route.at(ch)].publish(bytes(m.data)); !s) return s.error();
@@ -323,7 +323,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     ++published_;
     return true;
   });
-  if (!st.ok()) return Error{"reading " + path + " failed: " + st.message};
+  if (!st.ok()) return Error{"reading " + path + " failed: " + st.error().message};
   if (failure) return *failure;
   return !stopped;
 }

@@ -336,7 +336,7 @@ class Comparer {
       return Error{with_path(s, "empty file, not an MCAP file")};
     }
     mcap::IndexedReader index;
-    if (auto st = index.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
+    if (auto st = index.open(s.path); !st.ok()) return Error{with_path(s, describe(st.error()))};
     s.header = index.header();
     for (const auto& [id, channel] : index.channels()) s.summary_topics.insert(channel.topic);
     if (Status st = read_dt(s, index); !st) return st;
@@ -349,7 +349,7 @@ class Comparer {
         if (index.channels().count(channel_id) == 0) s.summary_known = false;
       }
     }
-    if (auto st = s.pump.open(s.path); !st.ok()) return Error{with_path(s, describe(st))};
+    if (auto st = s.pump.open(s.path); !st.ok()) return Error{with_path(s, describe(st.error()))};
     return Ok{};
   }
 
@@ -365,13 +365,13 @@ class Comparer {
     if (scene_topics.empty()) return Ok{};
     mcap::ReadMessagesOptions options;
     options.topics = scene_topics;
-    const mcap::Status st = index.read_messages(options, [&](const mcap::MessageEntry& e) {
+    const Status st = index.read_messages(options, [&](const mcap::MessageEntry& e) {
       Result<msgs::SceneMessage> scene = msgs::decode_scene(cdr(e.message.data));
       if (scene && std::isfinite(scene->dt) && scene->dt > 0.0) s.dt = scene->dt;
       if (scene) s.scene = std::move(scene.value());
       return false;
     });
-    if (!st.ok()) return Error{with_path(s, describe(st))};
+    if (!st.ok()) return Error{with_path(s, describe(st.error()))};
     return Ok{};
   }
 
@@ -379,17 +379,17 @@ class Comparer {
     return msgs::topic_for_type(schema_name) == &msgs::topic(id);
   }
 
-  static std::string describe(const mcap::Status& st) {
+  static std::string describe(const Error& st) {
     switch (st.code) {
-      case mcap::StatusCode::BadMagic:
+      case ErrorCode::BadMagic:
         return st.message.starts_with("not an MCAP file") ? st.message
                                                           : "not an MCAP file (" + st.message + ")";
-      case mcap::StatusCode::Truncated:
+      case ErrorCode::Truncated:
         return "truncated or incomplete MCAP file (" + st.message + ")";
-      case mcap::StatusCode::CrcMismatch:
+      case ErrorCode::CrcMismatch:
         return "corrupted MCAP file (" + st.message + ")";
-      case mcap::StatusCode::Malformed:
-      case mcap::StatusCode::DecompressionFailed:
+      case ErrorCode::Malformed:
+      case ErrorCode::DecompressionFailed:
         return "corrupted MCAP file (" + st.message + ")";
       default:
         return st.message;
@@ -409,7 +409,7 @@ class Comparer {
     Side& s = side_[si];
     mcap::Record* next = s.pump.next();
     if (next == nullptr) {
-      if (!s.pump.status().ok()) return Error{with_path(s, describe(s.pump.status()))};
+      if (!s.pump.status().ok()) return Error{with_path(s, describe(s.pump.status().error()))};
       s.done = true;
       return Ok{};
     }

@@ -31,8 +31,8 @@ class RecordPump {
 
   ~RecordPump() { stop(); }
 
-  mcap::Status open(const std::string& path) {
-    mcap::Status st = reader_.open(path);
+  Status open(const std::string& path) {
+    Status st = reader_.open(path);
     if (st.ok()) thread_ = std::thread([this] { run(); });
     return st;
   }
@@ -71,7 +71,7 @@ class RecordPump {
     cv_.notify_all();
     return current_.empty() ? next() : &current_[pos_++];
   }
-  const mcap::Status& status() const { return status_; }  // valid once next() returned null
+  const Status& status() const { return status_; }  // valid once next() returned null
 
  private:
   void run() {
@@ -128,7 +128,7 @@ class RecordPump {
   std::deque<std::pair<std::vector<mcap::Record>, std::uint64_t>> batches_;
   std::uint64_t queued_ = 0;
   bool stop_ = false, finished_ = false;
-  mcap::Status status_;
+  Status status_;
   std::vector<mcap::Bytes> spare_;     // guarded by mu_: recycled buffers for the reader thread
   std::uint64_t spare_bytes_ = 0;      // their capacity
   std::vector<mcap::Record> current_;  // consumer side

@@ -59,13 +59,13 @@ class GoldenLogReader {
 
   Status open() {
     if (std::string e = mcap_tools::unreadable(path_); !e.empty()) return fail(e);
-    if (mcap::Status s = reader_.open(path_); !s.ok()) return fail(mcap_tools::read_error(s));
-    if (mcap::Status s = reader_.verify_data_section_crc(); !s.ok()) return fail(mcap_tools::read_error(s));
+    if (Status s = reader_.open(path_); !s.ok()) return fail(mcap_tools::read_error(s.error()));
+    if (Status s = reader_.verify_data_section_crc(); !s.ok()) return fail(mcap_tools::read_error(s.error()));
     // A file whose summary lists no channels defines them in its data section: only reading it
     // makes them known (a recording cut short; rbsim's goldens have a summary).
     if (reader_.channels().empty()) {
-      const mcap::Status s = reader_.read_messages({}, [](const mcap::MessageEntry&) { return true; });
-      if (!s.ok()) return fail(mcap_tools::read_error(s));
+      const Status s = reader_.read_messages({}, [](const mcap::MessageEntry&) { return true; });
+      if (!s.ok()) return fail(mcap_tools::read_error(s.error()));
     }
     return Ok{};
   }
@@ -129,13 +129,13 @@ class GoldenLogReader {
     }
     if (o.topics.empty()) return Ok{};
     Status failure = Ok{};
-    const mcap::Status st = reader_.read_messages(o, [&](const mcap::MessageEntry& e) {
+    const Status st = reader_.read_messages(o, [&](const mcap::MessageEntry& e) {
       const auto it = route_.find(e.message.channel_id);
       if (it == route_.end()) return true;  // another channel of the same name
       failure = dispatch(e, it->second);
       return static_cast<bool>(failure);
     });
-    if (!st.ok()) return fail(mcap_tools::read_error(st));
+    if (!st.ok()) return fail(mcap_tools::read_error(st.error()));
     return failure;
   }
 

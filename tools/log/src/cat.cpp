@@ -30,7 +30,7 @@ struct ChannelDecoder {
 Status cat(const std::string& path, const CatOptions& options,
            const std::function<void(std::string_view line)>& on_line) {
   mcap::IndexedReader reader;
-  if (mcap::Status st = reader.open(path); !st.ok()) return Error{path + ": " + mcap_tools::read_error(st)};
+  if (Status st = reader.open(path); !st.ok()) return Error{path + ": " + mcap_tools::read_error(st.error())};
 
   mcap::ReadMessagesOptions ro;
   if (const auto start = to_ns(options.start)) ro.start_time = *start;
@@ -59,7 +59,7 @@ Status cat(const std::string& path, const CatOptions& options,
   std::map<std::uint16_t, ChannelDecoder> decoders;
   std::string line;
   Status failure = Ok{};
-  mcap::Status read = reader.read_messages(ro, [&](const mcap::MessageEntry& e) -> bool {
+  Status read = reader.read_messages(ro, [&](const mcap::MessageEntry& e) -> bool {
     const mcap::Message& m = e.message;
     auto [it, fresh] = decoders.try_emplace(m.channel_id);
     if (fresh && e.channel != nullptr && e.schema != nullptr && e.schema->encoding == "ros2msg" &&
@@ -93,7 +93,7 @@ Status cat(const std::string& path, const CatOptions& options,
     on_line(line);
     return true;
   });
-  if (!read.ok()) return Error{path + ": " + mcap_tools::read_error(read)};
+  if (!read.ok()) return Error{path + ": " + mcap_tools::read_error(read.error())};
   return failure;
 }
 
