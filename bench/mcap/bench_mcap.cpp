@@ -135,12 +135,12 @@ std::uint64_t write_file(benchmark::State& state, const std::string& path, const
   mcap::WriterOptions options = log::writer_options(codec.compression);
   options.compression_level = codec.level;
   if (auto st = writer.open(path, options); !st.ok()) {
-    state.SkipWithError(st.message.c_str());
+    state.SkipWithError(st.error().message.c_str());
     return 0;
   }
   auto channel = log::add_topic(writer, msgs::topic(msgs::TopicId::BodyStates), "rbsim");
   if (!channel.ok()) {
-    state.SkipWithError(channel.status().message.c_str());
+    state.SkipWithError(channel.error().message.c_str());
     return 0;
   }
   std::uint64_t bytes = 0;
@@ -149,13 +149,13 @@ std::uint64_t write_file(benchmark::State& state, const std::string& path, const
     const mcap::Timestamp t = static_cast<mcap::Timestamp>(i) * 1'000'000;
     if (auto st = writer.write_message(channel.value(), static_cast<std::uint32_t>(i), t, t, view(buf));
         !st.ok()) {
-      state.SkipWithError(st.message.c_str());
+      state.SkipWithError(st.error().message.c_str());
       return 0;
     }
     bytes += buf.size();
   }
   if (auto st = writer.close(); !st.ok()) {
-    state.SkipWithError(st.message.c_str());
+    state.SkipWithError(st.error().message.c_str());
     return 0;
   }
   return bytes;
@@ -231,7 +231,7 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
   for (auto _ : state) {
     mcap::IndexedReader reader;
     if (auto st = reader.open(path); !st.ok()) {
-      state.SkipWithError(st.message.c_str());
+      state.SkipWithError(st.error().message.c_str());
       break;
     }
     std::optional<msgs::MessageDecoder> decoder;
@@ -265,7 +265,7 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
       benchmark::DoNotOptimize(scalars.data());
       return true;
     });
-    if (!st.ok()) error = st.message;
+    if (!st.ok()) error = st.error().message;
     if (!error.empty() || seen_messages != count || seen_bytes != bytes) {
       if (error.empty())
         error = "read " + std::to_string(seen_messages) + " messages, wrote " + std::to_string(count);

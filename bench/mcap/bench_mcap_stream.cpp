@@ -61,7 +61,7 @@ void keep_first_of_each_id(std::vector<Record>& records) {
 bool load(const std::string& path, Capture& out) {
   mcap::StreamReader reader;
   if (auto st = reader.open(path); !st.ok()) {
-    std::fprintf(stderr, "%s: %s\n", path.c_str(), st.message.c_str());
+    std::fprintf(stderr, "%s: %s\n", path.c_str(), st.error().message.c_str());
     return false;
   }
   mcap::RecordEntry entry;
@@ -76,7 +76,7 @@ bool load(const std::string& path, Capture& out) {
     }
   }
   if (!reader.status().ok()) {
-    std::fprintf(stderr, "%s: %s\n", path.c_str(), reader.status().message.c_str());
+    std::fprintf(stderr, "%s: %s\n", path.c_str(), reader.status().error().message.c_str());
     return false;
   }
   // A capture written with a summary repeats its schemas and channels there: keep the first of each.
@@ -87,7 +87,7 @@ bool load(const std::string& path, Capture& out) {
 
 int write_rbsim(const Capture& cap, const std::string& path, const mcap::WriterOptions& options) {
   mcap::Writer writer;
-  mcap::Status st = writer.open(path, options);
+  Status st = writer.open(path, options);
   for (const auto& s : cap.schemas) {
     if (st.ok()) st = writer.add_schema(s);
   }
@@ -104,7 +104,7 @@ int write_rbsim(const Capture& cap, const std::string& path, const mcap::WriterO
     (void)writer.close();
   }
   if (!st.ok()) {
-    std::fprintf(stderr, "%s: %s\n", path.c_str(), st.message.c_str());
+    std::fprintf(stderr, "%s: %s\n", path.c_str(), st.error().message.c_str());
     return 1;
   }
   return 0;

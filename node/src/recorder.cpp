@@ -73,7 +73,7 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size,
                                                                   options.compression_level));
       !st.ok()) {
-    return Error{options.path + ": " + st.message};
+    return Error{options.path + ": " + st.error().message};
   }
   r->waitset_ = dds_create_waitset(participant.handle());
   for (const msgs::TopicSpec* spec : wanted) {
@@ -98,7 +98,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
   bool any = false;
   // A chunk compressed while no message came in reaches the file now, not at the next message.
-  if (auto st = writer_.write_compressed_chunk(); !st.ok()) return Error{options_.path + ": " + st.message};
+  if (auto st = writer_.write_compressed_chunk(); !st.ok())
+    return Error{options_.path + ": " + st.error().message};
   Received sample;
   for (Topic& t : topics_) {
     while (t.subscription.take(sample)) {
@@ -151,13 +152,13 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
 Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time) {
   if (t.channel == 0) {  // like rosbag2: the channel says what the (first) publisher offers
     auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
-    if (!channel.ok()) return Error{options_.path + ": " + channel.status().message};
+    if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
     t.channel = channel.value();
   }
   const std::uint64_t source =
       sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : log_time;
   if (auto st = writer_.write_message(t.channel, t.received, log_time, source, view(sample.cdr)); !st.ok()) {
-    return Error{options_.path + ": " + st.message};
+    return Error{options_.path + ": " + st.error().message};
   }
   ++t.received;
   const msgs::TopicId id = t.subscription.spec().id;
@@ -220,7 +221,7 @@ std::vector<Recorder::TopicCount> Recorder::counts() const {
 
 Status Recorder::close() {
   if (Status st = release_held(); !st) return st;
-  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.message};
+  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
   return Ok{};
 }
 

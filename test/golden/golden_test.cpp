@@ -276,13 +276,13 @@ void copy_without(const fs::path& in, const fs::path& out, const std::string& to
       ASSERT_TRUE(writer.add_channel(channel).ok());
     }
   }
-  const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+  const Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
     if (e.channel->topic != topic) {
       EXPECT_TRUE(writer.write_message(e.message).ok());
     }
     return true;
   });
-  ASSERT_TRUE(st.ok()) << st.message;
+  ASSERT_TRUE(st.ok()) << st.error().message;
   ASSERT_TRUE(writer.close().ok());
 }
 
@@ -392,7 +392,7 @@ void copy_joined_late(const fs::path& in, const fs::path& out, std::size_t n) {
   for (const auto& [id, schema] : reader.schemas()) ASSERT_TRUE(writer.add_schema(schema).ok());
   for (const auto& [id, channel] : reader.channels()) ASSERT_TRUE(writer.add_channel(channel).ok());
   std::map<std::string, std::size_t> seen;
-  const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+  const Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
     // The latched topics reach a late joiner too.
     if (e.channel->topic == "/rbsim/scene" || e.channel->topic == "/rbsim/markers" ||
         seen[e.channel->topic]++ >= n) {
@@ -400,7 +400,7 @@ void copy_joined_late(const fs::path& in, const fs::path& out, std::size_t n) {
     }
     return true;
   });
-  ASSERT_TRUE(st.ok()) << st.message;
+  ASSERT_TRUE(st.ok()) << st.error().message;
   ASSERT_TRUE(writer.close().ok());
 }
 
@@ -635,12 +635,12 @@ std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs
     std::map<std::string, std::pair<std::string, std::string>> schemas;
     mcap::IndexedReader reader;
     EXPECT_TRUE(reader.open(path.string()).ok());
-    const mcap::Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
+    const Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
       messages[e.channel->topic].push_back(e.message.data);
       schemas[e.channel->topic] = {e.schema->name, std::string(e.schema->data.begin(), e.schema->data.end())};
       return true;
     });
-    EXPECT_TRUE(st.ok()) << st.message;
+    EXPECT_TRUE(st.ok()) << st.error().message;
     return std::pair{messages, schemas};
   };
   const auto [run_msgs, schemas] = read(run);

@@ -96,7 +96,7 @@ RawRecord find_record(const std::vector<RawRecord>& records, mcap::Opcode opcode
 
 mcap::Record parse_at(const mcap::Bytes& file, const RawRecord& at) {
   auto r = mcap::parse_record(at.opcode, mcap::ByteView(file).subspan(at.offset + 9, at.length - 9));
-  if (!r.ok()) throw std::runtime_error(r.status().message);
+  if (!r.ok()) throw std::runtime_error(r.error().message);
   return std::move(r).value();
 }
 

@@ -29,7 +29,7 @@ Bytes small_file(Compression compression, bool chunks) {
 
 struct Outcome {
   bool ok = false;
-  StatusCode code = StatusCode::Success;
+  std::optional<ErrorCode> code;  // none: ok
   std::size_t records = 0;
 };
 
@@ -50,9 +50,9 @@ Outcome stream_all(const Bytes& data, bool verify = true) {
     }
   }
   out.ok = r.status().ok();
-  out.code = r.status().code;
+  out.code = r.status().code();
   if (!out.ok) {
-    EXPECT_FALSE(r.status().message.empty());
+    EXPECT_FALSE(r.status().error().message.empty());
   }
   return out;
 }
@@ -63,13 +63,13 @@ Outcome index_all(const Bytes& data) {
   Status s = r.open_buffer(data);
   if (s.ok()) {
     auto m = r.read_all_messages();
-    s = m.ok() ? Status::Ok() : m.status();
+    if (!m.ok()) s = m.error();
     if (m.ok()) out.records = m->size();
   }
   for (const auto& ai : r.attachment_indexes()) (void)r.read_attachment(ai).ok();
   for (const auto& mi : r.metadata_indexes()) (void)r.read_metadata(mi).ok();
   out.ok = s.ok();
-  out.code = s.code;
+  out.code = s.code();
   return out;
 }
 
@@ -87,7 +87,7 @@ TEST_P(CorruptFile, TruncatedAtEveryByte) {
     EXPECT_FALSE(s.ok) << "prefix " << n;
     EXPECT_LE(s.records, whole.records);
     if (n >= 8) {
-      EXPECT_NE(s.code, StatusCode::BadMagic) << "prefix " << n;
+      EXPECT_NE(s.code, ErrorCode::BadMagic) << "prefix " << n;
     }
     EXPECT_FALSE(index_all(cut).ok) << "prefix " << n;
   }
@@ -128,8 +128,8 @@ TEST(BadInput, HugeLengthFieldsAreBoundedByTheFile) {
   Bytes file = small_file(Compression::Zstd, true);
   Bytes bad = file;
   set_u64(bad, 9, UINT64_MAX);  // Header length
-  EXPECT_EQ(stream_all(bad).code, StatusCode::Truncated);
-  EXPECT_EQ(index_all(bad).code, StatusCode::Truncated);
+  EXPECT_EQ(stream_all(bad).code, ErrorCode::Truncated);
+  EXPECT_EQ(index_all(bad).code, ErrorCode::Truncated);
 
   // First chunk: find it, then claim an absurd uncompressed size.
   StreamReader r;
@@ -151,30 +151,30 @@ TEST(BadInput, HugeLengthFieldsAreBoundedByTheFile) {
   EXPECT_FALSE(index_all(bad).ok);
   bad = file;
   set_u64(bad, chunk_at + 1, UINT64_MAX - 3);  // Chunk record length
-  EXPECT_EQ(stream_all(bad, false).code, StatusCode::Truncated);
+  EXPECT_EQ(stream_all(bad, false).code, ErrorCode::Truncated);
 }
 
 TEST(BadInput, EmptyAndForeignFiles) {
-  EXPECT_EQ(stream_all({}).code, StatusCode::Truncated);
-  EXPECT_EQ(index_all({}).code, StatusCode::Truncated);
+  EXPECT_EQ(stream_all({}).code, ErrorCode::Truncated);
+  EXPECT_EQ(index_all({}).code, ErrorCode::Truncated);
   const std::string text = "this is not an MCAP file, just some text that is long enough";
   const Bytes foreign(text.begin(), text.end());
-  EXPECT_EQ(stream_all(foreign).code, StatusCode::BadMagic);
-  EXPECT_EQ(index_all(foreign).code, StatusCode::BadMagic);
+  EXPECT_EQ(stream_all(foreign).code, ErrorCode::BadMagic);
+  EXPECT_EQ(index_all(foreign).code, ErrorCode::BadMagic);
   const Bytes png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13};
-  EXPECT_EQ(stream_all(png).code, StatusCode::BadMagic);
+  EXPECT_EQ(stream_all(png).code, ErrorCode::BadMagic);
   const Bytes magic_only(std::begin(kMagic), std::end(kMagic));
-  EXPECT_EQ(stream_all(magic_only).code, StatusCode::Truncated);
-  EXPECT_EQ(stream_all(Bytes(kMagic, kMagic + 5)).code, StatusCode::Truncated);
+  EXPECT_EQ(stream_all(magic_only).code, ErrorCode::Truncated);
+  EXPECT_EQ(stream_all(Bytes(kMagic, kMagic + 5)).code, ErrorCode::Truncated);
 
   StreamReader r;
   ASSERT_FALSE(r.open("/nonexistent/file.mcap").ok());
   RecordEntry e;
   EXPECT_FALSE(r.next(e));
-  EXPECT_EQ(r.status().code, StatusCode::NotOpen);
+  EXPECT_EQ(r.status().code(), ErrorCode::NotOpen);
   IndexedReader ir;
-  EXPECT_EQ(ir.open("/nonexistent/file.mcap").code, StatusCode::IoError);
-  EXPECT_EQ(ir.read_all_messages().status().code, StatusCode::NotOpen);
+  EXPECT_EQ(ir.open("/nonexistent/file.mcap").code(), ErrorCode::IoError);
+  EXPECT_EQ(ir.read_all_messages().code(), ErrorCode::NotOpen);
 }
 
 // Unknown opcodes and unknown trailing fields are skipped (spec: Records).
@@ -196,7 +196,7 @@ TEST(BadInput, UnknownRecordsAndFieldsAreSkipped) {
   std::vector<std::string> types;
   RecordEntry e;
   while (r.next(e)) types.emplace_back(record_type_name(e.record));
-  ASSERT_TRUE(r.status().ok()) << r.status().message;
+  ASSERT_TRUE(r.status().ok()) << r.status().error().message;
   EXPECT_EQ(types,
             (std::vector<std::string>{"Header", "Unknown", "Channel", "Message", "DataEnd", "Footer"}));
   IndexedReader ir;

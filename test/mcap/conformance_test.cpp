@@ -71,7 +71,7 @@ TEST_P(Conformance, StreamedReader) {
   json records = json::array();
   RecordEntry entry;
   while (reader.next(entry)) records.push_back(record_to_json(entry.record));
-  ASSERT_TRUE(reader.status().ok()) << reader.status().message;
+  ASSERT_TRUE(reader.status().ok()) << reader.status().error().message;
   EXPECT_EQ(records.dump(1), expected["records"].dump(1));
 }
 
@@ -82,14 +82,14 @@ TEST_P(Conformance, IndexedReader) {
   const json expected = indexed_view_of(file["records"]);
   IndexedReader reader;
   const Status opened = reader.open(GetParam());
-  ASSERT_TRUE(opened.ok()) << opened.message;
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
   EXPECT_EQ(reader.indexed(), has_feature(file, "ch") && has_feature(file, "chx"));
   json messages = json::array();
   const Status read = reader.read_messages({}, [&](const MessageEntry& e) {
     messages.push_back(record_to_json(e.message));
     return true;
   });
-  ASSERT_TRUE(read.ok()) << read.message;
+  ASSERT_TRUE(read.ok()) << read.error().message;
   json schemas = json::array(), channels = json::array(), stats = json::array();
   for (const auto& [id, s] : reader.schemas()) schemas.push_back(record_to_json(s));
   for (const auto& [id, c] : reader.channels()) channels.push_back(record_to_json(c));

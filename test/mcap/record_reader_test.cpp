@@ -40,7 +40,7 @@ std::vector<RecordView> all_records(ByteSource& source, std::uint64_t begin, std
     out.back().content = {};  // views the source only until its next read
     if (out.size() > source.size()) break;
   }
-  EXPECT_TRUE(reader.status().ok()) << reader.status().message;
+  EXPECT_TRUE(reader.status().ok()) << reader.status().error().message;
   EXPECT_TRUE(reader.at_end());
   return out;
 }
@@ -71,7 +71,7 @@ TEST(RecordReader, ReadsAGoodFileRecordByRecord) {
     EXPECT_EQ(records[i].offset, e.offset) << i;
     EXPECT_EQ(records[i].length, e.length) << i;
   }
-  ASSERT_TRUE(stream.status().ok()) << stream.status().message;
+  ASSERT_TRUE(stream.status().ok()) << stream.status().error().message;
   EXPECT_EQ(i, records.size());
 
   std::uint64_t at = kMagicSize;
@@ -91,7 +91,7 @@ TEST(RecordReader, ReadsAGoodFileRecordByRecord) {
   ASSERT_TRUE(read_record(*source, kMagicSize, header).ok());
   EXPECT_EQ(header.opcode, opcode_of<Header>());
   auto footer = read_footer(*source);
-  ASSERT_TRUE(footer.ok()) << footer.status().message;
+  ASSERT_TRUE(footer.ok()) << footer.error().message;
   EXPECT_NE(footer.value().summary_start, 0u);
 }
 
@@ -117,9 +117,9 @@ TEST(RecordReader, ReportsATruncatedRecordWithItsOffset) {
     const RecordProblem& p = problems.front();
     EXPECT_EQ(p.offset, cut.offset);
     EXPECT_EQ(p.available, keep);
-    EXPECT_EQ(p.status.code, StatusCode::Truncated);
-    EXPECT_NE(p.status.message.find("at offset " + std::to_string(cut.offset)), std::string::npos)
-        << p.status.message;
+    EXPECT_EQ(p.status.code(), ErrorCode::Truncated);
+    EXPECT_NE(p.status.error().message.find("at offset " + std::to_string(cut.offset)), std::string::npos)
+        << p.status.error().message;
     ASSERT_TRUE(p.opcode.has_value());
     EXPECT_EQ(*p.opcode, cut.opcode);
     EXPECT_EQ(p.content_length.has_value(), keep >= RecordReader::kPrefixSize);
@@ -128,7 +128,7 @@ TEST(RecordReader, ReportsATruncatedRecordWithItsOffset) {
     }
     EXPECT_EQ(reader.position(), cut.offset);
     EXPECT_EQ(reader.problem().offset, cut.offset);
-    EXPECT_EQ(reader.status().code, StatusCode::Truncated);
+    EXPECT_EQ(reader.status().code(), ErrorCode::Truncated);
   }
 }
 
@@ -144,12 +144,12 @@ TEST(RecordReader, ALengthPastTheEndIsAProblemNotARead) {
   ASSERT_TRUE(reader.next(r));
   EXPECT_FALSE(reader.next(r));
   const RecordProblem& p = reader.problem();
-  EXPECT_EQ(p.status.code, StatusCode::Truncated);
+  EXPECT_EQ(p.status.code(), ErrorCode::Truncated);
   EXPECT_EQ(p.offset, bad.offset);
   EXPECT_EQ(p.content_length, UINT64_MAX);
   EXPECT_EQ(p.available, file.size() - bad.offset);
-  EXPECT_NE(p.status.message.find("claims 18446744073709551615 bytes"), std::string::npos)
-      << p.status.message;
+  EXPECT_NE(p.status.error().message.find("claims 18446744073709551615 bytes"), std::string::npos)
+      << p.status.error().message;
 
   // A caller may resync past the bad record and read on.
   reader.seek(records[2].offset);
@@ -159,8 +159,8 @@ TEST(RecordReader, ALengthPastTheEndIsAProblemNotARead) {
   EXPECT_EQ(r.opcode, records[2].opcode);
 
   RecordView one;
-  EXPECT_EQ(read_record(*source, bad.offset, one).code, StatusCode::Truncated);
-  EXPECT_EQ(read_record(*source, file.size(), one).code, StatusCode::Truncated);
+  EXPECT_EQ(read_record(*source, bad.offset, one).code(), ErrorCode::Truncated);
+  EXPECT_EQ(read_record(*source, file.size(), one).code(), ErrorCode::Truncated);
 }
 
 TEST(CheckMagic, BadTruncatedAndGoodMagic) {
@@ -168,23 +168,23 @@ TEST(CheckMagic, BadTruncatedAndGoodMagic) {
   auto good = make_buffer_source(file);
   EXPECT_TRUE(check_magic(*good, 0).ok());
   EXPECT_TRUE(check_magic(*good, file.size() - kMagicSize).ok());
-  EXPECT_EQ(check_magic(*good, kMagicSize).code, StatusCode::BadMagic);  // the Header, not magic
+  EXPECT_EQ(check_magic(*good, kMagicSize).code(), ErrorCode::BadMagic);  // the Header, not magic
 
   Bytes flipped = file;
   flipped[3] ^= 0x20;  // 'C' -> 'c'
   auto bad = make_buffer_source(flipped);
   const Status s = check_magic(*bad, 0);
-  EXPECT_EQ(s.code, StatusCode::BadMagic);
-  EXPECT_NE(s.message.find("at offset 0"), std::string::npos) << s.message;
+  EXPECT_EQ(s.code(), ErrorCode::BadMagic);
+  EXPECT_NE(s.error().message.find("at offset 0"), std::string::npos) << s.error().message;
 
   auto short_good = make_buffer_source(Bytes(file.begin(), file.begin() + 5));
-  EXPECT_EQ(check_magic(*short_good, 0).code, StatusCode::Truncated);
+  EXPECT_EQ(check_magic(*short_good, 0).code(), ErrorCode::Truncated);
   auto short_bad = make_buffer_source(Bytes(flipped.begin(), flipped.begin() + 5));
-  EXPECT_EQ(check_magic(*short_bad, 0).code, StatusCode::BadMagic);
+  EXPECT_EQ(check_magic(*short_bad, 0).code(), ErrorCode::BadMagic);
 
   // Without its trailing magic a file has no Footer to read.
   auto cut = make_buffer_source(Bytes(file.begin(), file.end() - 1));
-  EXPECT_EQ(read_footer(*cut).status().code, StatusCode::Truncated);
+  EXPECT_EQ(read_footer(*cut).code(), ErrorCode::Truncated);
 }
 
 TEST(ByteSource, FileAndBufferSourcesGiveTheSameRecords) {
@@ -199,7 +199,7 @@ TEST(ByteSource, FileAndBufferSourcesGiveTheSameRecords) {
     std::fclose(f);
   }
   auto from_file = open_file_source(path);
-  ASSERT_TRUE(from_file.ok()) << from_file.status().message;
+  ASSERT_TRUE(from_file.ok()) << from_file.error().message;
   ASSERT_EQ(from_file.value()->size(), file.size());
   auto from_buffer = make_buffer_source(file);
   ViewSource from_view(file);
@@ -218,7 +218,7 @@ TEST(ByteSource, FileAndBufferSourcesGiveTheSameRecords) {
     EXPECT_EQ(file_contents[i], buffer_contents[i]) << i;
     EXPECT_EQ(view_contents[i], buffer_contents[i]) << i;
   }
-  EXPECT_EQ(open_file_source(path + ".missing").status().code, StatusCode::IoError);
+  EXPECT_EQ(open_file_source(path + ".missing").code(), ErrorCode::IoError);
   std::remove(path.c_str());
 }
 

@@ -15,7 +15,7 @@ std::vector<mcap::Message> all_messages(const fs::path& path) {
   mcap::IndexedReader r;
   EXPECT_TRUE(r.open(path.string()).ok());
   auto m = r.read_all_messages();
-  EXPECT_TRUE(m.ok()) << m.status().message;
+  EXPECT_TRUE(m.ok()) << m.error().message;
   return m.ok() ? std::move(m).value() : std::vector<mcap::Message>{};
 }
 

@@ -13,8 +13,8 @@ mcap::ByteView view(const msgs::Bytes& b) {
   return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
 }
 
-Error fail(const std::string& path, const mcap::Status& st) {
-  return Error{path + ": " + st.message};
+Error fail(const std::string& path, const Error& error) {
+  return Error{path + ": " + error.message};
 }
 
 class McapSink final : public Sink {
@@ -33,11 +33,11 @@ class McapSink final : public Sink {
     if (auto st = writer_.open(file_.temp_path(), writer_options(options_.compression, options_.chunk_size,
                                                                  options_.compression_level));
         !st.ok()) {
-      return fail(path_, st);
+      return fail(path_, st.error());
     }
     for (msgs::TopicId id : ids_) {
       auto channel = add_topic(writer_, msgs::topic(id), options_.ns);
-      if (!channel.ok()) return fail(path_, channel.status());
+      if (!channel.ok()) return fail(path_, channel.error());
       channels_[static_cast<std::size_t>(id)] = channel.value();
     }
     return record(world, true);
@@ -49,7 +49,7 @@ class McapSink final : public Sink {
   }
 
   Status finish() override {
-    if (auto st = writer_.close(); !st.ok()) return fail(path_, st);
+    if (auto st = writer_.close(); !st.ok()) return fail(path_, st.error());
     return file_.commit();
   }
 
@@ -62,7 +62,7 @@ class McapSink final : public Sink {
       encoder_->encode(id, world, buffer_);
       const auto k = static_cast<std::size_t>(id);
       if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, t, view(buffer_)); !st.ok()) {
-        return fail(path_, st);
+        return fail(path_, st.error());
       }
     }
     return Ok{};
@@ -94,19 +94,18 @@ mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t 
   return o;
 }
 
-mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec,
-                                      std::string_view ns) {
+Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns) {
   return add_topic(writer, spec, ns, msgs::offered_qos(spec));
 }
 
-mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
-                                      const msgs::OfferedQos& offered) {
+Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
+                                const msgs::OfferedQos& offered) {
   Result<std::string> schema = msgs::ros2msg_schema(spec.type);
-  if (!schema) return mcap::Status::Error(mcap::StatusCode::InvalidArgument, schema.error().message);
+  if (!schema) return schema.error();
   const std::string& text = schema.value();
   auto schema_id = writer.add_schema(spec.type, "ros2msg",
                                      {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
-  if (!schema_id.ok()) return schema_id.status();
+  if (!schema_id.ok()) return schema_id.error();
   return writer.add_channel(schema_id.value(), msgs::topic_name(spec, ns), "cdr",
                             {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}});
 }

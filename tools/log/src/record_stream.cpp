@@ -7,15 +7,15 @@ namespace rbsim::log {
 
 Status RecordStream::open(const std::string& path) {
   path_ = path;
-  if (const mcap::Status st = reader_.open(path); !st.ok())
-    return Error{path + ": " + mcap_tools::read_error(st)};
+  if (const Status st = reader_.open(path); !st.ok())
+    return Error{path + ": " + mcap_tools::read_error(st.error())};
   thread_ = std::thread([this] { run(); });
   return Ok{};
 }
 
 Status RecordStream::status() const {
   if (status_.ok()) return Ok{};
-  return Error{path_ + ": " + mcap_tools::read_error(status_)};
+  return Error{path_ + ": " + mcap_tools::read_error(status_.error())};
 }
 
 void RecordStream::run() {

@@ -165,7 +165,7 @@ struct Recording::Impl {
     mcap::ReadMessagesOptions ro;
     ro.topics.push_back(topic);
     Status failure = Ok{};
-    const mcap::Status st = reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+    const Status st = reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
       const auto r = route.find(e.message.channel_id);
       if (r == route.end() || r->second != msgs::TopicId::Scene) return true;
       Result<msgs::SceneMessage> decoded = msgs::decode_scene(bytes_of(e.message));
@@ -176,7 +176,7 @@ struct Recording::Impl {
       scene = std::move(decoded.value());
       return false;  // published once (latched): a repeat carries the same constants
     });
-    if (!st.ok()) return fail(mcap_tools::read_error(st));
+    if (!st.ok()) return fail(mcap_tools::read_error(st.error()));
     if (!failure) return failure;
     if (!scene && options.require_scene) {
       return fail("no scene description recorded (topic " + topic + " of type " +
@@ -332,16 +332,16 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
     }
   }
   if (std::string e = mcap_tools::unreadable(path); !e.empty()) return im.fail(e);
-  if (mcap::Status s = im.reader.open(path); !s.ok()) return im.fail(mcap_tools::read_error(s));
+  if (Status s = im.reader.open(path); !s.ok()) return im.fail(mcap_tools::read_error(s.error()));
   if (options.verify_crc) {
-    if (mcap::Status s = im.reader.verify_data_section_crc(); !s.ok())
-      return im.fail(mcap_tools::read_error(s));
+    if (Status s = im.reader.verify_data_section_crc(); !s.ok())
+      return im.fail(mcap_tools::read_error(s.error()));
   }
   // A file whose summary lists no channels defines them in its data section: read it once to
   // learn them.
   if (im.reader.channels().empty()) {
-    const mcap::Status s = im.reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
-    if (!s.ok()) return im.fail(mcap_tools::read_error(s));
+    const Status s = im.reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
+    if (!s.ok()) return im.fail(mcap_tools::read_error(s.error()));
   }
   im.learn_channels();
   if (Status st = im.classify(); !st) return st.error();
@@ -400,12 +400,12 @@ std::optional<mcap::Timestamp> Recording::last_log_time() const {
 Status Recording::read_messages(const MessageFilter& filter, const MessageCallback& on_message) {
   Impl& im = *impl_;
   const mcap::ReadMessagesOptions ro{filter.topics, filter.start, filter.end};
-  const mcap::Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+  const Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
     const RecordedChannel* channel = im.channel_of(e);
     if (channel == nullptr) return true;  // a message on a channel the file never defines
     return on_message(RecordedMessage{channel, &e.message});
   });
-  if (!st.ok()) return im.fail(mcap_tools::read_error(st));
+  if (!st.ok()) return im.fail(mcap_tools::read_error(st.error()));
   return Ok{};
 }
 
@@ -430,7 +430,7 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   };
   Status failure = Ok{};
   bool stopped = false;
-  const mcap::Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+  const Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
     const auto r = im.route.find(e.message.channel_id);
     const int i = r == im.route.end() ? -1 : per_step_index(r->second);
     if (i < 0) {
@@ -444,7 +444,7 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
     if (failure) failure = im.drain(false, on_step);
     return static_cast<bool>(failure);
   });
-  if (!st.ok()) return im.fail(mcap_tools::read_error(st));
+  if (!st.ok()) return im.fail(mcap_tools::read_error(st.error()));
   if (!failure || stopped) return failure;
   return im.drain(true, on_step);
 }

@@ -13,8 +13,8 @@ namespace rbsim::mcap {
 namespace detail {
 namespace {
 
-Status io_error(const std::string& what, const std::string& path) {
-  return Status::Error(StatusCode::IoError, what + " '" + path + "': " + std::strerror(errno));
+Error io_error(const std::string& what, const std::string& path) {
+  return Error{what + " '" + path + "': " + std::strerror(errno), ErrorCode::IoError};
 }
 
 struct FileCloser {
@@ -35,16 +35,16 @@ class FileSource final : public ByteSource {
     // Sequential reads (the common case) skip the seek so stdio's read-ahead keeps working.
     if (offset != position_ && fseeko(file_.get(), static_cast<off_t>(offset), SEEK_SET) != 0) {
       position_ = UINT64_MAX;
-      return Status::Error(StatusCode::IoError, std::string("seek failed: ") + std::strerror(errno));
+      return Error{std::string("seek failed: ") + std::strerror(errno), ErrorCode::IoError};
     }
     const std::size_t got = std::fread(buffer_.data(), 1, n, file_.get());
     position_ = offset + got;
     if (got != n) {
       position_ = UINT64_MAX;
-      return Status::Error(StatusCode::IoError, "short read at offset " + std::to_string(offset));
+      return Error{"short read at offset " + std::to_string(offset), ErrorCode::IoError};
     }
     out = ByteView(buffer_).first(n);
-    return Status::Ok();
+    return Ok{};
   }
 
  private:
@@ -61,7 +61,7 @@ class BufferSource final : public ByteSource {
   Status read(std::uint64_t offset, std::uint64_t length, ByteView& out) override {
     if (offset > data_.size() || length > data_.size() - offset) return out_of_range(offset, length, size());
     out = ByteView(data_).subspan(static_cast<std::size_t>(offset), static_cast<std::size_t>(length));
-    return Status::Ok();
+    return Ok{};
   }
 
  private:
@@ -82,15 +82,15 @@ class FileSink final : public ByteSink {
     if (fd_ >= 0) ::close(fd_);
   }
   Status write(ByteView data) override {
-    if (fd_ < 0) return Status::Error(StatusCode::NotOpen, "file closed");
+    if (fd_ < 0) return Error{"file closed", ErrorCode::NotOpen};
     if (buffer_.size() + data.size() <= kBuffer) {
       buffer_.insert(buffer_.end(), data.begin(), data.end());
-      return Status::Ok();
+      return Ok{};
     }
     if (data.size() < kDirect) {
       if (Status s = flush(); !s.ok()) return s;
       buffer_.assign(data.begin(), data.end());
-      return Status::Ok();
+      return Ok{};
     }
     Status s = write_fully(buffer_.size() + data.size(), [&](std::size_t done) {
       const std::size_t skip = std::min(done, buffer_.size());
@@ -103,7 +103,7 @@ class FileSink final : public ByteSink {
     return s;
   }
   Status flush() override {
-    if (fd_ < 0) return Status::Ok();
+    if (fd_ < 0) return Ok{};
     Status s = write_fully(buffer_.size(), [&](std::size_t done) {
       return ::write(fd_, buffer_.data() + done, buffer_.size() - done);
     });
@@ -111,20 +111,20 @@ class FileSink final : public ByteSink {
     return s;
   }
   Status close() override {
-    if (fd_ < 0) return Status::Ok();
+    if (fd_ < 0) return Ok{};
     Status s = flush();
     const int rc = ::close(fd_);
     fd_ = -1;
     if (s.ok() && rc != 0) {
-      return Status::Error(StatusCode::IoError, std::string("close failed: ") + std::strerror(errno));
+      return Error{std::string("close failed: ") + std::strerror(errno), ErrorCode::IoError};
     }
     return s;
   }
   const Bytes& buffer() const override { return empty_; }
   bool seekable() const override { return seekable_; }
   Status write_at(std::uint64_t offset, ByteView data) override {
-    if (fd_ < 0) return Status::Error(StatusCode::NotOpen, "file closed");
-    if (!seekable_) return Status::Error(StatusCode::IoError, "write_at on a file that cannot seek");
+    if (fd_ < 0) return Error{"file closed", ErrorCode::NotOpen};
+    if (!seekable_) return Error{"write_at on a file that cannot seek", ErrorCode::IoError};
     // The bytes may still sit in the buffer. pwrite() leaves the file position (where write()
     // appends next) where it is.
     if (Status s = flush(); !s.ok()) return s;
@@ -146,12 +146,12 @@ class FileSink final : public ByteSink {
       const ssize_t n = put(done);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) {
-        return Status::Error(StatusCode::IoError,
-                             std::string("write failed: ") + std::strerror(errno != 0 ? errno : EIO));
+        return Error{std::string("write failed: ") + std::strerror(errno != 0 ? errno : EIO),
+                     ErrorCode::IoError};
       }
       done += static_cast<std::size_t>(n);
     }
-    return Status::Ok();
+    return Ok{};
   }
 
   int fd_ = -1;
@@ -164,18 +164,18 @@ class BufferSink final : public ByteSink {
  public:
   Status write(ByteView data) override {
     data_.insert(data_.end(), data.begin(), data.end());
-    return Status::Ok();
+    return Ok{};
   }
-  Status flush() override { return Status::Ok(); }
-  Status close() override { return Status::Ok(); }
+  Status flush() override { return Ok{}; }
+  Status close() override { return Ok{}; }
   const Bytes& buffer() const override { return data_; }
   bool seekable() const override { return true; }
   Status write_at(std::uint64_t offset, ByteView data) override {
     if (offset > data_.size() || data.size() > data_.size() - offset) {
-      return Status::Error(StatusCode::InvalidArgument, "write_at past the end of the buffer");
+      return Error{"write_at past the end of the buffer", ErrorCode::InvalidArgument};
     }
     std::copy(data.begin(), data.end(), data_.begin() + static_cast<std::ptrdiff_t>(offset));
-    return Status::Ok();
+    return Ok{};
   }
 
  private:
@@ -204,7 +204,7 @@ Status ViewSource::read(std::uint64_t offset, std::uint64_t length, ByteView& ou
     return detail::out_of_range(offset, length, size());
   }
   out = data_.subspan(static_cast<std::size_t>(offset), static_cast<std::size_t>(length));
-  return Status::Ok();
+  return Ok{};
 }
 
 namespace detail {

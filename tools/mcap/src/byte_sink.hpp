@@ -26,10 +26,10 @@ class ByteSink {
 Result<std::unique_ptr<ByteSink>> open_file_sink(const std::string& path);
 std::unique_ptr<ByteSink> make_buffer_sink();
 
-inline Status out_of_range(std::uint64_t offset, std::uint64_t length, std::uint64_t size) {
-  return Status::Error(StatusCode::Truncated, "read of " + std::to_string(length) + " bytes at offset " +
-                                                  std::to_string(offset) + " past end of file (size " +
-                                                  std::to_string(size) + ")");
+inline Error out_of_range(std::uint64_t offset, std::uint64_t length, std::uint64_t size) {
+  return Error{"read of " + std::to_string(length) + " bytes at offset " + std::to_string(offset) +
+                   " past end of file (size " + std::to_string(size) + ")",
+               ErrorCode::Truncated};
 }
 
 }  // namespace rbsim::mcap::detail

@@ -40,9 +40,9 @@ Status Compressor::compress(ByteView in, ByteView& out) {
   switch (impl_->compression) {
     case Compression::None:
       out = in;
-      return Status::Ok();
+      return Ok{};
     case Compression::Zstd: {
-      if (impl_->zstd == nullptr) return Status::Error(StatusCode::IoError, "out of memory for zstd context");
+      if (impl_->zstd == nullptr) return Error{"out of memory for zstd context", ErrorCode::IoError};
       const std::size_t bound = ZSTD_compressBound(in.size());
       std::uint8_t* dst = impl_->room(bound);
       // Level 0 is the MCAP C++ library's default for zstd chunks, 1 (zstd's own default is 3).
@@ -50,10 +50,10 @@ Status Compressor::compress(ByteView in, ByteView& out) {
       const int level = impl_->level == 0 ? 1 : impl_->level;
       const std::size_t n = ZSTD_compressCCtx(impl_->zstd, dst, bound, in.data(), in.size(), level);
       if (ZSTD_isError(n)) {
-        return Status::Error(StatusCode::IoError, std::string("zstd: ") + ZSTD_getErrorName(n));
+        return Error{std::string("zstd: ") + ZSTD_getErrorName(n), ErrorCode::IoError};
       }
       out = ByteView(dst, n);
-      return Status::Ok();
+      return Ok{};
     }
     case Compression::Lz4: {
       LZ4F_preferences_t prefs{};
@@ -62,13 +62,13 @@ Status Compressor::compress(ByteView in, ByteView& out) {
       std::uint8_t* dst = impl_->room(bound);
       const std::size_t n = LZ4F_compressFrame(dst, bound, in.data(), in.size(), &prefs);
       if (LZ4F_isError(n)) {
-        return Status::Error(StatusCode::IoError, std::string("lz4: ") + LZ4F_getErrorName(n));
+        return Error{std::string("lz4: ") + LZ4F_getErrorName(n), ErrorCode::IoError};
       }
       out = ByteView(dst, n);
-      return Status::Ok();
+      return Ok{};
     }
   }
-  return Status::Error(StatusCode::UnsupportedCompression, "unknown compression");
+  return Error{"unknown compression", ErrorCode::UnsupportedCompression};
 }
 
 ChunkWorker::ChunkWorker(Compression compression, int level, bool crc)
@@ -119,7 +119,7 @@ void ChunkWorker::run() {
     start_ = false;
     lock.unlock();
     crc_ = with_crc_ ? crc32(records_) : 0;
-    Status s = compression_ == Compression::None ? Status::Ok() : compressor_.compress(records_, compressed_);
+    Status s = compression_ == Compression::None ? Ok{} : compressor_.compress(records_, compressed_);
     lock.lock();
     status_ = std::move(s);
     finished_.store(true, std::memory_order_release);
@@ -131,8 +131,8 @@ Result<Compression> compression_from_name(std::string_view name) {
   if (name.empty()) return Compression::None;
   if (name == "lz4") return Compression::Lz4;
   if (name == "zstd") return Compression::Zstd;
-  return Status::Error(StatusCode::UnsupportedCompression,
-                       "unsupported chunk compression '" + std::string(name) + "'");
+  return Error{"unsupported chunk compression '" + std::string(name) + "'",
+               ErrorCode::UnsupportedCompression};
 }
 
 }  // namespace detail
@@ -140,7 +140,7 @@ Result<Compression> compression_from_name(std::string_view name) {
 namespace {
 
 Status decompress_error(std::string_view codec, const char* what) {
-  return Status::Error(StatusCode::DecompressionFailed, std::string(codec) + ": " + what);
+  return Error{std::string(codec) + ": " + what, ErrorCode::DecompressionFailed};
 }
 
 // Output grows with what the decoder really produces (never to a declared size up front), and
@@ -184,7 +184,7 @@ Status zstd_decompress(ZSTD_DCtx* ctx, ByteView in, std::uint64_t expected, Byte
     if (hint != 0 && ob.pos == 0 && ib.pos == before_in) return decompress_error("zstd", "truncated frame");
   }
   o.finish();
-  return Status::Ok();
+  return Ok{};
 }
 
 Status lz4_decompress(LZ4F_dctx* ctx, ByteView in, std::uint64_t expected, Bytes& out) {
@@ -202,7 +202,7 @@ Status lz4_decompress(LZ4F_dctx* ctx, ByteView in, std::uint64_t expected, Bytes
     if (hint != 0 && dst == 0 && src == 0) return decompress_error("lz4", "truncated frame");
   }
   o.finish();
-  return Status::Ok();
+  return Ok{};
 }
 
 }  // namespace
@@ -235,7 +235,7 @@ Decompressor::~Decompressor() {
 
 Status Decompressor::decompress(const Chunk& chunk, ByteView records, Bytes& out, bool verify_crc) {
   auto compression = compression_from_name(chunk.compression);
-  if (!compression.ok()) return compression.status();
+  if (!compression.ok()) return compression.error();
   Status status;
   switch (*compression) {
     case Compression::None:
@@ -264,18 +264,19 @@ Status Decompressor::decompress(const Chunk& chunk, ByteView records, Bytes& out
   }
   if (!status.ok()) return status;
   if (out.size() != chunk.uncompressed_size) {
-    return Status::Error(StatusCode::Malformed, "chunk decompresses to " + std::to_string(out.size()) +
-                                                    " bytes, header says " +
-                                                    std::to_string(chunk.uncompressed_size));
+    return Error{"chunk decompresses to " + std::to_string(out.size()) + " bytes, header says " +
+                     std::to_string(chunk.uncompressed_size),
+                 ErrorCode::Malformed};
   }
   if (verify_crc && chunk.uncompressed_crc != 0) {
     const std::uint32_t crc = crc32(out);
     if (crc != chunk.uncompressed_crc) {
-      return Status::Error(StatusCode::CrcMismatch, "chunk CRC mismatch: computed " + crc_text(crc) +
-                                                        ", stored " + crc_text(chunk.uncompressed_crc));
+      return Error{
+          "chunk CRC mismatch: computed " + crc_text(crc) + ", stored " + crc_text(chunk.uncompressed_crc),
+          ErrorCode::CrcMismatch};
     }
   }
-  return Status::Ok();
+  return Ok{};
 }
 
 }  // namespace detail

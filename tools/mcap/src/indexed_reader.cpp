@@ -12,8 +12,8 @@ using namespace detail;
 
 namespace {
 
-Status with_context(const Status& s, const std::string& context) {
-  return Status::Error(s.code, s.message + " (" + context + ")");
+Error with_context(const Error& e, const std::string& context) {
+  return Error{e.message + " (" + context + ")", e.code};
 }
 
 struct Pending {
@@ -47,7 +47,8 @@ struct IndexedReader::Impl {
   std::optional<Statistics> statistics;
 
   Status check_open() const {
-    return open ? Status::Ok() : Status::Error(StatusCode::NotOpen, "indexed reader is not open");
+    if (open) return Ok{};
+    return Error{"indexed reader is not open", ErrorCode::NotOpen};
   }
 
   void learn(Record& record) {
@@ -65,32 +66,31 @@ struct IndexedReader::Impl {
     while (records.position() < end) {
       if (!records.next(rec)) return records.status();
       if (rec.offset + rec.length > end) {
-        return Status::Error(StatusCode::Malformed, "summary record at offset " + std::to_string(rec.offset) +
-                                                        " overruns its section");
+        return Error{"summary record at offset " + std::to_string(rec.offset) + " overruns its section",
+                     ErrorCode::Malformed};
       }
       auto record = parse_record(rec.opcode, rec.content);
-      if (!record.ok()) return with_context(record.status(), "summary offset " + std::to_string(rec.offset));
+      if (!record.ok()) return with_context(record.error(), "summary offset " + std::to_string(rec.offset));
       visit(record.value());
     }
-    return Status::Ok();
+    return Ok{};
   }
 
   Status read_header() {
-    if (source->size() == 0) return Status::Error(StatusCode::Truncated, "empty file");
+    if (source->size() == 0) return Error{"empty file", ErrorCode::Truncated};
     // A file shorter than the magic whose bytes match is cut off: the Header read below says so.
-    if (Status st = check_magic(*source, 0); !st.ok() && st.code != StatusCode::Truncated) {
-      if (st.code == StatusCode::BadMagic)
-        return Status::Error(StatusCode::BadMagic, "not an MCAP file (bad magic)");
+    if (Status st = check_magic(*source, 0); !st.ok() && st.code() != ErrorCode::Truncated) {
+      if (st.code() == ErrorCode::BadMagic) return Error{"not an MCAP file (bad magic)", ErrorCode::BadMagic};
       return st;
     }
     RecordView rec;
     if (Status st = read_record(*source, sizeof kMagic, rec); !st.ok()) return st;
     auto parsed = parse_record(rec.opcode, rec.content);
     if (!parsed.ok() || rec.opcode != static_cast<std::uint8_t>(Opcode::Header)) {
-      return Status::Error(StatusCode::Malformed, "first record is not a valid Header");
+      return Error{"first record is not a valid Header", ErrorCode::Malformed};
     }
     header = std::get<Header>(std::move(parsed).value());
-    return Status::Ok();
+    return Ok{};
   }
 
   Status load(std::unique_ptr<ByteSource> s, const IndexedOptions& opts) {
@@ -100,7 +100,7 @@ struct IndexedReader::Impl {
     if (Status st = read_header(); !st.ok()) return st;
     // Footer and trailing magic sit at fixed distances from the end (spec: Footer).
     auto read = read_footer(*source);
-    if (!read.ok()) return read.status();
+    if (!read.ok()) return read.error();
     footer = read.value();
     const std::uint64_t footer_offset = mcap::footer_offset(source->size());
     ByteView view;
@@ -110,7 +110,7 @@ struct IndexedReader::Impl {
     if ((footer.summary_start != 0 && (footer.summary_start < 8 || footer.summary_start > summary_end)) ||
         (footer.summary_offset_start != 0 &&
          (footer.summary_offset_start < 8 || footer.summary_offset_start > footer_offset))) {
-      return Status::Error(StatusCode::Malformed, "Footer offsets point outside the file");
+      return Error{"Footer offsets point outside the file", ErrorCode::Malformed};
     }
     if (options.verify_summary_crc && footer.summary_crc != 0) {
       // Covers the summary (if any) through Footer.summary_offset_start.
@@ -123,8 +123,9 @@ struct IndexedReader::Impl {
       }
       const std::uint32_t crc = crc32(view);
       if (crc != footer.summary_crc) {
-        return Status::Error(StatusCode::CrcMismatch, "summary CRC mismatch: computed " + crc_text(crc) +
-                                                          ", stored " + crc_text(footer.summary_crc));
+        return Error{
+            "summary CRC mismatch: computed " + crc_text(crc) + ", stored " + crc_text(footer.summary_crc),
+            ErrorCode::CrcMismatch};
       }
     }
     if (footer.summary_start != 0) {
@@ -151,7 +152,7 @@ struct IndexedReader::Impl {
     }
     open = true;
     if (chunk_indexes.empty()) return scan(nullptr);  // no index: learn schemas/channels linearly
-    return Status::Ok();
+    return Ok{};
   }
 
   // Linear fallback for unindexed files: every record in order, messages handed to `on_message`.
@@ -174,29 +175,29 @@ struct IndexedReader::Impl {
     const std::string where = "chunk at offset " + std::to_string(index.chunk_start_offset);
     RecordView rec;
     if (Status s = read_record(*source, index.chunk_start_offset, rec); !s.ok())
-      return with_context(s, where);
+      return with_context(s.error(), where);
     auto record = parse_record(rec.opcode, rec.content);
     if (!record.ok() || rec.opcode != static_cast<std::uint8_t>(Opcode::Chunk)) {
-      return Status::Error(StatusCode::Malformed, "chunk index points at no Chunk (" + where + ")");
+      return Error{"chunk index points at no Chunk (" + where + ")", ErrorCode::Malformed};
     }
     Bytes data;
     if (Status s = decompress_chunk(std::get<Chunk>(record.value()), data, options.verify_chunk_crcs);
         !s.ok()) {
-      return with_context(s, where);
+      return with_context(s.error(), where);
     }
     ViewSource chunk_source(data);
     RecordReader records(chunk_source);
     while (records.next(rec)) {
       auto inner = parse_record(rec.opcode, rec.content);
-      if (!inner.ok()) return with_context(inner.status(), where);
+      if (!inner.ok()) return with_context(inner.error(), where);
       if (auto* m = std::get_if<Message>(&inner.value())) {
         on_message(*m, rec.offset);
       } else {
         learn(inner.value());
       }
     }
-    if (!records.status().ok()) return Status::Error(StatusCode::Malformed, "record cut off inside " + where);
-    return Status::Ok();
+    if (!records.status().ok()) return Error{"record cut off inside " + where, ErrorCode::Malformed};
+    return Ok{};
   }
 };
 
@@ -205,7 +206,7 @@ IndexedReader::~IndexedReader() = default;
 
 Status IndexedReader::open(const std::string& path, const IndexedOptions& options) {
   auto source = open_file_source(path);
-  if (!source.ok()) return source.status();
+  if (!source.ok()) return source.error();
   return impl_->load(std::move(source).value(), options);
 }
 
@@ -252,7 +253,7 @@ Status IndexedReader::read_messages(const ReadMessagesOptions& options,
     for (Pending& p : heap) {
       if (!deliver(p)) break;
     }
-    return Status::Ok();
+    return Ok{};
   }
 
   // Chunks that may hold a wanted message: overlapping the time range and, when their message
@@ -286,11 +287,11 @@ Status IndexedReader::read_messages(const ReadMessagesOptions& options,
       });
       if (!s.ok()) return s;
     }
-    if (heap.empty()) return Status::Ok();
+    if (heap.empty()) return Ok{};
     std::pop_heap(heap.begin(), heap.end(), later);
     Pending p = std::move(heap.back());
     heap.pop_back();
-    if (!deliver(p)) return Status::Ok();
+    if (!deliver(p)) return Ok{};
   }
 }
 
@@ -300,32 +301,32 @@ Result<std::vector<Message>> IndexedReader::read_all_messages(const ReadMessages
     out.push_back(e.message);
     return true;
   });
-  if (!s.ok()) return s;
+  if (!s.ok()) return s.error();
   return out;
 }
 
 Result<Attachment> IndexedReader::read_attachment(const AttachmentIndex& index) {
-  if (Status s = impl_->check_open(); !s.ok()) return s;
+  if (Status s = impl_->check_open(); !s.ok()) return s.error();
   RecordView rec;
-  if (Status s = read_record(*impl_->source, index.offset, rec); !s.ok()) return s;
+  if (Status s = read_record(*impl_->source, index.offset, rec); !s.ok()) return s.error();
   auto record = parse_record(rec.opcode, rec.content);
-  if (!record.ok()) return record.status();
+  if (!record.ok()) return record.error();
   if (rec.opcode != static_cast<std::uint8_t>(Opcode::Attachment)) {
-    return Status::Error(StatusCode::Malformed, "attachment index points at no Attachment");
+    return Error{"attachment index points at no Attachment", ErrorCode::Malformed};
   }
   Attachment a = std::get<Attachment>(std::move(record).value());
-  if (Status s = check_attachment_crc(rec.content, a); !s.ok()) return s;
+  if (Status s = check_attachment_crc(rec.content, a); !s.ok()) return s.error();
   return a;
 }
 
 Result<Metadata> IndexedReader::read_metadata(const MetadataIndex& index) {
-  if (Status s = impl_->check_open(); !s.ok()) return s;
+  if (Status s = impl_->check_open(); !s.ok()) return s.error();
   RecordView rec;
-  if (Status s = read_record(*impl_->source, index.offset, rec); !s.ok()) return s;
+  if (Status s = read_record(*impl_->source, index.offset, rec); !s.ok()) return s.error();
   auto record = parse_record(rec.opcode, rec.content);
-  if (!record.ok()) return record.status();
+  if (!record.ok()) return record.error();
   if (rec.opcode != static_cast<std::uint8_t>(Opcode::Metadata)) {
-    return Status::Error(StatusCode::Malformed, "metadata index points at no Metadata");
+    return Error{"metadata index points at no Metadata", ErrorCode::Malformed};
   }
   return std::get<Metadata>(std::move(record).value());
 }
@@ -338,10 +339,10 @@ Status IndexedReader::verify_data_section_crc() {
   Streamer streamer(*impl_->source, so);
   RecordEntry entry;
   while (streamer.next(entry)) {
-    if (std::holds_alternative<DataEnd>(entry.record)) return Status::Ok();
+    if (std::holds_alternative<DataEnd>(entry.record)) return Ok{};
   }
   if (!streamer.status().ok()) return streamer.status();
-  return Status::Error(StatusCode::Malformed, "no DataEnd record");
+  return Error{"no DataEnd record", ErrorCode::Malformed};
 }
 
 bool IndexedReader::indexed() const {

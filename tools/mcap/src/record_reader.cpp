@@ -15,12 +15,11 @@ Status check_magic(ByteSource& source, std::uint64_t offset) {
   if (n > 0) {
     if (Status s = source.read(offset, n, view); !s.ok()) return s;
     if (std::memcmp(view.data(), kMagic, view.size()) != 0) {
-      return Status::Error(StatusCode::BadMagic, "bad magic" + at(offset));
+      return Error{"bad magic" + at(offset), ErrorCode::BadMagic};
     }
   }
-  if (n < sizeof kMagic)
-    return Status::Error(StatusCode::Truncated, "file ends inside the magic" + at(offset));
-  return Status::Ok();
+  if (n < sizeof kMagic) return Error{"file ends inside the magic" + at(offset), ErrorCode::Truncated};
+  return Ok{};
 }
 
 void RecordReader::reset(std::uint64_t begin, std::uint64_t end) {
@@ -45,13 +44,13 @@ bool RecordReader::next(RecordView& out) {
   if (!problem_.status.ok() || position_ >= end_) return false;
   const std::uint64_t offset = position_;
   const std::uint64_t available = end_ - offset;
-  RecordProblem problem{offset, available, std::nullopt, std::nullopt, Status::Ok()};
+  RecordProblem problem{offset, available, std::nullopt, std::nullopt, Ok{}};
   ByteView prefix;
   if (available < kPrefixSize) {
     if (Status s = source_->read(offset, available, prefix); !s.ok())
       return fail({offset, available, {}, {}, s});
     problem.opcode = prefix[0];
-    problem.status = Status::Error(StatusCode::Truncated, "record header cut off" + at(offset));
+    problem.status = Error{"record header cut off" + at(offset), ErrorCode::Truncated};
     return fail(std::move(problem));
   }
   if (Status s = source_->read(offset, kPrefixSize, prefix); !s.ok())
@@ -63,10 +62,10 @@ bool RecordReader::next(RecordView& out) {
   problem.opcode = opcode;
   problem.content_length = length;
   if (length > available - kPrefixSize) {
-    problem.status =
-        Status::Error(StatusCode::Truncated, "record (opcode " + std::to_string(opcode) + ")" + at(offset) +
-                                                 " claims " + std::to_string(length) + " bytes, only " +
-                                                 std::to_string(available - kPrefixSize) + " remain");
+    problem.status = Error{"record (opcode " + std::to_string(opcode) + ")" + at(offset) + " claims " +
+                               std::to_string(length) + " bytes, only " +
+                               std::to_string(available - kPrefixSize) + " remain",
+                           ErrorCode::Truncated};
     return fail(std::move(problem));
   }
   if (Status s = source_->read(offset + kPrefixSize, length, out.content); !s.ok()) {
@@ -82,10 +81,10 @@ bool RecordReader::next(RecordView& out) {
 
 Status read_record(ByteSource& source, std::uint64_t offset, RecordView& out) {
   RecordReader reader(source, offset);
-  if (reader.next(out)) return Status::Ok();
+  if (reader.next(out)) return Ok{};
   if (!reader.status().ok()) return reader.status();
   // An offset at (or past) the end: no bytes of a header at all.
-  return Status::Error(StatusCode::Truncated, "record header cut off" + at(offset));
+  return Error{"record header cut off" + at(offset), ErrorCode::Truncated};
 }
 
 std::uint64_t footer_offset(std::uint64_t size) {
@@ -96,19 +95,19 @@ Result<Footer> read_footer(ByteSource& source) {
   const std::uint64_t size = source.size();
   const std::uint64_t min_size =
       sizeof kMagic + detail::kRecordPrefix + detail::kFooterRecord + sizeof kMagic;
-  if (size < min_size) return Status::Error(StatusCode::Truncated, "file too short for a Footer");
+  if (size < min_size) return Error{"file too short for a Footer", ErrorCode::Truncated};
   if (Status s = check_magic(source, size - sizeof kMagic); !s.ok()) {
-    if (s.code == StatusCode::IoError) return s;
-    return Status::Error(StatusCode::Truncated, "no trailing magic: file truncated or never closed");
+    if (s.code() == ErrorCode::IoError) return s.error();
+    return Error{"no trailing magic: file truncated or never closed", ErrorCode::Truncated};
   }
   RecordView record;
-  if (Status s = read_record(source, footer_offset(size), record); !s.ok()) return s;
+  if (Status s = read_record(source, footer_offset(size), record); !s.ok()) return s.error();
   if (record.opcode != static_cast<std::uint8_t>(Opcode::Footer) ||
       record.content.size() != detail::kFooterContent) {
-    return Status::Error(StatusCode::Malformed, "no Footer before the trailing magic");
+    return Error{"no Footer before the trailing magic", ErrorCode::Malformed};
   }
   auto parsed = parse_record(record.opcode, record.content);
-  if (!parsed.ok()) return parsed.status();
+  if (!parsed.ok()) return parsed.error();
   return std::get<Footer>(std::move(parsed).value());
 }
 

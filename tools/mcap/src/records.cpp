@@ -13,8 +13,8 @@ namespace {
 
 using detail::Cursor;
 
-Status malformed(std::string_view type) {
-  return Status::Error(StatusCode::Malformed, std::string(type) + " record is too short for its fields");
+Error malformed(std::string_view type) {
+  return Error{std::string(type) + " record is too short for its fields", ErrorCode::Malformed};
 }
 
 // Each parse_* reads the known fields in wire order and ignores whatever follows them (spec:
@@ -97,13 +97,13 @@ Status parse_chunk_view(ByteView content, Chunk& r, ByteView& records) {
     return malformed("Chunk");
   }
   r.records.clear();
-  return Status::Ok();
+  return Ok{};
 }
 
 Status parse_message_into(ByteView content, Message& r) {
   Cursor c(content);
   if (!parse(c, r)) return malformed("Message");
-  return Status::Ok();
+  return Ok{};
 }
 
 }  // namespace detail

@@ -16,12 +16,13 @@ constexpr std::uint8_t op(Opcode o) {
 }  // namespace
 
 Status check_attachment_crc(ByteView content, const Attachment& a) {
-  if (a.crc == 0) return Status::Ok();
+  if (a.crc == 0) return Ok{};
   const std::size_t covered = 8 + 8 + 4 + a.name.size() + 4 + a.media_type.size() + 8 + a.data.size();
   const std::uint32_t crc = crc32(content.subspan(0, covered));
-  if (crc == a.crc) return Status::Ok();
-  return Status::Error(StatusCode::CrcMismatch, "attachment '" + a.name + "' CRC mismatch: computed " +
-                                                    crc_text(crc) + ", stored " + crc_text(a.crc));
+  if (crc == a.crc) return Ok{};
+  return Error{
+      "attachment '" + a.name + "' CRC mismatch: computed " + crc_text(crc) + ", stored " + crc_text(a.crc),
+      ErrorCode::CrcMismatch};
 }
 
 bool Streamer::fail(Status status) {
@@ -48,22 +49,21 @@ bool Streamer::next(RecordEntry& out) {
 bool Streamer::next_in_chunk(RecordEntry& out) {
   RecordView rec;
   if (!chunk_records_.next(rec)) {
-    return fail(Status::Error(StatusCode::Malformed, "record cut off at byte " +
-                                                         std::to_string(chunk_records_.position()) +
-                                                         " of the chunk" + at(chunk_offset_)));
+    return fail(Error{"record cut off at byte " + std::to_string(chunk_records_.position()) +
+                          " of the chunk" + at(chunk_offset_),
+                      ErrorCode::Malformed});
   }
   if (rec.opcode == op(Opcode::Message)) {
     // Into the caller's Message, reusing its buffer: a fresh one per message is fresh pages.
     Message* message = std::get_if<Message>(&out.record);
     if (message == nullptr) message = &out.record.emplace<Message>();
     if (Status s = parse_message_into(rec.content, *message); !s.ok()) {
-      return fail(Status::Error(s.code, s.message + " in chunk" + at(chunk_offset_)));
+      return fail(Error{s.error().message + " in chunk" + at(chunk_offset_), s.error().code});
     }
   } else {
     auto record = parse_record(rec.opcode, rec.content);
     if (!record.ok()) {
-      return fail(
-          Status::Error(record.status().code, record.status().message + " in chunk" + at(chunk_offset_)));
+      return fail(Error{record.error().message + " in chunk" + at(chunk_offset_), record.error().code});
     }
     out.record = std::move(record).value();
   }
@@ -84,13 +84,13 @@ void Streamer::update_crcs(const RecordView& record) {
 
 // The leading magic; the records follow it.
 bool Streamer::start() {
-  if (source_.size() == 0) return fail(Status::Error(StatusCode::Truncated, "empty file"));
+  if (source_.size() == 0) return fail(Error{"empty file", ErrorCode::Truncated});
   if (Status s = check_magic(source_, 0); !s.ok()) {
-    if (s.code == StatusCode::BadMagic) {
-      return fail(Status::Error(StatusCode::BadMagic, "not an MCAP file (bad magic)"));
+    if (s.code() == ErrorCode::BadMagic) {
+      return fail(Error{"not an MCAP file (bad magic)", ErrorCode::BadMagic});
     }
-    if (s.code == StatusCode::Truncated) {
-      return fail(Status::Error(StatusCode::Truncated, "file ends inside the magic"));
+    if (s.code() == ErrorCode::Truncated) {
+      return fail(Error{"file ends inside the magic", ErrorCode::Truncated});
     }
     return fail(s);
   }
@@ -104,26 +104,26 @@ bool Streamer::start() {
 // The summary CRC, then the trailing magic and nothing after it.
 bool Streamer::check_footer(const RecordView& footer_record, const Footer& footer) {
   // Spec: "The last record in the data section MUST be the Data End record".
-  if (!seen_data_end_) return fail(Status::Error(StatusCode::Malformed, "Footer without a DataEnd record"));
+  if (!seen_data_end_) return fail(Error{"Footer without a DataEnd record", ErrorCode::Malformed});
   // The summary CRC runs from the end of DataEnd through Footer.summary_offset_start.
   const std::uint32_t stored = footer.summary_crc;
   const std::uint32_t computed =
       crc32(footer_record.content.subspan(0, 16), crc32(footer_record.prefix_bytes(), summary_crc_));
   if (options_.verify_crcs && stored != 0 && stored != computed) {
-    return fail(Status::Error(
-        StatusCode::CrcMismatch,
-        "summary CRC mismatch: computed " + std::to_string(computed) + ", stored " + std::to_string(stored)));
+    return fail(Error{
+        "summary CRC mismatch: computed " + std::to_string(computed) + ", stored " + std::to_string(stored),
+        ErrorCode::CrcMismatch});
   }
   const std::uint64_t size = source_.size();
   if (size - position_ < sizeof kMagic) {
-    return fail(Status::Error(StatusCode::Truncated, "file ends inside the trailing magic"));
+    return fail(Error{"file ends inside the trailing magic", ErrorCode::Truncated});
   }
   if (Status s = check_magic(source_, position_); !s.ok()) {
-    if (s.code != StatusCode::BadMagic) return fail(s);
-    return fail(Status::Error(StatusCode::BadMagic, "bad trailing magic" + at(position_)));
+    if (s.code() != ErrorCode::BadMagic) return fail(s);
+    return fail(Error{"bad trailing magic" + at(position_), ErrorCode::BadMagic});
   }
   if (size - position_ > sizeof kMagic) {
-    return fail(Status::Error(StatusCode::Malformed, "unexpected bytes after the trailing magic"));
+    return fail(Error{"unexpected bytes after the trailing magic", ErrorCode::Malformed});
   }
   position_ = size;
   state_ = State::Done;
@@ -135,12 +135,12 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
   RecordView rec;
   if (!records_.next(rec)) {
     if (!records_.status().ok()) return fail(records_.status());
-    return fail(Status::Error(StatusCode::Truncated, "file ends without a Footer"));
+    return fail(Error{"file ends without a Footer", ErrorCode::Truncated});
   }
   const std::uint8_t opcode = rec.opcode;
   const ByteView content = rec.content;
   if (first_record_ && opcode != op(Opcode::Header)) {
-    return fail(Status::Error(StatusCode::Malformed, "first record is not a Header" + at(position_)));
+    return fail(Error{"first record is not a Header" + at(position_), ErrorCode::Malformed});
   }
   first_record_ = false;
   const bool is_data_end = opcode == op(Opcode::DataEnd);
@@ -155,13 +155,13 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
   if (chunk_view) {
     Chunk chunk;
     if (Status s = parse_chunk_view(content, chunk, chunk_records); !s.ok()) {
-      return fail(Status::Error(s.code, s.message + at(position_)));
+      return fail(Error{s.error().message + at(position_), s.error().code});
     }
     parsed = Record(std::move(chunk));
   } else {
     parsed = parse_record(opcode, content);
   }
-  if (!parsed.ok()) return fail(Status::Error(parsed.status().code, parsed.status().message + at(position_)));
+  if (!parsed.ok()) return fail(Error{parsed.error().message + at(position_), parsed.error().code});
   Record& record = parsed.value();
   const std::uint64_t record_offset = position_;
   out.offset = record_offset;
@@ -174,9 +174,9 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
     case Opcode::DataEnd: {
       const std::uint32_t stored = std::get<DataEnd>(record).data_section_crc;
       if (options_.verify_crcs && stored != 0 && stored != data_crc) {
-        return fail(Status::Error(StatusCode::CrcMismatch, "data section CRC mismatch: computed " +
-                                                               crc_text(data_crc) + ", stored " +
-                                                               std::to_string(stored)));
+        return fail(Error{"data section CRC mismatch: computed " + crc_text(data_crc) + ", stored " +
+                              std::to_string(stored),
+                          ErrorCode::CrcMismatch});
       }
       seen_data_end_ = true;
       break;
@@ -186,7 +186,10 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
         const Chunk& chunk = std::get<Chunk>(record);
         chunk_error_ = decompressor_.decompress(chunk, chunk_view ? chunk_records : ByteView(chunk.records),
                                                 chunk_data_, options_.verify_crcs);
-        if (!chunk_error_.ok()) chunk_error_.message += " (chunk" + at(record_offset) + ")";
+        if (!chunk_error_.ok()) {
+          chunk_error_ = Error{chunk_error_.error().message + " (chunk" + at(record_offset) + ")",
+                               chunk_error_.error().code};
+        }
         chunk_source_.reset(chunk_data_);
         chunk_records_.reset(0);
         chunk_offset_ = record_offset;
@@ -217,12 +220,12 @@ bool Streamer::read_top_level(RecordEntry& out, bool& yield) {
 struct StreamReader::Impl {
   std::unique_ptr<ByteSource> source;
   std::unique_ptr<detail::Streamer> streamer;
-  Status not_open = Status::Error(StatusCode::NotOpen, "stream reader is not open");
+  Status not_open = Error{"stream reader is not open", ErrorCode::NotOpen};
 
   Status start(std::unique_ptr<ByteSource> s, const StreamOptions& options) {
     source = std::move(s);
     streamer = std::make_unique<detail::Streamer>(*source, options);
-    return Status::Ok();
+    return Ok{};
   }
 };
 
@@ -231,7 +234,7 @@ StreamReader::~StreamReader() = default;
 
 Status StreamReader::open(const std::string& path, const StreamOptions& options) {
   auto source = open_file_source(path);
-  if (!source.ok()) return source.status();
+  if (!source.ok()) return source.error();
   return impl_->start(std::move(source).value(), options);
 }
 

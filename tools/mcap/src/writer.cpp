@@ -59,8 +59,8 @@ struct Writer::Impl {
 
   Status check_open() const {
     if (!error.ok()) return error;
-    if (!open) return Status::Error(StatusCode::NotOpen, "writer is not open");
-    return Status::Ok();
+    if (!open) return Error{"writer is not open", ErrorCode::NotOpen};
+    return Ok{};
   }
 
   Status write(ByteView bytes) {
@@ -84,7 +84,7 @@ struct Writer::Impl {
     }
     if (into_chunk) {
       serialize_record(record, chunk);
-      return Status::Ok();
+      return Ok{};
     }
     scratch.clear();
     serialize_record(record, scratch);
@@ -146,7 +146,7 @@ struct Writer::Impl {
 
   // Completes the streamed chunk: its header rewritten with the final sizes, CRCs and times.
   Status finish_streamed_chunk() {
-    if (!streaming) return Status::Ok();
+    if (!streaming) return Ok{};
     streaming = false;
     scratch.clear();
     chunk_header(scratch, stream_size, stream_size, options.enable_crcs ? stream_crc : 0, chunk_meta);
@@ -170,7 +170,7 @@ struct Writer::Impl {
   // finishes and writes the chunk before it, keeping file order).
   Status flush_chunk() {
     if (stream) return finish_streamed_chunk();
-    if (chunk.empty()) return Status::Ok();
+    if (chunk.empty()) return Ok{};
     Status s;
     // The worker takes the chunk when it is free. While it is still busy with the chunk before,
     // this one is compressed here meanwhile (two cores at work), and both are written in order.
@@ -180,7 +180,7 @@ struct Writer::Impl {
       worker_meta = std::move(chunk_meta);
       chunk_meta = ChunkMeta{};
       worker->submit();
-      return Status::Ok();
+      return Ok{};
     }
     // An uncompressed chunk is written straight from `chunk`, without a copy through the compressor.
     ByteView payload = chunk;
@@ -196,12 +196,12 @@ struct Writer::Impl {
   }
 
   Status write_compressed_chunk() {
-    return worker && worker->pending() && worker->finished() ? finish_pending() : Status::Ok();
+    return worker && worker->pending() && worker->finished() ? finish_pending() : Ok{};
   }
 
   // Writes the chunk the worker holds, once compressed (waiting for it if need be).
   Status finish_pending() {
-    if (!worker || !worker->pending()) return Status::Ok();
+    if (!worker || !worker->pending()) return Ok{};
     Status s = worker->wait();
     if (!s.ok()) {
       worker->release();
@@ -250,14 +250,14 @@ struct Writer::Impl {
 
   template <typename T>
   Status write_group(Opcode opcode, const std::vector<T>& records, std::vector<SummaryOffset>& groups) {
-    if (records.empty()) return Status::Ok();
+    if (records.empty()) return Ok{};
     const std::uint64_t start = offset;
     for (const T& r : records) {
       Status s = emit(r, false);
       if (!s.ok()) return s;
     }
     groups.push_back({static_cast<std::uint8_t>(opcode), start, offset - start});
-    return Status::Ok();
+    return Ok{};
   }
 
   Status finish() {
@@ -319,43 +319,42 @@ Writer::~Writer() {
 }
 
 Status Writer::open(const std::string& path, const WriterOptions& options) {
-  if (impl_->open) return Status::Error(StatusCode::InvalidArgument, "writer is already open");
+  if (impl_->open) return Error{"writer is already open", ErrorCode::InvalidArgument};
   auto sink = open_file_sink(path);
-  if (!sink.ok()) return sink.status();
+  if (!sink.ok()) return sink.error();
   return impl_->begin(std::move(sink).value(), options);
 }
 
 Status Writer::open_buffer(const WriterOptions& options) {
-  if (impl_->open) return Status::Error(StatusCode::InvalidArgument, "writer is already open");
+  if (impl_->open) return Error{"writer is already open", ErrorCode::InvalidArgument};
   return impl_->begin(make_buffer_sink(), options);
 }
 
 Status Writer::add_schema(const Schema& schema) {
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
-  if (schema.id == 0) return Status::Error(StatusCode::InvalidArgument, "schema id 0 is reserved");
+  if (schema.id == 0) return Error{"schema id 0 is reserved", ErrorCode::InvalidArgument};
   // Spec: "Any two schema records sharing a common ID must be identical".
   if (auto it = w.schemas.find(schema.id); it != w.schemas.end()) {
     const Schema& old = it->second;
     if (old.name == schema.name && old.encoding == schema.encoding && old.data == schema.data) {
-      return Status::Ok();
+      return Ok{};
     }
-    return Status::Error(StatusCode::InvalidArgument,
-                         "schema id " + std::to_string(schema.id) + " redefined");
+    return Error{"schema id " + std::to_string(schema.id) + " redefined", ErrorCode::InvalidArgument};
   }
   if (Status s = w.emit(schema, w.options.use_chunks); !s.ok()) return s;
   w.schemas.emplace(schema.id, schema);
   w.stats.schema_count = static_cast<std::uint16_t>(w.schemas.size());
-  return Status::Ok();
+  return Ok{};
 }
 
 Result<std::uint16_t> Writer::add_schema(std::string_view name, std::string_view encoding, ByteView data) {
   const std::uint16_t id =
       static_cast<std::uint16_t>(impl_->schemas.empty() ? 1 : impl_->schemas.rbegin()->first + 1);
-  if (id == 0) return Status::Error(StatusCode::InvalidArgument, "schema ids exhausted");
+  if (id == 0) return Error{"schema ids exhausted", ErrorCode::InvalidArgument};
   Status s =
       add_schema(Schema{id, std::string(name), std::string(encoding), Bytes(data.begin(), data.end())});
-  if (!s.ok()) return s;
+  if (!s.ok()) return s.error();
   return id;
 }
 
@@ -363,31 +362,29 @@ Status Writer::add_channel(const Channel& channel) {
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
   if (channel.schema_id != 0 && w.schemas.count(channel.schema_id) == 0) {
-    return Status::Error(StatusCode::InvalidArgument,
-                         "unknown schema id " + std::to_string(channel.schema_id));
+    return Error{"unknown schema id " + std::to_string(channel.schema_id), ErrorCode::InvalidArgument};
   }
   if (auto it = w.channels.find(channel.id); it != w.channels.end()) {
     const Channel& old = it->second;
     if (old.schema_id == channel.schema_id && old.topic == channel.topic &&
         old.message_encoding == channel.message_encoding && old.metadata == channel.metadata) {
-      return Status::Ok();
+      return Ok{};
     }
-    return Status::Error(StatusCode::InvalidArgument,
-                         "channel id " + std::to_string(channel.id) + " redefined");
+    return Error{"channel id " + std::to_string(channel.id) + " redefined", ErrorCode::InvalidArgument};
   }
   if (Status s = w.emit(channel, w.options.use_chunks); !s.ok()) return s;
   w.channels.emplace(channel.id, channel);
   w.stats.channel_count = static_cast<std::uint32_t>(w.channels.size());
-  return Status::Ok();
+  return Ok{};
 }
 
 Result<std::uint16_t> Writer::add_channel(std::uint16_t schema_id, std::string_view topic,
                                           std::string_view message_encoding, const KeyValueMap& metadata) {
   const std::uint16_t id =
       static_cast<std::uint16_t>(impl_->channels.empty() ? 1 : impl_->channels.rbegin()->first + 1);
-  if (id == 0) return Status::Error(StatusCode::InvalidArgument, "channel ids exhausted");
+  if (id == 0) return Error{"channel ids exhausted", ErrorCode::InvalidArgument};
   Status s = add_channel(Channel{id, schema_id, std::string(topic), std::string(message_encoding), metadata});
-  if (!s.ok()) return s;
+  if (!s.ok()) return s.error();
   return id;
 }
 
@@ -401,7 +398,7 @@ Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, T
   Impl& w = *impl_;
   if (Status s = w.check_open(); !s.ok()) return s;
   if (w.channels.count(channel_id) == 0) {
-    return Status::Error(StatusCode::InvalidArgument, "unknown channel id " + std::to_string(channel_id));
+    return Error{"unknown channel id " + std::to_string(channel_id), ErrorCode::InvalidArgument};
   }
   Statistics& st = w.stats;
   st.message_start_time = st.message_count == 0 ? log_time : std::min(st.message_start_time, log_time);
@@ -434,7 +431,7 @@ Status Writer::write_message(std::uint16_t channel_id, std::uint32_t sequence, T
   // A compressed chunk goes to the file as soon as it is ready, not only when the next one is full.
   if (Status s = w.write_compressed_chunk(); !s.ok()) return s;
   if ((w.stream ? w.stream_size : w.chunk.size()) >= w.options.chunk_size) return w.flush_chunk();
-  return Status::Ok();
+  return Ok{};
 }
 
 Status Writer::add_attachment(Timestamp log_time, Timestamp create_time, std::string_view name,
@@ -459,7 +456,7 @@ Status Writer::add_attachment(Timestamp log_time, Timestamp create_time, std::st
   if (Status s = w.write(out); !s.ok()) return s;
   if (w.options.emit_attachment_indexes) w.attachment_indexes.push_back(std::move(index));
   ++w.stats.attachment_count;
-  return Status::Ok();
+  return Ok{};
 }
 
 Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) {
@@ -473,7 +470,7 @@ Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) 
     w.metadata_indexes.push_back({start, w.offset - start, std::string(name)});
   }
   ++w.stats.metadata_count;
-  return Status::Ok();
+  return Ok{};
 }
 
 Status Writer::flush_chunk() {
@@ -488,7 +485,7 @@ Status Writer::write_compressed_chunk() {
 }
 
 Status Writer::close() {
-  if (!impl_->open) return Status::Error(StatusCode::NotOpen, "writer is not open");
+  if (!impl_->open) return Error{"writer is not open", ErrorCode::NotOpen};
   impl_->open = false;
   if (!impl_->error.ok()) {
     impl_->worker.reset();

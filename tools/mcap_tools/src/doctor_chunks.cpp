@@ -65,7 +65,7 @@ void Doctor::examine_chunk(PendingChunk& p) {
     auto parsed = mcap::parse_record(opcode, record.content);
     if (!parsed.ok()) {
       error(cat(scan.where, ": failed to parse ", opcode_name(opcode), " at byte ", record.offset, ": ",
-                parsed.status().message));
+                parsed.error().message));
     } else if (const auto* schema = std::get_if<mcap::Schema>(&parsed.value())) {
       examine_schema(*schema);
     } else if (const auto* channel = std::get_if<mcap::Channel>(&parsed.value())) {
@@ -90,13 +90,14 @@ void Doctor::examine_chunk(PendingChunk& p) {
 
 // The chunk's records into `data`; false (reported) when they cannot be had or fail the CRC.
 bool Doctor::decompress(const mcap::Chunk& chunk, const std::string& where, mcap::Bytes& data) {
-  if (mcap::Status s = mcap::decompress_chunk(chunk, data, false); !s.ok()) {
-    if (s.code == mcap::StatusCode::UnsupportedCompression) {
+  if (Status s = mcap::decompress_chunk(chunk, data, false); !s.ok()) {
+    if (s.code() == ErrorCode::UnsupportedCompression) {
       error(cat(where, ": Unsupported compression format: \"", chunk.compression, "\""));
-    } else if (s.code == mcap::StatusCode::Malformed) {
-      error(cat(where, ": Uncompressed chunk data size != Chunk.uncompressed_size (", s.message, ")"));
+    } else if (s.code() == ErrorCode::Malformed) {
+      error(
+          cat(where, ": Uncompressed chunk data size != Chunk.uncompressed_size (", s.error().message, ")"));
     } else {
-      error(cat(where, ": Could not decompress: ", s.message));
+      error(cat(where, ": Could not decompress: ", s.error().message));
     }
     return false;
   }

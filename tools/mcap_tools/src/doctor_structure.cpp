@@ -32,12 +32,12 @@ bool Doctor::walk(mcap::ByteSource& source) {
 }
 
 bool Doctor::check_leading_magic(mcap::ByteSource& source) {
-  const mcap::Status magic = mcap::check_magic(source, 0);
-  if (magic.code == mcap::StatusCode::BadMagic) {
+  const Status magic = mcap::check_magic(source, 0);
+  if (magic.code() == ErrorCode::BadMagic) {
     error("not an MCAP file: the leading magic bytes are wrong");
     return false;
   }
-  if (magic.code == mcap::StatusCode::Truncated) {
+  if (magic.code() == ErrorCode::Truncated) {
     error(cat("truncated: the file ends inside the leading magic (", size_, " bytes)"));
     return false;
   }
@@ -52,7 +52,7 @@ bool Doctor::check_leading_magic(mcap::ByteSource& source) {
 }
 
 void Doctor::report_unframed(const mcap::RecordProblem& p, std::uint8_t last_opcode) {
-  if (p.status.code == mcap::StatusCode::IoError) {
+  if (p.status.code() == ErrorCode::IoError) {
     error(p.content_length ? cat("cannot read ", *p.content_length, " bytes at offset ",
                                  p.offset + RecordReader::kPrefixSize)
                            : cat("cannot read at offset ", p.offset));
@@ -95,7 +95,7 @@ Doctor::Step Doctor::walk_record(mcap::ByteSource& source, const mcap::RecordVie
     auto parsed = mcap::parse_record(opcode, record.content);
     if (!parsed.ok()) {
       error(cat("failed to parse ", opcode_name(opcode), " record at offset ", pos_, ": ",
-                parsed.status().message));
+                parsed.error().message));
     } else {
       handle(record, parsed.value());
     }

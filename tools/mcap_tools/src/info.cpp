@@ -10,8 +10,8 @@ namespace rbsim::mcap_tools {
 
 namespace {
 
-Error fail(const mcap::Status& s) {
-  return Error{read_error(s)};
+Error fail(const Status& s) {
+  return Error{read_error(s.error())};
 }
 
 CompressionStats& stats_for(std::vector<CompressionStats>& v, const std::string& name) {
@@ -49,7 +49,7 @@ Result<LogInfo> scan(const std::string& path, LogInfo info) {
   mcap::StreamReader reader;
   mcap::StreamOptions so;
   so.report_chunks = true;
-  if (mcap::Status s = reader.open(path, so); !s.ok()) return fail(s);
+  if (Status s = reader.open(path, so); !s.ok()) return fail(s);
   std::map<std::uint16_t, mcap::Schema> schemas;
   std::map<std::uint16_t, mcap::Channel> channels;
   std::map<std::uint16_t, std::uint64_t> counts;
@@ -116,9 +116,9 @@ Result<LogInfo> info(const std::string& path) {
     if (info.file_size == 0) return Error{"empty file (0 bytes): not an MCAP file"};
   }
   mcap::IndexedReader reader;
-  if (mcap::Status s = reader.open(path); !s.ok()) return fail(s);
+  if (Status s = reader.open(path); !s.ok()) return fail(s);
   // The summary says nothing about a byte flipped in a chunk: the data section CRC does.
-  if (mcap::Status s = reader.verify_data_section_crc(); !s.ok()) return fail(s);
+  if (Status s = reader.verify_data_section_crc(); !s.ok()) return fail(s);
   info.header = reader.header();
   const auto& stats = reader.statistics();
   if (!stats) {
@@ -149,7 +149,7 @@ Result<LogInfo> info(const std::string& path) {
   std::map<std::uint16_t, mcap::Channel> channels = reader.channels();
   std::map<std::uint16_t, mcap::Schema> schemas = reader.schemas();
   if (channels.size() < stats->channel_count) {
-    if (mcap::Status s = reader.read_messages({}, [](const mcap::MessageEntry&) { return true; }); !s.ok()) {
+    if (Status s = reader.read_messages({}, [](const mcap::MessageEntry&) { return true; }); !s.ok()) {
       return fail(s);
     }
     channels = reader.channels();

@@ -54,7 +54,7 @@ std::optional<CutRecord> record_at(mcap::ByteSource& file, std::uint64_t offset)
 // Whether `byte` could start the trailing magic (whose cut-off the read status already words).
 bool starts_magic(std::uint8_t byte) {
   mcap::ViewSource first(mcap::ByteView(&byte, 1));
-  return mcap::check_magic(first, 0).code != mcap::StatusCode::BadMagic;
+  return mcap::check_magic(first, 0).code() != ErrorCode::BadMagic;
 }
 
 class Recoverer {
@@ -62,45 +62,45 @@ class Recoverer {
   explicit Recoverer(RecoverReport& report) : report_(report) {}
 
   // Copies one data-section record; errors only for output failures.
-  mcap::Status copy(mcap::Record& record) {
+  Status copy(mcap::Record& record) {
     if (auto* m = std::get_if<mcap::Message>(&record)) return message(*m);
     if (auto* s = std::get_if<mcap::Schema>(&record)) {
-      mcap::Status st = writer_.add_schema(*s);
-      if (st.code == mcap::StatusCode::InvalidArgument) {
-        note("schema " + std::to_string(s->id) + " skipped: " + st.message);
-        return mcap::Status::Ok();
+      Status st = writer_.add_schema(*s);
+      if (st.code() == ErrorCode::InvalidArgument) {
+        note("schema " + std::to_string(s->id) + " skipped: " + st.error().message);
+        return Ok{};
       }
       if (st.ok() && schema_ids_.insert(s->id)) ++report_.schemas;
       return st;
     }
     if (auto* c = std::get_if<mcap::Channel>(&record)) {
-      mcap::Status st = writer_.add_channel(*c);
-      if (st.code == mcap::StatusCode::InvalidArgument) {
-        note("channel " + std::to_string(c->id) + " (" + c->topic + ") skipped: " + st.message);
-        return mcap::Status::Ok();
+      Status st = writer_.add_channel(*c);
+      if (st.code() == ErrorCode::InvalidArgument) {
+        note("channel " + std::to_string(c->id) + " (" + c->topic + ") skipped: " + st.error().message);
+        return Ok{};
       }
       if (st.ok() && channel_ids_.insert(c->id)) ++report_.channels;
       return st;
     }
     if (auto* a = std::get_if<mcap::Attachment>(&record)) {
-      mcap::Status st = writer_.add_attachment(a->log_time, a->create_time, a->name, a->media_type, a->data);
+      Status st = writer_.add_attachment(a->log_time, a->create_time, a->name, a->media_type, a->data);
       if (st.ok()) ++report_.attachments;
       return st;
     }
     if (auto* md = std::get_if<mcap::Metadata>(&record)) {
-      mcap::Status st = writer_.add_metadata(md->name, md->metadata);
+      Status st = writer_.add_metadata(md->name, md->metadata);
       if (st.ok()) ++report_.metadata;
       return st;
     }
-    return mcap::Status::Ok();
+    return Ok{};
   }
 
-  mcap::Status chunk(const mcap::Chunk& chunk, std::uint64_t offset) {
+  Status chunk(const mcap::Chunk& chunk, std::uint64_t offset) {
     mcap::Bytes data;
-    if (mcap::Status s = mcap::decompress_chunk(chunk, data, true); !s.ok()) {
+    if (Status s = mcap::decompress_chunk(chunk, data, true); !s.ok()) {
       ++report_.corrupt_chunks;
-      note("chunk at offset " + std::to_string(offset) + " skipped: " + s.message);
-      return mcap::Status::Ok();
+      note("chunk at offset " + std::to_string(offset) + " skipped: " + s.error().message);
+      return Ok{};
     }
     mcap::ViewSource records(data);
     mcap::RecordReader reader(records);
@@ -112,13 +112,13 @@ class Recoverer {
       auto record = mcap::parse_record(view.opcode, view.content);
       if (!record.ok()) {
         note("chunk at offset " + std::to_string(offset) +
-             ": unreadable record skipped: " + record.status().message);
+             ": unreadable record skipped: " + record.error().message);
         continue;
       }
-      if (mcap::Status s = copy(record.value()); !s.ok()) return s;
+      if (Status s = copy(record.value()); !s.ok()) return s;
     }
     ++report_.chunks;
-    return mcap::Status::Ok();
+    return Ok{};
   }
 
   struct IdSet {
@@ -141,34 +141,34 @@ class Recoverer {
   }
 
  private:
-  mcap::Status restore_channel(std::uint16_t id) {
+  Status restore_channel(std::uint16_t id) {
     const auto c = fallback_channels_.find(id);
-    if (c == fallback_channels_.end()) return mcap::Status::Ok();
+    if (c == fallback_channels_.end()) return Ok{};
     const std::uint16_t schema_id = c->second.schema_id;
     if (schema_id != 0 && !schema_ids_.seen[schema_id]) {
       const auto s = fallback_schemas_.find(schema_id);
-      if (s == fallback_schemas_.end()) return mcap::Status::Ok();
+      if (s == fallback_schemas_.end()) return Ok{};
       mcap::Record r = s->second;
-      if (mcap::Status st = copy(r); !st.ok()) return st;
+      if (Status st = copy(r); !st.ok()) return st;
     }
     mcap::Record r = c->second;
-    if (mcap::Status st = copy(r); !st.ok()) return st;
+    if (Status st = copy(r); !st.ok()) return st;
     if (channel_ids_.seen[id])
       note("channel " + std::to_string(id) + " (" + c->second.topic + ") restored from the summary section");
-    return mcap::Status::Ok();
+    return Ok{};
   }
 
-  mcap::Status message(const mcap::Message& m) {
+  Status message(const mcap::Message& m) {
     if (!channel_ids_.seen[m.channel_id]) {
-      if (mcap::Status st = restore_channel(m.channel_id); !st.ok()) return st;
+      if (Status st = restore_channel(m.channel_id); !st.ok()) return st;
     }
-    mcap::Status st = writer_.write_message(m);
-    if (st.code == mcap::StatusCode::InvalidArgument) {
+    Status st = writer_.write_message(m);
+    if (st.code() == ErrorCode::InvalidArgument) {
       if (report_.dropped_messages++ == 0) {
         note("messages of channels whose Channel record was lost are dropped (first: channel " +
              std::to_string(m.channel_id) + ")");
       }
-      return mcap::Status::Ok();
+      return Ok{};
     }
     if (st.ok()) ++report_.messages;
     return st;
@@ -225,13 +225,13 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   mcap::StreamOptions so;
   so.descend_into_chunks = false;  // chunks are decompressed and checked here, one by one
   so.verify_crcs = true;           // data section, attachment and summary CRCs
-  if (mcap::Status s = reader.open(in, so); !s.ok())
-    return Error{in + ": " + s.message + "; nothing written"};
+  if (Status s = reader.open(in, so); !s.ok())
+    return Error{in + ": " + s.error().message + "; nothing written"};
 
   mcap::RecordEntry entry;
   if (!reader.next(entry) || !std::holds_alternative<mcap::Header>(entry.record)) {
-    const mcap::Status& s = reader.status();
-    return Error{in + ": " + (s.ok() ? std::string("no Header record") : s.message) +
+    const Status& s = reader.status();
+    return Error{in + ": " + (s.ok() ? std::string("no Header record") : s.error().message) +
                  "; nothing to recover, nothing written"};
   }
   const mcap::Header header = std::get<mcap::Header>(entry.record);
@@ -249,8 +249,8 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   wo.background_compression = true;
   wo.profile = header.profile;
   wo.library = header.library;
-  if (mcap::Status s = rec.writer().open(output.temp_path(), wo); !s.ok())
-    return Error{out + ": " + s.message};
+  if (Status s = rec.writer().open(output.temp_path(), wo); !s.ok())
+    return Error{out + ": " + s.error().message};
   auto abandon = [&](const std::string& why) -> Result<RecoverReport> {
     (void)rec.writer().close();
     return Error{out + ": " + why};  // output's destructor removes the temporary
@@ -265,21 +265,21 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     }
     if (std::holds_alternative<mcap::DataEnd>(entry.record)) in_summary = true;
     if (in_summary) continue;  // the summary is rebuilt; reading on only checks the rest of the file
-    mcap::Status s = std::holds_alternative<mcap::Chunk>(entry.record)
-                         ? rec.chunk(std::get<mcap::Chunk>(entry.record), entry.offset)
-                         : rec.copy(entry.record);
-    if (!s.ok()) return abandon(s.message);
+    Status s = std::holds_alternative<mcap::Chunk>(entry.record)
+                   ? rec.chunk(std::get<mcap::Chunk>(entry.record), entry.offset)
+                   : rec.copy(entry.record);
+    if (!s.ok()) return abandon(s.error().message);
   }
-  const mcap::Status& status = reader.status();
+  const Status& status = reader.status();
   report.input_intact = status.ok() && !garbage_at && report.corrupt_chunks == 0;
   report.stopped_at = garbage_at ? *garbage_at : status.ok() ? report.input_size : reader.position();
   if (garbage_at) {
     report.problem = "invalid record (opcode 0x00) at offset " + std::to_string(*garbage_at) +
                      ": the rest of the file is not MCAP records (zero-filled?)";
   } else if (!status.ok()) {
-    report.problem = status.message;
-    if (status.code == mcap::StatusCode::Truncated) {
-      report.problem = "truncated: " + status.message;
+    report.problem = status.error().message;
+    if (status.code() == ErrorCode::Truncated) {
+      report.problem = "truncated: " + status.error().message;
       // Which record does the file end in? A chunk loses its messages.
       const std::uint64_t left = report.input_size - std::min(report.stopped_at, report.input_size);
       const std::optional<CutRecord> cut = record_at(file, report.stopped_at);
@@ -307,7 +307,7 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     return abandon("nothing to recover from " + in + " (" + report.problem +
                    "): it holds no complete message; nothing written");
   }
-  if (mcap::Status s = rec.writer().close(); !s.ok()) return Error{out + ": " + s.message};
+  if (Status s = rec.writer().close(); !s.ok()) return Error{out + ": " + s.error().message};
   if (Status st = output.commit(); !st) return st.error();
   return report;
 }

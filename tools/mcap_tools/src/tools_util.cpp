@@ -19,7 +19,7 @@ Result<std::unique_ptr<mcap::ByteSource>> open_input(const std::string& path) {
   auto source = mcap::open_file_source(path);
   if (!source.ok()) {
     // The library names the path ("cannot open 'x': ..."); the tools' callers already did.
-    std::string message = source.status().message;
+    std::string message = source.error().message;
     const std::string quoted = " '" + path + "'";
     if (const std::size_t at = message.find(quoted); at != std::string::npos)
       message.erase(at, quoted.size());
@@ -44,17 +44,17 @@ std::string unreadable(const std::string& path) {
   return {};
 }
 
-std::string read_error(const mcap::Status& status) {
-  switch (status.code) {
-    case mcap::StatusCode::Truncated:
-      return "truncated: " + status.message +
+std::string read_error(const Error& error) {
+  switch (error.code) {
+    case ErrorCode::Truncated:
+      return "truncated: " + error.message +
              " (rbsim log recover rebuilds a valid file from its complete chunks)";
-    case mcap::StatusCode::CrcMismatch:
-    case mcap::StatusCode::DecompressionFailed:
-    case mcap::StatusCode::Malformed:
-      return "corrupted: " + status.message + " (rbsim log doctor lists the problems)";
+    case ErrorCode::CrcMismatch:
+    case ErrorCode::DecompressionFailed:
+    case ErrorCode::Malformed:
+      return "corrupted: " + error.message + " (rbsim log doctor lists the problems)";
     default:
-      return status.message;
+      return error.message;
   }
 }
 

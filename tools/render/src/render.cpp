@@ -153,7 +153,7 @@ class FrameSink final : public Sink {
 }  // namespace
 
 bool is_recording(const std::string& path) {
-  mcap::Result<std::unique_ptr<mcap::ByteSource>> source = mcap::open_file_source(path);
+  Result<std::unique_ptr<mcap::ByteSource>> source = mcap::open_file_source(path);
   return source.ok() && mcap::check_magic(*source.value(), 0).ok();
 }
 

@@ -31,9 +31,9 @@ std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options = {
 
 // Adds the schema and channel of `spec` to a writer in the rosbag2 layout; returns the channel id.
 // The channel's offered_qos_profiles say `offered` (by default what rbsim's node offers).
-mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
-                                      const msgs::OfferedQos& offered);
-mcap::Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns);
+Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
+                                const msgs::OfferedQos& offered);
+Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns);
 // The writer options of every rbsim log (profile "ros2", library "rbsim <version>").
 mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size = 1 << 20,
                                    int compression_level = 0);

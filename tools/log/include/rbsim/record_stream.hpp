@@ -85,7 +85,7 @@ class RecordStream {
   std::deque<std::pair<std::vector<mcap::Record>, std::uint64_t>> batches_;
   std::uint64_t queued_ = 0;
   bool stop_ = false, finished_ = false;
-  mcap::Status status_;
+  Status status_;
   std::vector<mcap::Bytes> spare_;     // guarded by mu_: recycled buffers for the reader thread
   std::uint64_t spare_bytes_ = 0;      // their capacity
   std::vector<mcap::Record> current_;  // consumer side

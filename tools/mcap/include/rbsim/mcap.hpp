@@ -4,7 +4,8 @@
 // comments below ("spec: Chunk") refer to that document. All integers are little-endian; strings,
 // maps and arrays carry a uint32 byte-length prefix; every record is <opcode u8><length u64><content>.
 //
-// No exceptions cross this API: fallible calls return a [[nodiscard]] Status or Result<T>.
+// No exceptions cross this API: fallible calls return a [[nodiscard]] rbsim::Status or Result<T>
+// (rbsim/status.hpp), whose Error carries an ErrorCode (BadMagic, Truncated, CrcMismatch, ...).
 #pragma once
 
 #include <cstdint>
@@ -19,6 +20,8 @@
 #include <variant>
 #include <vector>
 
+#include "rbsim/status.hpp"
+
 namespace rbsim::mcap {
 
 using Bytes = std::vector<std::uint8_t>;
@@ -29,54 +32,6 @@ using KeyValueMap = std::map<std::string, std::string>;
 // Leading and trailing bytes of every file: 0x89 "MCAP" '0' (major version) "\r\n".
 inline constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
 inline constexpr Timestamp kMaxTime = UINT64_MAX;
-
-// ---------------------------------------------------------------------------------------------
-// Status / Result
-
-enum class StatusCode : std::uint8_t {
-  Success,
-  NotOpen,          // call on a closed writer/reader
-  InvalidArgument,  // e.g. unknown channel id
-  IoError,          // open/read/write failed
-  BadMagic,         // missing or wrong magic bytes: not an MCAP file
-  Truncated,        // file or record ends before the data it announces
-  Malformed,        // structurally invalid record or section
-  CrcMismatch,
-  UnsupportedCompression,
-  DecompressionFailed,
-};
-
-struct [[nodiscard]] Status {
-  StatusCode code = StatusCode::Success;
-  std::string message;
-
-  bool ok() const { return code == StatusCode::Success; }
-  static Status Ok() { return {}; }
-  static Status Error(StatusCode c, std::string msg) { return {c, std::move(msg)}; }
-};
-
-template <typename T>
-class [[nodiscard]] Result {
- public:
-  Result(T value) : value_(std::move(value)) {}  // NOLINT: implicit on purpose, like std::expected
-  Result(Status status) : status_(std::move(status)) {
-    if (status_.ok()) status_ = Status::Error(StatusCode::InvalidArgument, "Result built from Ok");
-  }
-
-  bool ok() const { return status_.ok(); }
-  const Status& status() const { return status_; }
-  T& value() & { return *value_; }
-  const T& value() const& { return *value_; }
-  T&& value() && { return std::move(*value_); }
-  T& operator*() & { return *value_; }
-  const T& operator*() const& { return *value_; }
-  T* operator->() { return &*value_; }
-  const T* operator->() const { return &*value_; }
-
- private:
-  Status status_;
-  std::optional<T> value_;
-};
 
 // ---------------------------------------------------------------------------------------------
 // Records (spec: Records). Field order follows the wire layout.
@@ -352,7 +307,7 @@ class StreamReader {
   Status open_buffer(Bytes data, const StreamOptions& options = {});
 
   // Fills `out` with the next record. Returns false at the end or on error: then check status().
-  // A file that stops before its Footer and trailing magic ends with StatusCode::Truncated after
+  // A file that stops before its Footer and trailing magic ends with ErrorCode::Truncated after
   // every complete record was reported. The first failure ends the stream (a recover tool reads
   // what came before it).
   bool next(RecordEntry& out);

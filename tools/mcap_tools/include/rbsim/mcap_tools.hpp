@@ -99,6 +99,6 @@ std::string unreadable(const std::string& path);
 // "1.500000000" seconds for a nanosecond timestamp.
 std::string seconds(std::uint64_t ns);
 // A read error with a hint of which tool helps ("... (rbsim log recover can save ...)").
-std::string read_error(const mcap::Status& status);
+std::string read_error(const Error& error);
 
 }  // namespace rbsim::mcap_tools
