@@ -10,6 +10,7 @@
 
 #include "compare_values.hpp"
 #include "layout.hpp"
+#include "rbsim/cdr_builder.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/msgs.hpp"
 #include "sentences.hpp"
@@ -30,23 +31,7 @@ constexpr const char* kSchema =
     "MSG: test_msgs/Inner\nfloat64 x\nint32 id\n";
 enum Group : std::uint32_t { kStep, kT, kItemsLength, kX, kId, kName, kV, kGroups };
 
-// Little-endian CDR written by hand, aligned as CDR aligns (relative to the end of the header).
-struct Cdr {
-  rbsim::msgs::Bytes bytes{std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0}};
-  template <class T>
-  Cdr& put(T v) {
-    while ((bytes.size() - 4) % sizeof(T) != 0) bytes.push_back(std::byte{0});
-    const auto* p = reinterpret_cast<const std::byte*>(&v);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
-    return *this;
-  }
-  Cdr& str(const std::string& s) {
-    put<std::uint32_t>(static_cast<std::uint32_t>(s.size() + 1));
-    for (char c : s) bytes.push_back(static_cast<std::byte>(c));
-    bytes.push_back(std::byte{0});
-    return *this;
-  }
-};
+using rbsim::test::Cdr;
 
 struct Item {
   double x;

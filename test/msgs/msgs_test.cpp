@@ -8,6 +8,7 @@
 #include "decoder_for.hpp"
 #include "rbsim/builders.hpp"
 #include "rbsim/cdr.hpp"
+#include "rbsim/cdr_builder.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace {
@@ -235,23 +236,7 @@ TEST(EncoderMarkersAndScene, DecodeCleanly) {
   EXPECT_EQ(v[0].u, 7u);
 }
 
-// Little-endian CDR written by hand, aligned as CDR aligns (relative to the end of the header).
-struct Cdr {
-  rbsim::msgs::Bytes bytes{std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0}};
-  template <class T>
-  Cdr& put(T v) {
-    while ((bytes.size() - 4) % sizeof(T) != 0) bytes.push_back(std::byte{0});
-    const auto* p = reinterpret_cast<const std::byte*>(&v);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
-    return *this;
-  }
-  Cdr& str(const std::string& s) {
-    put<std::uint32_t>(static_cast<std::uint32_t>(s.size() + 1));
-    for (char c : s) bytes.push_back(static_cast<std::byte>(c));
-    bytes.push_back(std::byte{0});
-    return *this;
-  }
-};
+using rbsim::test::Cdr;
 
 // The one CDR cursor (rbsim/cdr.hpp) that every CDR reader walks with.
 TEST(CdrCursor, AlignsFromTheEndOfTheHeaderAndNeverReadsPastTheData) {
