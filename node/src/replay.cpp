@@ -63,10 +63,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   im.options = options;
   const std::string& path = options.path;
   // Raw messages only: every channel of our types is replayed as recorded, whatever it holds.
-  log::RecordingOptions ro;
-  ro.steps = false;
-  ro.scene = false;
-  auto opened = log::Recording::open(path, ro);
+  auto opened = log::Recording::open(path, log::raw_options());
   if (!opened) return Error{"cannot read " + opened.error().message};
   im.recording = std::move(opened.value());
 

@@ -326,10 +326,7 @@ TEST(Recording, ReadMessagesGivesRawMessagesInLogTimeOrder) {
                          {TopicId::SpringStates, 0, 20},
                          {TopicId::Energy, 0, 50},
                          {TopicId::BodyStates, 1, 40}});
-  log::RecordingOptions raw;
-  raw.steps = false;
-  raw.scene = false;
-  auto opened = log::Recording::open(file.string(), raw);
+  auto opened = log::Recording::open(file.string(), log::raw_options());
   ASSERT_TRUE(opened.ok()) << opened.error().message;
   log::Recording& r = *opened.value();
   EXPECT_EQ(r.scene(), nullptr);
@@ -381,10 +378,7 @@ TEST(Recording, ChannelsListsTopicsOfOtherTypes) {
   ASSERT_FALSE(steps.ok());
   EXPECT_NE(steps.error().message.find("no rbsim_msgs/msg/SceneDescription topic"), std::string::npos)
       << steps.error().message;
-  log::RecordingOptions raw;
-  raw.steps = false;
-  raw.scene = false;
-  auto opened = log::Recording::open(file.string(), raw);
+  auto opened = log::Recording::open(file.string(), log::raw_options());
   ASSERT_TRUE(opened.ok()) << opened.error().message;
   const auto& channels = opened.value()->channels();
   ASSERT_EQ(channels.size(), 1u);

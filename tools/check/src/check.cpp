@@ -137,10 +137,7 @@ class Comparer {
   Status open(Side& s) {
     // The summary first: a clear error for a truncated or non-MCAP file before any comparing, and
     // the file's whole topic list (so messages of a topic the other file lacks are not queued).
-    log::RecordingOptions raw;  // any file, whatever types it carries: no topic is required
-    raw.steps = false;
-    raw.scene = false;
-    auto recording = log::Recording::open(s.path, raw);
+    auto recording = log::Recording::open(s.path, log::raw_options());  // any file, whatever it carries
     if (!recording) return Error{s.role + " log " + recording.error().message};
     const log::Recording& r = *recording.value();
     s.header = r.header();

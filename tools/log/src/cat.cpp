@@ -28,10 +28,7 @@ struct ChannelDecoder {
 
 Status cat(const std::string& path, const CatOptions& options,
            const std::function<void(std::string_view line)>& on_line) {
-  RecordingOptions raw;  // every topic as recorded, whatever its type
-  raw.steps = false;
-  raw.scene = false;
-  auto opened = Recording::open(path, raw);
+  auto opened = Recording::open(path, raw_options());  // every topic as recorded, whatever its type
   if (!opened) return opened.error();
   Recording& recording = *opened.value();
 

@@ -86,6 +86,15 @@ struct RecordingOptions {
   bool require_scene = true;
   bool verify_crc = false;  // check the data section CRC on open (reads the whole file once)
 };
+// The options of a reader of raw messages only (rbsim check, replay, log cat): neither steps nor
+// a scene description are looked for, so a file of any types opens.
+inline RecordingOptions raw_options() {
+  RecordingOptions o;
+  o.steps = false;
+  o.scene = false;
+  return o;
+}
+
 // One recorded step. A message pointer is null when the topic is not read, not recorded, or has
 // no message for this step (lost by a live recorder, or a recording cut short). The messages are
 // checked against the scene description when there is one: as many bodies, springs, and gravity
