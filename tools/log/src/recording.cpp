@@ -106,21 +106,20 @@ struct Recording::Impl {
 
   Error fail(const std::string& what) const { return Error{path + ": " + what}; }
 
+  // The description of `channel`, made the first time it is asked for.
+  const RecordedChannel& described(const mcap::Channel& channel) {
+    const auto [it, fresh] = channel_at.try_emplace(channel.id, channels.size());
+    if (fresh) channels.push_back(describe_channel(reader, channel));
+    return channels[it->second];
+  }
+
   // The channel a message arrived on (one the summary did not list is described now).
   const RecordedChannel* channel_of(const mcap::MessageEntry& e) {
-    const std::uint16_t id = e.message.channel_id;
-    if (const auto it = channel_at.find(id); it != channel_at.end()) return &channels[it->second];
-    if (e.channel == nullptr) return nullptr;
-    channel_at.emplace(id, channels.size());
-    return &channels.emplace_back(describe_channel(reader, *e.channel));
+    return e.channel == nullptr ? nullptr : &described(*e.channel);
   }
 
   void learn_channels() {
-    for (const auto& [id, channel] : reader.channels()) {
-      if (channel_at.count(id) != 0) continue;
-      channel_at.emplace(id, channels.size());
-      channels.push_back(describe_channel(reader, channel));
-    }
+    for (const auto& [id, channel] : reader.channels()) described(channel);
   }
 
   Status classify() {
