@@ -67,10 +67,6 @@ std::string temp_path(const std::string& tag) {
          std::to_string(::getpid()) + "_" + tag + ".mcap";
 }
 
-mcap::ByteView view(const msgs::Bytes& b) {
-  return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
-}
-
 // A Scene around builders::grid (the encoders need its colours).
 Scene grid_scene(std::int32_t n, bool wind_and_springs) {
   Scene s;
@@ -147,8 +143,7 @@ std::uint64_t write_file(benchmark::State& state, const std::string& path, const
   for (std::size_t i = 0; i < count; ++i) {
     encoder.body_states(snaps.worlds[(first_snapshot + i) % snaps.worlds.size()], buf);
     const mcap::Timestamp t = static_cast<mcap::Timestamp>(i) * 1'000'000;
-    if (auto st = writer.write_message(channel.value(), static_cast<std::uint32_t>(i), t, t, view(buf));
-        !st.ok()) {
+    if (auto st = writer.write_message(channel.value(), static_cast<std::uint32_t>(i), t, t, buf); !st.ok()) {
       state.SkipWithError(st.error().message.c_str());
       return 0;
     }
@@ -244,8 +239,7 @@ void bm_read(benchmark::State& state, Codec codec, Decode mode) {
         benchmark::DoNotOptimize(e.message.data.data());
         return true;
       }
-      const std::span<const std::byte> cdr(reinterpret_cast<const std::byte*>(e.message.data.data()),
-                                           e.message.data.size());
+      const std::span<const std::byte> cdr = e.message.data;
       if (mode == Decode::Typed) {
         if (Status ds = msgs::decode_body_states(cdr, typed); !ds) return error = ds.error().message, false;
         if (typed.bodies.size() != bodies) return error = "decoded body count differs", false;

@@ -16,9 +16,6 @@ std::uint64_t wall_ns() {
                                         std::chrono::system_clock::now().time_since_epoch())
                                         .count());
 }
-mcap::ByteView view(std::span<const std::byte> b) {
-  return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
-}
 }  // namespace
 
 void Recorder::Gaps::add(std::int64_t stamp, double dt) {
@@ -157,7 +154,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
   }
   const std::uint64_t source =
       sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : log_time;
-  if (auto st = writer_.write_message(t.channel, t.received, log_time, source, view(sample.cdr)); !st.ok()) {
+  if (auto st = writer_.write_message(t.channel, t.received, log_time, source, sample.cdr); !st.ok()) {
     return Error{options_.path + ": " + st.error().message};
   }
   ++t.received;

@@ -25,10 +25,6 @@ bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
   }
 }
 
-std::span<const std::byte> bytes(const mcap::Bytes& b) {
-  return std::as_bytes(std::span(b.data(), b.size()));
-}
-
 // rosgraph_msgs/msg/Clock in CDR: encapsulation header (CDR_LE), int32 sec, uint32 nanosec.
 std::array<std::byte, 12> clock_cdr(std::uint64_t t_ns) {
   std::array<std::byte, 12> out{};
@@ -233,8 +229,8 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     if (!st) return Error{"cannot read " + st.error().message};
     for (const auto& [ch, m] : latched) {
       if (stop()) return false;
-      if (Status s = im.publishers[im.route.at(ch)].publish(bytes(m.data)); !s) return s.error();
-      to_tap(ch, m.log_time, bytes(m.data));
+      if (Status s = im.publishers[im.route.at(ch)].publish(m.data); !s) return s.error();
+      to_tap(ch, m.log_time, m.data);
       ++published_;
       if (m.log_time >= start) sent_early.insert(ch);
     }
@@ -282,11 +278,11 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
       if (tap != nullptr && tap->message) tap->message(outputs_.size() - 1, m.log_time, cdr);
       ++published_;
     }
-    if (Status s = im.publishers[route->second].publish(bytes(m.data)); !s) {
+    if (Status s = im.publishers[route->second].publish(m.data); !s) {
       failure = s.error();
       return false;
     }
-    to_tap(m.channel_id, m.log_time, bytes(m.data));
+    to_tap(m.channel_id, m.log_time, m.data);
     ++published_;
     return true;
   });

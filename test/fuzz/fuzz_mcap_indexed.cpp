@@ -3,6 +3,7 @@
 // metadata, the data-section CRC) returns a value or an error, never crashes.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -10,8 +11,9 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace mcap = rbsim::mcap;
+  const auto input = std::as_bytes(std::span(data, size));
   mcap::IndexedReader reader;
-  if (!reader.open_buffer(mcap::Bytes(data, data + size)).ok()) return 0;
+  if (!reader.open_buffer(mcap::Bytes(input.begin(), input.end())).ok()) return 0;
   (void)reader.read_all_messages();
   mcap::ReadMessagesOptions filtered;
   for (const auto& [id, channel] : reader.channels()) {

@@ -16,6 +16,7 @@
 #include "rbsim/golden.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/subprocess.hpp"
+#include "rbsim/test_bytes.hpp"
 
 namespace {
 
@@ -637,7 +638,7 @@ std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs
     EXPECT_TRUE(reader.open(path.string()).ok());
     const Status st = reader.read_messages({}, [&](const mcap::MessageEntry& e) {
       messages[e.channel->topic].push_back(e.message.data);
-      schemas[e.channel->topic] = {e.schema->name, std::string(e.schema->data.begin(), e.schema->data.end())};
+      schemas[e.channel->topic] = {e.schema->name, text_of(e.schema->data)};
       return true;
     });
     EXPECT_TRUE(st.ok()) << st.error().message;
@@ -652,13 +653,12 @@ std::map<std::string, std::pair<double, std::uint64_t>> independent_max(const fs
     EXPECT_TRUE(decoder.ok());
     for (std::size_t m = 0; m < msgs.size(); ++m) {
       std::vector<msgs::Scalar> a, b;
-      const auto as = [](const mcap::Bytes& v) { return std::as_bytes(std::span<const std::uint8_t>(v)); };
-      EXPECT_TRUE(decoder->decode(as(run_msgs.at(topic)[m]), a).ok());
-      EXPECT_TRUE(decoder->decode(as(msgs[m]), b).ok());
+      EXPECT_TRUE(decoder->decode(run_msgs.at(topic)[m], a).ok());
+      EXPECT_TRUE(decoder->decode(msgs[m], b).ok());
       EXPECT_EQ(a.size(), b.size());
       for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
         if (b[i].kind != msgs::Scalar::Kind::Float) continue;
-        const std::string field = std::regex_replace(decoder->path(as(msgs[m]), i), index, "[]");
+        const std::string field = std::regex_replace(decoder->path(msgs[m], i), index, "[]");
         auto& [max, values] = out[topic + " " + field];
         max = std::max(max, std::fabs(a[i].f - b[i].f));
         ++values;

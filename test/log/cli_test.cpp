@@ -191,7 +191,7 @@ TEST(ExportCli, ErrorsAreOneLine) {
   ASSERT_TRUE(w.open((dir / "other.mcap").string(), log::writer_options(mcap::Compression::Zstd)).ok());
   for (const char* type :
        {"rbsim_msgs/msg/SceneDescription", "rbsim_msgs/msg/BodyStates", "rbsim_msgs/msg/EnergyTerms"}) {
-    const auto s = w.add_schema(type, "ros2msg", mcap::Bytes{'f', 'l', 'o', 'a', 't', '6', '4', ' ', 'x'});
+    const auto s = w.add_schema(type, "ros2msg", bytes_of("float64 x"));
     ASSERT_TRUE(s.ok());
     ASSERT_TRUE(w.add_channel(s.value(), std::string("/rbsim/") + type, "cdr").ok());
   }
@@ -522,8 +522,8 @@ TEST(LogCli, EveryToolOnBadInputFailsCleanly) {
 
   std::vector<std::pair<std::string, mcap::Bytes>> inputs;
   inputs.emplace_back("empty", mcap::Bytes{});
-  inputs.emplace_back("text", mcap::Bytes{'t', ',', 'x', '\n', '0', ',', '1', '\n'});
-  inputs.emplace_back("zeros", mcap::Bytes(1000, 0));
+  inputs.emplace_back("text", bytes_of("t,x\n0,1\n"));
+  inputs.emplace_back("zeros", mcap::Bytes(1000, std::byte{0}));
   inputs.emplace_back("magic_only", mcap::Bytes(std::begin(mcap::kMagic), std::end(mcap::kMagic)));
   for (std::uint64_t cut : {std::uint64_t{3}, std::uint64_t{20}, chunk.offset + 100, index.offset + 3,
                             stats.offset + 10, footer.offset + 5, good.size() - 4}) {
@@ -534,18 +534,18 @@ TEST(LogCli, EveryToolOnBadInputFailsCleanly) {
        {std::uint64_t{1}, std::uint64_t{12}, chunk.offset + 4, chunk.offset + chunk.length / 2,
         index.offset + 12, stats.offset + 12, footer.offset + 12, good.size() - 3}) {
     mcap::Bytes b = good;
-    b[at] ^= 0x41;
+    b[at] ^= std::byte{0x41};
     inputs.emplace_back("flip_" + std::to_string(at), b);
   }
   {
     mcap::Bytes b(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(chunk.offset + chunk.length + 5));
-    b.resize(b.size() + 100'000, 0);
+    b.resize(b.size() + 100'000, std::byte{0});
     inputs.emplace_back("zero_tail", b);
   }
   // A huge length in a record header: must not allocate it or loop.
   {
     mcap::Bytes b = good;
-    for (int i = 0; i < 8; ++i) b[chunk.offset + 1 + static_cast<std::uint64_t>(i)] = 0xFF;
+    for (int i = 0; i < 8; ++i) b[chunk.offset + 1 + static_cast<std::uint64_t>(i)] = std::byte{0xFF};
     inputs.emplace_back("huge_length", b);
   }
 

@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 
 mcap::Bytes read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
-  return mcap::Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return bytes_of(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
 }
 
 void write_bytes(const fs::path& path, const mcap::Bytes& bytes) {
@@ -65,20 +65,20 @@ void record_scene(const std::string& scene_path, const fs::path& out, std::int64
 }
 
 namespace {
-std::uint64_t le64(const std::uint8_t* p) {
+std::uint64_t le64(const std::byte* p) {
   std::uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
+  for (int i = 7; i >= 0; --i) v = (v << 8) | std::to_integer<std::uint64_t>(p[i]);
   return v;
 }
-void put32(std::uint8_t* p, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+void put32(std::byte* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::byte>(v >> (8 * i));
 }
 }  // namespace
 
 std::vector<RawRecord> top_level_records(const mcap::Bytes& file) {
   std::vector<RawRecord> out;
   for (std::uint64_t pos = 8; pos + 9 <= file.size();) {
-    const RawRecord r{file[pos], pos, 9 + le64(&file[pos + 1])};
+    const RawRecord r{std::to_integer<std::uint8_t>(file[pos]), pos, 9 + le64(&file[pos + 1])};
     if (r.length > file.size() - pos) break;
     out.push_back(r);
     pos += r.length;
@@ -125,7 +125,7 @@ std::vector<ChunkCount> chunk_message_counts(const fs::path& path) {
   for (const mcap::ChunkIndex& ci : reader.chunk_indexes()) {
     ChunkCount c{ci.chunk_start_offset, ci.chunk_start_offset + ci.chunk_length, 0};
     for (const auto& [channel, offset] : ci.message_index_offsets) {
-      const RawRecord at{file[offset], offset, 9 + le64(&file[offset + 1])};
+      const RawRecord at{std::to_integer<std::uint8_t>(file[offset]), offset, 9 + le64(&file[offset + 1])};
       const auto mi = std::get<mcap::MessageIndex>(parse_at(file, at));
       EXPECT_EQ(mi.channel_id, channel);
       c.messages += mi.records.size();

@@ -12,6 +12,7 @@
 #include "rbsim/mcap.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/mcap_tools.hpp"
+#include "rbsim/test_bytes.hpp"
 
 namespace rbsim::test {
 

@@ -59,8 +59,7 @@ void write_recording(const fs::path& out, const std::vector<Planned>& plan, cons
   std::uint32_t sequence = 0;
   for (const Planned& p : plan) {
     const msgs::Bytes& b = encoded.at({p.topic, p.step});
-    const mcap::ByteView data{reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
-    ASSERT_TRUE(writer.write_message(channel.at(p.topic), sequence++, p.log_time, p.log_time, data).ok());
+    ASSERT_TRUE(writer.write_message(channel.at(p.topic), sequence++, p.log_time, p.log_time, b).ok());
   }
   ASSERT_TRUE(writer.close().ok());
 }
@@ -307,7 +306,7 @@ TEST(Recording, OpenChoosesTheNamespaceAmongSeveralRecordings) {
 TEST(Recording, OpenNamesTheFileOfAnUnreadableInput) {
   TempDir dir;
   const fs::path junk = dir / "junk.mcap";
-  write_bytes(junk, mcap::Bytes{'n', 'o', 't', ' ', 'm', 'c', 'a', 'p'});
+  write_bytes(junk, bytes_of("not mcap"));
   auto r = log::Recording::open(junk.string(), {});
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().message.rfind(junk.string() + ": ", 0), 0u) << r.error().message;
@@ -366,12 +365,10 @@ TEST(Recording, ChannelsListsTopicsOfOtherTypes) {
     mcap::Writer w;
     ASSERT_TRUE(w.open(file.string(), log::writer_options(mcap::Compression::None)).ok());
     const std::string text = "int32 x\n";
-    ASSERT_TRUE(
-        w.add_schema({1, "other_msgs/msg/Thing", "ros2msg", mcap::Bytes(text.begin(), text.end())}).ok());
+    ASSERT_TRUE(w.add_schema({1, "other_msgs/msg/Thing", "ros2msg", bytes_of(text)}).ok());
     ASSERT_TRUE(w.add_channel({1, 1, "/thing", "cdr", {}}).ok());
-    const mcap::Bytes cdr = {0, 1, 0, 0, 7, 0, 0, 0};
-    for (std::uint32_t k = 0; k < 3; ++k)
-      ASSERT_TRUE(w.write_message(1, k, 100 + k, 100 + k, mcap::ByteView{cdr.data(), cdr.size()}).ok());
+    const mcap::Bytes cdr = bytes({0, 1, 0, 0, 7, 0, 0, 0});
+    for (std::uint32_t k = 0; k < 3; ++k) ASSERT_TRUE(w.write_message(1, k, 100 + k, 100 + k, cdr).ok());
     ASSERT_TRUE(w.close().ok());
   }
   auto steps = log::Recording::open(file.string(), {});

@@ -14,14 +14,14 @@ Bytes small_file(Compression compression, bool chunks) {
   o.chunk_size = 200;
   Writer w;
   EXPECT_TRUE(w.open_buffer(o).ok());
-  const std::uint16_t schema = w.add_schema("S", "jsonschema", Bytes{'{', '}'}).value();
+  const std::uint16_t schema = w.add_schema("S", "jsonschema", bytes_of("{}")).value();
   const std::uint16_t a = w.add_channel(schema, "/a", "json", {{"k", "v"}}).value();
   const std::uint16_t b = w.add_channel(0, "/b", "raw").value();
   for (std::uint32_t i = 0; i < 12; ++i) {
-    const Bytes data(20 + i, static_cast<std::uint8_t>(i));
+    const Bytes data(20 + i, static_cast<std::byte>(i));
     EXPECT_TRUE(w.write_message(i % 2 ? a : b, i, 100 - i, 100 - i, data).ok());
   }
-  EXPECT_TRUE(w.add_attachment(1, 2, "x", "text/plain", Bytes{'h', 'i'}).ok());
+  EXPECT_TRUE(w.add_attachment(1, 2, "x", "text/plain", bytes_of("hi")).ok());
   EXPECT_TRUE(w.add_metadata("m", {{"a", "b"}}).ok());
   EXPECT_TRUE(w.close().ok());
   return w.buffer();
@@ -100,7 +100,7 @@ TEST_P(CorruptFile, FlippedBytesAreDetected) {
   for (std::size_t i = 0; i < full.size(); ++i) {
     for (std::uint8_t mask : {std::uint8_t{0xFF}, std::uint8_t{0x01}}) {
       Bytes bad = full;
-      bad[i] ^= mask;
+      bad[i] ^= std::byte{mask};
       EXPECT_FALSE(stream_all(bad).ok) << "byte " << i << " mask " << int{mask};
       (void)stream_all(bad, false);
       (void)index_all(bad);
@@ -121,7 +121,7 @@ INSTANTIATE_TEST_SUITE_P(All, CorruptFile,
                          variant_name);
 
 void set_u64(Bytes& b, std::size_t at, std::uint64_t v) {
-  for (std::size_t i = 0; i < 8; ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+  for (std::size_t i = 0; i < 8; ++i) b[at + i] = static_cast<std::byte>(v >> (8 * i));
 }
 
 TEST(BadInput, HugeLengthFieldsAreBoundedByTheFile) {
@@ -158,10 +158,10 @@ TEST(BadInput, EmptyAndForeignFiles) {
   EXPECT_EQ(stream_all({}).code, ErrorCode::Truncated);
   EXPECT_EQ(index_all({}).code, ErrorCode::Truncated);
   const std::string text = "this is not an MCAP file, just some text that is long enough";
-  const Bytes foreign(text.begin(), text.end());
+  const Bytes foreign = bytes_of(text);
   EXPECT_EQ(stream_all(foreign).code, ErrorCode::BadMagic);
   EXPECT_EQ(index_all(foreign).code, ErrorCode::BadMagic);
-  const Bytes png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13};
+  const Bytes png = bytes({0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13});
   EXPECT_EQ(stream_all(png).code, ErrorCode::BadMagic);
   const Bytes magic_only(std::begin(kMagic), std::end(kMagic));
   EXPECT_EQ(stream_all(magic_only).code, ErrorCode::Truncated);
@@ -181,12 +181,12 @@ TEST(BadInput, EmptyAndForeignFiles) {
 TEST(BadInput, UnknownRecordsAndFieldsAreSkipped) {
   Bytes file(std::begin(kMagic), std::end(kMagic));
   serialize_record(Header{"p", "l"}, file);
-  serialize_record(UnknownRecord{0x80, {9, 9}}, file);
+  serialize_record(UnknownRecord{0x80, bytes({9, 9})}, file);
   const std::size_t channel_at = file.size();
   serialize_record(Channel{1, 0, "/x", "raw", {}}, file);
-  file.insert(file.end(), {0xAA, 0xBB});  // two unknown trailing bytes on the Channel
+  file.insert(file.end(), {std::byte{0xAA}, std::byte{0xBB}});  // two unknown trailing bytes on the Channel
   set_u64(file, channel_at + 1, file.size() - channel_at - 9);
-  serialize_record(Message{1, 7, 5, 5, {1}}, file);
+  serialize_record(Message{1, 7, 5, 5, bytes({1})}, file);
   serialize_record(DataEnd{0}, file);
   serialize_record(Footer{}, file);
   file.insert(file.end(), std::begin(kMagic), std::end(kMagic));

@@ -29,7 +29,7 @@ std::string str(const json& record, const char* name) {
 Bytes bytes(const json& record, const char* name) {
   Bytes out;
   for (const auto& v : field(record, name))
-    out.push_back(static_cast<std::uint8_t>(std::stoul(v.get<std::string>())));
+    out.push_back(static_cast<std::byte>(std::stoul(v.get<std::string>())));
   return out;
 }
 KeyValueMap string_map(const json& record, const char* name) {
@@ -52,12 +52,12 @@ class Builder {
                           !std::holds_alternative<DataEnd>(record) && !std::holds_alternative<Footer>(record);
     if (std::holds_alternative<Attachment>(record)) {
       const std::uint32_t crc = crc32(ByteView(out).subspan(start + 9, out.size() - start - 9 - 4));
-      for (std::size_t i = 0; i < 4; ++i) out[out.size() - 4 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
+      for (std::size_t i = 0; i < 4; ++i) out[out.size() - 4 + i] = static_cast<std::byte>(crc >> (8 * i));
     }
     if (pad_ && paddable) {
-      out.insert(out.end(), {0x01, 0xFF, 0xFF});
+      out.insert(out.end(), {std::byte{0x01}, std::byte{0xFF}, std::byte{0xFF}});
       const std::uint64_t length = out.size() - start - 9;
-      for (std::size_t i = 0; i < 8; ++i) out[start + 1 + i] = static_cast<std::uint8_t>(length >> (8 * i));
+      for (std::size_t i = 0; i < 8; ++i) out[start + 1 + i] = static_cast<std::byte>(length >> (8 * i));
     }
     return out.size() - start;
   }
@@ -202,15 +202,16 @@ std::string sha256_hex(ByteView data) {
                                     0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
   Bytes msg(data.begin(), data.end());
   const std::uint64_t bits = static_cast<std::uint64_t>(data.size()) * 8;
-  msg.push_back(0x80);
-  while (msg.size() % 64 != 56) msg.push_back(0);
-  for (int i = 7; i >= 0; --i) msg.push_back(static_cast<std::uint8_t>(bits >> (8 * i)));
+  msg.push_back(std::byte{0x80});
+  while (msg.size() % 64 != 56) msg.push_back(std::byte{0});
+  for (int i = 7; i >= 0; --i) msg.push_back(static_cast<std::byte>(bits >> (8 * i)));
   auto rotr = [](std::uint32_t x, int n) { return (x >> n) | (x << (32 - n)); };
   for (std::size_t block = 0; block < msg.size(); block += 64) {
     std::array<std::uint32_t, 64> w{};
     for (std::size_t i = 0; i < 16; ++i) {
-      const std::uint8_t* p = &msg[block + 4 * i];
-      w[i] = std::uint32_t{p[0]} << 24 | std::uint32_t{p[1]} << 16 | std::uint32_t{p[2]} << 8 | p[3];
+      const std::byte* p = &msg[block + 4 * i];
+      w[i] = std::to_integer<std::uint32_t>(p[0]) << 24 | std::to_integer<std::uint32_t>(p[1]) << 16 |
+             std::to_integer<std::uint32_t>(p[2]) << 8 | std::to_integer<std::uint32_t>(p[3]);
     }
     for (std::size_t i = 16; i < 64; ++i) {
       const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);

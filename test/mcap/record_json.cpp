@@ -17,7 +17,7 @@ json num(T v) {
 }
 json bytes(const Bytes& b) {
   json a = json::array();
-  for (std::uint8_t v : b) a.push_back(num(v));
+  for (std::byte v : b) a.push_back(num(std::to_integer<unsigned>(v)));
   return a;
 }
 json string_map(const KeyValueMap& m) {
@@ -160,7 +160,7 @@ json indexed_view_of(const json& records) {
 
 Bytes read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return bytes_of(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
 }
 
 }  // namespace rbsim::mcap::test

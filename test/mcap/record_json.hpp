@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rbsim/mcap.hpp"
+#include "rbsim/test_bytes.hpp"
 
 namespace rbsim::mcap::test {
 

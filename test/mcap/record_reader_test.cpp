@@ -19,12 +19,12 @@ Bytes recording() {
   o.chunk_size = 300;
   Writer w;
   EXPECT_TRUE(w.open_buffer(o).ok());
-  const std::uint16_t schema = w.add_schema("S", "jsonschema", Bytes{'{', '}'}).value();
+  const std::uint16_t schema = w.add_schema("S", "jsonschema", bytes_of("{}")).value();
   const std::uint16_t channel = w.add_channel(schema, "/a", "json").value();
   for (std::uint32_t i = 0; i < 20; ++i) {
-    EXPECT_TRUE(w.write_message(channel, i, 10 * i, 10 * i, Bytes(40, static_cast<std::uint8_t>(i))).ok());
+    EXPECT_TRUE(w.write_message(channel, i, 10 * i, 10 * i, Bytes(40, static_cast<std::byte>(i))).ok());
   }
-  EXPECT_TRUE(w.add_attachment(1, 2, "x", "text/plain", Bytes{'h', 'i'}).ok());
+  EXPECT_TRUE(w.add_attachment(1, 2, "x", "text/plain", bytes_of("hi")).ok());
   EXPECT_TRUE(w.close().ok());
   return w.buffer();
 }
@@ -47,7 +47,7 @@ std::vector<RecordView> all_records(ByteSource& source, std::uint64_t begin, std
 
 std::uint64_t length_field(const RecordView& r) {
   std::uint64_t v = 0;
-  for (int i = 8; i >= 1; --i) v = (v << 8) | r.prefix[i];
+  for (int i = 8; i >= 1; --i) v = (v << 8) | std::to_integer<std::uint64_t>(r.prefix[i]);
   return v;
 }
 
@@ -77,7 +77,7 @@ TEST(RecordReader, ReadsAGoodFileRecordByRecord) {
   std::uint64_t at = kMagicSize;
   for (const RecordView& r : records) {
     EXPECT_EQ(r.offset, at);
-    EXPECT_EQ(r.prefix[0], r.opcode);
+    EXPECT_EQ(std::to_integer<std::uint8_t>(r.prefix[0]), r.opcode);
     EXPECT_EQ(length_field(r) + RecordReader::kPrefixSize, r.length);
     EXPECT_TRUE(is_known_opcode(r.opcode)) << opcode_name(r.opcode);
     at += r.length;
@@ -137,7 +137,7 @@ TEST(RecordReader, ALengthPastTheEndIsAProblemNotARead) {
   auto good = make_buffer_source(file);
   const auto records = all_records(*good, kMagicSize, file.size() - kMagicSize);
   const RecordView& bad = records[1];
-  for (std::size_t i = 1; i <= 8; ++i) file[bad.offset + i] = 0xFF;  // length UINT64_MAX
+  for (std::size_t i = 1; i <= 8; ++i) file[bad.offset + i] = std::byte{0xFF};  // length UINT64_MAX
   auto source = make_buffer_source(file);
   RecordReader reader(*source, kMagicSize);
   RecordView r;
@@ -171,7 +171,7 @@ TEST(CheckMagic, BadTruncatedAndGoodMagic) {
   EXPECT_EQ(check_magic(*good, kMagicSize).code(), ErrorCode::BadMagic);  // the Header, not magic
 
   Bytes flipped = file;
-  flipped[3] ^= 0x20;  // 'C' -> 'c'
+  flipped[3] ^= std::byte{0x20};  // 'C' -> 'c'
   auto bad = make_buffer_source(flipped);
   const Status s = check_magic(*bad, 0);
   EXPECT_EQ(s.code(), ErrorCode::BadMagic);

@@ -31,7 +31,7 @@ std::vector<Sample> samples() {
     s.sequence = i;
     s.log_time = 1000 + (i * 7919) % 500;  // repeats: equal times must keep file order
     s.data.resize(1 + (i * 37) % 97);
-    for (std::size_t k = 0; k < s.data.size(); ++k) s.data[k] = static_cast<std::uint8_t>(i + k);
+    for (std::size_t k = 0; k < s.data.size(); ++k) s.data[k] = static_cast<std::byte>(i + k);
     out.push_back(std::move(s));
   }
   return out;
@@ -51,7 +51,7 @@ std::size_t recovered_messages(const Bytes& partial, std::optional<ErrorCode>& e
 Bytes write_sample_file(const WriterOptions& options, const std::vector<Sample>& input) {
   Writer w;
   EXPECT_TRUE(w.open_buffer(options).ok());
-  const Bytes schema_data = {'i', 'n', 't'};
+  const Bytes schema_data = bytes_of("int");
   const std::uint16_t schema = w.add_schema("Pose", "ros2msg", schema_data).value();
   EXPECT_EQ(w.add_channel(schema, "/pose", "cdr", {{"qos", "reliable"}}).value(), 1);
   EXPECT_EQ(w.add_channel(schema, "/twist", "cdr").value(), 2);
@@ -61,7 +61,7 @@ Bytes write_sample_file(const WriterOptions& options, const std::vector<Sample>&
     const Sample& s = input[i];
     EXPECT_TRUE(w.write_message(s.channel, s.sequence, s.log_time, s.log_time + 1, s.data).ok());
     if (i == input.size() / 2) {
-      const Bytes blob = {1, 2, 3, 4};
+      const Bytes blob = bytes({1, 2, 3, 4});
       EXPECT_TRUE(w.add_attachment(5, 6, "calib.bin", "application/octet-stream", blob).ok());
     }
   }
@@ -146,7 +146,7 @@ TEST_P(WriterRoundTrip, BothReadersReturnEveryMessage) {
     ASSERT_EQ(indexed.attachment_indexes().size(), 1u);
     auto att = indexed.read_attachment(indexed.attachment_indexes()[0]);
     ASSERT_TRUE(att.ok()) << att.error().message;
-    EXPECT_EQ(att->data, (Bytes{1, 2, 3, 4}));
+    EXPECT_EQ(att->data, bytes({1, 2, 3, 4}));
     EXPECT_NE(att->crc, 0u);
     ASSERT_EQ(indexed.metadata_indexes().size(), 1u);
     auto md = indexed.read_metadata(indexed.metadata_indexes()[0]);
@@ -254,7 +254,7 @@ TEST(Writer, RejectsBadUse) {
 TEST(Writer, KeepsExplicitIds) {
   Writer w;
   ASSERT_TRUE(w.open_buffer().ok());
-  const Schema schema{7, "S", "jsonschema", {'{', '}'}};
+  const Schema schema{7, "S", "jsonschema", bytes_of("{}")};
   const Channel channel{42, 7, "/x", "json", {{"a", "b"}}};
   ASSERT_TRUE(w.add_schema(schema).ok());
   ASSERT_TRUE(w.add_schema(schema).ok());  // identical: no-op
@@ -263,7 +263,7 @@ TEST(Writer, KeepsExplicitIds) {
   ASSERT_TRUE(w.add_channel(channel).ok());
   EXPECT_EQ(w.add_channel(Channel{43, 9, "/y", "json", {}}).code(), ErrorCode::InvalidArgument);
   EXPECT_EQ(w.add_channel(0, "/next", "raw").value(), 43);
-  ASSERT_TRUE(w.write_message(Message{42, 1, 10, 11, {5}}).ok());
+  ASSERT_TRUE(w.write_message(Message{42, 1, 10, 11, bytes({5})}).ok());
   ASSERT_TRUE(w.close().ok());
   IndexedReader r;
   ASSERT_TRUE(r.open_buffer(w.buffer()).ok());
@@ -317,7 +317,7 @@ TEST(Writer, WriteCompressedChunkWritesAFinishedChunkWhileIdle) {
   Writer w;
   ASSERT_TRUE(w.open(path, o).ok());
   const std::uint16_t ch = w.add_channel(0, "/t", "raw").value();
-  const Bytes big(2000, 7);  // one message fills a chunk: it is handed to the worker at once
+  const Bytes big(2000, std::byte{7});  // one message fills a chunk: it is handed to the worker at once
   ASSERT_TRUE(w.write_message(ch, 0, 10, 10, big).ok());
   EXPECT_EQ(w.statistics().chunk_count, 0u) << "written before it could have been compressed";
   for (int i = 0; i < 5000 && w.statistics().chunk_count == 0; ++i) {
@@ -354,8 +354,8 @@ TEST(Writer, ReportsWriteErrorsWithBackgroundCompression) {
 }
 
 TEST(Crc32, MatchesZlib) {
-  const std::string s = "123456789";
-  const ByteView v(reinterpret_cast<const std::uint8_t*>(s.data()), s.size());
+  const Bytes s = bytes_of("123456789");
+  const ByteView v(s);
   EXPECT_EQ(crc32(v), 0xCBF43926u);
   EXPECT_EQ(crc32(v.subspan(4), crc32(v.first(4))), 0xCBF43926u);
   EXPECT_EQ(crc32({}), 0u);
@@ -367,11 +367,11 @@ TEST(Crc32, MatchesZlib) {
 TEST(Crc32, LongInputsMatchTheBitwiseDefinition) {
   Bytes data(70'000);
   std::uint32_t x = 12345;
-  for (auto& b : data) b = static_cast<std::uint8_t>((x = x * 1103515245u + 12345u) >> 24);
+  for (auto& b : data) b = static_cast<std::byte>((x = x * 1103515245u + 12345u) >> 24);
   const auto bitwise = [](ByteView v) {
     std::uint32_t c = 0xFFFFFFFFu;
-    for (std::uint8_t b : v) {
-      c ^= b;
+    for (std::byte b : v) {
+      c ^= std::to_integer<std::uint32_t>(b);
       for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
     }
     return ~c;
@@ -389,7 +389,7 @@ TEST(Crc32, LongInputsMatchTheBitwiseDefinition) {
 TEST(Crc32, CombineEqualsTheCrcOfTheConcatenation) {
   Bytes data(70'000);
   std::uint32_t x = 777;
-  for (auto& b : data) b = static_cast<std::uint8_t>((x = x * 1103515245u + 12345u) >> 24);
+  for (auto& b : data) b = static_cast<std::byte>((x = x * 1103515245u + 12345u) >> 24);
   const ByteView all(data);
   for (std::size_t split : {0u, 1u, 3u, 64u, 4096u, 69'999u, 70'000u}) {
     for (std::size_t end : {split, split + (70'000u - split) / 3, std::size_t{70'000u}}) {
@@ -407,7 +407,7 @@ Bytes write_uncompressed(const std::string& path, std::uint64_t chunk_size, bool
   o.enable_crcs = crcs;
   Writer w;
   EXPECT_TRUE((path.empty() ? w.open_buffer(o) : w.open(path, o)).ok());
-  const Bytes schema_data = {'i', 'n', 't'};
+  const Bytes schema_data = bytes_of("int");
   const std::uint16_t schema = w.add_schema("Pose", "ros2msg", schema_data).value();
   EXPECT_EQ(w.add_channel(schema, "/pose", "cdr").value(), 1);
   EXPECT_EQ(w.add_channel(0, "/log", "json").value(), 2);
@@ -431,7 +431,7 @@ TEST(Writer, StreamedUncompressedChunksMatchBufferedOnes) {
       std::thread reader([&] {
         std::FILE* f = std::fopen(fifo.c_str(), "rb");
         ASSERT_NE(f, nullptr);
-        std::uint8_t buf[4096];
+        std::byte buf[4096];
         for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;)
           piped.insert(piped.end(), buf, buf + n);
         std::fclose(f);

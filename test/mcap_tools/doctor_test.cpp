@@ -84,7 +84,7 @@ TEST_F(DoctorTest, FlippedByteInAChunkIsACrcError) {
   const RawRecord& chunk = find_record(records_, mcap::Opcode::Chunk, 1);
   const std::uint64_t at = chunk.offset + chunk.length / 2;
   // Without fixing the CRCs: both the chunk and the data section are reported.
-  const auto r = doctor_patched([&](mcap::Bytes& b) { b[at] ^= 0x10; }, false);
+  const auto r = doctor_patched([&](mcap::Bytes& b) { b[at] ^= std::byte{0x10}; }, false);
   EXPECT_FALSE(r.ok());
   EXPECT_TRUE(has_finding(r, "Chunk at offset " + std::to_string(chunk.offset))) << dump(r);
   EXPECT_TRUE(has_finding(r, "data section CRC mismatch")) << dump(r);
@@ -98,8 +98,8 @@ TEST_F(DoctorTest, FlippedByteInAnUncompressedChunkIsAChunkCrcError) {
   ASSERT_NO_FATAL_FAILURE(record_scene(source_path("scenes/cantilever.xml"), raw, 50, spec));
   mcap::Bytes b = read_bytes(raw);
   const RawRecord& chunk = find_record(top_level_records(b), mcap::Opcode::Chunk, 0);
-  b[chunk.offset + chunk.length - 3] ^= 0x01;  // the last message's payload
-  fix_crcs(b);                                 // only the chunk CRC can notice
+  b[chunk.offset + chunk.length - 3] ^= std::byte{0x01};  // the last message's payload
+  fix_crcs(b);                                            // only the chunk CRC can notice
   write_bytes(raw, b);
   const auto r = mcap_tools::doctor(raw.string());
   EXPECT_TRUE(has_finding(r, "invalid CRC")) << dump(r);
@@ -247,8 +247,8 @@ TEST(DoctorCrafted, UnknownSchemaAndChannelReferences) {
   mcap::Bytes b(std::begin(mcap::kMagic), std::end(mcap::kMagic));
   mcap::serialize_record(mcap::Header{"", "test"}, b);
   mcap::serialize_record(mcap::Channel{1, 7, "/a", "json", {}}, b);
-  mcap::serialize_record(mcap::Message{9, 0, 5, 5, {1, 2, 3}}, b);
-  mcap::serialize_record(mcap::Message{1, 1, 4, 4, {1, 2, 3}}, b);  // earlier than the previous one
+  mcap::serialize_record(mcap::Message{9, 0, 5, 5, bytes({1, 2, 3})}, b);
+  mcap::serialize_record(mcap::Message{1, 1, 4, 4, bytes({1, 2, 3})}, b);  // earlier than the previous one
   mcap::serialize_record(mcap::DataEnd{0}, b);
   mcap::serialize_record(mcap::Footer{0, 0, 0}, b);
   b.insert(b.end(), std::begin(mcap::kMagic), std::end(mcap::kMagic));
@@ -305,14 +305,14 @@ TEST(DoctorHostile, EveryFlipAndEveryTruncationOfASmallFileIsAnError) {
   mcap::WriterOptions o = log::writer_options(mcap::Compression::Zstd, 200);
   mcap::Writer w;
   ASSERT_TRUE(w.open_buffer(o).ok());
-  const auto schema = w.add_schema("S", "jsonschema", mcap::Bytes{'{', '}'});
+  const auto schema = w.add_schema("S", "jsonschema", bytes_of("{}"));
   ASSERT_TRUE(schema.ok());
   const auto a = w.add_channel(schema.value(), "/a", "json", {{"k", "v"}});
   ASSERT_TRUE(a.ok());
   for (std::uint32_t i = 0; i < 12; ++i) {
-    ASSERT_TRUE(w.write_message(a.value(), i, i, i, mcap::Bytes(20 + i, static_cast<std::uint8_t>(i))).ok());
+    ASSERT_TRUE(w.write_message(a.value(), i, i, i, mcap::Bytes(20 + i, static_cast<std::byte>(i))).ok());
   }
-  ASSERT_TRUE(w.add_attachment(1, 2, "x", "text/plain", mcap::Bytes{'h', 'i'}).ok());
+  ASSERT_TRUE(w.add_attachment(1, 2, "x", "text/plain", bytes_of("hi")).ok());
   ASSERT_TRUE(w.add_metadata("m", {{"a", "b"}}).ok());
   ASSERT_TRUE(w.close().ok());
   const mcap::Bytes good = w.buffer();
@@ -322,7 +322,7 @@ TEST(DoctorHostile, EveryFlipAndEveryTruncationOfASmallFileIsAnError) {
   ASSERT_EQ(mcap_tools::doctor(path.string()).errors, 0u) << dump(mcap_tools::doctor(path.string()));
   for (std::size_t i = 0; i < good.size(); ++i) {
     mcap::Bytes b = good;
-    b[i] ^= 0x04;
+    b[i] ^= std::byte{0x04};
     write_bytes(path, b);
     EXPECT_FALSE(mcap_tools::doctor(path.string()).ok()) << "flip at byte " << i;
   }

@@ -53,16 +53,17 @@ TEST(Info, FileWithoutSummaryIsScanned) {
   o.emit_attachment_indexes = o.emit_metadata_indexes = false;
   mcap::Writer w;
   ASSERT_TRUE(w.open_buffer(o).ok());
-  const auto s = w.add_schema("S", "jsonschema", mcap::Bytes{'{', '}'});
+  const auto s = w.add_schema("S", "jsonschema", bytes_of("{}"));
   ASSERT_TRUE(s.ok());
   const auto a = w.add_channel(s.value(), "/a", "json");
   const auto b = w.add_channel(0, "/b", "raw");
   ASSERT_TRUE(a.ok() && b.ok());
   for (std::uint32_t k = 0; k < 30; ++k) {
-    ASSERT_TRUE(
-        w.write_message(k % 3 ? a.value() : b.value(), k, 1'000'000'000ull + k, 0, mcap::Bytes(40, 7)).ok());
+    ASSERT_TRUE(w.write_message(k % 3 ? a.value() : b.value(), k, 1'000'000'000ull + k, 0,
+                                mcap::Bytes(40, std::byte{7}))
+                    .ok());
   }
-  ASSERT_TRUE(w.add_attachment(1, 2, "notes.txt", "text/plain", mcap::Bytes{'h', 'i'}).ok());
+  ASSERT_TRUE(w.add_attachment(1, 2, "notes.txt", "text/plain", bytes_of("hi")).ok());
   ASSERT_TRUE(w.add_metadata("run", {{"k", "v"}}).ok());
   ASSERT_TRUE(w.close().ok());
   TempDir dir;
@@ -102,11 +103,11 @@ TEST(Info, DamagedFilesAreErrors) {
     EXPECT_NE(info.error().message.find(needle), std::string::npos) << info.error().message;
   };
   expect_error({}, "empty file");
-  expect_error(mcap::Bytes{'P', 'K', 3, 4}, "not an MCAP file");
+  expect_error(bytes({'P', 'K', 3, 4}), "not an MCAP file");
   expect_error(mcap::Bytes(good.begin(), good.end() - 100), "truncated");
   for (std::size_t at : {std::size_t{20}, good.size() / 2, good.size() - 200, good.size() - 20}) {
     mcap::Bytes b = good;
-    b[at] ^= 0x01;
+    b[at] ^= std::byte{0x01};
     write_bytes(bad, b);
     EXPECT_FALSE(mcap_tools::info(bad.string()).ok()) << "flip at " << at;
   }

@@ -125,7 +125,7 @@ TEST_F(RecoverTest, CorruptChunkIsSkippedAndTheRestKept) {
   for (std::size_t k : {std::size_t{0}, std::size_t{3}, chunks_.size() - 1}) {
     SCOPED_TRACE("chunk " + std::to_string(k));
     mcap::Bytes b = bytes_;
-    b[(chunks_[k].start + chunks_[k].end) / 2] ^= 0x20;
+    b[(chunks_[k].start + chunks_[k].end) / 2] ^= std::byte{0x20};
     write_bytes(cut_, b);
     const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
     ASSERT_TRUE(r.ok()) << r.error().message;
@@ -142,7 +142,7 @@ TEST_F(RecoverTest, CorruptChunkIsSkippedAndTheRestKept) {
 TEST_F(RecoverTest, ZeroFilledTailStopsReadingThere) {
   const auto& c = chunks_[chunks_.size() / 2];
   mcap::Bytes b(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(c.end + 10));
-  b.resize(b.size() + 1'000'000, 0);
+  b.resize(b.size() + 1'000'000, std::byte{0});
   write_bytes(cut_, b);
   const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
   ASSERT_TRUE(r.ok()) << r.error().message;
@@ -170,7 +170,7 @@ TEST_F(RecoverTest, RefusesToOverwriteItsInput) {
 }
 
 TEST_F(RecoverTest, NothingWrittenForUnreadableInput) {
-  for (const mcap::Bytes& b : {mcap::Bytes{}, mcap::Bytes{'h', 'e', 'l', 'l', 'o'}, mcap::Bytes(4096, 0)}) {
+  for (const mcap::Bytes& b : {mcap::Bytes{}, bytes_of("hello"), mcap::Bytes(4096, std::byte{0})}) {
     write_bytes(cut_, b);
     const auto r = mcap_tools::recover(cut_.string(), recovered_.string());
     EXPECT_FALSE(r.ok());

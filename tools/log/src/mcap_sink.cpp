@@ -9,10 +9,6 @@ namespace rbsim::log {
 
 namespace {
 
-mcap::ByteView view(const msgs::Bytes& b) {
-  return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
-}
-
 Error fail(const std::string& path, const Error& error) {
   return Error{path + ": " + error.message};
 }
@@ -61,7 +57,7 @@ class McapSink final : public Sink {
       if (!spec.per_step && !first) continue;
       encoder_->encode(id, world, buffer_);
       const auto k = static_cast<std::size_t>(id);
-      if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, t, view(buffer_)); !st.ok()) {
+      if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, t, buffer_); !st.ok()) {
         return fail(path_, st.error());
       }
     }
@@ -103,8 +99,7 @@ Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spe
   Result<std::string> schema = msgs::ros2msg_schema(spec.type);
   if (!schema) return schema.error();
   const std::string& text = schema.value();
-  auto schema_id = writer.add_schema(spec.type, "ros2msg",
-                                     {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+  auto schema_id = writer.add_schema(spec.type, "ros2msg", std::as_bytes(std::span(text)));
   if (!schema_id.ok()) return schema_id.error();
   return writer.add_channel(schema_id.value(), msgs::topic_name(spec, ns), "cdr",
                             {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}});

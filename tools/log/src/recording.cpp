@@ -27,10 +27,6 @@ int per_step_index(msgs::TopicId id) {
   return -1;
 }
 
-std::span<const std::byte> bytes_of(const mcap::Message& m) {
-  return {reinterpret_cast<const std::byte*>(m.data.data()), m.data.size()};
-}
-
 }  // namespace
 
 std::string_view RecordedChannel::schema_text() const {
@@ -167,7 +163,7 @@ struct Recording::Impl {
     const Status st = reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
       const auto r = route.find(e.message.channel_id);
       if (r == route.end() || r->second != msgs::TopicId::Scene) return true;
-      Result<msgs::SceneMessage> decoded = msgs::decode_scene(bytes_of(e.message));
+      Result<msgs::SceneMessage> decoded = msgs::decode_scene(e.message.data);
       if (!decoded) {
         failure = fail(where(e) + ": " + decoded.error().message);
         return false;
@@ -202,7 +198,7 @@ struct Recording::Impl {
   }
 
   Status message(const mcap::MessageEntry& e, std::size_t i) {
-    const auto cdr = bytes_of(e.message);
+    const ByteView cdr = e.message.data;
     Status decoded = Ok{};
     switch (i) {
       case kStates:

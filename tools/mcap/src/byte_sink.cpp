@@ -95,7 +95,7 @@ class FileSink final : public ByteSink {
     Status s = write_fully(buffer_.size() + data.size(), [&](std::size_t done) {
       const std::size_t skip = std::min(done, buffer_.size());
       iovec rest[2] = {{buffer_.data() + skip, buffer_.size() - skip},
-                       {const_cast<std::uint8_t*>(data.data()) + (done - skip), data.size() - (done - skip)}};
+                       {const_cast<std::byte*>(data.data()) + (done - skip), data.size() - (done - skip)}};
       const int first = rest[0].iov_len == 0 ? 1 : 0;
       return ::writev(fd_, rest + first, 2 - first);
     });

@@ -15,11 +15,11 @@ struct Compressor::Impl {
   ZSTD_CCtx* zstd = nullptr;  // reused across chunks: creating one costs more than a small chunk
   // Output buffer, grown when a bound exceeds it and never value-initialised (a std::vector
   // resized up to the bound for every chunk would zero what the last one's shrink gave back).
-  std::unique_ptr<std::uint8_t[]> buffer;
+  std::unique_ptr<std::byte[]> buffer;
   std::size_t capacity = 0;
-  std::uint8_t* room(std::size_t n) {
+  std::byte* room(std::size_t n) {
     if (n > capacity) {
-      buffer.reset(new std::uint8_t[n]);
+      buffer.reset(new std::byte[n]);
       capacity = n;
     }
     return buffer.get();
@@ -44,7 +44,7 @@ Status Compressor::compress(ByteView in, ByteView& out) {
     case Compression::Zstd: {
       if (impl_->zstd == nullptr) return Error{"out of memory for zstd context", ErrorCode::IoError};
       const std::size_t bound = ZSTD_compressBound(in.size());
-      std::uint8_t* dst = impl_->room(bound);
+      std::byte* dst = impl_->room(bound);
       // Level 0 is the MCAP C++ library's default for zstd chunks, 1 (zstd's own default is 3).
       // scripts/bench-mcap prints what levels 3 and -3 cost and save against it.
       const int level = impl_->level == 0 ? 1 : impl_->level;
@@ -59,7 +59,7 @@ Status Compressor::compress(ByteView in, ByteView& out) {
       LZ4F_preferences_t prefs{};
       prefs.compressionLevel = impl_->level;
       const std::size_t bound = LZ4F_compressFrameBound(in.size(), &prefs);
-      std::uint8_t* dst = impl_->room(bound);
+      std::byte* dst = impl_->room(bound);
       const std::size_t n = LZ4F_compressFrame(dst, bound, in.data(), in.size(), &prefs);
       if (LZ4F_isError(n)) {
         return Error{std::string("lz4: ") + LZ4F_getErrorName(n), ErrorCode::IoError};
@@ -159,7 +159,7 @@ class GrowingOutput {
     out_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(limit_, out_.size() * 2)));
     return true;
   }
-  std::uint8_t* data() { return out_.data() + produced; }
+  std::byte* data() { return out_.data() + produced; }
   std::size_t room() const { return out_.size() - produced; }
   void finish() { out_.resize(produced); }
 

@@ -49,14 +49,14 @@ bool RecordReader::next(RecordView& out) {
   if (available < kPrefixSize) {
     if (Status s = source_->read(offset, available, prefix); !s.ok())
       return fail({offset, available, {}, {}, s});
-    problem.opcode = prefix[0];
+    problem.opcode = std::to_integer<std::uint8_t>(prefix[0]);
     problem.status = Error{"record header cut off" + at(offset), ErrorCode::Truncated};
     return fail(std::move(problem));
   }
   if (Status s = source_->read(offset, kPrefixSize, prefix); !s.ok())
     return fail({offset, available, {}, {}, s});
   std::memcpy(out.prefix, prefix.data(), kPrefixSize);
-  const std::uint8_t opcode = prefix[0];
+  const auto opcode = std::to_integer<std::uint8_t>(prefix[0]);
   std::uint64_t length = 0;
   detail::Cursor(prefix.subspan(1)).u64(length);  // the prefix holds all 8 bytes: cannot fail
   problem.opcode = opcode;

@@ -279,12 +279,12 @@ Result<Record> parse_record(std::uint8_t opcode, ByteView content) {
 }
 
 void serialize_record(const Record& record, Bytes& out) {
-  out.push_back(opcode_of(record));
+  out.push_back(std::byte{opcode_of(record)});
   const std::size_t length_at = out.size();
   put_u64(out, 0);
   std::visit([&out](const auto& r) { body(out, r); }, record);
   const std::uint64_t n = out.size() - length_at - 8;
-  for (std::size_t i = 0; i < 8; ++i) out[length_at + i] = static_cast<std::uint8_t>(n >> (8 * i));
+  for (std::size_t i = 0; i < 8; ++i) out[length_at + i] = static_cast<std::byte>(n >> (8 * i));
 }
 
 std::uint32_t crc32(ByteView data, std::uint32_t crc) {

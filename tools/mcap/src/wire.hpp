@@ -104,7 +104,7 @@ class Cursor {
     if (remaining() < sizeof(T)) return false;
     T out = 0;
     for (std::size_t i = 0; i < sizeof(T); ++i)
-      out = static_cast<T>(out | static_cast<T>(T{data_[pos_ + i]} << (8 * i)));
+      out = static_cast<T>(out | static_cast<T>(std::to_integer<T>(data_[pos_ + i]) << (8 * i)));
     v = out;
     pos_ += sizeof(T);
     return true;
@@ -120,10 +120,10 @@ class Cursor {
 
 template <typename T>
 inline void put(Bytes& out, T v) {
-  for (std::size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  for (std::size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<std::byte>(v >> (8 * i)));
 }
 inline void put_u8(Bytes& out, std::uint8_t v) {
-  out.push_back(v);
+  out.push_back(std::byte{v});
 }
 inline void put_u16(Bytes& out, std::uint16_t v) {
   put(out, v);
@@ -138,7 +138,7 @@ inline void put_raw(Bytes& out, ByteView v) {
   out.insert(out.end(), v.begin(), v.end());
 }
 inline ByteView as_bytes(std::string_view s) {
-  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
+  return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
 }
 inline void put_string(Bytes& out, std::string_view s) {
   put_u32(out, static_cast<std::uint32_t>(s.size()));
@@ -159,7 +159,7 @@ inline std::size_t begin_prefix(Bytes& out) {
 }
 inline void finish_prefix(Bytes& out, std::size_t body_start) {
   const auto n = static_cast<std::uint32_t>(out.size() - body_start);
-  for (std::size_t i = 0; i < 4; ++i) out[body_start - 4 + i] = static_cast<std::uint8_t>(n >> (8 * i));
+  for (std::size_t i = 0; i < 4; ++i) out[body_start - 4 + i] = static_cast<std::byte>(n >> (8 * i));
 }
 inline void put_string_map(Bytes& out, const KeyValueMap& map) {
   const std::size_t start = begin_prefix(out);

@@ -131,8 +131,8 @@ struct Writer::Impl {
     if (!streaming) {
       Bytes header;
       chunk_header(header, 0, 0, 0, ChunkMeta{});
-      for (std::size_t i = 1; i < 9; ++i) header[i] = 0xFF;  // record length UINT64_MAX
-      stream_start = offset;                                 // stream_size and stream_crc are 0 here
+      for (std::size_t i = 1; i < 9; ++i) header[i] = std::byte{0xFF};  // record length UINT64_MAX
+      stream_start = offset;  // stream_size and stream_crc are 0 here
       streaming = true;
       if (!(s = sink->write(header)).ok()) return error = s;
       offset += header.size();  // its CRC is taken once its final bytes are known

@@ -53,7 +53,8 @@ std::optional<CutRecord> record_at(mcap::ByteSource& file, std::uint64_t offset)
 
 // Whether `byte` could start the trailing magic (whose cut-off the read status already words).
 bool starts_magic(std::uint8_t byte) {
-  mcap::ViewSource first(mcap::ByteView(&byte, 1));
+  const std::byte first_byte{byte};
+  mcap::ViewSource first(mcap::ByteView(&first_byte, 1));
   return mcap::check_magic(first, 0).code() != ErrorCode::BadMagic;
 }
 

@@ -53,7 +53,7 @@ struct RecordedMessage {
   const RecordedChannel* channel = nullptr;
   const mcap::Message* message = nullptr;  // log and publish time, sequence, data
   const std::string& topic() const { return channel->channel->topic; }
-  std::span<const std::byte> cdr() const { return std::as_bytes(std::span(message->data)); }
+  std::span<const std::byte> cdr() const { return message->data; }
 };
 
 // Which messages read_messages() passes on: by topic name (empty: every topic) and log time.

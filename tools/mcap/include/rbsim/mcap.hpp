@@ -20,17 +20,19 @@
 #include <variant>
 #include <vector>
 
+#include "rbsim/bytes.hpp"
 #include "rbsim/status.hpp"
 
 namespace rbsim::mcap {
 
-using Bytes = std::vector<std::uint8_t>;
-using ByteView = std::span<const std::uint8_t>;
+using rbsim::Bytes;
+using rbsim::ByteView;
 using Timestamp = std::uint64_t;  // nanoseconds since a user-chosen epoch
 using KeyValueMap = std::map<std::string, std::string>;
 
 // Leading and trailing bytes of every file: 0x89 "MCAP" '0' (major version) "\r\n".
-inline constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
+inline constexpr std::byte kMagic[8] = {std::byte{0x89}, std::byte{'M'},  std::byte{'C'},  std::byte{'A'},
+                                        std::byte{'P'},  std::byte{0x30}, std::byte{'\r'}, std::byte{'\n'}};
 inline constexpr Timestamp kMaxTime = UINT64_MAX;
 
 // ---------------------------------------------------------------------------------------------

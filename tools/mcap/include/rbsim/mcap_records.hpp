@@ -94,7 +94,7 @@ struct RecordView {
   std::uint64_t length = 0;  // whole record: prefix and content
   ByteView content;
   // The opcode and length bytes as they were read (a CRC over whole records covers them).
-  std::uint8_t prefix[9] = {};
+  std::byte prefix[9] = {};
   ByteView prefix_bytes() const { return ByteView(prefix, sizeof prefix); }
 };
 

@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rbsim/bytes.hpp"
 #include "rbsim/core.hpp"
 #include "rbsim/scene.hpp"
 
@@ -119,7 +120,7 @@ struct Time {
 Time sim_time(const World& world);
 std::uint64_t sim_time_ns(const World& world);
 
-using Bytes = std::vector<std::byte>;
+using rbsim::Bytes;
 
 // The quaternion of a rotation by theta about +z (a planar body's orientation).
 struct Quaternion {
