@@ -3,17 +3,15 @@
 
 #include <tinyxml2.h>
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
-#include <sstream>
 
+#include "rbsim/read_file.hpp"
 #include "xml_dialect.hpp"
 
 namespace rbsim {
@@ -395,12 +393,9 @@ Result<Scene> parse_scene(std::string_view text, const std::string& path) {
 Result<Scene> load_scene(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return Error{path + ": is a directory, not a scene file"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path + ": cannot open scene file: " + std::strerror(errno)};
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) return Error{path + ": read error"};
-  return parse_scene(buffer.str(), path);
+  Result<std::string> text = read_text_file(path, "scene file");
+  if (!text) return text.error();
+  return parse_scene(text.value(), path);
 }
 
 }  // namespace rbsim

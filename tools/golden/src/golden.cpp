@@ -2,11 +2,11 @@
 // output, and verify_golden, which reads the golden once (golden_log.cpp) and runs the stages of
 // stages.hpp in order, each on the messages of its topics.
 #include <filesystem>
-#include <fstream>
 
 #include "golden_log.hpp"
 #include "physics.hpp"
 #include "rbsim/golden.hpp"
+#include "rbsim/read_file.hpp"
 #include "stages.hpp"
 #include "tally.hpp"
 
@@ -19,9 +19,8 @@ namespace {
 bool same_file_contents(const fs::path& a, const std::string& bytes) {
   std::error_code ec;
   if (fs::file_size(a, ec) != bytes.size() || ec) return false;
-  std::ifstream in(a, std::ios::binary);
-  std::string other((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return other == bytes;
+  const Result<std::string> other = read_text_file(a.string());
+  return other && other.value() == bytes;
 }
 
 // The per-step topics every golden has, and the scene description: without them nothing can be
@@ -78,9 +77,9 @@ std::int64_t golden_record_every(std::int64_t steps) {
 
 FosssimMatch find_fosssim_reference(const std::string& scene_path, const std::string& fosssim_dir) {
   FosssimMatch match;
-  std::ifstream in(scene_path, std::ios::binary);
-  if (!in) return match;
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const Result<std::string> scene = read_text_file(scene_path);
+  if (!scene) return match;
+  const std::string& bytes = scene.value();
   const fs::path scenes = fs::path(fosssim_dir) / "scenes";
   std::error_code ec;
   std::vector<fs::path> candidates;

@@ -2,27 +2,19 @@
 #include <zstd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "rbsim/fosssim.hpp"
+#include "rbsim/read_file.hpp"
 
 namespace rbsim {
 
 Result<std::vector<std::byte>> read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path + ": cannot open: " + std::strerror(errno)};
-  std::vector<char> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return Error{path + ": read error"};
+  Result<Bytes> read = read_whole_file(path);
+  if (!read || !path.ends_with(".zst")) return read;
+  const Bytes& raw = read.value();
   std::vector<std::byte> out;
-  if (!path.ends_with(".zst")) {
-    out.resize(raw.size());
-    std::memcpy(out.data(), raw.data(), raw.size());
-    return out;
-  }
   ZSTD_DCtx* ctx = ZSTD_createDCtx();
   ZSTD_inBuffer input{raw.data(), raw.size(), 0};
   std::vector<std::byte> chunk(ZSTD_DStreamOutSize());

@@ -5,14 +5,13 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/golden.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
+#include "rbsim/read_file.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/scene.hpp"
 
@@ -109,12 +108,11 @@ bool GoldenUpdateRequested() {
     return failure(what, "refusing to write golden " + golden_mcap + ": " + actual_mcap +
                              " fails verification against " + scene_path + lines);
   }
-  std::ifstream in(actual_mcap, std::ios::binary);
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (!in.good() && !in.eof()) return failure(what, "cannot read " + actual_mcap);
+  const Result<Bytes> bytes = read_whole_file(actual_mcap);
+  if (!bytes) return failure(what, bytes.error().message);
   AtomicFile out;
   if (Status st = out.open(golden_mcap); !st) return failure(what, st.error().message);
-  if (Status st = out.write(bytes.data(), bytes.size()); !st) return failure(what, st.error().message);
+  if (Status st = out.write(bytes->data(), bytes->size()); !st) return failure(what, st.error().message);
   if (Status st = out.commit(); !st) return failure(what, st.error().message);
   return ::testing::AssertionSuccess() << "golden " << golden_mcap << " updated from " << actual_mcap
                                        << " (verified: " << verified->rule << ")";
