@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""ROS 2 interop with a client library that is not ours: rbsim's node seen by ros2-client (Rust,
+on RustDDS) through rbsim-ros2-peer (test/ros2_peer/src/main.rs).
+
+RustDDS multicasts discovery, so every case runs the peer and the node in two network namespaces
+this test creates (e2e.py's TwoHosts: a veth pair, 10.231.0.1 <-> 10.231.0.2), never on a real
+interface; inside them Cyclone DDS may multicast too (ros2-client finds participants by SPDP
+multicast). Cases share e2e.py's harness (processes, domains, cleanup) and its exit codes:
+0 pass, 1 fail, 77 skip (namespaces not permitted here).
+"""
+import json
+import os
+import signal
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
+import e2e  # noqa: E402
+
+PEER = os.environ.get("RBSIM_ROS2_PEER", "")
+
+
+def namespace_config(address):
+    """Cyclone inside a test namespace: its one veth interface, multicast allowed (the namespace
+    has no other interface: nothing leaves it)."""
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<CycloneDDS xmlns="https://cdds.io/config">
+  <Domain Id="any">
+    <General>
+      <Interfaces><NetworkInterface address="{address}" multicast="true"/></Interfaces>
+      <AllowMulticast>spdp</AllowMulticast>
+    </General>
+    <Discovery><SPDPInterval>0.5 s</SPDPInterval></Discovery>
+  </Domain>
+</CycloneDDS>
+"""
+
+
+class PeerNet(e2e.TwoHosts):
+    """TwoHosts with multicast routed onto each veth and Cyclone configured to use it."""
+
+    def __enter__(self):
+        super().__enter__()
+        if self.skip:
+            return self
+        for ns, dev in ((self.a, self.va), (self.b, self.vb)):
+            e2e.ip(self.ctx, "-n", ns, "link", "set", dev, "multicast", "on")
+            e2e.ip(self.ctx, "-n", ns, "route", "add", "224.0.0.0/4", "dev", dev)
+        with open(self.cfg_a, "w") as f:
+            f.write(namespace_config("10.231.0.1"))
+        return self
+
+    def peer(self, name, *args):
+        """Starts rbsim-ros2-peer in namespace b on the case's domain."""
+        env = self.ctx.env()
+        env["ROS_DOMAIN_ID"] = str(self.ctx.domain)
+        env.setdefault("RUST_LOG", "warn")
+        return self.ctx.start(name, ["ip", "netns", "exec", self.b, PEER, *map(str, args)], env=env)
+
+
+def lines(proc):
+    out = []
+    for line in proc.stdout().splitlines():
+        try:
+            out.append(json.loads(line))
+        except json.JSONDecodeError:
+            pass
+    return out
+
+
+def with_node(ctx, body):
+    """Runs `body(net, node)` with rbsim node looping a scene in namespace a at real time."""
+    if not PEER or not os.access(PEER, os.X_OK):
+        raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
+    with PeerNet(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return e2e.SKIP
+        node = net.rb("node-in-a", "a", *e2e.node_args(ctx, ctx.scene("chain.xml"), "--loop"))
+        try:
+            body(net, node)
+        finally:
+            node.signal(signal.SIGINT)
+            e2e.exited_ok(ctx, node, 30, "rbsim node after SIGINT")
+    return 0
+
+
+def case_tf(ctx):
+    """ros2-client subscribes to /tf: every body's frame under world, in order, with positions."""
+    def body(net, node):
+        peer = net.peer("peer-tf", "tf", 20, "--timeout", 60)
+        e2e.exited_ok(ctx, peer, 90, "rbsim-ros2-peer tf")
+        got = [m for m in lines(peer) if "tf" in m]
+        ctx.check(len(got) >= 20, f"peer printed {len(got)} /tf messages, want 20\n{peer.output()}")
+        if got:
+            ctx.log(f"ros2-client decoded /tf: {got[0]} ... {got[-1]}")
+        # The values ros2-client decoded are the run's: body 0's position at each message's stamp
+        # equals rbsim run --csv's at that time, bit for bit.
+        last = max((m["stamp_ns"] for m in got), default=0)
+        csv = ctx.path("chain.csv")
+        ctx.rbrun("run-csv", "run", ctx.scene("chain.xml"), "--duration", last / 1e9 + 0.01, "--csv", csv)
+        with open(csv) as f:
+            rows = [r.split(",") for r in f.read().splitlines()[1:]]
+        body0 = {round(float(r[1]) * 1e9): (float(r[3]), float(r[4])) for r in rows if r[2] == "0"}
+        for m in got:
+            want = body0.get(m["stamp_ns"])
+            ctx.check(want == (m["x"], m["y"]),
+                      f"/tf at {m['stamp_ns']} ns: body_0 at ({m['x']}, {m['y']}), rbsim run --csv says {want}")
+        for m in got:
+            ctx.check(m["frame"] == "world" and m["child"] == f"{ctx.ns}/body_0",
+                      f"/tf frames {m['frame']} -> {m['child']}, want world -> {ctx.ns}/body_0")
+            ctx.check(m["transforms"] > 0, f"/tf message with {m['transforms']} transforms")
+    return with_node(ctx, body)
+
+
+def case_graph(ctx):
+    """ros2-client finds the node by its name in ros_discovery_info."""
+    def body(net, node):
+        peer = net.peer("peer-graph", "graph", f"/{ctx.ns}", "--timeout", 60)
+        e2e.exited_ok(ctx, peer, 90, "rbsim-ros2-peer graph")
+        found = [m for m in lines(peer) if m.get("node") == f"/{ctx.ns}"]
+        ctx.check(bool(found), f"node /{ctx.ns} not in what ros2-client decoded\n{peer.output()}")
+        for m in found[:1]:
+            ctx.check(m["namespace"] == "/" and m["name"] == ctx.ns,
+                      f"node namespace {m['namespace']!r} name {m['name']!r}, want '/' and {ctx.ns!r}")
+    return with_node(ctx, body)
+
+
+def case_rosout(ctx):
+    """ros2-client reads the node's start line on /rosout (transient local: a late reader too)."""
+    def body(net, node):
+        peer = net.peer("peer-rosout", "rosout", "rbsim node:", "--timeout", 60)
+        e2e.exited_ok(ctx, peer, 90, "rbsim-ros2-peer rosout")
+        got = [m for m in lines(peer) if "rbsim node:" in m.get("rosout", "")]
+        ctx.check(bool(got), f"no start line on /rosout\n{peer.output()}")
+        for m in got[:1]:
+            ctx.check(m["level"] == 20, f"start line level {m['level']}, want 20 (INFO)")
+            ctx.check(m["name"] == ctx.ns, f"rosout name {m['name']!r}, want {ctx.ns!r}")
+    return with_node(ctx, body)
+
+
+e2e.CASES.clear()
+e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout})
+
+if __name__ == "__main__":
+    sys.exit(e2e.main())

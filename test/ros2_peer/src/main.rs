@@ -1,0 +1,241 @@
+//! rbsim-ros2-peer: a ROS 2 node written with ros2-client (not ours) that looks at rbsim the way a
+//! ROS 2 tool does. One line of JSON per finding on stdout, diagnostics on stderr; exit 0 when
+//! the awaited thing was seen, 1 on timeout, 2 on usage errors.
+//!
+//!   rbsim-ros2-peer graph /rbsim [--timeout S]     wait for the node in ros_discovery_info
+//!   rbsim-ros2-peer tf N [--timeout S]             take N /tf messages
+//!   rbsim-ros2-peer rosout TEXT [--timeout S]      wait for a /rosout line containing TEXT
+use std::{process::ExitCode, time::Duration};
+
+use futures::StreamExt;
+use ros2_client::{
+  Context, ContextOptions, MessageTypeName, Name, NodeEvent, NodeName, NodeOptions, QosProfile,
+  builtin_interfaces::Time,
+  qos::{Durability, History, Reliability, WhenFull},
+};
+use serde::{Deserialize, Serialize};
+
+mod tf {
+  //! tf2_msgs/msg/TFMessage, field for field (serde's CDR follows declaration order).
+  use super::*;
+  #[derive(Debug, Clone, Serialize, Deserialize)]
+  pub struct Header {
+    pub stamp: Time,
+    pub frame_id: String,
+  }
+  #[derive(Debug, Clone, Serialize, Deserialize)]
+  pub struct Vector3 {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+  }
+  #[derive(Debug, Clone, Serialize, Deserialize)]
+  pub struct Quaternion {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub w: f64,
+  }
+  #[derive(Debug, Clone, Serialize, Deserialize)]
+  pub struct Transform {
+    pub translation: Vector3,
+    pub rotation: Quaternion,
+  }
+  #[derive(Debug, Clone, Serialize, Deserialize)]
+  pub struct TransformStamped {
+    pub header: Header,
+    pub child_frame_id: String,
+    pub transform: Transform,
+  }
+  #[derive(Debug, Clone, Serialize, Deserialize)]
+  pub struct TFMessage {
+    pub transforms: Vec<TransformStamped>,
+  }
+  impl ros2_client::Message for TFMessage {}
+}
+
+struct Args {
+  verb: String,
+  operand: String,
+  timeout: Duration,
+}
+
+fn parse_args() -> Result<Args, String> {
+  let mut words: Vec<String> = std::env::args().skip(1).collect();
+  let mut timeout = Duration::from_secs(20);
+  if let Some(i) = words.iter().position(|w| w == "--timeout") {
+    let value = words.get(i + 1).ok_or("--timeout needs seconds")?;
+    let s: f64 = value.parse().map_err(|_| format!("--timeout: not a number: {value}"))?;
+    if !(s > 0.0 && s < 3600.0) {
+      return Err(format!("--timeout: must be in (0, 3600) s (got {value})"));
+    }
+    timeout = Duration::from_secs_f64(s);
+    words.drain(i..i + 2);
+  }
+  if words.len() != 2 {
+    return Err("usage: rbsim-ros2-peer graph NODE | tf COUNT | rosout TEXT [--timeout S]".into());
+  }
+  Ok(Args { verb: words[0].clone(), operand: words[1].clone(), timeout })
+}
+
+fn json_string(s: &str) -> String {
+  let mut out = String::from("\"");
+  for c in s.chars() {
+    match c {
+      '"' => out.push_str("\\\""),
+      '\\' => out.push_str("\\\\"),
+      c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+      c => out.push(c),
+    }
+  }
+  out.push('"');
+  out
+}
+
+/// Runs `work` until it returns true or `timeout` passes.
+fn within(timeout: Duration, work: impl std::future::Future<Output = bool>) -> bool {
+  smol::block_on(smol::future::or(work, async {
+    smol::Timer::after(timeout).await;
+    false
+  }))
+}
+
+fn main() -> ExitCode {
+  let args = match parse_args() {
+    Ok(a) => a,
+    Err(e) => {
+      eprintln!("rbsim-ros2-peer: {e}");
+      return ExitCode::from(2);
+    }
+  };
+  // ROS_DOMAIN_ID as every ROS 2 tool reads it (ros2-client itself takes the id as an argument).
+  let domain: u16 = match std::env::var("ROS_DOMAIN_ID") {
+    Ok(v) => match v.parse() {
+      Ok(d) if d <= 232 => d,
+      _ => {
+        eprintln!("rbsim-ros2-peer: ROS_DOMAIN_ID: an integer in [0, 232] (got {v})");
+        return ExitCode::from(2);
+      }
+    },
+    Err(_) => 0,
+  };
+  let context = Context::with_options(ContextOptions::new().domain_id(domain)).expect("DDS participant");
+  let mut node = context
+    .new_node(NodeName::new("/rbsim_test", "ros2_peer").unwrap(), NodeOptions::new().enable_rosout(false))
+    .expect("node");
+  // The spinner first: ros2-client hands out graph events only to a node that spins.
+  let spinner = node.spinner().expect("spinner");
+  let events = node.status_receiver().expect("status receiver");
+  smol::spawn(spinner.spin()).detach();
+
+  let found = match args.verb.as_str() {
+    "graph" => within(args.timeout, async {
+      let mut events = Box::pin(events);
+      while let Some(event) = events.next().await {
+        if let NodeEvent::ParticipantEntities(info) = event {
+          for n in info.nodes() {
+            // ros2-client decoded this from our ros_discovery_info: its name, namespace and
+            // endpoint GIDs as it understood them.
+            println!(
+              "{{\"participant\": \"{:?}\", \"node\": {}, \"namespace\": {}, \"name\": {}, \"entities\": {}}}",
+              info.gid(),
+              json_string(&n.fully_qualified_name()),
+              json_string(n.namespace()),
+              json_string(n.name()),
+              json_string(&format!("{n:?}"))
+            );
+            if n.fully_qualified_name() == args.operand {
+              return true;
+            }
+          }
+        }
+      }
+      false
+    }),
+    "tf" => {
+      let want: usize = match args.operand.parse() {
+        Ok(n) if n > 0 => n,
+        _ => {
+          eprintln!("rbsim-ros2-peer: tf COUNT: a positive integer (got {})", args.operand);
+          return ExitCode::from(2);
+        }
+      };
+      let qos = QosProfile::subscription_default()
+        .reliability(Reliability::Reliable { when_full: WhenFull::Block })
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 100 });
+      let topic = node
+        .create_topic(&Name::new("/", "tf").unwrap(), MessageTypeName::new("tf2_msgs", "TFMessage"), &qos)
+        .expect("topic /tf");
+      let sub = node.create_subscription::<tf::TFMessage>(&topic, Some(qos)).expect("subscription /tf");
+      within(args.timeout, async {
+        let mut stream = Box::pin(sub.async_stream());
+        let mut seen = 0;
+        while let Some(m) = stream.next().await {
+          let Ok((msg, _)) = m else { continue };
+          seen += 1;
+          let first = msg.transforms.first();
+          println!(
+            "{{\"tf\": {seen}, \"transforms\": {}, \"stamp_ns\": {}, \"frame\": {}, \"child\": {}, \"x\": {:?}, \"y\": {:?}}}",
+            msg.transforms.len(),
+            first.map(|t| t.header.stamp.to_nanos()).unwrap_or(-1),
+            json_string(first.map(|t| t.header.frame_id.as_str()).unwrap_or("")),
+            json_string(first.map(|t| t.child_frame_id.as_str()).unwrap_or("")),
+            first.map(|t| t.transform.translation.x).unwrap_or(f64::NAN),
+            first.map(|t| t.transform.translation.y).unwrap_or(f64::NAN)
+          );
+          if seen >= want {
+            return true;
+          }
+        }
+        false
+      })
+    }
+    "rosout" => {
+      let qos = QosProfile::subscription_default()
+        .reliability(Reliability::Reliable { when_full: WhenFull::Block })
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1000 });
+      let topic = node
+        .create_topic(&Name::new("/", "rosout").unwrap(), MessageTypeName::new("rcl_interfaces", "Log"), &qos)
+        .expect("topic /rosout");
+      let sub = node.create_subscription::<ros2_client::Log>(&topic, Some(qos)).expect("subscription /rosout");
+      within(args.timeout, async {
+        let mut stream = Box::pin(sub.async_stream());
+        while let Some(m) = stream.next().await {
+          let Ok((log, _)) = m else { continue };
+          println!(
+            "{{\"rosout\": {}, \"level\": {}, \"name\": {}, \"file\": {}, \"function\": {}, \"line\": {}, \"stamp_ns\": {}}}",
+            json_string(log.get_msg()),
+            log.get_level(),
+            json_string(log.name()),
+            json_string(log.get_file()),
+            json_string(&log.function),
+            log.line,
+            log.stamp.to_nanos()
+          );
+          if log.get_msg().contains(&args.operand) {
+            return true;
+          }
+        }
+        false
+      })
+    }
+    other => {
+      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout)");
+      return ExitCode::from(2);
+    }
+  };
+  // Leave the graph the way a ROS 2 node does: stop spinning and drop the node and its DDS
+  // participant (RustDDS then announces that it left), so the peers do not wait for its lease.
+  node.stop_spinner();
+  drop(node);
+  drop(context);
+  std::thread::sleep(Duration::from_millis(200));
+  if found {
+    ExitCode::SUCCESS
+  } else {
+    eprintln!("rbsim-ros2-peer: {} {}: not seen within {:?}", args.verb, args.operand, args.timeout);
+    ExitCode::from(1)
+  }
+}
