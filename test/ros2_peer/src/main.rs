@@ -5,6 +5,9 @@
 //!   rbsim-ros2-peer graph /rbsim [--timeout S]     wait for the node in ros_discovery_info
 //!   rbsim-ros2-peer tf N [--timeout S]             take N /tf messages
 //!   rbsim-ros2-peer rosout TEXT [--timeout S]      wait for a /rosout line containing TEXT
+//!   rbsim-ros2-peer events NAME [--timeout S]      wait for NAME on /parameter_events
+//!   rbsim-ros2-peer params NODE list|get|describe|types|set|set-atomic ARGS...
+//!   rbsim-ros2-peer call SERVICE trigger | step N | impulse BODY JX JY PX PY
 use std::{process::ExitCode, time::Duration};
 
 use futures::StreamExt;
@@ -14,6 +17,8 @@ use ros2_client::{
   qos::{Durability, History, Reliability, WhenFull},
 };
 use serde::{Deserialize, Serialize};
+
+mod services;
 
 mod tf {
   //! tf2_msgs/msg/TFMessage, field for field (serde's CDR follows declaration order).
@@ -57,6 +62,7 @@ mod tf {
 struct Args {
   verb: String,
   operand: String,
+  rest: Vec<String>,
   timeout: Duration,
 }
 
@@ -72,13 +78,17 @@ fn parse_args() -> Result<Args, String> {
     timeout = Duration::from_secs_f64(s);
     words.drain(i..i + 2);
   }
-  if words.len() != 2 {
-    return Err("usage: rbsim-ros2-peer graph NODE | tf COUNT | rosout TEXT [--timeout S]".into());
+  if words.len() < 2 {
+    return Err(
+      "usage: rbsim-ros2-peer graph NODE | tf COUNT | rosout TEXT | events NAME | params NODE ... | call SERVICE ... \
+       [--timeout S]"
+        .into(),
+    );
   }
-  Ok(Args { verb: words[0].clone(), operand: words[1].clone(), timeout })
+  Ok(Args { verb: words[0].clone(), operand: words[1].clone(), rest: words[2..].to_vec(), timeout })
 }
 
-fn json_string(s: &str) -> String {
+pub(crate) fn json_string(s: &str) -> String {
   let mut out = String::from("\"");
   for c in s.chars() {
     match c {
@@ -221,8 +231,57 @@ fn main() -> ExitCode {
         false
       })
     }
+    "events" => {
+      // rclcpp's parameter events QoS: reliable, volatile, keep last 1000.
+      let qos = QosProfile::subscription_default()
+        .reliability(Reliability::Reliable { when_full: WhenFull::Block })
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 1000 });
+      let topic = node
+        .create_topic(
+          &Name::new("/", "parameter_events").unwrap(),
+          MessageTypeName::new("rcl_interfaces", "ParameterEvent"),
+          &qos,
+        )
+        .expect("topic /parameter_events");
+      let sub = node
+        .create_subscription::<ros2_client::parameters::raw::ParameterEvent>(&topic, Some(qos))
+        .expect("subscription /parameter_events");
+      within(args.timeout, async {
+        let mut stream = Box::pin(sub.async_stream());
+        while let Some(m) = stream.next().await {
+          let Ok((event, _)) = m else { continue };
+          let mut hit = false;
+          for p in event.new_parameters.iter().chain(event.changed_parameters.iter()) {
+            println!(
+              "{{\"event\": {}, \"node\": {}, \"value\": {}, \"stamp_ns\": {}}}",
+              json_string(&p.name),
+              json_string(&event.node),
+              services::value_json(&p.value),
+              event.stamp.to_nanos()
+            );
+            hit |= p.name == args.operand;
+          }
+          if hit {
+            return true;
+          }
+        }
+        false
+      })
+    }
+    "params" | "call" => {
+      let result = if args.verb == "params" {
+        services::params(&mut node, &args.operand, &args.rest, args.timeout)
+      } else {
+        services::call_service(&mut node, &args.operand, &args.rest, args.timeout)
+      };
+      if let Err(e) = &result {
+        eprintln!("rbsim-ros2-peer: {e}");
+      }
+      result.is_ok()
+    }
     other => {
-      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout)");
+      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, params, call)");
       return ExitCode::from(2);
     }
   };

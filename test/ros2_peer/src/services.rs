@@ -1,0 +1,220 @@
+//! Parameter services and rbsim's own services, called the way rmw_cyclonedds_cpp's clients call
+//! them: ServiceMapping::Cyclone (its request header: client GUID half and sequence number). A
+//! test that passed with ros2-client's default Enhanced mapping would prove the wrong wire format.
+use std::time::Duration;
+
+use ros2_client::{
+  Message, Name, Node, ParameterValue, QosProfile, ServiceMapping, ServiceTypeName,
+  parameters::raw,
+  qos::{Durability, History, Reliability, WhenFull},
+  rcl_interfaces::*,
+};
+use serde::{Deserialize, Serialize, de::DeserializeOwned};
+
+use crate::json_string;
+
+/// rmw_qos_profile_services_default: reliable, volatile, keep last 10.
+fn service_qos() -> QosProfile {
+  QosProfile::subscription_default()
+    .reliability(Reliability::Reliable { when_full: WhenFull::Block })
+    .durability(Durability::Volatile)
+    .history(History::KeepLast { depth: 10 })
+}
+
+/// "/ns/node/get_parameters" -> Name("/ns/node", "get_parameters").
+fn service_name(full: &str) -> Result<Name, String> {
+  let (ns, base) = full.rsplit_once('/').ok_or(format!("{full}: not a fully qualified name"))?;
+  Name::new(if ns.is_empty() { "/" } else { ns }, base).map_err(|e| format!("{full}: {e:?}"))
+}
+
+/// Calls `service` once (bounded by `timeout`, the wait for the server included).
+pub fn call<Req, Resp>(
+  node: &mut Node, service: &str, pkg: &str, ty: &str, request: Req, timeout: Duration,
+) -> Result<Resp, String>
+where
+  Req: Message + Clone + 'static,
+  Resp: Message + DeserializeOwned + 'static,
+{
+  let client = node
+    .create_client::<Req, Resp>(
+      ServiceMapping::Cyclone,
+      &service_name(service)?,
+      &ServiceTypeName::new(pkg, ty),
+      service_qos(),
+      service_qos(),
+    )
+    .map_err(|e| format!("client {service}: {e:?}"))?;
+  let node: &Node = node;
+  smol::block_on(smol::future::or(
+    async {
+      client.wait_for_service(node).await;
+      client.async_call_service(request).await.map_err(|e| format!("{service}: {e:?}"))
+    },
+    async {
+      smol::Timer::after(timeout).await;
+      Err(format!("{service}: no reply within {timeout:?}"))
+    },
+  ))
+}
+
+pub fn value_json(raw: &raw::ParameterValue) -> String {
+  match ParameterValue::from(raw.clone()) {
+    ParameterValue::NotSet => "null".into(),
+    ParameterValue::Boolean(b) => b.to_string(),
+    ParameterValue::Integer(i) => i.to_string(),
+    ParameterValue::Double(d) => format!("{{\"double\": {d:?}}}"),
+    ParameterValue::String(s) => json_string(&s),
+    other => json_string(&format!("{other:?}")),
+  }
+}
+
+/// NAME=VALUE as the ROS 2 command line types it: true/false bool, an integer, a number with a
+/// point or exponent double, else a string.
+pub fn parse_assignment(item: &str) -> Result<raw::Parameter, String> {
+  let (name, text) = item.split_once('=').ok_or(format!("{item}: want NAME=VALUE"))?;
+  let value = if text == "true" || text == "false" {
+    ParameterValue::Boolean(text == "true")
+  } else if let Ok(i) = text.parse::<i64>() {
+    ParameterValue::Integer(i)
+  } else if let Ok(d) = text.parse::<f64>() {
+    ParameterValue::Double(d)
+  } else {
+    ParameterValue::String(text.to_string())
+  };
+  Ok(ros2_client::Parameter { name: name.to_string(), value }.into())
+}
+
+/// std_srvs/srv/Trigger.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TriggerRequest {
+  structure_needs_at_least_one_member: u8,
+}
+impl Message for TriggerRequest {}
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TriggerResponse {
+  pub success: bool,
+  pub message: String,
+}
+impl Message for TriggerResponse {}
+
+/// rbsim_msgs/srv/Step.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StepRequest {
+  pub steps: u32,
+}
+impl Message for StepRequest {}
+/// rbsim_msgs/srv/ApplyImpulse: J in world axes (N s) at p in the body frame (m).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ApplyImpulseRequest {
+  pub body: u32,
+  pub jx: f64,
+  pub jy: f64,
+  pub px: f64,
+  pub py: f64,
+}
+impl Message for ApplyImpulseRequest {}
+/// The reply of both: success, message, the step at which it applied.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StepReply {
+  pub success: bool,
+  pub message: String,
+  pub step: u64,
+}
+impl Message for StepReply {}
+
+fn number<T: std::str::FromStr>(word: &str) -> Result<T, String> {
+  word.parse().map_err(|_| format!("not a number: {word}"))
+}
+
+/// `params NODE VERB ARGS...`: one JSON line per answer.
+pub fn params(node: &mut Node, target: &str, words: &[String], timeout: Duration) -> Result<(), String> {
+  let (verb, rest) = words.split_first().ok_or("params NODE list|get|describe|types|set|set-atomic ...")?;
+  let names: Vec<String> = rest.to_vec();
+  let svc = |s: &str| format!("{target}/{s}");
+  match verb.as_str() {
+    "list" => {
+      let r: ListParametersResponse = call(
+        node, &svc("list_parameters"), "rcl_interfaces", "ListParameters",
+        ListParametersRequest { prefixes: names, depth: 0 }, timeout)?;
+      let list: Vec<String> = r.result.names.iter().map(|n| json_string(n)).collect();
+      println!("{{\"list\": [{}]}}", list.join(", "));
+    }
+    "get" => {
+      let r: GetParametersResponse =
+        call(node, &svc("get_parameters"), "rcl_interfaces", "GetParameters", GetParametersRequest { names: names.clone() }, timeout)?;
+      for (n, v) in names.iter().zip(r.values.iter()) {
+        println!("{{\"get\": {}, \"type\": {}, \"value\": {}}}", json_string(n), v.ptype, value_json(v));
+      }
+      if r.values.len() != names.len() {
+        println!("{{\"get_count\": {}}}", r.values.len());
+      }
+    }
+    "types" => {
+      let r: GetParameterTypesResponse = call(
+        node, &svc("get_parameter_types"), "rcl_interfaces", "GetParameterTypes",
+        GetParameterTypesRequest { names: names.clone() }, timeout)?;
+      for (n, t) in names.iter().zip(r.values.iter()) {
+        println!("{{\"types\": {}, \"type\": {t}}}", json_string(n));
+      }
+    }
+    "describe" => {
+      let r: DescribeParametersResponse = call(
+        node, &svc("describe_parameters"), "rcl_interfaces", "DescribeParameters",
+        DescribeParametersRequest { names }, timeout)?;
+      for d in &r.values {
+        let fr: Vec<String> = d.floating_point_range.iter()
+          .map(|r| format!("[{:?}, {:?}, {:?}]", r.from_value, r.to_value, r.step)).collect();
+        let ir: Vec<String> = d.integer_range.iter()
+          .map(|r| format!("[{}, {}, {}]", r.from_value, r.to_value, r.step)).collect();
+        println!(
+          "{{\"describe\": {}, \"type\": {}, \"read_only\": {}, \"description\": {}, \"floating_point_range\": [{}], \"integer_range\": [{}]}}",
+          json_string(&d.name), d.r#type, d.read_only, json_string(&d.description), fr.join(", "), ir.join(", "));
+      }
+    }
+    "set" | "set-atomic" => {
+      let parameter = rest.iter().map(|w| parse_assignment(w)).collect::<Result<Vec<_>, _>>()?;
+      let results = if verb == "set" {
+        let r: SetParametersResponse = call(
+          node, &svc("set_parameters"), "rcl_interfaces", "SetParameters", SetParametersRequest { parameter }, timeout)?;
+        r.results
+      } else {
+        let r: SetParametersAtomicallyResponse = call(
+          node, &svc("set_parameters_atomically"), "rcl_interfaces", "SetParametersAtomically",
+          SetParametersRequest { parameter }, timeout)?;
+        vec![r.result]
+      };
+      for r in results {
+        println!("{{\"{verb}\": {}, \"reason\": {}}}", r.successful, json_string(&r.reason));
+      }
+    }
+    other => return Err(format!("params: unknown verb {other}")),
+  }
+  Ok(())
+}
+
+/// `call SERVICE trigger | step N | impulse BODY JX JY PX PY`.
+pub fn call_service(node: &mut Node, service: &str, words: &[String], timeout: Duration) -> Result<(), String> {
+  let (kind, rest) = words.split_first().ok_or("call SERVICE trigger|step N|impulse BODY JX JY PX PY")?;
+  match (kind.as_str(), rest.len()) {
+    ("trigger", 0) => {
+      let r: TriggerResponse = call(
+        node, service, "std_srvs", "Trigger", TriggerRequest { structure_needs_at_least_one_member: 0 }, timeout)?;
+      println!("{{\"call\": {}, \"success\": {}, \"message\": {}}}", json_string(service), r.success, json_string(&r.message));
+    }
+    ("step", 1) => {
+      let r: StepReply = call(node, service, "rbsim_msgs", "Step", StepRequest { steps: number(&rest[0])? }, timeout)?;
+      println!("{{\"call\": {}, \"success\": {}, \"message\": {}, \"step\": {}}}", json_string(service), r.success,
+               json_string(&r.message), r.step);
+    }
+    ("impulse", 5) => {
+      let req = ApplyImpulseRequest {
+        body: number(&rest[0])?, jx: number(&rest[1])?, jy: number(&rest[2])?, px: number(&rest[3])?, py: number(&rest[4])?,
+      };
+      let r: StepReply = call(node, service, "rbsim_msgs", "ApplyImpulse", req, timeout)?;
+      println!("{{\"call\": {}, \"success\": {}, \"message\": {}, \"step\": {}}}", json_string(service), r.success,
+               json_string(&r.message), r.step);
+    }
+    _ => return Err(format!("call {service}: want trigger | step N | impulse BODY JX JY PX PY")),
+  }
+  Ok(())
+}
