@@ -18,15 +18,20 @@
 namespace rbsim::node {
 
 namespace {
+constexpr dds_duration_t kWriteSlice = DDS_MSECS(100);
+constexpr dds_duration_t kMaxBlocked = DDS_SECS(30);
+
 Error dds_error(const std::string& what, dds_return_t rc) {
   return Error{what + ": " + dds_strretcode(rc)};
 }
 
 dds_qos_t* make_qos(const QosSpec& q, bool reader) {
   dds_qos_t* qos = dds_create_qos();
-  // A reliable writer blocks (up to 30 s) when its readers fall behind: a slow recorder throttles
-  // the node instead of losing samples.
-  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(30));
+  // A reliable writer blocks when its readers fall behind: a slow recorder throttles the node
+  // instead of losing samples. Each write blocks at most kWriteSlice; Publisher::publish retries
+  // up to kMaxBlocked in all, asking its stop predicate between slices, so Ctrl-C ends a node
+  // whose subscriber died (still matched until its lease expires) at once.
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, kWriteSlice);
   dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   // Per-step topics keep all: with keep-last, a writer drops samples a slow reader has not yet
   // acknowledged once `depth` newer ones exist, so a recorder that falls behind loses steps;
@@ -137,15 +142,32 @@ Publisher::~Publisher() {
   if (topic_ > 0) dds_delete(topic_);
 }
 
-Status Publisher::publish(std::span<const std::byte> cdr) {
+Status Publisher::publish(std::span<const std::byte> cdr, bool (*stop)()) {
   ddsi_serdata* d = make_raw_serdata(sertype_, cdr);
-  const dds_return_t rc = dds_writecdr(writer_, d);  // takes the reference
+  dds_return_t rc = DDS_RETCODE_TIMEOUT;
+  for (dds_duration_t blocked = 0; rc == DDS_RETCODE_TIMEOUT && blocked < kMaxBlocked;
+       blocked += kWriteSlice) {
+    if (blocked > 0 && stop != nullptr && stop()) break;  // stopping: this sample is not sent
+    rc = dds_writecdr(writer_, ddsi_serdata_ref(d));      // each attempt takes one reference
+  }
+  ddsi_serdata_unref(d);
+  if (rc == DDS_RETCODE_TIMEOUT && stop != nullptr && stop()) {
+    return Error{"stopped while subscribers of " + ros_topic_ + " were not keeping up", ErrorCode::Cancelled};
+  }
   if (rc < 0) return dds_error("publishing on " + ros_topic_ + " failed", rc);
   return Ok{};
 }
 
-Status Publisher::flush(double timeout_s) {
-  const dds_return_t rc = dds_wait_for_acks(writer_, static_cast<dds_duration_t>(timeout_s * 1e9));
+Status Publisher::flush(double timeout_s, bool (*stop)()) {
+  // In slices, so a stop request (a second Ctrl-C, or the first when a subscriber died) cuts the
+  // wait to kStoppingFlush.
+  const auto timeout = static_cast<dds_duration_t>(timeout_s * 1e9);
+  constexpr dds_duration_t kStoppingFlush = DDS_SECS(1);
+  dds_return_t rc = DDS_RETCODE_TIMEOUT;
+  for (dds_duration_t waited = 0; rc == DDS_RETCODE_TIMEOUT && waited < timeout; waited += kWriteSlice) {
+    if (stop != nullptr && stop() && waited >= kStoppingFlush) break;
+    rc = dds_wait_for_acks(writer_, std::min(kWriteSlice, timeout - waited));
+  }
   if (rc < 0)
     return dds_error("subscribers of " + ros_topic_ + " did not acknowledge everything in time", rc);
   return Ok{};

@@ -138,8 +138,34 @@ def case_rosout(ctx):
     return with_node(ctx, body)
 
 
+def case_killed_peer(ctx):
+    """A ros2-client subscriber killed (SIGKILL: it never says goodbye, and stays matched until its
+    lease expires) while the node publishes reliably to it: Ctrl-C still ends the node at once,
+    cleanly (exit 0), instead of after 30 s of blocked writes."""
+    import time
+    if not PEER or not os.access(PEER, os.X_OK):
+        raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
+    with PeerNet(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return e2e.SKIP
+        node = net.rb("node-in-a", "a", *e2e.node_args(ctx, ctx.scene("chain.xml"), "--loop"))
+        peer = net.peer("peer-tf", "tf", 10**9, "--timeout", 120)
+        peer.wait_for_text('"tf": 10,', 60)
+        peer.signal(signal.SIGKILL)
+        time.sleep(1.0)  # the node's writes now block on the dead reader's full window
+        t0 = time.monotonic()
+        node.signal(signal.SIGINT)
+        rc = node.wait(30)
+        took = time.monotonic() - t0
+        ctx.check(rc == 0, f"node exited with {rc} after SIGINT (want 0)\n{node.output()}")
+        ctx.check(took < 5, f"node took {took:.1f} s to stop after SIGINT (want < 5 s)")
+        ctx.log(f"node stopped {took:.2f} s after SIGINT with its subscriber dead")
+    return 0
+
+
 e2e.CASES.clear()
-e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout})
+e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

@@ -35,6 +35,7 @@ int node_command(const NodeArgs& a) {
   if (!participant) return fail("node", participant.error().message);
   // Each step is encoded once for DDS and the Foxglove server alike.
   node::NodeOptions node_options = a.node;
+  node_options.stop = stop_requested;
   node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
   auto sink = node::DdsSink::create(participant.value(), node_options);
   if (!sink) return fail("node", sink.error().message);

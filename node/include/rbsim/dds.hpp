@@ -68,10 +68,13 @@ class Publisher {
   Publisher(Publisher&&) noexcept;
   Publisher& operator=(Publisher&&) = delete;
   ~Publisher();
-  [[nodiscard]] Status publish(std::span<const std::byte> cdr);
+  // Blocks while a reliable subscriber's window is full, up to 30 s in all; when `stop` turns
+  // true meanwhile, gives up on this sample with ErrorCode::Cancelled.
+  [[nodiscard]] Status publish(std::span<const std::byte> cdr, bool (*stop)() = nullptr);
   std::int32_t matched() const;  // subscriptions currently matched
-  // Waits until every matched reliable reader acknowledged everything written (bounded).
-  [[nodiscard]] Status flush(double timeout_s);
+  // Waits until every matched reliable reader acknowledged everything written (bounded; about a
+  // second once `stop` is true).
+  [[nodiscard]] Status flush(double timeout_s, bool (*stop)() = nullptr);
   std::int32_t writer() const { return writer_; }
   const std::string& ros_topic() const { return ros_topic_; }
 

@@ -23,6 +23,10 @@ struct NodeOptions {
   // Shared with the other sinks of a run (the Foxglove sink), so each step is encoded once; when
   // null the sink encodes for itself.
   std::shared_ptr<msgs::StepMessages> messages;
+  // Ctrl-C: a write blocked on a subscriber that stopped reading (or died: it stays matched until
+  // its lease expires) gives up on its sample once this turns true, and finish() waits about a
+  // second for acknowledgements instead of 30 s.
+  bool (*stop)() = nullptr;
 };
 // Publishes the selected latched topics (scene description, markers: transient local) at begin()
 // and the selected per-step topics on every k-th step.

@@ -26,6 +26,7 @@ enum class ErrorCode : std::uint8_t {
   CrcMismatch,
   UnsupportedCompression,
   DecompressionFailed,
+  Cancelled,  // gave up because the user asked to stop (Ctrl-C): not a failure of its own
 };
 
 struct Error {
