@@ -357,6 +357,9 @@ CommandResult Controller::impulse(const Command& command, World& world) {
     return failed("apply_impulse: no body " + std::to_string(a.body) + " (the scene has " +
                   std::to_string(world.body_count()) + " bodies)");
   }
+  for (double v : {a.impulse.x(), a.impulse.y(), a.point.x(), a.point.y()}) {
+    if (!std::isfinite(v)) return failed("apply_impulse: the impulse and its point must be finite");
+  }
   const BodyId body{static_cast<std::int32_t>(a.body)};
   const BodyState before = world.state(body);
   if (Status st = world.apply_impulse(body, a.impulse, a.point); !st) {
