@@ -25,6 +25,7 @@ MODULES = {
     "core": ("sim_core", set()),
     "scene": ("sim_core/scene", {"core"}),
     "io": ("tools/io", {"core", "scene"}),
+    "control": ("tools/control", {"core", "scene", "io"}),
     "msgs": ("tools/msgs", {"core", "scene"}),
     "mcap": ("tools/mcap", set()),
     "mcap_tools": ("tools/mcap_tools", {"mcap"}),
@@ -32,7 +33,7 @@ MODULES = {
     "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
-    "node": ("node", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
+    "node": ("node", {"core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
     "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module

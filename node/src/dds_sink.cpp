@@ -81,6 +81,11 @@ Status Pacer::begin(const Scene&, const World& world) {
   return Ok{};
 }
 
+void Pacer::rebase(const World& world) {
+  start_ns_ = monotonic_ns();
+  start_step_ = world.step_index();
+}
+
 Status Pacer::write(const World& world) {
   if (rate_ <= 0.0 || world.step_index() % every_ != 0) return Ok{};
   const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / rate_;

@@ -2,6 +2,8 @@
 // command ("rbsim check: error: ..."), unknown commands are named, and `rbsim help` works.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -82,6 +84,42 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{{"node", "scene.xml", "--topics", ","}, "rbsim node: error: --topics", "no topic given"},
         UsageCase{{"log", "cat"}, "rbsim log cat: error:", "file"},
         UsageCase{{"log", "cat", "x.mcap", "--start", "-1"}, "rbsim log cat: error:", "--start"}));
+
+// rbsim node --ros-args: a bad parameter is a usage error naming where it came from and the
+// parameter, before any DDS is started.
+TEST(NodeRosArgs, BadParametersAreUsageErrorsNamingOriginAndParameter) {
+  const std::string scene = std::string(RBSIM_TEST_DATA_DIR) + "/fosssim/scenes/gravitytests/test00sym.xml";
+  const std::string yaml = ::testing::TempDir() + "rbsim_usage_params.yaml";
+  {
+    std::ofstream out(yaml);
+    out << "/rbsim:\n  ros__parameters:\n    forces.0.fx: 1.0\n    forces.0.fy: abc\n";
+  }
+  struct Case {
+    std::vector<std::string> args;
+    std::string mentions;
+  };
+  for (const Case& c : std::vector<Case>{
+           {{"-p", "rate:=2"}, "-p rate:=2: parameter 'rate': Wrong parameter type"},
+           {{"-p", "forces.1.fx:=1.0"}, "parameter 'forces.1.fx': parameter 'forces.1.fx' is not declared"},
+           {{"-p", "use_sim_time:=true"}, "rbsim is the clock"},
+           {{"-p", "dt:=0.1"}, "read-only"},
+           {{"--params-file", yaml}, yaml + ":4: parameter 'forces.0.fy'"},
+           {{"-r", "a:=b"}, "'-r' is not supported"},
+       }) {
+    std::vector<std::string> args = {"node", scene, "--domain", "0", "--ros-args"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const test::Outcome o = rbsim(args);
+    EXPECT_EQ(o.exit_code, 2) << o;
+    ASSERT_FALSE(o.err_lines().empty()) << o;
+    EXPECT_EQ(o.err_lines()[0].rfind("rbsim node: error: ", 0), 0u) << o;
+    EXPECT_NE(o.err.find(c.mentions), std::string::npos) << o;
+  }
+  std::remove(yaml.c_str());
+  // Only rbsim node takes ROS arguments.
+  const test::Outcome run = rbsim({"run", scene, "--ros-args", "-p", "rate:=2.0"});
+  EXPECT_EQ(run.exit_code, 2) << run;
+  EXPECT_NE(run.err.find("--ros-args"), std::string::npos) << run;
+}
 
 TEST(Help, HelpCommandShowsTheCommandsHelp) {
   const test::Outcome o = rbsim({"help", "log", "recover"});

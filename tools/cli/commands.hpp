@@ -24,11 +24,13 @@ Subcommand add_grade_command(CLI::App& parent);
 Subcommand add_render_command(CLI::App& parent);  // render.cpp
 Subcommand add_plot_command(CLI::App& parent);    // render.cpp
 Subcommand add_node_command(CLI::App& parent);    // node.cpp
-Subcommand add_record_command(CLI::App& parent);  // record.cpp
-Subcommand add_replay_command(CLI::App& parent);  // replay.cpp
-Subcommand add_log_command(CLI::App& parent);     // log.cpp: info, doctor, recover, export
-Subcommand add_check_command(CLI::App& parent);   // check.cpp: golden-log comparison
-Subcommand add_bridge_command(CLI::App& parent);  // bridge.cpp: DDS -> Foxglove relay
+// The tokens of rbsim node's --ros-args sections, cut from the command line before parsing (main.cpp).
+void set_ros_args(std::vector<std::string> tokens);  // node.cpp
+Subcommand add_record_command(CLI::App& parent);     // record.cpp
+Subcommand add_replay_command(CLI::App& parent);     // replay.cpp
+Subcommand add_log_command(CLI::App& parent);        // log.cpp: info, doctor, recover, export
+Subcommand add_check_command(CLI::App& parent);      // check.cpp: golden-log comparison
+Subcommand add_bridge_command(CLI::App& parent);     // bridge.cpp: DDS -> Foxglove relay
 
 // The DDS commands' --domain (record.cpp): bound to `domain`, which starts as ROS_DOMAIN_ID (or 0),
 // so the command line wins; an invalid ROS_DOMAIN_ID leaves node::kDomainFromEnvironment for

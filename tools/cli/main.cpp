@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "rbsim/core.hpp"
+#include "rbsim/ros_args.hpp"
 
 namespace {
 
@@ -72,6 +73,9 @@ int main(int argc, char** argv) {
     }
     level = sub;
   }
+  // ROS 2's arguments (--ros-args ... [--]) are rbsim node's: cut out before CLI11 sees them. For
+  // any other command they stay, and CLI11 calls them unexpected.
+  if (level->get_name() == "node") rbsim::cli::set_ros_args(rbsim::control::take_ros_args(args));
   std::reverse(args.begin(), args.end());  // CLI11 takes the arguments last first
   args.pop_back();                         // without the program name
   try {

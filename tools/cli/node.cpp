@@ -5,7 +5,9 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/control.hpp"
 #include "rbsim/dds_sink.hpp"
+#include "rbsim/ros_args.hpp"
 #include "rbsim/run.hpp"
 #include "validators.hpp"
 
@@ -24,18 +26,44 @@ struct NodeArgs {
   std::optional<std::string> foxglove;  // [ADDR:]PORT
 };
 
+std::vector<std::string>& ros_args() {
+  static std::vector<std::string> tokens;
+  return tokens;
+}
+
+// --ros-args' parameters (-p, --params-file) applied to the scene and the run's settings before
+// step 0: the run starts with them, and a reset returns to them.
+Status apply_ros_args(Scene& scene, std::int64_t steps, control::RunSettings& settings,
+                      const std::string& ns) {
+  Result<std::vector<control::ParameterOverride>> overrides = control::parse_ros_args(ros_args(), "/" + ns);
+  if (!overrides) return overrides.error();
+  std::vector<std::string> warnings;
+  if (Status st = control::apply_overrides(overrides.value(), scene, steps, settings, &warnings); !st)
+    return st;
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  return Ok{};
+}
+
 int node_command(const NodeArgs& a) {
   Result<Scene> loaded = load_scene(a.scene);
   if (!loaded) return fail("node", loaded.error().message);
-  const Scene& scene = loaded.value();
+  Scene& scene = loaded.value();
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
   const std::int64_t steps = steps_for(a.duration.value_or(scene.duration), scene.world.dt);
+  control::RunSettings settings{a.node.rate, a.node.publish_every, false};
+  if (Status st = apply_ros_args(scene, steps, settings, a.node.ns); !st) {
+    std::fprintf(stderr, "rbsim node: error: %s\nRun 'rbsim node --help' for usage.\n",
+                 st.error().message.c_str());
+    return 2;
+  }
 
   auto participant = node::Participant::create(a.node.domain);
   if (!participant) return fail("node", participant.error().message);
   // Each step is encoded once for DDS and the Foxglove server alike.
   node::NodeOptions node_options = a.node;
   node_options.stop = stop_requested;
+  node_options.rate = settings.rate;
+  node_options.publish_every = settings.publish_every;
   node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
   auto sink = node::DdsSink::create(participant.value(), node_options);
   if (!sink) return fail("node", sink.error().message);
@@ -46,7 +74,7 @@ int node_command(const NodeArgs& a) {
   std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
   if (a.foxglove) {
     foxglove::SinkOptions fo;
-    fo.publish_every = a.node.publish_every;
+    fo.publish_every = settings.publish_every;
     fo.topics = a.node.topics;
     fo.ns = a.node.ns;
     fo.messages = node_options.messages;
@@ -63,8 +91,11 @@ int node_command(const NodeArgs& a) {
     std::fprintf(stderr,
                  "rbsim node: %s on domain %u, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
                  scene.name.c_str(), a.node.domain, a.node.ns.c_str(),
-                 a.node.rate > 0 ? (std::to_string(a.node.rate) + "x").c_str() : "as fast as possible",
-                 static_cast<long long>(steps), a.loop ? ", looping" : "");
+                 settings.rate > 0 ? (std::to_string(settings.rate) + "x").c_str() : "as fast as possible",
+                 static_cast<long long>(steps),
+                 a.loop            ? ", looping"
+                 : settings.paused ? ", paused"
+                                   : "");
   }
   if (a.wait_for > 0) {
     if (!a.quiet) std::fprintf(stderr, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
@@ -74,14 +105,23 @@ int node_command(const NodeArgs& a) {
   Result<Driver> created = Driver::create(scene);
   if (!created) return fail("node", created.error().message);
   Driver& driver = created.value();
-  node::Pacer pacer(a.node.rate, a.node.publish_every);
+  node::Pacer pacer(settings.rate, settings.publish_every);
   driver.add(pacer);
   if (foxglove_sink) driver.add(*foxglove_sink);
   driver.add(*sink.value());
+  // Commands (parameters, pause, step, reset, impulses) apply at step boundaries; rate and
+  // publish_every changes reach the pacer and the publishers there.
+  control::Controller controller(scene, steps, settings);
+  controller.on_settings([&](const control::RunSettings& s) {
+    pacer.set_pace(s.rate, s.publish_every);
+    sink.value()->set_publish_every(s.publish_every);
+    if (foxglove_sink) foxglove_sink->set_publish_every(s.publish_every);
+  });
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;
   options.stop = stop_requested;
+  options.control = &controller;
   do {
     if (Status st = driver.begin(); !st) return fail("node", st.error().message);
     const Result<PassEnd> end = driver.run(options);
@@ -95,19 +135,32 @@ int node_command(const NodeArgs& a) {
                               " (--allow-nonfinite keeps going).");
     }
   } while (a.loop && !stop_requested());
+  controller.close("the node stopped");
   if (Status st = driver.finish(); !st) return fail("node", st.error().message);
   if (!a.quiet) {
     const std::int64_t total_steps = driver.steps_done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published%s\n",
+    const control::ControlCounters counted = controller.counters();
+    std::fprintf(stderr,
+                 "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s, %s%s\n",
                  stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
                  format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
                  static_cast<unsigned long long>(sink.value()->published()),
+                 count_of(static_cast<std::int64_t>(counted.commands + counted.queries), "service call",
+                          "service calls")
+                     .c_str(),
+                 count_of(static_cast<std::int64_t>(counted.parameter_changes), "parameter change",
+                          "parameter changes")
+                     .c_str(),
                  server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;
 }
 }  // namespace
+
+void set_ros_args(std::vector<std::string> tokens) {
+  ros_args() = std::move(tokens);
+}
 
 Subcommand add_node_command(CLI::App& parent) {
   auto a = std::make_shared<NodeArgs>();
@@ -154,8 +207,13 @@ Subcommand add_node_command(CLI::App& parent) {
       "--foxglove serves the same topics to Foxglove beside DDS: encoding cdr, ros2msg schemas as in MCAP, "
       "log time = simulated time; a client that falls behind loses the oldest per-step messages (never the "
       "latched scene and markers), one that stops reading is disconnected.\n"
+      "Parameters, as a ROS 2 node takes them, after the other options: --ros-args -p NAME:=VALUE "
+      "--params-file FILE [--] (rcl's YAML: /NS: or /**: then ros__parameters:). Read-write: rate, "
+      "publish_every, paused, forces.<i>.fx|fy (gravity), forces.<i>.beta|fx|fy|pointsperedge (wind), "
+      "springs.<j>.k|l0; values typed as YAML types them (2.0 double, 2 integer, true bool). They apply "
+      "from step 0, and a reset returns to them.\n"
       "Exit status: 0 done, or stopped by Ctrl-C/SIGTERM (cleanly); 1 error (bad scene, DDS failure, "
-      "divergence, --foxglove port in use); 2 usage error.");
+      "divergence, --foxglove port in use); 2 usage error (also a bad --ros-args value or parameters file).");
   return {app, [a] { return node_command(*a); }};
 }
 

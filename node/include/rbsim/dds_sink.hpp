@@ -42,6 +42,8 @@ class DdsSink final : public Sink {
   // default); false when `stop` turned true.
   bool wait_for_subscribers(std::int32_t count, bool (*stop)());
   std::uint64_t published() const { return published_; }
+  // A live change (a control command, between steps); values < 1 are taken as 1.
+  void set_publish_every(std::int64_t every) { options_.publish_every = every < 1 ? 1 : every; }
 
  private:
   DdsSink() = default;
@@ -64,6 +66,15 @@ class Pacer final : public Sink {
   Status begin(const Scene& scene, const World& world) override;
   Status write(const World& world) override;
   Status finish() override { return Ok{}; }
+  // A live change of pace (a control command, between steps). The Driver then calls rebase(),
+  // from which the new pace counts.
+  void set_pace(double rate, std::int64_t publish_every) {
+    rate_ = rate;
+    every_ = publish_every < 1 ? 1 : publish_every;
+  }
+  // After a pause, a reset or a change of pace: the next steps are due from now, counted from
+  // `world`'s step (no burst to catch up the time spent paused).
+  void rebase(const World& world) override;
 
  private:
   double rate_;

@@ -165,6 +165,20 @@ class World {
   void set_state(BodyId b, const BodyState& s);  // e.g. to restart from a recorded step
   void set_step_index(std::int64_t step) { step_ = step; }
   BodyQuantities quantities(BodyId b) const;
+
+  // Changes between steps (a control command at a step boundary, never inside step()). Each
+  // refuses a value the scene loader would refuse (non-finite, negative k, l0 or beta, fewer than
+  // 1 point per edge, an index out of range) and then changes nothing; callers validate first
+  // (rbsim/control.hpp), these guard the core. Derived data stays consistent: finite_bound()
+  // follows gravity and the springs, a wind's edge moments follow its points per edge. Runners
+  // that cached finite_bound() or the peaks must read them again (the Driver does). None of them
+  // allocates.
+  [[nodiscard]] Status set_gravity(std::int32_t field, const Vec2& acceleration);  // gravity()[field]
+  [[nodiscard]] Status set_wind(std::int32_t wind, const WindDef& def);            // winds()[wind]
+  [[nodiscard]] Status set_spring(SpringId s, double stiffness, double rest_length);
+  // An instantaneous linear impulse J (N s, world axes) at the body point p (m, body frame,
+  // relative to the centre of mass): V += J / M, omega += ((R(theta) p) x J) / I.
+  [[nodiscard]] Status apply_impulse(BodyId b, const Vec2& impulse, const Vec2& point);
   // Force and torque accumulated by the last step() (zero before the first step).
   Vec2 force(BodyId b) const { return {fx_[b.index], fy_[b.index]}; }
   double torque(BodyId b) const { return tau_[b.index]; }

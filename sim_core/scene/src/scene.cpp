@@ -263,6 +263,8 @@ void Loader::element(const tinyxml2::XMLElement* e) {
     scene_.world.springs.push_back(s);
   } else if (name == "rigidbodygravityforce") {
     check_attributes(e, {"fx", "fy"}, false);
+    scene_.forces.push_back(
+        {ForceRef::Kind::Gravity, static_cast<std::int32_t>(scene_.world.gravity.size())});
     scene_.world.gravity.push_back(GravityDef{{number(e, "fx"), number(e, "fy")}});
   } else if (name == "rigidbodywindforce") {
     check_attributes(e, {"beta", "fx", "fy", "pointsperedge"}, false);
@@ -274,6 +276,7 @@ void Loader::element(const tinyxml2::XMLElement* e) {
       fail(e, "pointsperedge", "must be an integer in [2, 1000000] (got " + std::to_string(points) + ")");
     }
     w.points_per_edge = static_cast<std::int32_t>(points);
+    scene_.forces.push_back({ForceRef::Kind::Wind, static_cast<std::int32_t>(scene_.world.winds.size())});
     scene_.world.winds.push_back(w);
   } else if (name == "rigidbodycolor") {
     check_attributes(e, {"body", "r", "g", "b"}, false);

@@ -41,11 +41,27 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
   // dt * limit per step: a running bound (rounding covered by the 1e-12 factor) stands in for a
   // pass over them. Below World::finite_bound() every derived quantity is finite; a velocity past
   // the limit doubles it (one exact pass), and only beyond finite_bound() does the exact search run.
-  const double bound = world.finite_bound();
+  double bound = world.finite_bound();
   double position = world.peak_position();
   double limit = std::min(bound, std::max(1.0, 2.0 * world.peak_velocity()));
+  if (options.control != nullptr) options.control->start(world);
   while (world.step_index() < options.steps) {
     if (options.stop != nullptr && options.stop()) return PassEnd::Stopped;
+    if (options.control != nullptr) {
+      const StepHook::Boundary boundary = options.control->boundary(world, options.stop);
+      if (boundary.stop) return PassEnd::Stopped;
+      if (boundary.state_changed) {
+        // A change between steps breaks the running bound's premise (positions move only by dt
+        // times a checked velocity): start it again from the state as it now is.
+        bound = world.finite_bound();
+        position = world.peak_position();
+        limit = std::min(bound, std::max(1.0, 2.0 * world.peak_velocity()));
+      }
+      if (boundary.timeline_changed) {
+        for (Sink* sink : sinks_) sink->rebase(world);
+      }
+      if (world.step_index() >= options.steps) break;
+    }
     world.step();
     ++steps_done_;
     if (!options.allow_nonfinite) {

@@ -22,6 +22,15 @@ struct Viewport {
   double size = 1.0;          // half-extent of the shorter side (FOSSSim convention)
 };
 
+// A gravity or wind force of the scene, in file order: forces are numbered together from 0 as
+// the scene lists them (the `forces.<i>.*` parameters, rbsim/control.hpp); `index` is into
+// WorldDef::gravity or WorldDef::winds. Springs are numbered apart (WorldDef::springs).
+struct ForceRef {
+  enum class Kind : std::uint8_t { Gravity, Wind };
+  Kind kind = Kind::Gravity;
+  std::int32_t index = 0;
+};
+
 struct Scene {
   std::string path;  // as given to load_scene
   std::string name;  // file stem, e.g. "test00ee"
@@ -34,6 +43,7 @@ struct Scene {
   Color background{1.0, 1.0, 1.0};
   std::vector<Color> body_colors;     // one per body
   std::vector<Color> spring_colors;   // one per spring
+  std::vector<ForceRef> forces;       // the gravity and wind forces in file order
   std::vector<std::string> warnings;  // "file:line: warning: ..." lines, e.g. unknown nodes
 
   // Steps to cover `duration`: ceil(duration / dt) in double precision, so 0.07 / 0.01 gives 8.

@@ -276,6 +276,8 @@ class FoxgloveSink final : public Sink {
   Status write(const World& world) override;
   // Flushes the server (bounded, 2 s): viewers that keep up get the last steps.
   Status finish() override;
+  // A live change (a control command, between steps); values < 1 are taken as 1.
+  void set_publish_every(std::int64_t every) { options_.publish_every = every < 1 ? 1 : every; }
 
  private:
   void publish(const msgs::TopicSpec& spec, const World& world);

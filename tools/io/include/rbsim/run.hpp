@@ -27,6 +27,26 @@ struct Divergence {
 // not use it); a command may append what its outputs hold and its own options.
 std::string describe_divergence(const Divergence& divergence);
 
+// The run loop's one hook for control (rbsim/control.hpp's Controller is the implementation):
+// called on the loop's thread at every step boundary, never inside a step.
+class StepHook {
+ public:
+  virtual ~StepHook() = default;
+  // What a boundary did, for the driver to follow.
+  struct Boundary {
+    bool state_changed = false;     // parameters, velocities or the whole world changed: the
+                                    // divergence check's cached bounds are read again
+    bool timeline_changed = false;  // resumed, reset or re-paced: every sink's rebase() is called
+    bool stop = false;              // a stop request arrived while paused: the pass ends (Stopped)
+  };
+  // A pass starts (Driver::run), on the world it will step.
+  virtual void start(World& world) = 0;
+  // Before `world` takes its next step. May change the world between steps (a parameter, an
+  // impulse, a reset to step 0) and may block while the run is paused, in bounded waits that
+  // poll `stop` (may be null).
+  virtual Boundary boundary(World& world, bool (*stop)()) = 0;
+};
+
 struct DriverOptions {
   std::int64_t steps = 0;        // a pass runs from step 0 to step `steps`
   bool allow_nonfinite = false;  // keep stepping and writing through inf/NaN
@@ -35,6 +55,9 @@ struct DriverOptions {
   bool (*stop)() = nullptr;
   // Called after every step's writes with the step index; must not block.
   std::function<void(std::int64_t)> progress;
+  // Control at step boundaries (pause, step, reset, parameters, impulses); null: none, and the
+  // loop is exactly the one without control.
+  StepHook* control = nullptr;
 };
 
 enum class PassEnd { Done, Stopped, Diverged };

@@ -19,6 +19,10 @@ class Sink {
   // Completes the output (called after the last step, also after an interruption: whatever was
   // written stays a valid file).
   [[nodiscard]] virtual Status finish() = 0;
+  // The run's timeline changed between two steps, by a control command (rbsim/control.hpp): it
+  // resumed after a pause, was reset to step 0, or its pace changed. A sink that paces to wall time
+  // starts afresh from `world`'s step (node::Pacer); the others ignore it.
+  virtual void rebase(const World& world) { (void)world; }
 };
 
 // One row per body per step, columns kBodyCsvColumns (rbsim/csv.hpp), every value printed in

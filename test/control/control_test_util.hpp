@@ -1,0 +1,47 @@
+// Scenes and a recording sink shared by the control tests.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rbsim/control.hpp"
+#include "rbsim/run.hpp"
+#include "rbsim/scene.hpp"
+
+namespace rbsim::test {
+
+// Two bodies, a spring between them and one to a fixed point, forces in the file order gravity,
+// wind, gravity (forces.0 gravity, forces.1 wind, forces.2 gravity). Each force's and spring's
+// attributes are unique substrings, so a test edits one by replacing its text.
+std::string control_scene_text();
+Scene scene_from(const std::string& text);
+inline Scene control_scene() {
+  return scene_from(control_scene_text());
+}
+
+// Every step a sink is given: the step index and the state arrays, in order.
+struct Snapshot {
+  std::int64_t step = 0;
+  std::vector<double> state;  // x, y, theta, vx, vy, omega of every body
+  bool operator==(const Snapshot&) const = default;
+};
+Snapshot snapshot(const World& world);
+
+class RecordingSink final : public Sink {
+ public:
+  Status begin(const Scene&, const World& world) override;
+  Status write(const World& world) override;
+  Status finish() override { return Ok{}; }
+  void rebase(const World&) override { ++rebases; }
+  std::vector<Snapshot> snapshots;
+  int rebases = 0;
+};
+
+// One pass of `scene` for `steps` steps with an optional controller; the snapshots of every step.
+std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller = nullptr);
+
+// Bit-for-bit equality of two doubles (memcmp: -0.0 differs from 0.0).
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b);
+
+}  // namespace rbsim::test

@@ -1,0 +1,219 @@
+// The parameter table (rbsim/parameters.hpp): declarations, values, every parameter's set and
+// refuse paths, rclcpp's list semantics, and overrides applied to a scene.
+#include "rbsim/parameters.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "control_test_util.hpp"
+
+namespace rbsim::control {
+namespace {
+
+using V = ParameterValue;
+
+std::vector<std::string> names(const ParameterTable& t) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < t.size(); ++i) out.push_back(t.descriptor(i).name);
+  return out;
+}
+
+TEST(ParameterTable, DeclaresTheRunsParametersWithForcesInFileOrder) {
+  const Scene scene = test::control_scene();
+  const ParameterTable t(scene, 200, RunSettings{2.0, 3, false});
+  const std::vector<std::string> expected = {
+      "scene",         "dt",           "integrator",  "bodies",
+      "springs",       "steps",        "rate",        "publish_every",
+      "paused",        "use_sim_time", "forces.0.fx", "forces.0.fy",             // gravity
+      "forces.1.beta", "forces.1.fx",  "forces.1.fy", "forces.1.pointsperedge",  // wind
+      "forces.2.fx",   "forces.2.fy",                                            // gravity
+      "springs.0.k",   "springs.0.l0", "springs.1.k", "springs.1.l0"};
+  EXPECT_EQ(names(t), expected);
+  const auto value = [&](const char* name) { return t.value(*t.find(name)); };
+  EXPECT_EQ(value("scene"), V::of_string("control.xml"));
+  EXPECT_EQ(value("dt"), V::of_double(scene.world.dt));
+  EXPECT_EQ(value("integrator"), V::of_string("symplectic-euler"));
+  EXPECT_EQ(value("bodies"), V::of_integer(2));
+  EXPECT_EQ(value("springs"), V::of_integer(2));
+  EXPECT_EQ(value("steps"), V::of_integer(200));
+  EXPECT_EQ(value("rate"), V::of_double(2.0));
+  EXPECT_EQ(value("publish_every"), V::of_integer(3));
+  EXPECT_EQ(value("paused"), V::of_bool(false));
+  EXPECT_EQ(value("use_sim_time"), V::of_bool(false));
+  EXPECT_EQ(value("forces.0.fy"), V::of_double(scene.world.gravity[0].acceleration.y()));
+  EXPECT_EQ(value("forces.1.beta"), V::of_double(scene.world.winds[0].beta));
+  EXPECT_EQ(value("forces.1.pointsperedge"), V::of_integer(scene.world.winds[0].points_per_edge));
+  EXPECT_EQ(value("forces.2.fx"), V::of_double(scene.world.gravity[1].acceleration.x()));
+  EXPECT_EQ(value("springs.1.k"), V::of_double(scene.world.springs[1].stiffness));
+  EXPECT_EQ(value("springs.0.l0"), V::of_double(scene.world.springs[0].rest_length));
+  for (const char* ro : {"scene", "dt", "integrator", "bodies", "springs", "steps"}) {
+    EXPECT_TRUE(t.descriptor(*t.find(ro)).read_only) << ro;
+  }
+  for (std::size_t i = 6; i < t.size(); ++i) EXPECT_FALSE(t.descriptor(i).read_only) << t.descriptor(i).name;
+}
+
+// One row per read-write parameter: a value it takes, one of the wrong type, one out of range.
+struct Case {
+  const char* name;
+  V good;
+  V wrong_type;
+  std::optional<V> out_of_range;
+};
+
+std::vector<Case> cases() {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {
+      {"rate", V::of_double(0.0), V::of_integer(2), V::of_double(-0.5)},
+      {"publish_every", V::of_integer(1), V::of_double(2.0), V::of_integer(0)},
+      {"paused", V::of_bool(true), V::of_integer(1), std::nullopt},
+      {"use_sim_time", V::of_bool(false), V::of_string("false"), V::of_bool(true)},
+      {"forces.0.fx", V::of_double(-1e6), V::of_bool(true), V::of_double(nan)},
+      {"forces.0.fy", V::of_double(3.7), V::of_integer(-3),
+       V::of_double(-std::numeric_limits<double>::infinity())},
+      {"forces.1.beta", V::of_double(0.0), V::of_integer(0), V::of_double(-1e-9)},
+      {"forces.1.fx", V::of_double(5.0), V::of_string("5"), V::of_double(nan)},
+      {"forces.1.fy", V::of_double(-5.0), V::of_integer(5),
+       V::of_double(std::numeric_limits<double>::infinity())},
+      {"forces.1.pointsperedge", V::of_integer(1'000'000), V::of_double(4.0), V::of_integer(1)},
+      {"forces.2.fx", V::of_double(0.5), V::of_integer(1), V::of_double(nan)},
+      {"forces.2.fy", V::of_double(0.5), V::of_bool(false), V::of_double(nan)},
+      {"springs.0.k", V::of_double(0.0), V::of_integer(3), V::of_double(-2.0)},
+      {"springs.0.l0", V::of_double(1.5), V::of_integer(1), V::of_double(-0.1)},
+      {"springs.1.k", V::of_double(100.0), V::of_string("x"), V::of_double(nan)},
+      {"springs.1.l0", V::of_double(0.0), V::of_bool(true), V::of_double(-1.0)},
+  };
+}
+
+TEST(ParameterTableCheck, EveryReadWriteParameterTakesItsTypeInRangeAndRefusesTheRest) {
+  const ParameterTable t(test::control_scene(), 200, RunSettings{});
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    EXPECT_TRUE(t.check({c.name, c.good}).successful);
+    const SetParametersResult type = t.check({c.name, c.wrong_type});
+    EXPECT_FALSE(type.successful);
+    EXPECT_NE(type.reason.find(std::string("{") + c.name + "}"), std::string::npos) << type.reason;
+    EXPECT_NE(type.reason.find("Wrong parameter type"), std::string::npos) << type.reason;
+    if (c.out_of_range) {
+      const SetParametersResult range = t.check({c.name, *c.out_of_range});
+      EXPECT_FALSE(range.successful);
+      EXPECT_NE(range.reason.find(c.name), std::string::npos) << range.reason;
+    }
+  }
+}
+
+TEST(ParameterTableCheck, RefusesReadOnlyUnknownAndNotSet) {
+  const ParameterTable t(test::control_scene(), 200, RunSettings{});
+  for (const char* name : {"scene", "dt", "integrator", "bodies", "springs", "steps"}) {
+    const SetParametersResult r = t.check({name, t.value(*t.find(name))});  // even its own value
+    EXPECT_FALSE(r.successful) << name;
+    EXPECT_NE(r.reason.find("read-only"), std::string::npos) << r.reason;
+    EXPECT_NE(r.reason.find(name), std::string::npos) << r.reason;
+  }
+  for (const char* name : {"forces.3.fx", "springs.2.k", "forces.1.fz", "gravity", ""}) {
+    const SetParametersResult r = t.check({name, V::of_double(1.0)});
+    EXPECT_FALSE(r.successful) << name;
+    EXPECT_NE(r.reason.find("not declared"), std::string::npos) << r.reason;
+  }
+  EXPECT_FALSE(t.check({"rate", V{}}).successful);  // NOT_SET: no undeclaring
+}
+
+TEST(ParameterTableCheck, UseSimTimeTrueIsRefusedWithAReason) {
+  const ParameterTable t(test::control_scene(), 200, RunSettings{});
+  const SetParametersResult r = t.check({"use_sim_time", V::of_bool(true)});
+  EXPECT_FALSE(r.successful);
+  EXPECT_NE(r.reason.find("rbsim is the clock"), std::string::npos) << r.reason;
+}
+
+TEST(ParameterTableCheck, AnIntegerForADoubleIsRefusedAsRclcppDoes) {
+  const ParameterTable t(test::control_scene(), 200, RunSettings{});
+  const SetParametersResult r = t.check({"rate", V::of_integer(2)});
+  EXPECT_FALSE(r.successful);
+  EXPECT_NE(
+      r.reason.find("Wrong parameter type, parameter {rate} is of type {double}, setting it to {integer} "
+                    "is not allowed."),
+      std::string::npos)
+      << r.reason;
+}
+
+TEST(ParameterTableList, FollowsRclcppPrefixAndDepthRules) {
+  const ParameterTable t(test::control_scene(), 200, RunSettings{});
+  const ListParametersResult all = t.list({}, kDepthRecursive);
+  EXPECT_EQ(all.names, names(t));
+  EXPECT_EQ(all.prefixes,
+            (std::vector<std::string>{"forces.0", "forces.1", "forces.2", "springs.0", "springs.1"}));
+  const ListParametersResult top = t.list({}, 1);  // names without a '.'
+  for (const std::string& n : top.names) EXPECT_EQ(n.find('.'), std::string::npos) << n;
+  EXPECT_EQ(top.names.size(), 10u);
+  const ListParametersResult wind = t.list({"forces.1"}, kDepthRecursive);
+  EXPECT_EQ(wind.names, (std::vector<std::string>{"forces.1.beta", "forces.1.fx", "forces.1.fy",
+                                                  "forces.1.pointsperedge"}));
+  EXPECT_EQ(t.list({"forces"}, 1).names.size(), 0u);  // forces.<i>.<a>: <i>.<a> has one '.'
+  EXPECT_EQ(t.list({"forces"}, 2).names.size(), 8u);
+  EXPECT_EQ(t.list({"forces.1"}, 1).names.size(), 4u);
+  EXPECT_EQ(t.list({"rate"}, kDepthRecursive).names, std::vector<std::string>{"rate"});
+}
+
+TEST(ApplyOverrides, EditsTheSceneAndSettingsAsOneBatch) {
+  Scene scene = test::control_scene();
+  RunSettings settings;
+  const std::vector<ParameterOverride> overrides = {
+      {{"forces.2.fy", V::of_double(-2.0)}, "-p", false},
+      {{"rate", V::of_double(4.0)}, "-p", false},
+      {{"forces.2.fy", V::of_double(-3.0)}, "f.yaml:3", false},  // the last wins
+      {{"springs.1.l0", V::of_double(2.5)}, "f.yaml:4", false},
+      {{"forces.1.pointsperedge", V::of_integer(9)}, "f.yaml:5", false},
+      {{"paused", V::of_bool(true)}, "f.yaml:6", false},
+  };
+  ASSERT_TRUE(apply_overrides(overrides, scene, 200, settings).ok());
+  EXPECT_EQ(scene.world.gravity[1].acceleration.y(), -3.0);
+  EXPECT_EQ(scene.world.springs[1].rest_length, 2.5);
+  EXPECT_EQ(scene.world.winds[0].points_per_edge, 9);
+  EXPECT_EQ(settings.rate, 4.0);
+  EXPECT_TRUE(settings.paused);
+}
+
+TEST(ApplyOverrides, TheFirstBadOneNamesOriginAndParameterAndNothingChanges) {
+  Scene scene = test::control_scene();
+  const WorldDef before = scene.world;
+  RunSettings settings;
+  const std::vector<ParameterOverride> overrides = {
+      {{"forces.0.fy", V::of_double(-2.0)}, "-p forces.0.fy:=-2.0", false},
+      {{"springs.0.k", V::of_integer(3)}, "params.yaml:7", false},
+  };
+  const Status st = apply_overrides(overrides, scene, 200, settings);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().message.rfind("params.yaml:7: parameter 'springs.0.k': ", 0), 0u)
+      << st.error().message;
+  EXPECT_EQ(scene.world.gravity[0].acceleration.y(), before.gravity[0].acceleration.y());
+}
+
+TEST(ApplyOverrides, UnknownNamesAreErrorsUnlessFromAWildcardKey) {
+  Scene scene = test::control_scene();
+  RunSettings settings;
+  std::vector<std::string> warnings;
+  ASSERT_TRUE(apply_overrides({{{"qos_overrides.x", V::of_integer(1)}, "f.yaml:2", true}}, scene, 200,
+                              settings, &warnings)
+                  .ok());
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("f.yaml:2"), std::string::npos);
+  EXPECT_NE(warnings[0].find("qos_overrides.x"), std::string::npos);
+  const Status st = apply_overrides({{{"qos_overrides.x", V::of_integer(1)}, "f.yaml:2", false}}, scene, 200,
+                                    settings, &warnings);
+  EXPECT_FALSE(st.ok());
+}
+
+TEST(ParameterValueToString, ReadsAsTyped) {
+  EXPECT_EQ(to_string(V::of_double(0.1)), "0.1");
+  EXPECT_EQ(to_string(V::of_integer(-7)), "-7");
+  EXPECT_EQ(to_string(V::of_bool(true)), "true");
+  EXPECT_EQ(to_string(V::of_string("a")), "'a'");
+  V array;
+  array.type = ParameterType::IntegerArray;
+  array.integer_array_value = {1, 2};
+  EXPECT_EQ(to_string(array), "[1, 2]");
+}
+
+}  // namespace
+}  // namespace rbsim::control

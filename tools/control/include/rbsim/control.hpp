@@ -1,0 +1,158 @@
+// Control of a running scene: commands as data, applied at step boundaries.
+//
+// Every control input, from any source (a ROS 2 service, Foxglove, a script), is one Command: the
+// step at which it applies, what it is, its arguments and where it came from. A Controller queues
+// commands from any thread and applies them on the run loop's thread at step boundaries (the
+// Driver's StepHook, rbsim/run.hpp), never inside a step, and delivers each result (success, a
+// message, the step at which it applied) through a future or a callback. While paused the run
+// loop idles in the controller, still answering commands and stop requests (bounded waits).
+//
+// Determinism: a change applied at the boundary of step k acts on the steps from k on exactly as
+// if the world had been made with it there; a run with no commands steps exactly as a run without
+// a controller; pauses change wall time only.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rbsim/core.hpp"
+#include "rbsim/parameters.hpp"
+#include "rbsim/run.hpp"
+#include "rbsim/scene.hpp"
+
+namespace rbsim::control {
+
+enum class CommandKind : std::uint8_t { SetParameters, Pause, Resume, Step, Reset, Impulse };
+const char* to_string(
+    CommandKind kind);  // "set_parameters", "pause", "resume", "step", "reset", "apply_impulse"
+
+// A linear impulse J (N s, world axes) at the point p (m, body frame, relative to the centre of
+// mass) of body `body`: V += J / M, omega += ((R(theta) p) x J) / I (World::apply_impulse).
+struct ImpulseArgs {
+  std::int64_t body = 0;  // as received: checked against the body count when applied
+  Vec2 impulse{0.0, 0.0};
+  Vec2 point{0.0, 0.0};
+};
+
+// One control input as data (issue 23 records these as rbsim_msgs/msg/Command).
+struct Command {
+  static constexpr std::int64_t kNextStep = -1;
+  // The step boundary at which it applies (the world at this step, before it steps on), or
+  // kNextStep: the next boundary (a live request). A command for a boundary already passed fails.
+  std::int64_t step = kNextStep;
+  CommandKind kind = CommandKind::Pause;
+  std::vector<Parameter> parameters;  // SetParameters
+  bool atomic = true;                 // SetParameters: all or nothing (set_parameters_atomically), or
+                                      // each its own result (set_parameters)
+  std::int64_t steps = 0;             // Step: how many, >= 1; only while paused
+  ImpulseArgs impulse;                // Impulse
+  std::string source;                 // "ros2 service", "foxglove", "script", ...
+};
+
+struct CommandResult {
+  bool successful = false;
+  std::string message;
+  std::int64_t step = Command::kNextStep;  // the boundary at which it applied (kNextStep: it never did)
+  // SetParameters: one result for an atomic batch, one per parameter otherwise.
+  std::vector<SetParametersResult> results;
+};
+
+// For the end line: calls answered (commands applied or refused, and reads) and parameters
+// changed.
+struct ControlCounters {
+  std::uint64_t commands = 0;
+  std::uint64_t queries = 0;
+  std::uint64_t parameter_changes = 0;
+};
+
+class Controller final : public StepHook {
+ public:
+  // `scene` holds the run's initial parameters (apply_overrides) and outlives the controller:
+  // reset goes back to its step 0. `steps` is the pass length (the `steps` parameter).
+  Controller(const Scene& scene, std::int64_t steps, RunSettings settings);
+  ~Controller() override;
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  // ---- Any thread.
+  // Queues a command; its result arrives once it applied (or was refused) at a boundary, or when
+  // the controller closes.
+  std::future<CommandResult> submit(Command command);
+  // Same; `done` runs on the run loop's thread (or the closing one) and must not block.
+  void submit(Command command, std::function<void(const CommandResult&)> done);
+  // Reads as of the last boundary (rcl_interfaces' get, describe, get_types, list). An unknown
+  // name gives nullopt or NotSet; rclcpp's services answer an empty list when any name is
+  // undeclared. list() keeps the table's order (rclcpp's is alphabetical, from its std::map).
+  std::vector<std::optional<ParameterValue>> get(const std::vector<std::string>& names) const;
+  std::vector<std::optional<ParameterDescriptor>> describe(const std::vector<std::string>& names) const;
+  std::vector<ParameterType> types(const std::vector<std::string>& names) const;
+  ListParametersResult list(const std::vector<std::string>& prefixes, std::uint64_t depth) const;
+  RunSettings settings() const;
+  ControlCounters counters() const;
+  // Answers every queued command with failure (`reason`) and refuses later ones at once. Also
+  // wakes a paused loop, which then ends its pass as stopped.
+  void close(const std::string& reason);
+
+  // ---- Set up before the run (not thread-safe against a running loop).
+  // Called on the loop's thread whenever rate, publish_every or paused changed (the node's pacer
+  // and publishers follow it).
+  void on_settings(std::function<void(const RunSettings&)> listener) {
+    settings_listener_ = std::move(listener);
+  }
+  // Called on the loop's thread for every command applied or refused at a boundary, with its
+  // step filled in (the record of commands as data).
+  void on_command(std::function<void(const Command&, const CommandResult&)> observer) {
+    observer_ = std::move(observer);
+  }
+
+  // ---- The run loop's thread (StepHook).
+  void start(World& world) override;
+  Boundary boundary(World& world, bool (*stop)()) override;
+
+ private:
+  struct Pending {
+    Command command;
+    std::uint64_t sequence = 0;
+    std::function<void(const CommandResult&)> done;
+  };
+  void enqueue(Pending pending);
+  // Moves the incoming queue into the schedule (step order, then arrival order).
+  void take_incoming();
+  bool due(std::int64_t step) const;
+  CommandResult execute(Command& command, World& world, Boundary& boundary);
+  CommandResult set_parameters(const Command& command, World& world, Boundary& boundary);
+  CommandResult impulse(const Command& command, World& world);
+  void settings_changed(Boundary& boundary);
+  void publish_values(const World& world);
+
+  const Scene& scene_;
+  std::int64_t steps_;
+
+  mutable std::mutex mutex_;  // guards the members down to closed_
+  std::condition_variable wake_;
+  std::vector<Pending> incoming_;
+  ParameterTable published_;  // what readers see: the table as of the last boundary
+  RunSettings published_settings_;
+  mutable ControlCounters counters_;
+  bool closed_ = false;
+  std::string close_reason_;
+  std::uint64_t next_sequence_ = 0;
+  std::atomic<bool> has_incoming_{false};
+
+  // The loop thread's own state.
+  ParameterTable table_;
+  RunSettings settings_;
+  std::vector<Pending> schedule_;  // sorted by (step, sequence); kNextStep first
+  std::int64_t step_budget_ = 0;   // steps left of a `step N` while paused
+  std::function<void(const RunSettings&)> settings_listener_;
+  std::function<void(const Command&, const CommandResult&)> observer_;
+};
+
+}  // namespace rbsim::control

@@ -1,0 +1,218 @@
+// The parameters of a running scene, with ROS 2's parameter semantics (rcl_interfaces, rclcpp):
+// typed values, descriptors (description, read-only, ranges), checks that name the parameter and
+// the rule it breaks. No I/O and no DDS: the DDS parameter services, the Foxglove server and a
+// script of commands all read and change parameters through this table (rbsim/control.hpp).
+//
+// The table of a run:
+//   read-only   scene (string: the path), dt (double), integrator (string), bodies, springs,
+//               steps (integers)
+//   read-write  rate (double >= 0), publish_every (integer >= 1), paused (bool),
+//               forces.<i>.fx|fy (gravity i, double), forces.<i>.beta (wind, double >= 0),
+//               forces.<i>.fx|fy (wind velocity, double), forces.<i>.pointsperedge (wind,
+//               integer in [2, 1000000]), springs.<j>.k, springs.<j>.l0 (doubles >= 0),
+//               use_sim_time (bool, false: true is refused, rbsim is the clock)
+// Forces are the scene's gravity and wind forces numbered together in file order from 0
+// (Scene::forces); springs are numbered apart, in file order. Doubles must be finite.
+//
+// Types are strict, as rclcpp's statically typed parameters: an integer value for a double
+// parameter is refused ("Wrong parameter type, parameter {rate} is of type {double}, setting it
+// to {integer} is not allowed."), so `rate:=2` must be written `rate:=2.0`, as for any rclcpp
+// node. Ranges follow rcl_interfaces: one FloatingPointRange or IntegerRange (step 0: any value
+// in [from, to]); "no upper bound" is the largest finite double (JSON and CDR carry it), and the
+// range check also refuses NaN and infinities, which rclcpp's lets through.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rbsim/core.hpp"
+#include "rbsim/scene.hpp"
+
+namespace rbsim::control {
+
+// rcl_interfaces/msg/ParameterType: the values are the message's constants.
+enum class ParameterType : std::uint8_t {
+  NotSet = 0,
+  Bool = 1,
+  Integer = 2,
+  Double = 3,
+  String = 4,
+  ByteArray = 5,
+  BoolArray = 6,
+  IntegerArray = 7,
+  DoubleArray = 8,
+  StringArray = 9,
+};
+// rclcpp's names: "not set", "bool", "integer", "double", "string", "byte_array", ...
+const char* to_string(ParameterType type);
+
+// rcl_interfaces/msg/ParameterValue: `type` says which field holds the value.
+struct ParameterValue {
+  ParameterType type = ParameterType::NotSet;
+  bool bool_value = false;
+  std::int64_t integer_value = 0;
+  double double_value = 0.0;
+  std::string string_value;
+  std::vector<std::uint8_t> byte_array_value;
+  std::vector<bool> bool_array_value;
+  std::vector<std::int64_t> integer_array_value;
+  std::vector<double> double_array_value;
+  std::vector<std::string> string_array_value;
+
+  static ParameterValue of_bool(bool v);
+  static ParameterValue of_integer(std::int64_t v);
+  static ParameterValue of_double(double v);
+  static ParameterValue of_string(std::string v);
+  bool operator==(const ParameterValue&) const = default;
+};
+// The value as a person reads it: 2.5 (shortest round trip), 7, true, 'text', [1, 2].
+std::string to_string(const ParameterValue& value);
+
+// rcl_interfaces/msg/Parameter.
+struct Parameter {
+  std::string name;
+  ParameterValue value;
+};
+
+// rcl_interfaces/msg/FloatingPointRange and IntegerRange (step 0: no step).
+struct FloatingPointRange {
+  double from_value = 0.0;
+  double to_value = 0.0;
+  double step = 0.0;
+};
+struct IntegerRange {
+  std::int64_t from_value = 0;
+  std::int64_t to_value = 0;
+  std::uint64_t step = 0;
+};
+
+// rcl_interfaces/msg/ParameterDescriptor (a range is a sequence of at most one, as there).
+struct ParameterDescriptor {
+  std::string name;
+  ParameterType type = ParameterType::NotSet;
+  std::string description;
+  std::string additional_constraints;
+  bool read_only = false;
+  bool dynamic_typing = false;
+  std::vector<FloatingPointRange> floating_point_range;
+  std::vector<IntegerRange> integer_range;
+};
+
+// rcl_interfaces/msg/SetParametersResult.
+struct SetParametersResult {
+  bool successful = true;
+  std::string reason;
+};
+
+// rcl_interfaces/msg/ListParametersResult.
+struct ListParametersResult {
+  std::vector<std::string> names;
+  std::vector<std::string> prefixes;
+};
+inline constexpr std::uint64_t kDepthRecursive = 0;  // ListParameters.Request.DEPTH_RECURSIVE
+
+// The run's own settings, beside the scene's parameters.
+struct RunSettings {
+  double rate = 1.0;               // real-time factor; 0: as fast as possible
+  std::int64_t publish_every = 1;  // publish every k-th step
+  bool paused = false;
+};
+
+// What a parameter is bound to (the table's internal map from a name to the state it reads and
+// changes).
+struct ParameterTarget {
+  enum class Kind : std::uint8_t {
+    // read-only
+    Scene,
+    Dt,
+    Integrator,
+    Bodies,
+    Springs,
+    Steps,
+    // the run's settings
+    Rate,
+    PublishEvery,
+    Paused,
+    UseSimTime,
+    // index: into WorldDef::gravity
+    GravityX,
+    GravityY,
+    // index: into WorldDef::winds
+    WindBeta,
+    WindX,
+    WindY,
+    WindPoints,
+    // index: into WorldDef::springs
+    SpringK,
+    SpringL0,
+  };
+  Kind kind = Kind::Scene;
+  std::int32_t index = 0;
+};
+
+// The declared parameters of one run, in a fixed order (the read-only ones, the run settings,
+// forces, springs), with their current values.
+class ParameterTable {
+ public:
+  // The parameters of a run of `scene` for `steps` steps with `settings`, valued from
+  // scene.world and settings. A scene made in code without Scene::forces numbers its gravity
+  // fields first, then its winds.
+  ParameterTable(const Scene& scene, std::int64_t steps, const RunSettings& settings);
+
+  std::size_t size() const { return entries_.size(); }
+  const ParameterDescriptor& descriptor(std::size_t i) const { return entries_[i].descriptor; }
+  const ParameterValue& value(std::size_t i) const { return entries_[i].value; }
+  ParameterTarget target(std::size_t i) const { return entries_[i].target; }
+  std::optional<std::size_t> find(std::string_view name) const;
+
+  // Why setting `p` would be refused, as rclcpp words it where rclcpp has a rule: unknown name,
+  // read-only, wrong type, out of range, not finite, use_sim_time true. Successful if none.
+  SetParametersResult check(const Parameter& p) const;
+  // Records a value that check() accepted (the caller applied it to the state).
+  void store(std::size_t i, const ParameterValue& value) { entries_[i].value = value; }
+  // Values read again from a world and settings (after a reset, a new pass).
+  void refresh(const World& world, const RunSettings& settings);
+  // rclcpp's list_parameters: names under any of `prefixes` (all when empty), at most `depth`
+  // levels of '.' below the prefix (kDepthRecursive: any), and the prefixes of those names.
+  ListParametersResult list(const std::vector<std::string>& prefixes, std::uint64_t depth) const;
+
+ private:
+  struct Entry {
+    ParameterDescriptor descriptor;
+    ParameterValue value;
+    ParameterTarget target;
+  };
+  void add(ParameterDescriptor descriptor, ParameterValue value, ParameterTarget target);
+  std::vector<Entry> entries_;
+};
+
+// Applies a value the table accepted to a scene definition (initial values, before the World
+// exists), to a live world (at a step boundary) or to run settings. Settings targets are ignored
+// by the first two, scene targets by the last.
+void apply(const ParameterTarget& target, const ParameterValue& value, WorldDef& def);
+[[nodiscard]] Status apply(const ParameterTarget& target, const ParameterValue& value, World& world);
+void apply(const ParameterTarget& target, const ParameterValue& value, RunSettings& settings);
+bool is_setting(const ParameterTarget& target);
+
+// A parameter given before the run (--ros-args -p, --params-file) and where it came from, for
+// errors: "params.yaml:4" or "-p".
+struct ParameterOverride {
+  Parameter parameter;
+  std::string origin;
+  // From a wildcard node key of a parameters file (/**): a name this node does not declare is
+  // skipped with a warning, since a file shared by several nodes holds the others' parameters.
+  // Elsewhere (-p, /NS:) an unknown name is an error.
+  bool wildcard = false;
+};
+// Applies overrides in order (the last of a name wins) to the scene and the settings, as one
+// atomic batch: the first refused one is the error, "ORIGIN: parameter 'NAME': REASON", and
+// nothing changes. Skipped wildcard names are added to `warnings` (when given).
+[[nodiscard]] Status apply_overrides(const std::vector<ParameterOverride>& overrides, Scene& scene,
+                                     std::int64_t steps, RunSettings& settings,
+                                     std::vector<std::string>* warnings = nullptr);
+
+}  // namespace rbsim::control

@@ -1,0 +1,385 @@
+// The Controller: a thread-safe queue of commands drained by the run loop at step boundaries.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <utility>
+
+#include "rbsim/assert.hpp"
+#include "rbsim/control.hpp"
+
+namespace rbsim::control {
+
+namespace {
+// A paused loop wakes at least this often to poll its stop request (Ctrl-C).
+constexpr auto kIdleWait = std::chrono::milliseconds(20);
+
+CommandResult failed(std::string message) {
+  CommandResult r;
+  r.successful = false;
+  r.message = std::move(message);
+  return r;
+}
+
+std::string at(std::int64_t step) {
+  return "step " + std::to_string(step);
+}
+}  // namespace
+
+const char* to_string(CommandKind kind) {
+  switch (kind) {
+    case CommandKind::SetParameters:
+      return "set_parameters";
+    case CommandKind::Pause:
+      return "pause";
+    case CommandKind::Resume:
+      return "resume";
+    case CommandKind::Step:
+      return "step";
+    case CommandKind::Reset:
+      return "reset";
+    case CommandKind::Impulse:
+      return "apply_impulse";
+  }
+  return "?";
+}
+
+Controller::Controller(const Scene& scene, std::int64_t steps, RunSettings settings)
+    : scene_(scene),
+      steps_(steps),
+      published_(scene, steps, settings),
+      published_settings_(settings),
+      table_(scene, steps, settings),
+      settings_(settings) {}
+
+Controller::~Controller() {
+  close("the run ended");
+  for (Pending& p : schedule_) {
+    if (p.done) p.done(failed(std::string(to_string(p.command.kind)) + ": " + close_reason_));
+  }
+}
+
+std::future<CommandResult> Controller::submit(Command command) {
+  auto promise = std::make_shared<std::promise<CommandResult>>();
+  std::future<CommandResult> future = promise->get_future();
+  submit(std::move(command), [promise](const CommandResult& r) { promise->set_value(r); });
+  return future;
+}
+
+void Controller::submit(Command command, std::function<void(const CommandResult&)> done) {
+  enqueue(Pending{std::move(command), 0, std::move(done)});
+}
+
+void Controller::enqueue(Pending pending) {
+  std::unique_lock lock(mutex_);
+  if (closed_) {
+    ++counters_.commands;
+    const std::string reason = close_reason_;
+    lock.unlock();
+    if (pending.done) pending.done(failed(std::string(to_string(pending.command.kind)) + ": " + reason));
+    return;
+  }
+  pending.sequence = next_sequence_++;
+  incoming_.push_back(std::move(pending));
+  has_incoming_.store(true, std::memory_order_release);
+  wake_.notify_all();
+}
+
+void Controller::close(const std::string& reason) {
+  std::vector<Pending> refused;
+  {
+    const std::lock_guard lock(mutex_);
+    if (!closed_) {
+      closed_ = true;
+      close_reason_ = reason;
+    }
+    refused.swap(incoming_);
+    counters_.commands += refused.size();
+    has_incoming_.store(false, std::memory_order_release);
+    wake_.notify_all();
+  }
+  for (Pending& p : refused) {
+    if (p.done) p.done(failed(std::string(to_string(p.command.kind)) + ": " + close_reason_));
+  }
+}
+
+std::vector<std::optional<ParameterValue>> Controller::get(const std::vector<std::string>& names) const {
+  const std::lock_guard lock(mutex_);
+  ++counters_.queries;
+  std::vector<std::optional<ParameterValue>> values;
+  for (const std::string& name : names) {
+    const std::optional<std::size_t> i = published_.find(name);
+    values.push_back(i ? std::optional(published_.value(*i)) : std::nullopt);
+  }
+  return values;
+}
+
+std::vector<std::optional<ParameterDescriptor>> Controller::describe(
+    const std::vector<std::string>& names) const {
+  const std::lock_guard lock(mutex_);
+  ++counters_.queries;
+  std::vector<std::optional<ParameterDescriptor>> out;
+  for (const std::string& name : names) {
+    const std::optional<std::size_t> i = published_.find(name);
+    out.push_back(i ? std::optional(published_.descriptor(*i)) : std::nullopt);
+  }
+  return out;
+}
+
+std::vector<ParameterType> Controller::types(const std::vector<std::string>& names) const {
+  const std::lock_guard lock(mutex_);
+  ++counters_.queries;
+  std::vector<ParameterType> out;
+  for (const std::string& name : names) {
+    const std::optional<std::size_t> i = published_.find(name);
+    out.push_back(i ? published_.descriptor(*i).type : ParameterType::NotSet);
+  }
+  return out;
+}
+
+ListParametersResult Controller::list(const std::vector<std::string>& prefixes, std::uint64_t depth) const {
+  const std::lock_guard lock(mutex_);
+  ++counters_.queries;
+  return published_.list(prefixes, depth);
+}
+
+RunSettings Controller::settings() const {
+  const std::lock_guard lock(mutex_);
+  return published_settings_;
+}
+
+ControlCounters Controller::counters() const {
+  const std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+void Controller::publish_values(const World& world) {
+  (void)world;
+  const std::lock_guard lock(mutex_);
+  published_ = table_;
+  published_settings_ = settings_;
+}
+
+void Controller::start(World& world) {
+  table_.refresh(world, settings_);
+  publish_values(world);
+}
+
+void Controller::take_incoming() {
+  std::vector<Pending> arrived;
+  {
+    const std::lock_guard lock(mutex_);
+    arrived.swap(incoming_);
+    has_incoming_.store(false, std::memory_order_release);
+  }
+  for (Pending& p : arrived) {
+    const auto later = [](const Pending& a, const Pending& b) {
+      return a.command.step != b.command.step ? a.command.step < b.command.step : a.sequence < b.sequence;
+    };
+    schedule_.insert(std::upper_bound(schedule_.begin(), schedule_.end(), p, later), std::move(p));
+  }
+}
+
+bool Controller::due(std::int64_t step) const {
+  return !schedule_.empty() && schedule_.front().command.step <= step;
+}
+
+StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
+  Boundary b;
+  // The common case, a running loop with nothing queued: two loads and a compare.
+  if (!has_incoming_.load(std::memory_order_acquire) && !settings_.paused && !due(world.step_index()))
+    return b;
+  bool idled = false;
+  for (;;) {
+    if (has_incoming_.load(std::memory_order_acquire)) take_incoming();
+    bool applied = false;
+    while (due(world.step_index())) {
+      Pending p = std::move(schedule_.front());
+      schedule_.erase(schedule_.begin());
+      const std::int64_t now = world.step_index();
+      CommandResult r;
+      if (p.command.step != Command::kNextStep && p.command.step < now) {
+        r = failed(std::string(to_string(p.command.kind)) + ": " + at(p.command.step) +
+                   " has passed (now at " + at(now) + ")");
+      } else {
+        r = execute(p.command, world, b);
+      }
+      r.step = now;
+      p.command.step = now;
+      applied = true;
+      {
+        const std::lock_guard lock(mutex_);
+        ++counters_.commands;
+      }
+      if (observer_) observer_(p.command, r);
+      if (p.done) p.done(r);
+    }
+    if (applied) publish_values(world);
+    bool closed = false;
+    {
+      const std::lock_guard lock(mutex_);
+      closed = closed_;
+    }
+    if (closed) {
+      b.stop = true;
+      return b;
+    }
+    if (!settings_.paused || step_budget_ > 0) break;
+    if (stop != nullptr && stop()) {
+      b.stop = true;
+      return b;
+    }
+    std::unique_lock lock(mutex_);
+    wake_.wait_for(lock, kIdleWait, [this] { return !incoming_.empty() || closed_; });
+    idled = true;
+  }
+  if (settings_.paused) --step_budget_;  // one step of a `step N`
+  // Wall time went on while the loop idled: pacers start afresh from here.
+  if (idled) b.timeline_changed = true;
+  return b;
+}
+
+void Controller::settings_changed(Boundary& boundary) {
+  boundary.timeline_changed = true;
+  if (settings_listener_) settings_listener_(settings_);
+}
+
+CommandResult Controller::execute(Command& command, World& world, Boundary& boundary) {
+  const std::int64_t now = world.step_index();
+  CommandResult r;
+  r.successful = true;
+  switch (command.kind) {
+    case CommandKind::SetParameters:
+      return set_parameters(command, world, boundary);
+    case CommandKind::Pause:
+      r.message = settings_.paused ? "already paused at " + at(now) : "paused at " + at(now);
+      if (!settings_.paused) {
+        settings_.paused = true;
+        table_.store(*table_.find("paused"), ParameterValue::of_bool(true));
+        settings_changed(boundary);
+      }
+      return r;
+    case CommandKind::Resume:
+      r.message = settings_.paused ? "resumed at " + at(now) : "already running at " + at(now);
+      step_budget_ = 0;
+      if (settings_.paused) {
+        settings_.paused = false;
+        table_.store(*table_.find("paused"), ParameterValue::of_bool(false));
+        settings_changed(boundary);
+      }
+      return r;
+    case CommandKind::Step:
+      if (!settings_.paused) return failed("step: only while paused (running at " + at(now) + ")");
+      if (command.steps < 1)
+        return failed("step: steps must be >= 1 (got " + std::to_string(command.steps) + ")");
+      if (command.steps > steps_ - now - step_budget_) {
+        return failed("step: " + std::to_string(command.steps) +
+                      " steps would go past the run's last step (" + at(steps_) + ", now at " + at(now) +
+                      (step_budget_ > 0 ? ", already stepping" : "") + ")");
+      }
+      step_budget_ += command.steps;
+      r.message = "stepping from " + at(now) + " to " + at(now + step_budget_) + ", then paused";
+      return r;
+    case CommandKind::Reset: {
+      Result<World> fresh = World::create(scene_.world);
+      if (!fresh) return failed("reset: " + fresh.error().message);
+      world = std::move(fresh.value());
+      step_budget_ = 0;
+      table_.refresh(world, settings_);
+      boundary.state_changed = true;
+      boundary.timeline_changed = true;
+      r.message = "reset at " + at(now) + " to step 0";
+      return r;
+    }
+    case CommandKind::Impulse: {
+      CommandResult applied = impulse(command, world);
+      boundary.state_changed |= applied.successful;
+      return applied;
+    }
+  }
+  return failed("unknown command");
+}
+
+CommandResult Controller::set_parameters(const Command& command, World& world, Boundary& boundary) {
+  CommandResult r;
+  std::vector<SetParametersResult> checks;
+  for (const Parameter& p : command.parameters) checks.push_back(table_.check(p));
+  if (command.atomic) {
+    const auto bad = std::find_if(checks.begin(), checks.end(), [](const auto& c) { return !c.successful; });
+    if (bad != checks.end()) {
+      r.results = {*bad};
+      r.message = bad->reason;
+      return r;  // nothing of the batch changes
+    }
+  }
+  bool settings = false;
+  std::size_t changed = 0;
+  for (std::size_t k = 0; k < command.parameters.size(); ++k) {
+    if (!checks[k].successful) continue;
+    const Parameter& p = command.parameters[k];
+    const std::size_t i = *table_.find(p.name);
+    const ParameterTarget t = table_.target(i);
+    if (is_setting(t)) {
+      apply(t, p.value, settings_);
+      if (t.kind == ParameterTarget::Kind::Paused && !p.value.bool_value) step_budget_ = 0;
+      settings = true;
+    } else {
+      const Status st = apply(t, p.value, world);
+      RBSIM_ASSERT(st.ok(), "a parameter the table accepted was refused by the world");
+      boundary.state_changed = true;
+    }
+    table_.store(i, p.value);
+    ++changed;
+  }
+  if (settings) settings_changed(boundary);
+  {
+    const std::lock_guard lock(mutex_);
+    counters_.parameter_changes += changed;
+  }
+  r.successful = changed == command.parameters.size();
+  if (command.atomic) {
+    r.results = {SetParametersResult{}};
+  } else {
+    r.results = std::move(checks);
+  }
+  r.message = "set " + std::to_string(changed) + " of " + std::to_string(command.parameters.size()) +
+              " parameters at " + at(world.step_index());
+  for (const SetParametersResult& c : r.results) {
+    if (!c.successful) r.message += "; " + c.reason;
+  }
+  return r;
+}
+
+CommandResult Controller::impulse(const Command& command, World& world) {
+  const ImpulseArgs& a = command.impulse;
+  const std::int64_t now = world.step_index();
+  if (a.body < 0 || a.body >= world.body_count()) {
+    return failed("apply_impulse: no body " + std::to_string(a.body) + " (the scene has " +
+                  std::to_string(world.body_count()) + " bodies)");
+  }
+  for (double v : {a.impulse.x(), a.impulse.y(), a.point.x(), a.point.y()}) {
+    if (!std::isfinite(v)) return failed("apply_impulse: the impulse and its point must be finite");
+  }
+  const BodyId body{static_cast<std::int32_t>(a.body)};
+  const BodyState before = world.state(body);
+  if (Status st = world.apply_impulse(body, a.impulse, a.point); !st) {
+    return failed("apply_impulse: " + st.error().message);
+  }
+  // A finite impulse can still be too large: refuse one that takes a velocity past the bound
+  // under which every quantity the run reports stays finite, restoring the state exactly.
+  const BodyState after = world.state(body);
+  const double bound = world.finite_bound();
+  for (double v : {after.velocity.x(), after.velocity.y(), after.omega}) {
+    if (!std::isfinite(v) || (bound > 0.0 && std::abs(v) > bound)) {
+      world.set_state(body, before);
+      return failed("apply_impulse: too large: body " + std::to_string(a.body) +
+                    "'s velocity would leave the range the run can report");
+    }
+  }
+  CommandResult r;
+  r.successful = true;
+  r.message = "impulse applied to body " + std::to_string(a.body) + " at " + at(now);
+  return r;
+}
+
+}  // namespace rbsim::control
