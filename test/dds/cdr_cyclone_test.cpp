@@ -814,6 +814,7 @@ Expected expected_op(const std::string& type, bool element) {
   for (const Prim& p : kPrims) {
     if (type == p.name) return p.e;
   }
+  if (type.starts_with("string<=")) return {DDS_OP_VAL_BST, 0};  // msg2idl: string<N>
   return {element ? std::uint32_t{DDS_OP_VAL_STU} : std::uint32_t{DDS_OP_VAL_EXT}, 0};
 }
 
