@@ -71,5 +71,5 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # static libraries links against.
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "ffmpeg, gnuplot-nox, fonts-dejavu-core")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS
-    "cmake, pkg-config, libeigen3-dev, libtinyxml2-dev, libzstd-dev, liblz4-dev, libdeflate-dev, libgtest-dev")
+    "cmake, pkg-config, libeigen3-dev, libtinyxml2-dev, libzstd-dev, liblz4-dev, libdeflate-dev, libssl-dev, libgtest-dev")
 include(CPack)

@@ -6,7 +6,8 @@ in one run, then reads the recording with the official Python `mcap` reader (CRC
 `mcap-ros2-support` (CDR decoding driven by the file's own ros2msg schemas) and checks:
 
   * the rosbag2 layout: profile "ros2", every schema "ros2msg", every channel "cdr" with an
-    "offered_qos_profiles" YAML profile (history/depth/reliability/durability/... present);
+    "offered_qos_profiles" YAML profile (history/depth/reliability/durability/... present) and a
+    "topic_type_hash" equal to an independent REP 2011 hash of tools/msgs/definitions;
   * every schema's text byte for byte against an independent implementation of rosbag2's
     LocalMessageDefinitionSource::get_full_text() over tools/msgs/definitions;
   * every message of every topic decodes, and the decoded values equal the run's own outputs:
@@ -27,7 +28,9 @@ it); a missing venv is a failure with instructions, never a skip.
 import argparse
 import array
 import csv
+import hashlib
 import io
+import json
 import math
 import os
 import re
@@ -164,6 +167,78 @@ def rosbag2_full_text(root_type: str, definitions_dir: str) -> bytes:
         return result
 
     return append_recursive(root_type, _MAX_RECURSION_DEPTH).encode()
+
+
+# ---------------------------------------------------------------------------------------------
+# topic_type_hash: the REP 2011 hash rosbag2 (Jazzy) writes per channel, written here from REP 2011
+# and rosidl_generator_type_description's description (not from rbsim's code): field type ids of
+# type_description_interfaces/msg/FieldType (.msg char is IDL uint8), +48 fixed array, +96
+# bounded, +144 unbounded sequence; referenced types sorted; json.dumps(", ", ": "); SHA-256.
+
+_FIELD_TYPE_IDS = {"int8": 2, "uint8": 3, "char": 3, "int16": 4, "uint16": 5, "int32": 6, "uint32": 7,
+                   "int64": 8, "uint64": 9, "float32": 10, "float64": 11, "bool": 15, "byte": 16,
+                   "string": 17}
+
+
+def _hash_fields(type_name: str, definitions_dir: str) -> list:
+    pkg, _, name = type_name.split("/")
+    with open(os.path.join(definitions_dir, pkg, "msg", name + ".msg"), encoding="utf-8") as f:
+        text = f.read()
+    fields = []
+    for raw in text.splitlines():
+        words = raw.split("#", 1)[0].split()
+        if not words:
+            continue
+        ftype, fname = words[0], words[1]
+        if "=" in fname or (len(words) > 2 and words[2].startswith("=")):
+            continue  # a constant
+        base, capacity, offset = ftype, 0, 0
+        array_m = re.fullmatch(r"(.+)\[(<=)?(\d*)\]", ftype)
+        if array_m:
+            base = array_m.group(1)
+            if array_m.group(3) and not array_m.group(2):
+                capacity, offset = int(array_m.group(3)), 48
+            elif array_m.group(3):
+                capacity, offset = int(array_m.group(3)), 96
+            else:
+                offset = 144
+        string_capacity, nested = 0, ""
+        bounded_m = re.fullmatch(r"string<=(\d+)", base)
+        if bounded_m:
+            type_id, string_capacity = 21, int(bounded_m.group(1))
+        elif base in _FIELD_TYPE_IDS:
+            type_id = _FIELD_TYPE_IDS[base]
+        else:
+            type_id = 1
+            parts = base.split("/")
+            nested = "std_msgs/msg/Header" if base == "Header" else (
+                f"{pkg}/msg/{parts[0]}" if len(parts) == 1 else f"{parts[0]}/msg/{parts[-1]}")
+        fields.append({"name": fname, "type": {"type_id": type_id + offset, "capacity": capacity,
+                                               "string_capacity": string_capacity,
+                                               "nested_type_name": nested}})
+    if not fields:
+        fields.append({"name": "structure_needs_at_least_one_member",
+                       "type": {"type_id": 3, "capacity": 0, "string_capacity": 0, "nested_type_name": ""}})
+    return fields
+
+
+def rep2011_type_hash(root_type: str, definitions_dir: str) -> str:
+    described = {root_type: _hash_fields(root_type, definitions_dir)}
+    pending = [f["type"]["nested_type_name"] for f in described[root_type] if f["type"]["nested_type_name"]]
+    referenced = set()
+    while pending:
+        t = pending.pop()
+        if t in referenced:
+            continue
+        referenced.add(t)
+        described[t] = _hash_fields(t, definitions_dir)
+        pending += [f["type"]["nested_type_name"] for f in described[t] if f["type"]["nested_type_name"]]
+    description = {
+        "type_description": {"type_name": root_type, "fields": described[root_type]},
+        "referenced_type_descriptions": [{"type_name": t, "fields": described[t]} for t in sorted(referenced)],
+    }
+    text = json.dumps(description, ensure_ascii=True, separators=(", ", ": "))
+    return "RIHS01_" + hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -399,6 +474,8 @@ def main() -> int:
         c.equal(schema.name, type_name, "schema name", topic)
         c.check("offered_qos_profiles" in ch.metadata, "offered_qos_profiles", f"{topic}: metadata {ch.metadata}")
         check_qos(c, topic, ch.metadata.get("offered_qos_profiles", ""), transient_local)
+        c.equal(ch.metadata.get("topic_type_hash"), rep2011_type_hash(type_name, args.definitions),
+                "topic_type_hash (REP 2011)", topic)
         expected_text = rosbag2_full_text(type_name, args.definitions)
         c.check(schema.data == expected_text, "schema text (rosbag2 algorithm)",
                 lambda: f"{topic} ({type_name}): file schema differs from rosbag2's at byte "

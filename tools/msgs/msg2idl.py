@@ -22,6 +22,9 @@ PRIMITIVES = {
 def idl_type(msg_type, package):
     if msg_type in PRIMITIVES:
         return PRIMITIVES[msg_type], None
+    bounded = re.fullmatch(r"string<=(\d+)", msg_type)
+    if bounded:  # string<=N: a bounded IDL string (same CDR as a string)
+        return f"string<{bounded.group(1)}>", None
     parts = msg_type.split("/")
     pkg, name = (package, parts[0]) if len(parts) == 1 else (parts[0], parts[-1])
     return f"{pkg}::msg::dds_::{name}_", f"{pkg}/msg/{name}"
@@ -33,7 +36,7 @@ def convert(package, name, text):
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
-        m = re.match(r"^([\w/]+)(\[(<=)?(\d*)\])?\s+(\w+)\s*(=\s*(.+))?(\s+.*)?$", line)
+        m = re.match(r"^([\w/]+(?:<=\d+)?)(\[(<=)?(\d*)\])?\s+(\w+)\s*(=\s*(.+))?(\s+.*)?$", line)
         if not m:
             sys.exit(f"msg2idl: {package}/{name}: cannot parse '{raw}'")
         base, array, bounded, size, field, _, const_value, _ = m.groups()

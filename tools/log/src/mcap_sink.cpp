@@ -4,6 +4,7 @@
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap_sink.hpp"
+#include "rbsim/type_hash.hpp"
 
 namespace rbsim::log {
 
@@ -101,8 +102,12 @@ Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spe
   const std::string& text = schema.value();
   auto schema_id = writer.add_schema(spec.type, "ros2msg", std::as_bytes(std::span(text)));
   if (!schema_id.ok()) return schema_id.error();
-  return writer.add_channel(schema_id.value(), msgs::topic_name(spec, ns), "cdr",
-                            {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}});
+  // rosbag2_storage_mcap (Jazzy) writes the topic's type hash as channel metadata "topic_type_hash".
+  Result<std::string> hash = msgs::type_hash(spec.type);
+  if (!hash) return hash.error();
+  return writer.add_channel(
+      schema_id.value(), msgs::topic_name(spec, ns), "cdr",
+      {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}, {"topic_type_hash", hash.value()}});
 }
 
 std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options) {

@@ -315,6 +315,16 @@ std::optional<PrimitiveType> primitive_type(std::string_view type) {
   return PrimitiveType{kPrimitives[i].kind, kPrimitives[i].size};
 }
 
+namespace {
+// A decimal array size or bound: digits only, at most UINT32_MAX.
+std::optional<std::uint32_t> parse_bound(std::string_view digits) {
+  std::uint32_t n = 0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);
+  if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size()) return std::nullopt;
+  return n;
+}
+}  // namespace
+
 Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::string_view text) {
   const std::string name(type);
   const std::string package = name.substr(0, name.find('/'));
@@ -336,18 +346,27 @@ Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::strin
       if (field_type.back() != ']') return Error{name + ": bad array type in " + line};
       const std::string inside = field_type.substr(bracket + 1, field_type.size() - bracket - 2);
       field_type.resize(bracket);
-      if (inside.empty() || inside.starts_with("<=")) {
+      if (inside.empty()) {
         f.array = MsgField::Array::Sequence;
+      } else if (inside.starts_with("<=")) {
+        f.array = MsgField::Array::Sequence;
+        const auto n = parse_bound(std::string_view(inside).substr(2));
+        if (!n) return Error{name + ": bad sequence bound in " + line};
+        f.sequence_bound = *n;
       } else {
-        char* end = nullptr;
-        const unsigned long n = std::strtoul(inside.c_str(), &end, 10);
-        if (!std::isdigit(static_cast<unsigned char>(inside[0])) || *end != '\0' || n > UINT32_MAX)
-          return Error{name + ": bad array size in " + line};
+        const auto n = parse_bound(inside);
+        if (!n) return Error{name + ": bad array size in " + line};
         f.array = MsgField::Array::Fixed;
-        f.fixed_size = static_cast<std::uint32_t>(n);
+        f.fixed_size = *n;
       }
     }
-    if (field_type == "wstring") return Error{name + ": wstring fields are not supported"};
+    if (field_type == "wstring" || field_type.starts_with("wstring<="))
+      return Error{name + ": wstring fields are not supported"};
+    if (field_type.starts_with("string<=")) {
+      const auto n = parse_bound(std::string_view(field_type).substr(8));
+      if (!n || *n == 0) return Error{name + ": bad string bound in " + line};
+      f.string_capacity = *n;
+    }
     f.primitive = primitive_type(field_type);
     f.type = f.primitive ? field_type : canonical_type(field_type, package);
     fields.push_back(std::move(f));

@@ -190,7 +190,17 @@ std::string_view definition(std::string_view type) {
 
 std::vector<std::string_view> definition_types() {
   std::vector<std::string_view> out;
-  for (const detail::Definition& d : detail::definitions()) out.push_back(d.type);
+  for (const detail::Definition& d : detail::definitions()) {
+    if (d.type.find("/msg/") != std::string_view::npos) out.push_back(d.type);
+  }
+  return out;
+}
+
+std::vector<std::string_view> service_types() {
+  std::vector<std::string_view> out;
+  for (const detail::Definition& d : detail::definitions()) {
+    if (d.type.find("/srv/") != std::string_view::npos) out.push_back(d.type);
+  }
   return out;
 }
 

@@ -1,7 +1,7 @@
 // Recording a run to MCAP: the MCAP sink of `rbsim run --record` (the DDS recorder of `rbsim
 // record` is node/'s recorder) and the conventions every rbsim recording follows, the rosbag2
-// layout (profile "ros2", "ros2msg" schemas, "cdr" messages, "offered_qos_profiles" channel
-// metadata), so Foxglove and `ros2 bag` open them.
+// layout (profile "ros2", "ros2msg" schemas, "cdr" messages, "offered_qos_profiles" and
+// "topic_type_hash" channel metadata), so Foxglove and `ros2 bag` open them.
 #pragma once
 
 #include <cstdint>
@@ -30,7 +30,9 @@ struct RecordOptions {
 std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options = {});
 
 // Adds the schema and channel of `spec` to a writer in the rosbag2 layout; returns the channel id.
-// The channel's offered_qos_profiles say `offered` (by default what rbsim's node offers).
+// The channel's offered_qos_profiles say `offered` (by default what rbsim's node offers); its
+// topic_type_hash is msgs::type_hash(spec.type), where rosbag2 (Jazzy) writes it. The one place
+// channel metadata is written: the MCAP sink and the DDS recorder both come here.
 Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
                                 const msgs::OfferedQos& offered);
 Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns);

@@ -94,11 +94,14 @@ std::string offered_qos_yaml(const OfferedQos& qos);
 // ---------------------------------------------------------------------------------------------
 // Definitions and schemas
 
-// The .msg text of a type ("rbsim_msgs/msg/BodyStates" or "rbsim_msgs/BodyStates"); empty when
-// unknown.
+// The .msg text of a type ("rbsim_msgs/msg/BodyStates" or "rbsim_msgs/BodyStates"), or the .srv
+// text of a service ("std_srvs/srv/Trigger": request, a "---" line, response); empty when unknown.
 std::string_view definition(std::string_view type);
-// Every type name we carry, "pkg/msg/Name", sorted.
+// Every message type name we carry, "pkg/msg/Name", sorted (services are not messages: their
+// request and response are, under rosidl's names, in rbsim/type_hash.hpp).
 std::vector<std::string_view> definition_types();
+// Every service type we carry, "pkg/srv/Name", sorted.
+std::vector<std::string_view> service_types();
 // The schema rosbag2 writes for a type with encoding "ros2msg": its .msg text followed by each
 // dependency, depth first, once, as "\n" + 80 '=' + "\nMSG: pkg/Name\n" + text.
 Result<std::string> ros2msg_schema(std::string_view type);
@@ -375,11 +378,13 @@ struct MsgField {
   std::string type;                        // a primitive's name, or the canonical nested type
   std::optional<PrimitiveType> primitive;  // set for primitives
   enum class Array : std::uint8_t { None, Fixed, Sequence } array = Array::None;
-  std::uint32_t fixed_size = 0;  // Array::Fixed
+  std::uint32_t fixed_size = 0;       // Array::Fixed
+  std::uint32_t sequence_bound = 0;   // Array::Sequence written "[<=N]": N (0: unbounded)
+  std::uint32_t string_capacity = 0;  // "string<=N": N (0: an unbounded string or not a string)
 };
 // The fields of the .msg text of `type` ("pkg/msg/Name"; bare nested names resolve in its package),
-// constants and comments skipped. A message without fields gets rosidl's one uint8 member.
-// Fails on a malformed line, a bad array bound or a wstring.
+// constants, default values and comments skipped. A message without fields gets rosidl's one uint8
+// member. Fails on a malformed line, a bad array or string bound or a wstring.
 Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::string_view text);
 
 // Appends `text` to `out` as a JSON string: quoted, with '"', '\\' and control characters escaped.

@@ -1,0 +1,58 @@
+// REP 2011 type hashes ("RIHS01_<64 hex>") of ROS 2 interface types, computed from the .msg and
+// .srv definitions (never written down by hand): what rmw_cyclonedds_cpp on Jazzy puts in every
+// endpoint's USER_DATA ("typehash=RIHS01_...;") and rosbag2 records per topic.
+//
+// The hash is rosidl's (rosidl_generator_type_description; rcl computes the same at run time): the
+// type_description_interfaces/TypeDescription of the type (its fields' type ids, array capacities,
+// string bounds and nested type names; default values left out) followed by every type it refers
+// to, directly or not, sorted by name, written as JSON with Python's json.dumps separators
+// (", " and ": ", no newlines) and hashed with SHA-256.
+//
+// Type names are fully qualified: "std_msgs/msg/String", a service "std_srvs/srv/Trigger", or one
+// of the messages rosidl makes of a service: "std_srvs/srv/Trigger_Request", "..._Response" and
+// "..._Event" (service_msgs/msg/ServiceEventInfo info, the request and the response each as a
+// sequence of at most one).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "rbsim/status.hpp"
+
+namespace rbsim::msgs {
+
+// Where definitions come from: the .msg text of "pkg/msg/Name" or the .srv text of "pkg/srv/Name";
+// nullopt when unknown (an empty text is a message without fields, as std_msgs/msg/Empty).
+using DefinitionSource = std::function<std::optional<std::string_view>(std::string_view type)>;
+// The definitions rbsim ships (msgs::definition(), none of them empty).
+std::optional<std::string_view> shipped_definition(std::string_view type);
+
+// The JSON the hash is taken over (default values left out). Fails, naming the type, on an unknown
+// type, a missing dependency, a malformed definition or a service without exactly one "---".
+Result<std::string> type_description_json(std::string_view type, const DefinitionSource& source);
+// "RIHS01_" + the SHA-256 of type_description_json(type, source) in lower-case hex.
+Result<std::string> type_hash(std::string_view type, const DefinitionSource& source);
+// The same over shipped_definition(); each hash is computed once per
+// process and then served from a cache (thread-safe).
+Result<std::string> type_hash(std::string_view type);
+
+// The hashes rmw_cyclonedds_cpp (Jazzy) puts in the USER_DATA of a service's two endpoints: the
+// request topic's (rq/...Request: the service's reader, a client's writer) carries the hash of
+// "<service>_Request", the reply topic's (rr/...Reply) that of "<service>_Response"; neither carries
+// the service type's own hash (create_cdds_client / create_cdds_service in rmw_node.cpp take them
+// from the request and response type supports). `service` is "pkg/srv/Name"; shipped definitions,
+// cached as type_hash() is.
+struct ServiceEndpointHashes {
+  std::string request;  // rq/<service name>Request
+  std::string reply;    // rr/<service name>Reply
+};
+Result<ServiceEndpointHashes> service_endpoint_type_hashes(std::string_view service);
+
+// The USER_DATA entry of an endpoint as rmw_dds_common writes it: "typehash=" + hash + ";". An
+// endpoint's USER_DATA is rmw_cyclonedds's extra entries first ("serviceid=...;" or
+// "clientid=...;" for services), then this.
+std::string typehash_user_data(std::string_view hash);
+
+}  // namespace rbsim::msgs

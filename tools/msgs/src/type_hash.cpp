@@ -1,0 +1,325 @@
+// REP 2011 type descriptions and hashes (RIHS01) from the shipped .msg/.srv definitions. The
+// description and its JSON follow rosidl_generator_type_description (Jazzy): field type ids of
+// type_description_interfaces/msg/FieldType, capacities, string capacities, nested type names; the
+// referenced types sorted by name; json.dumps with separators (", ", ": ") and no default values.
+#include "rbsim/type_hash.hpp"
+
+#include <openssl/evp.h>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <vector>
+
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::msgs {
+
+namespace {
+
+constexpr std::string_view kRequest = "_Request";
+constexpr std::string_view kResponse = "_Response";
+constexpr std::string_view kEvent = "_Event";
+constexpr std::string_view kEventInfo = "service_msgs/msg/ServiceEventInfo";
+// A hostile or broken definition source cannot make a description grow without end.
+constexpr std::size_t kMaxTypes = 4096;
+
+// type_description_interfaces/msg/FieldType: the value type ids, and the offsets rosidl adds for
+// a fixed array, a bounded and an unbounded sequence of them.
+constexpr std::uint8_t kNestedType = 1;
+constexpr std::uint8_t kBoundedString = 21;
+constexpr std::uint8_t kArrayOffset = 48;
+constexpr std::uint8_t kBoundedSequenceOffset = 96;
+constexpr std::uint8_t kUnboundedSequenceOffset = 144;
+
+// .msg primitive -> FieldType id. rosidl maps .msg to IDL first: char becomes uint8 (not IDL char)
+// and byte becomes octet (FIELD_TYPE_BYTE), so char hashes as uint8.
+std::optional<std::uint8_t> primitive_type_id(std::string_view t) {
+  struct Entry {
+    std::string_view msg;
+    std::uint8_t id;
+  };
+  static constexpr Entry kIds[] = {
+      {"int8", 2},     {"uint8", 3},  {"char", 3},  {"int16", 4},   {"uint16", 5},
+      {"int32", 6},    {"uint32", 7}, {"int64", 8}, {"uint64", 9},  {"float32", 10},
+      {"float64", 11}, {"bool", 15},  {"byte", 16}, {"string", 17},
+  };
+  if (t.starts_with("string<=")) return kBoundedString;
+  for (const Entry& e : kIds) {
+    if (e.msg == t) return e.id;
+  }
+  return std::nullopt;
+}
+
+struct FieldDescription {
+  std::string name;
+  std::uint8_t type_id = 0;
+  std::uint32_t capacity = 0;
+  std::uint32_t string_capacity = 0;
+  std::string nested_type_name;
+};
+struct IndividualDescription {
+  std::string type_name;
+  std::vector<FieldDescription> fields;
+};
+
+// ROS names are identifiers: [A-Za-z][A-Za-z0-9_]*. Checking them keeps the JSON what rosidl would
+// write (no escapes needed) and rejects garbage with a clear message.
+bool is_identifier(std::string_view s) {
+  if (s.empty() || !((s[0] >= 'A' && s[0] <= 'Z') || (s[0] >= 'a' && s[0] <= 'z'))) return false;
+  for (const char c : s) {
+    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'))
+      return false;
+  }
+  return true;
+}
+
+struct TypeName {
+  std::string_view package, kind, name;
+};
+// "pkg/msg/Name" or "pkg/srv/Name", each part an identifier.
+std::optional<TypeName> split_type(std::string_view full) {
+  const auto a = full.find('/');
+  if (a == std::string_view::npos) return std::nullopt;
+  const auto b = full.find('/', a + 1);
+  if (b == std::string_view::npos) return std::nullopt;
+  TypeName n{full.substr(0, a), full.substr(a + 1, b - a - 1), full.substr(b + 1)};
+  if (!is_identifier(n.package) || (n.kind != "msg" && n.kind != "srv") || !is_identifier(n.name)) {
+    return std::nullopt;
+  }
+  return n;
+}
+
+FieldDescription nested_field(std::string name, std::string type, std::uint8_t id, std::uint32_t capacity) {
+  return FieldDescription{std::move(name), id, capacity, 0, std::move(type)};
+}
+
+Result<FieldDescription> describe_field(std::string_view owner, const MsgField& f) {
+  if (!is_identifier(f.name)) return Error{std::string(owner) + ": bad field name \"" + f.name + "\""};
+  FieldDescription d;
+  d.name = f.name;
+  if (f.primitive) {
+    const auto id = primitive_type_id(f.type);
+    if (!id) return Error{std::string(owner) + ": field " + f.name + " has unsupported type " + f.type};
+    d.type_id = *id;
+    d.string_capacity = f.string_capacity;
+  } else {
+    if (!split_type(f.type))
+      return Error{std::string(owner) + ": field " + f.name + " has bad type " + f.type};
+    d.type_id = kNestedType;
+    d.nested_type_name = f.type;
+  }
+  switch (f.array) {
+    case MsgField::Array::None:
+      break;
+    case MsgField::Array::Fixed:
+      d.type_id = static_cast<std::uint8_t>(d.type_id + kArrayOffset);
+      d.capacity = f.fixed_size;
+      break;
+    case MsgField::Array::Sequence:
+      d.type_id = static_cast<std::uint8_t>(
+          d.type_id + (f.sequence_bound > 0 ? kBoundedSequenceOffset : kUnboundedSequenceOffset));
+      d.capacity = f.sequence_bound;
+      break;
+  }
+  return d;
+}
+
+Result<IndividualDescription> describe_msg_text(std::string_view type, std::string_view text) {
+  auto parsed = parse_msg_fields(type, text);
+  if (!parsed) return parsed.error();
+  IndividualDescription d{std::string(type), {}};
+  for (const MsgField& f : parsed.value()) {
+    auto field = describe_field(type, f);
+    if (!field) return field.error();
+    d.fields.push_back(std::move(field.value()));
+  }
+  return d;
+}
+
+// The request (part 0) or response (part 1) of a .srv text: the lines before and after its one
+// "---" line (rosidl wants exactly one).
+Result<std::string> service_part(std::string_view service, std::string_view text, int part) {
+  std::string parts[2];
+  int separators = 0;
+  while (!text.empty()) {
+    const auto nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text = nl == std::string_view::npos ? std::string_view() : text.substr(nl + 1);
+    std::string_view bare = line;
+    while (!bare.empty() && (bare.back() == '\r' || bare.back() == ' ' || bare.back() == '\t'))
+      bare.remove_suffix(1);
+    if (bare == "---") {
+      ++separators;
+      continue;
+    }
+    if (separators < 2) parts[separators] += std::string(line) + "\n";
+  }
+  if (separators != 1) {
+    return Error{std::string(service) + ": a service definition needs exactly one \"---\" line (found " +
+                 std::to_string(separators) + ")"};
+  }
+  return std::move(parts[part]);
+}
+
+// The description of one type, without the types it refers to.
+Result<IndividualDescription> describe_type(std::string_view type, const DefinitionSource& source) {
+  const auto name = split_type(type);
+  if (!name)
+    return Error{"\"" + std::string(type) +
+                 "\" is not an interface type name (pkg/msg/Name or pkg/srv/Name)"};
+  if (name->kind == "msg") {
+    const auto text = source(type);
+    if (!text) return Error{"no definition for " + std::string(type)};
+    return describe_msg_text(type, *text);
+  }
+  const std::string prefix = std::string(name->package) + "/srv/";
+  if (source(type)) {
+    // The service itself: its three messages (rosidl_generator_type_description's add_srv).
+    const std::string base = std::string(type);
+    return IndividualDescription{
+        base,
+        {nested_field("request_message", base + std::string(kRequest), kNestedType, 0),
+         nested_field("response_message", base + std::string(kResponse), kNestedType, 0),
+         nested_field("event_message", base + std::string(kEvent), kNestedType, 0)}};
+  }
+  for (const std::string_view suffix : {kRequest, kResponse, kEvent}) {
+    if (!name->name.ends_with(suffix) || name->name.size() == suffix.size()) continue;
+    const std::string service = prefix + std::string(name->name.substr(0, name->name.size() - suffix.size()));
+    const auto text = source(service);
+    if (!text) return Error{"no definition for " + service + " (for " + std::string(type) + ")"};
+    if (suffix == kEvent) {
+      // rosidl_parser's Service.event_message: info, then the request and the response each as a
+      // sequence of at most one.
+      return IndividualDescription{
+          std::string(type),
+          {nested_field("info", std::string(kEventInfo), kNestedType, 0),
+           nested_field("request", service + std::string(kRequest), kNestedType + kBoundedSequenceOffset, 1),
+           nested_field("response", service + std::string(kResponse), kNestedType + kBoundedSequenceOffset,
+                        1)}};
+    }
+    auto part = service_part(service, *text, suffix == kRequest ? 0 : 1);
+    if (!part) return part.error();
+    return describe_msg_text(type, part.value());
+  }
+  return Error{"no definition for " + std::string(type)};
+}
+
+void append_type(std::string& out, const IndividualDescription& d) {
+  out += "{\"type_name\": ";
+  append_json_string(out, d.type_name);
+  out += ", \"fields\": [";
+  for (std::size_t i = 0; i < d.fields.size(); ++i) {
+    const FieldDescription& f = d.fields[i];
+    out += i == 0 ? "{\"name\": " : ", {\"name\": ";
+    append_json_string(out, f.name);
+    out += ", \"type\": {\"type_id\": " + std::to_string(f.type_id);
+    out += ", \"capacity\": " + std::to_string(f.capacity);
+    out += ", \"string_capacity\": " + std::to_string(f.string_capacity);
+    out += ", \"nested_type_name\": ";
+    append_json_string(out, f.nested_type_name);
+    out += "}}";
+  }
+  out += "]}";
+}
+
+// Lower-case hex SHA-256; nullopt if libcrypto refuses (no SHA-256 provider loaded).
+std::optional<std::string> sha256_hex(std::string_view data) {
+  std::array<unsigned char, EVP_MAX_MD_SIZE> digest{};
+  unsigned int size = 0;
+  if (EVP_Digest(data.data(), data.size(), digest.data(), &size, EVP_sha256(), nullptr) != 1 || size != 32) {
+    return std::nullopt;
+  }
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string hex;
+  for (unsigned int i = 0; i < size; ++i) {
+    hex += kHex[digest[i] >> 4];
+    hex += kHex[digest[i] & 0xf];
+  }
+  return hex;
+}
+
+}  // namespace
+
+std::optional<std::string_view> shipped_definition(std::string_view type) {
+  const std::string_view text = definition(type);
+  if (text.empty()) return std::nullopt;
+  return text;
+}
+
+Result<std::string> type_description_json(std::string_view type, const DefinitionSource& source) {
+  const std::string root_name = canonical_type(type, "");
+  auto root = describe_type(root_name, source);
+  if (!root) return root.error();
+  // Every type the root refers to, directly or not (rosidl's extract_full_type_description),
+  // sorted by name.
+  std::map<std::string, IndividualDescription> referenced;
+  std::deque<std::pair<std::string, std::string>> pending;  // (type, referenced by)
+  for (const FieldDescription& f : root.value().fields) {
+    if (!f.nested_type_name.empty()) pending.emplace_back(f.nested_type_name, root_name);
+  }
+  while (!pending.empty()) {
+    auto [name, by] = std::move(pending.front());
+    pending.pop_front();
+    if (referenced.contains(name)) continue;
+    if (referenced.size() >= kMaxTypes) return Error{root_name + ": refers to more than 4096 types"};
+    auto d = describe_type(name, source);
+    if (!d) return Error{root_name + ": " + d.error().message + " (referenced by " + by + ")"};
+    for (const FieldDescription& f : d.value().fields) {
+      if (!f.nested_type_name.empty()) pending.emplace_back(f.nested_type_name, name);
+    }
+    referenced.emplace(name, std::move(d.value()));
+  }
+  std::string out = "{\"type_description\": ";
+  append_type(out, root.value());
+  out += ", \"referenced_type_descriptions\": [";
+  bool first = true;
+  for (const auto& [name, d] : referenced) {
+    if (!first) out += ", ";
+    first = false;
+    append_type(out, d);
+  }
+  out += "]}";
+  return out;
+}
+
+Result<std::string> type_hash(std::string_view type, const DefinitionSource& source) {
+  auto json = type_description_json(type, source);
+  if (!json) return json.error();
+  const auto hex = sha256_hex(json.value());
+  if (!hex) return Error{std::string(type) + ": SHA-256 failed (OpenSSL libcrypto)"};
+  return "RIHS01_" + *hex;
+}
+
+Result<std::string> type_hash(std::string_view type) {
+  static std::mutex mutex;
+  static std::map<std::string, std::string, std::less<>> cache;
+  const std::lock_guard lock(mutex);
+  if (const auto it = cache.find(type); it != cache.end()) return it->second;
+  auto hash = type_hash(type, shipped_definition);
+  if (!hash) return hash.error();
+  cache.emplace(std::string(type), hash.value());
+  return hash;
+}
+
+Result<ServiceEndpointHashes> service_endpoint_type_hashes(std::string_view service) {
+  const auto name = split_type(service);
+  if (!name || name->kind != "srv" || !shipped_definition(service)) {
+    return Error{"\"" + std::string(service) + "\" is not a service rbsim carries (pkg/srv/Name)"};
+  }
+  auto request = type_hash(std::string(service) + std::string(kRequest));
+  if (!request) return request.error();
+  auto reply = type_hash(std::string(service) + std::string(kResponse));
+  if (!reply) return reply.error();
+  return ServiceEndpointHashes{std::move(request.value()), std::move(reply.value())};
+}
+
+std::string typehash_user_data(std::string_view hash) {
+  return "typehash=" + std::string(hash) + ";";
+}
+
+}  // namespace rbsim::msgs
