@@ -86,7 +86,9 @@ struct PubSub {
     waitset = dds_create_waitset(participant);
     dds_waitset_attach(waitset, dds_create_readcondition(reader, DDS_ANY_STATE), 0);
   }
-  static std::string service_type(const char* half) { return "rbsim_bench::msg::dds_::Ping" + std::string(half); }
+  static std::string service_type(const char* half) {
+    return "rbsim_bench::msg::dds_::Ping" + std::string(half);
+  }
   bool matched() const {
     dds_publication_matched_status_t p{};
     dds_subscription_matched_status_t s{};
@@ -96,7 +98,8 @@ struct PubSub {
   }
   void write(std::span<const std::byte> b) { dds_writecdr(writer, node::make_raw_serdata(type, b)); }
   bool take(double timeout_s) {
-    const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+    const auto end =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
     while (true) {
       ddsi_serdata* d = nullptr;
       dds_sample_info_t info{};
@@ -112,7 +115,8 @@ struct PubSub {
       }
       const auto left = end - Clock::now();
       if (left <= Clock::duration::zero()) return false;
-      dds_waitset_wait(waitset, nullptr, 0, std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
+      dds_waitset_wait(waitset, nullptr, 0,
+                       std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
     }
   }
 };
@@ -165,8 +169,7 @@ Caller rbsim_caller(const node::Participant& p, const std::string& ns) {
   if (!client) return {};
   auto c = std::make_shared<node::ServiceClient>(std::move(client.value()));
   const Bytes req = step_request();
-  return {[c](double t) { return c->wait_for_server(t).ok(); },
-          [c, req] { return c->call(req, 1.0).ok(); }};
+  return {[c](double t) { return c->wait_for_server(t).ok(); }, [c, req] { return c->call(req, 1.0).ok(); }};
 }
 
 Caller pubsub_caller(const node::Participant& p, const std::string& ns) {
@@ -174,7 +177,8 @@ Caller pubsub_caller(const node::Participant& p, const std::string& ns) {
   auto sample = std::make_shared<Bytes>();
   auto seq = std::make_shared<std::int64_t>(0);
   return {[ps](double t) {
-            const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t));
+            const auto end =
+                Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t));
             while (!ps->matched()) {
               if (Clock::now() > end) return false;
               dds_sleepfor(DDS_MSECS(5));
@@ -221,8 +225,12 @@ double quantile(std::vector<double> v, double q) {
 int run_peer(const Peer& peer, std::uint32_t domain, int calls, int warmup, Row& row) {
   const std::string ns = "/bench_service_" + std::to_string(getpid()) + "_" + peer.name;
   const std::string d = std::to_string(domain);
-  char* argv[] = {const_cast<char*>("rbsim_bench_service"), const_cast<char*>("serve"), const_cast<char*>(peer.name),
-                  const_cast<char*>(d.c_str()), const_cast<char*>(ns.c_str()), nullptr};
+  char* argv[] = {const_cast<char*>("rbsim_bench_service"),
+                  const_cast<char*>("serve"),
+                  const_cast<char*>(peer.name),
+                  const_cast<char*>(d.c_str()),
+                  const_cast<char*>(ns.c_str()),
+                  nullptr};
   pid_t pid = 0;
   if (posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, argv, environ) != 0) return 1;
   int rc = 1;
@@ -237,8 +245,10 @@ int run_peer(const Peer& peer, std::uint32_t domain, int calls, int warmup, Row&
           const auto t0 = Clock::now();
           const bool ok = c.call();
           const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
-          if (ok) row.us.push_back(us);
-          else ++row.failed;
+          if (ok)
+            row.us.push_back(us);
+          else
+            ++row.failed;
         }
         rc = 0;
       } else {
@@ -267,13 +277,17 @@ int main(int argc, char** argv) {
   std::uint32_t domain = 171;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string_view a = argv[i];
-    if (a == "--calls") calls = std::atoi(argv[i + 1]);
-    else if (a == "--warmup") warmup = std::atoi(argv[i + 1]);
-    else if (a == "--domain") domain = static_cast<std::uint32_t>(std::atoi(argv[i + 1]));
-    else return std::fprintf(stderr, "usage: rbsim_bench_service [--calls N] [--warmup N] [--domain D]\n"), 2;
+    if (a == "--calls")
+      calls = std::atoi(argv[i + 1]);
+    else if (a == "--warmup")
+      warmup = std::atoi(argv[i + 1]);
+    else if (a == "--domain")
+      domain = static_cast<std::uint32_t>(std::atoi(argv[i + 1]));
+    else
+      return std::fprintf(stderr, "usage: rbsim_bench_service [--calls N] [--warmup N] [--domain D]\n"), 2;
   }
-  std::printf("service round trip, Step (24 B request, 36 B reply), %d calls after %d warm-up, loopback\n", calls,
-              warmup);
+  std::printf("service round trip, Step (24 B request, 36 B reply), %d calls after %d warm-up, loopback\n",
+              calls, warmup);
   std::printf("%-8s %-42s %10s %10s %10s %7s\n", "peer", "path", "median us", "p99 us", "mean us", "failed");
   std::vector<Row> rows;
   for (const Peer& p : kPeers) {
@@ -285,7 +299,8 @@ int main(int argc, char** argv) {
                 quantile(row.us, 0.99), mean, row.failed);
     rows.push_back(std::move(row));
   }
-  std::printf("rbsim / pubsub: median %.2fx, p99 %.2fx\n", quantile(rows[0].us, 0.5) / quantile(rows[1].us, 0.5),
+  std::printf("rbsim / pubsub: median %.2fx, p99 %.2fx\n",
+              quantile(rows[0].us, 0.5) / quantile(rows[1].us, 0.5),
               quantile(rows[0].us, 0.99) / quantile(rows[1].us, 0.99));
   return 0;
 }

@@ -54,10 +54,11 @@ dds_qos_t* service_qos(const std::string& user_data, std::int32_t depth, dds_dur
 }
 
 // A topic of the raw-CDR sertype under `type_name`; `sertype` receives the one the topic uses.
-Result<dds_entity_t> make_topic(dds_entity_t participant, const std::string& name, const std::string& type_name,
-                                const ddsi_sertype** sertype) {
+Result<dds_entity_t> make_topic(dds_entity_t participant, const std::string& name,
+                                const std::string& type_name, const ddsi_sertype** sertype) {
   ddsi_sertype* type = make_raw_sertype(type_name.c_str());
-  const dds_entity_t topic = dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
+  const dds_entity_t topic =
+      dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
   if (topic < 0) {
     ddsi_sertype_unref(type);  // not taken over on failure
     return dds_error("cannot create DDS topic " + name, topic);
@@ -136,11 +137,11 @@ struct Endpoints {
 };
 
 // Creates both topics and endpoints; `listener` (may be null) goes to the reader.
-Status make_endpoints(dds_entity_t participant, const std::string& writer_topic, const std::string& writer_type,
-                      const std::string& writer_user_data, const std::string& reader_topic,
-                      const std::string& reader_type, const std::string& reader_user_data,
-                      std::int32_t reader_depth, dds_duration_t writer_blocking, const dds_listener_t* listener,
-                      Endpoints& out) {
+Status make_endpoints(dds_entity_t participant, const std::string& writer_topic,
+                      const std::string& writer_type, const std::string& writer_user_data,
+                      const std::string& reader_topic, const std::string& reader_type,
+                      const std::string& reader_user_data, std::int32_t reader_depth,
+                      dds_duration_t writer_blocking, const dds_listener_t* listener, Endpoints& out) {
   auto wt = make_topic(participant, writer_topic, writer_type, &out.writer_type);
   if (!wt) return wt.error();
   out.writer_topic = wt.value();
@@ -212,8 +213,9 @@ Result<RequestHeader> unwrap_service_sample(std::span<const std::byte> sample, B
   msgs::CdrCursor at(sample);
   RequestHeader h;
   if (!at.read(h.guid) || !at.read(h.seq)) {
-    return Error{"a service sample of " + std::to_string(sample.size()) + " bytes has no room for the request header",
-                 ErrorCode::Truncated};
+    return Error{
+        "a service sample of " + std::to_string(sample.size()) + " bytes has no room for the request header",
+        ErrorCode::Truncated};
   }
   body.resize(sample.size() - kRequestHeaderBytes);
   std::memcpy(body.data(), sample.data(), msgs::CdrCursor::kHeader);
@@ -365,9 +367,10 @@ struct ServiceServer::Impl {
           count_one(&ServiceStats::client_unmatched);
           return;
         }
-        pending.push_back({header, publication, body, Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                                          std::chrono::duration<double>(
-                                                                              options.client_match_timeout_s))});
+        pending.push_back(
+            {header, publication, body,
+             Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                std::chrono::duration<double>(options.client_match_timeout_s))});
         return;
     }
   }
@@ -422,10 +425,10 @@ Result<ServiceServer> ServiceServer::create(const Participant& participant, std:
   // The reader keeps as many requests as the queue: the listener drains it as they arrive, so the
   // queue, where drops are counted, is where a flood is cut.
   const auto depth = static_cast<std::int32_t>(std::min<std::size_t>(impl->options.queue_limit, INT32_MAX));
-  Status st = make_endpoints(participant.handle(), service_reply_topic(service), service_response_type(srv_type),
-                             user_data + options.reply_user_data, service_request_topic(service),
-                             service_request_type(srv_type), user_data + options.request_user_data,
-                             std::max(depth, 10), DDS_MSECS(10), listener, impl->dds);
+  Status st = make_endpoints(
+      participant.handle(), service_reply_topic(service), service_response_type(srv_type),
+      user_data + options.reply_user_data, service_request_topic(service), service_request_type(srv_type),
+      user_data + options.request_user_data, std::max(depth, 10), DDS_MSECS(10), listener, impl->dds);
   dds_delete_listener(listener);
   if (!st) return Error{"service " + std::string(service) + ": " + st.error().message};
   return ServiceServer(std::move(impl));
@@ -493,10 +496,10 @@ Result<ServiceClient> ServiceClient::create(const Participant& participant, std:
                                             std::string_view srv_type, const ClientOptions& options) {
   auto impl = std::make_unique<Impl>();
   const std::string user_data = "clientid=" + endpoint_pair_id(participant.handle()) + ";";
-  Status st = make_endpoints(participant.handle(), service_request_topic(service), service_request_type(srv_type),
-                             user_data + options.request_user_data, service_reply_topic(service),
-                             service_response_type(srv_type), user_data + options.reply_user_data, 10,
-                             DDS_SECS(1), nullptr, impl->dds);
+  Status st = make_endpoints(participant.handle(), service_request_topic(service),
+                             service_request_type(srv_type), user_data + options.request_user_data,
+                             service_reply_topic(service), service_response_type(srv_type),
+                             user_data + options.reply_user_data, 10, DDS_SECS(1), nullptr, impl->dds);
   if (!st) return Error{"client of " + std::string(service) + ": " + st.error().message};
   impl->id = endpoint_id(impl->dds.writer).instance_handle;
   impl->condition = dds_create_readcondition(impl->dds.reader, DDS_ANY_STATE);
@@ -508,11 +511,13 @@ Result<ServiceClient> ServiceClient::create(const Participant& participant, std:
 }
 
 bool ServiceClient::server_ready() const {
-  return publication_state(impl_->dds.writer).current > 0 && subscription_state(impl_->dds.reader).current > 0;
+  return publication_state(impl_->dds.writer).current > 0 &&
+         subscription_state(impl_->dds.reader).current > 0;
 }
 
 Status ServiceClient::wait_for_server(double timeout_s) {
-  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
   while (!server_ready()) {
     if (Clock::now() >= end) return Error{"no service server matched in time"};
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -521,7 +526,8 @@ Status ServiceClient::wait_for_server(double timeout_s) {
 }
 
 Result<std::int64_t> ServiceClient::send(std::span<const std::byte> request) {
-  if (request.size() < msgs::CdrCursor::kHeader) return Error{"a request must be a CDR message", ErrorCode::InvalidArgument};
+  if (request.size() < msgs::CdrCursor::kHeader)
+    return Error{"a request must be a CDR message", ErrorCode::InvalidArgument};
   const RequestHeader header{impl_->id, ++impl_->next_seq};
   wrap_service_sample(header, request, impl_->sample);
   ddsi_serdata* d = make_raw_serdata(impl_->dds.writer_type, impl_->sample);
@@ -552,7 +558,8 @@ bool ServiceClient::wait_reply(double timeout_s) {
 Result<Bytes> ServiceClient::call(std::span<const std::byte> request, double timeout_s) {
   auto seq = send(request);
   if (!seq) return seq.error();
-  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
   Bytes reply;
   RequestHeader header;
   while (true) {

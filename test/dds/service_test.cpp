@@ -59,7 +59,8 @@ bool step_handler(const RequestHeader& h, std::span<const std::byte> request, By
 // Serves until `done` holds, at most `seconds` (the node's loop: serve, then sleep a 1 ms step).
 template <class Done>
 bool serve_until(ServiceServer& server, Done done, double seconds = 5.0) {
-  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   while (Clock::now() < end) {
     server.serve(step_handler, 16);
     if (done()) return true;
@@ -94,7 +95,8 @@ msgs::StepResponse call_step(ServiceServer& server, ServiceClient& client, std::
   Result<Bytes> reply = Error{"not called"};
   const std::uint64_t before = server.stats().answered;
   std::thread caller([&] { reply = client.call(req, 5.0); });
-  serve_until(server, [&] { return server.stats().answered > before; }, 5.0);
+  serve_until(
+      server, [&] { return server.stats().answered > before; }, 5.0);
   caller.join();
   msgs::StepResponse res;
   EXPECT_TRUE(reply.ok()) << reply.error().message;
@@ -119,8 +121,8 @@ TEST(ServiceSample, WrapPutsTheRequestHeaderBeforeTheBody) {
   msgs::encode(msgs::StepRequest{7}, body);  // 00 01 00 00 | 07 00 00 00
   Bytes sample;
   wrap_service_sample({0x0102030405060708ull, -2}, body, sample);
-  EXPECT_EQ(sample, bytes({0, 1, 0, 0, 8, 7, 6, 5, 4, 3, 2, 1, 0xfe, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff,
-                           7, 0, 0, 0}));
+  EXPECT_EQ(sample, bytes({0,    1,    0,    0,    8,    7,    6,    5,    4, 3, 2, 1,
+                           0xfe, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 7, 0, 0, 0}));
   Bytes back;
   auto h = unwrap_service_sample(sample, back);
   ASSERT_TRUE(h.ok()) << h.error().message;
@@ -195,7 +197,8 @@ TEST_F(Loopback, EndpointsReportIdsAndCarryUserData) {
   }
   EXPECT_EQ(client.id(), client.request_writer().instance_handle);
   // What the server's reader sees of the client's writer (discovery data): USER_DATA.
-  dds_entity_t topic_reader = dds_create_reader(participant->handle(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+  dds_entity_t topic_reader =
+      dds_create_reader(participant->handle(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
   std::string user_data;
   for (int i = 0; i < 200 && user_data.empty(); ++i) {
     void* samples[16] = {};
@@ -288,7 +291,8 @@ TEST_F(Loopback, ServerDropsTheReplyOfAVanishedClientWithoutStalling) {
 
 // A raw DDS endpoint on a service topic (what a hostile or broken client can send).
 struct RawWriter {
-  RawWriter(dds_entity_t participant, const std::string& topic_name, const std::string& type, const std::string& user_data) {
+  RawWriter(dds_entity_t participant, const std::string& topic_name, const std::string& type,
+            const std::string& user_data) {
     ddsi_sertype* st = make_raw_sertype(type.c_str());
     topic = dds_create_topic_sertype(participant, topic_name.c_str(), &st, nullptr, nullptr, nullptr);
     sertype = st;
@@ -303,7 +307,9 @@ struct RawWriter {
     dds_delete(writer);
     dds_delete(topic);
   }
-  void write(std::span<const std::byte> b) { EXPECT_GE(dds_writecdr(writer, make_raw_serdata(sertype, b)), 0); }
+  void write(std::span<const std::byte> b) {
+    EXPECT_GE(dds_writecdr(writer, make_raw_serdata(sertype, b)), 0);
+  }
   bool matched() const {
     dds_publication_matched_status_t st{};
     dds_get_publication_matched_status(writer, &st);
@@ -320,7 +326,8 @@ TEST_F(Loopback, ReplyToAClientWithoutItsReplyReaderIsDroppedAfterTheMatchTimeou
   ServiceOptions so;
   so.client_match_timeout_s = 0.2;
   ServiceServer server = make_server(name, so);
-  RawWriter raw(participant->handle(), service_request_topic(name), service_request_type(kStep), "clientid=nobody;");
+  RawWriter raw(participant->handle(), service_request_topic(name), service_request_type(kStep),
+                "clientid=nobody;");
   for (int i = 0; i < 500 && !raw.matched(); ++i) std::this_thread::sleep_for(10ms);
   ASSERT_TRUE(raw.matched());
   Bytes body, sample;
@@ -407,7 +414,8 @@ TEST_F(Loopback, FloodOfRequestsIsBoundedAndTheServerStaysResponsive) {
   ServiceStats s = server.stats();
   EXPECT_LE(max_queued, so.queue_limit);
   EXPECT_GT(s.received, 0u);
-  EXPECT_EQ(s.received, s.answered + s.dropped_full + s.client_unmatched + s.client_gone + s.pending + s.queued);
+  EXPECT_EQ(s.received,
+            s.answered + s.dropped_full + s.client_unmatched + s.client_gone + s.pending + s.queued);
   EXPECT_LT(longest, 100ms) << "one serve() of 16 requests";
   // The replies that came back are to this client's requests, numbered as it sent them.
   RequestHeader h;

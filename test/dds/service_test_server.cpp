@@ -73,8 +73,8 @@ int main(int argc, char** argv) {
   }
   const std::string ns = argv[2];
   auto step_server = node::ServiceServer::create(participant.value(), ns + "/step", "rbsim_msgs/srv/Step");
-  auto params_server =
-      node::ServiceServer::create(participant.value(), ns + "/get_parameters", "rcl_interfaces/srv/GetParameters");
+  auto params_server = node::ServiceServer::create(participant.value(), ns + "/get_parameters",
+                                                   "rcl_interfaces/srv/GetParameters");
   if (!step_server || !params_server) {
     std::fprintf(stderr, "cannot create the services\n");
     return 1;

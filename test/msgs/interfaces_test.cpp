@@ -120,7 +120,8 @@ TEST(InterfacesCodec, StepResponseAlignsTheUint64AfterTheString) {
   Bytes cdr;
   encode(StepResponse{true, "ab", 5}, cdr);
   // 0: bool 01, 1-3 pad, 4: length 3, 8: 'a' 'b' NUL, 11-15 pad to 8, 16: u64 5; 24 bytes, no pad.
-  EXPECT_EQ(cdr, bytes({0, 1, 0, 0, 1, 0, 0, 0, 3, 0, 0, 0, 'a', 'b', 0, 0, 0, 0, 0, 0, 5, 0, 0, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(cdr,
+            bytes({0, 1, 0, 0, 1, 0, 0, 0, 3, 0, 0, 0, 'a', 'b', 0, 0, 0, 0, 0, 0, 5, 0, 0, 0, 0, 0, 0, 0}));
 }
 
 TEST(InterfacesCodec, SetParametersResultLayout) {
@@ -134,7 +135,8 @@ TEST(InterfacesCodec, ListParametersRequestAlignsDepthAfterTheStrings) {
   Bytes cdr;
   encode(ListParametersRequest{{"x"}, 3}, cdr);
   // 0: count 1, 4: length 2, 8: 'x' NUL, 10-15 pad to 8, 16: u64 depth 3.
-  EXPECT_EQ(cdr, bytes({0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 'x', 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(cdr,
+            bytes({0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 'x', 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0}));
 }
 
 TEST(InterfacesCodec, ParameterValueLayoutWithASequenceOfStrings) {
@@ -148,14 +150,14 @@ TEST(InterfacesCodec, ParameterValueLayoutWithASequenceOfStrings) {
   // length 1, 28: NUL, 29-31 pad, 32/36/40/44: four empty sequences (no element, no alignment),
   // 48: count 2, 52: length 2, 56: 'a' NUL, 58-59 pad, 60: length 3, 64: 'b' 'c' NUL; 67 bytes,
   // one of padding.
-  const Bytes expected = bytes({0, 1, 0, 1,                                    // header, pad count 1
-                                9, 0, 0, 0, 0, 0, 0, 0,                        // 0
-                                0, 0, 0, 0, 0, 0, 0, 0,                        // 8
-                                0, 0, 0, 0, 0, 0, 0xf0, 0x3f,                  // 16
-                                1, 0, 0, 0, 0, 0, 0, 0,                        // 24
-                                0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,  // 32
-                                2, 0, 0, 0, 2, 0, 0, 0, 'a', 0, 0, 0,          // 48
-                                3, 0, 0, 0, 'b', 'c', 0, 0});                  // 60
+  const Bytes expected = bytes({0, 1, 0, 1,                        // header, pad count 1
+                                9, 0, 0, 0, 0,   0,   0,    0,     // 0
+                                0, 0, 0, 0, 0,   0,   0,    0,     // 8
+                                0, 0, 0, 0, 0,   0,   0xf0, 0x3f,  // 16
+                                1, 0, 0, 0, 0,   0,   0,    0,     // 24
+                                0, 0, 0, 0, 0,   0,   0,    0,    0,   0, 0, 0, 0, 0, 0, 0,  // 32
+                                2, 0, 0, 0, 2,   0,   0,    0,    'a', 0, 0, 0,              // 48
+                                3, 0, 0, 0, 'b', 'c', 0,    0});                             // 60
   EXPECT_EQ(cdr, expected);
 }
 
@@ -193,8 +195,10 @@ TEST(InterfacesCodec, EveryTruncationOfAValidMessageFails) {
   expect_every_truncation_fails(set_request(), "rcl_interfaces/srv/SetParameters request");
   expect_every_truncation_fails(SetParametersAtomicallyRequest{set_request().parameters},
                                 "rcl_interfaces/srv/SetParametersAtomically request");
-  expect_every_truncation_fails(ListParametersRequest{{"forces", "x"}, 1}, "rcl_interfaces/srv/ListParameters request");
-  expect_every_truncation_fails(GetParametersRequest{{"rate", "dt"}}, "rcl_interfaces/srv/GetParameters request");
+  expect_every_truncation_fails(ListParametersRequest{{"forces", "x"}, 1},
+                                "rcl_interfaces/srv/ListParameters request");
+  expect_every_truncation_fails(GetParametersRequest{{"rate", "dt"}},
+                                "rcl_interfaces/srv/GetParameters request");
   expect_every_truncation_fails(DescribeParametersResponse{{descriptor()}}, "DescribeParameters response");
   expect_every_truncation_fails(StepRequest{3}, "rbsim_msgs/srv/Step request");
   expect_every_truncation_fails(ApplyImpulseRequest{1, 2, 3, 4, 5}, "rbsim_msgs/srv/ApplyImpulse request");

@@ -68,7 +68,7 @@ struct EndpointId {
 struct ServiceOptions {
   // Appended to each endpoint's USER_DATA after "serviceid=<id>;" (later "typehash=RIHS01_...;").
   std::string request_user_data, reply_user_data;
-  std::size_t queue_limit = 64;              // requests waiting for serve(); more are dropped
+  std::size_t queue_limit = 64;               // requests waiting for serve(); more are dropped
   std::size_t max_request_bytes = 64 * 1024;  // larger requests are dropped unread
   // How long a reply waits (retried at each serve()) for the client's reply reader to match.
   double client_match_timeout_s = 0.1;
@@ -78,12 +78,12 @@ struct ServiceOptions {
 // exactly one of the outcomes, or is still queued or pending).
 struct ServiceStats {
   std::uint64_t received = 0;
-  std::uint64_t answered = 0;        // a reply written
-  std::uint64_t unanswered = 0;      // the handler chose not to reply
-  std::uint64_t dropped_full = 0;    // the queue was full
-  std::uint64_t dropped_large = 0;   // over max_request_bytes
-  std::uint64_t malformed = 0;       // not a service sample (bad CDR header, shorter than the header)
-  std::uint64_t client_gone = 0;     // its request writer vanished before the reply: no reply
+  std::uint64_t answered = 0;          // a reply written
+  std::uint64_t unanswered = 0;        // the handler chose not to reply
+  std::uint64_t dropped_full = 0;      // the queue was full
+  std::uint64_t dropped_large = 0;     // over max_request_bytes
+  std::uint64_t malformed = 0;         // not a service sample (bad CDR header, shorter than the header)
+  std::uint64_t client_gone = 0;       // its request writer vanished before the reply: no reply
   std::uint64_t client_unmatched = 0;  // its reply reader never matched in time: no reply
   std::uint64_t write_failed = 0;
   std::size_t queued = 0, pending = 0;  // now: waiting for serve(); replies waiting for a match
@@ -94,7 +94,8 @@ class ServiceServer {
   // Answers a request: `request` is its body as a CDR message (encapsulation header included),
   // `reply` (cleared, its storage reused) receives the reply's body the same way. Returns false to
   // send no reply.
-  using Handler = std::function<bool(const RequestHeader& header, std::span<const std::byte> request, Bytes& reply)>;
+  using Handler =
+      std::function<bool(const RequestHeader& header, std::span<const std::byte> request, Bytes& reply)>;
 
   // `service` is the fully qualified ROS name ("/rbsim/pause"), `srv_type` "pkg/srv/Name".
   static Result<ServiceServer> create(const Participant& participant, std::string_view service,

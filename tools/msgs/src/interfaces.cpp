@@ -193,31 +193,79 @@ void get(Reader& r, ListParametersRequest& m) {
   get_strings(r, m.prefixes);
   m.depth = r.get<std::uint64_t>();
 }
-void put(CdrWriter& w, const ListParametersResponse& m) { put(w, m.result); }
-void get(Reader& r, ListParametersResponse& m) { get(r, m.result); }
-void put(CdrWriter& w, const GetParametersRequest& m) { put_strings(w, m.names); }
-void get(Reader& r, GetParametersRequest& m) { get_strings(r, m.names); }
-void put(CdrWriter& w, const GetParametersResponse& m) { put_all(w, m.values); }
-void get(Reader& r, GetParametersResponse& m) { get_all(r, m.values, kMinValue); }
-void put(CdrWriter& w, const SetParametersRequest& m) { put_all(w, m.parameters); }
-void get(Reader& r, SetParametersRequest& m) { get_all(r, m.parameters, kMinParameter); }
-void put(CdrWriter& w, const SetParametersResponse& m) { put_all(w, m.results); }
-void get(Reader& r, SetParametersResponse& m) { get_all(r, m.results, kMinResult); }
-void put(CdrWriter& w, const SetParametersAtomicallyRequest& m) { put_all(w, m.parameters); }
-void get(Reader& r, SetParametersAtomicallyRequest& m) { get_all(r, m.parameters, kMinParameter); }
-void put(CdrWriter& w, const SetParametersAtomicallyResponse& m) { put(w, m.result); }
-void get(Reader& r, SetParametersAtomicallyResponse& m) { get(r, m.result); }
-void put(CdrWriter& w, const DescribeParametersRequest& m) { put_strings(w, m.names); }
-void get(Reader& r, DescribeParametersRequest& m) { get_strings(r, m.names); }
-void put(CdrWriter& w, const DescribeParametersResponse& m) { put_all(w, m.descriptors); }
-void get(Reader& r, DescribeParametersResponse& m) { get_all(r, m.descriptors, kMinDescriptor); }
-void put(CdrWriter& w, const GetParameterTypesRequest& m) { put_strings(w, m.names); }
-void get(Reader& r, GetParameterTypesRequest& m) { get_strings(r, m.names); }
-void put(CdrWriter& w, const GetParameterTypesResponse& m) { put_values(w, m.types); }
-void get(Reader& r, GetParameterTypesResponse& m) { get_values(r, m.types); }
+void put(CdrWriter& w, const ListParametersResponse& m) {
+  put(w, m.result);
+}
+void get(Reader& r, ListParametersResponse& m) {
+  get(r, m.result);
+}
+void put(CdrWriter& w, const GetParametersRequest& m) {
+  put_strings(w, m.names);
+}
+void get(Reader& r, GetParametersRequest& m) {
+  get_strings(r, m.names);
+}
+void put(CdrWriter& w, const GetParametersResponse& m) {
+  put_all(w, m.values);
+}
+void get(Reader& r, GetParametersResponse& m) {
+  get_all(r, m.values, kMinValue);
+}
+void put(CdrWriter& w, const SetParametersRequest& m) {
+  put_all(w, m.parameters);
+}
+void get(Reader& r, SetParametersRequest& m) {
+  get_all(r, m.parameters, kMinParameter);
+}
+void put(CdrWriter& w, const SetParametersResponse& m) {
+  put_all(w, m.results);
+}
+void get(Reader& r, SetParametersResponse& m) {
+  get_all(r, m.results, kMinResult);
+}
+void put(CdrWriter& w, const SetParametersAtomicallyRequest& m) {
+  put_all(w, m.parameters);
+}
+void get(Reader& r, SetParametersAtomicallyRequest& m) {
+  get_all(r, m.parameters, kMinParameter);
+}
+void put(CdrWriter& w, const SetParametersAtomicallyResponse& m) {
+  put(w, m.result);
+}
+void get(Reader& r, SetParametersAtomicallyResponse& m) {
+  get(r, m.result);
+}
+void put(CdrWriter& w, const DescribeParametersRequest& m) {
+  put_strings(w, m.names);
+}
+void get(Reader& r, DescribeParametersRequest& m) {
+  get_strings(r, m.names);
+}
+void put(CdrWriter& w, const DescribeParametersResponse& m) {
+  put_all(w, m.descriptors);
+}
+void get(Reader& r, DescribeParametersResponse& m) {
+  get_all(r, m.descriptors, kMinDescriptor);
+}
+void put(CdrWriter& w, const GetParameterTypesRequest& m) {
+  put_strings(w, m.names);
+}
+void get(Reader& r, GetParameterTypesRequest& m) {
+  get_strings(r, m.names);
+}
+void put(CdrWriter& w, const GetParameterTypesResponse& m) {
+  put_values(w, m.types);
+}
+void get(Reader& r, GetParameterTypesResponse& m) {
+  get_values(r, m.types);
+}
 
-void put(CdrWriter& w, const TriggerRequest&) { w.u8(0); }  // structure_needs_at_least_one_member
-void get(Reader& r, TriggerRequest&) { (void)r.get<std::uint8_t>(); }
+void put(CdrWriter& w, const TriggerRequest&) {
+  w.u8(0);
+}  // structure_needs_at_least_one_member
+void get(Reader& r, TriggerRequest&) {
+  (void)r.get<std::uint8_t>();
+}
 void put(CdrWriter& w, const TriggerResponse& m) {
   w.boolean(m.success);
   w.string(m.message);
@@ -226,8 +274,12 @@ void get(Reader& r, TriggerResponse& m) {
   m.success = r.get<std::uint8_t>() != 0;
   m.message = r.string();
 }
-void put(CdrWriter& w, const StepRequest& m) { w.u32(m.steps); }
-void get(Reader& r, StepRequest& m) { m.steps = r.get<std::uint32_t>(); }
+void put(CdrWriter& w, const StepRequest& m) {
+  w.u32(m.steps);
+}
+void get(Reader& r, StepRequest& m) {
+  m.steps = r.get<std::uint32_t>();
+}
 void put(CdrWriter& w, const StepResponse& m) {
   w.boolean(m.success);
   w.string(m.message);
@@ -297,12 +349,12 @@ Status decode_message(std::span<const std::byte> cdr, T& out, std::string_view h
 
 }  // namespace
 
-#define RBSIM_INTERFACE_CODEC(T, half)                      \
-  void encode(const T& message, Bytes& out) {               \
-    encode_message(message, out);                           \
-  }                                                         \
-  Status decode(std::span<const std::byte> cdr, T& out) {   \
-    return decode_message(cdr, out, half);                  \
+#define RBSIM_INTERFACE_CODEC(T, half)                    \
+  void encode(const T& message, Bytes& out) {             \
+    encode_message(message, out);                         \
+  }                                                       \
+  Status decode(std::span<const std::byte> cdr, T& out) { \
+    return decode_message(cdr, out, half);                \
   }
 RBSIM_INTERFACE_CODEC(ParameterValue, "")
 RBSIM_INTERFACE_CODEC(Parameter, "")

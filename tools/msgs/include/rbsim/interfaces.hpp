@@ -216,8 +216,8 @@ struct ApplyImpulseResponse {
 // decode() fills `out` (replaced whole) or fails naming the type and the offset, `out` then
 // unspecified.
 
-#define RBSIM_INTERFACE_CODEC(T)                     \
-  void encode(const T& message, Bytes& out);         \
+#define RBSIM_INTERFACE_CODEC(T)             \
+  void encode(const T& message, Bytes& out); \
   [[nodiscard]] Status decode(std::span<const std::byte> cdr, T& out);
 RBSIM_INTERFACE_CODEC(ParameterValue)
 RBSIM_INTERFACE_CODEC(Parameter)
