@@ -243,7 +243,7 @@ struct ServiceServer::Impl {
   std::condition_variable arrived;
   std::vector<Slot> ring;
   std::size_t head = 0, count = 0;
-  ServiceStats stats;
+  ServiceStats stats;  // stats.pending: pending.size() as serve() left it
 
   // The caller's thread only (serve()).
   struct Pending {
@@ -447,6 +447,8 @@ std::size_t ServiceServer::serve(const Handler& handler, std::size_t budget) {
     }
     s.deliver(s.current.header, s.current.publication, s.reply);
   }
+  std::lock_guard lock(s.mu);
+  s.stats.pending = s.pending.size();  // for stats() from any thread
   return handled;
 }
 
@@ -460,7 +462,6 @@ ServiceStats ServiceServer::stats() const {
   std::lock_guard lock(impl_->mu);
   ServiceStats s = impl_->stats;
   s.queued = impl_->count;
-  s.pending = impl_->pending.size();
   return s;
 }
 EndpointId ServiceServer::request_reader() const {

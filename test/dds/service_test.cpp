@@ -414,8 +414,9 @@ TEST_F(Loopback, FloodOfRequestsIsBoundedAndTheServerStaysResponsive) {
   ServiceStats s = server.stats();
   EXPECT_LE(max_queued, so.queue_limit);
   EXPECT_GT(s.received, 0u);
-  EXPECT_EQ(s.received,
-            s.answered + s.dropped_full + s.client_unmatched + s.client_gone + s.pending + s.queued);
+  EXPECT_EQ(s.received, s.answered + s.unanswered + s.dropped_full + s.dropped_large + s.malformed +
+                            s.client_unmatched + s.client_gone + s.write_failed + s.pending + s.queued);
+  EXPECT_EQ(s.malformed + s.dropped_large + s.write_failed, 0u);
   EXPECT_LT(longest, 100ms) << "one serve() of 16 requests";
   // The replies that came back are to this client's requests, numbered as it sent them.
   RequestHeader h;

@@ -86,7 +86,8 @@ struct ServiceStats {
   std::uint64_t client_gone = 0;       // its request writer vanished before the reply: no reply
   std::uint64_t client_unmatched = 0;  // its reply reader never matched in time: no reply
   std::uint64_t write_failed = 0;
-  std::size_t queued = 0, pending = 0;  // now: waiting for serve(); replies waiting for a match
+  // Now: requests waiting for serve(); replies waiting for a match (as the last serve() left them).
+  std::size_t queued = 0, pending = 0;
 };
 
 class ServiceServer {
@@ -109,7 +110,7 @@ class ServiceServer {
   std::size_t serve(const Handler& handler, std::size_t budget = SIZE_MAX);
   // Waits until a request is queued or `timeout_s` passes; true when one is.
   bool wait(double timeout_s);
-  ServiceStats stats() const;
+  ServiceStats stats() const;  // from any thread
   EndpointId request_reader() const;
   EndpointId reply_writer() const;
   const std::string& service() const;
