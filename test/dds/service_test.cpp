@@ -350,6 +350,36 @@ TEST_F(Loopback, ReplyToAClientWithoutItsReplyReaderIsDroppedAfterTheMatchTimeou
   EXPECT_LT(longest, 50ms);
 }
 
+// typed_handler: a request that decodes is answered by the typed function; one that does not gets
+// the malformed reply (here: success false with the decoder's error), or none.
+TEST(ServiceTypedHandler, DecodesRequestsAndAnswersMalformedOnes) {
+  const ServiceServer::Handler h = typed_handler<msgs::StepRequest, msgs::StepResponse>(
+      [](const RequestHeader& header, const msgs::StepRequest& r) {
+        return msgs::StepResponse{true, "seq " + std::to_string(header.seq), 2ull * r.steps};
+      },
+      [](const Error& e) {
+        return std::optional<msgs::StepResponse>(msgs::StepResponse{false, e.message, 0});
+      });
+  Bytes req, reply;
+  msgs::encode(msgs::StepRequest{21}, req);
+  ASSERT_TRUE(h({5, 9}, req, reply));
+  msgs::StepResponse res;
+  ASSERT_TRUE(msgs::decode(reply, res).ok());
+  EXPECT_EQ(res, (msgs::StepResponse{true, "seq 9", 42}));
+  req.resize(6);  // the u32 cut short
+  ASSERT_TRUE(h({5, 10}, req, reply));
+  ASSERT_TRUE(msgs::decode(reply, res).ok());
+  EXPECT_FALSE(res.success);
+  EXPECT_NE(res.message.find("rbsim_msgs/srv/Step request"), std::string::npos) << res.message;
+  const ServiceServer::Handler silent =
+      typed_handler<msgs::GetParametersRequest, msgs::GetParametersResponse>(
+          [](const RequestHeader&, const msgs::GetParametersRequest&) {
+            return msgs::GetParametersResponse{};
+          },
+          [](const Error&) { return std::optional<msgs::GetParametersResponse>(); });
+  EXPECT_FALSE(silent({5, 11}, req, reply));
+}
+
 // Hostile samples: not CDR, shorter than the header, over the size limit, a truncated body. None
 // crashes; the first three are dropped and counted, the last one gets an unsuccessful reply.
 TEST_F(Loopback, HostileRequestsAreCountedOrRefused) {

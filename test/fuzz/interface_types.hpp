@@ -13,9 +13,10 @@ namespace rbsim::fuzz {
 namespace m = rbsim::msgs;
 using InterfaceTypes =
     std::tuple<m::ParameterValue, m::Parameter, m::ParameterDescriptor, m::SetParametersResult,
-               m::ListParametersResult, m::ParameterEvent, m::ListParametersRequest, m::ListParametersResponse,
-               m::GetParametersRequest, m::GetParametersResponse, m::SetParametersRequest, m::SetParametersResponse,
-               m::SetParametersAtomicallyRequest, m::SetParametersAtomicallyResponse, m::DescribeParametersRequest,
+               m::ListParametersResult, m::ParameterEvent, m::ListParametersRequest,
+               m::ListParametersResponse, m::GetParametersRequest, m::GetParametersResponse,
+               m::SetParametersRequest, m::SetParametersResponse, m::SetParametersAtomicallyRequest,
+               m::SetParametersAtomicallyResponse, m::DescribeParametersRequest,
                m::DescribeParametersResponse, m::GetParameterTypesRequest, m::GetParameterTypesResponse,
                m::TriggerRequest, m::TriggerResponse, m::StepRequest, m::StepResponse, m::ApplyImpulseRequest,
                m::ApplyImpulseResponse>;
@@ -26,7 +27,8 @@ template <class F>
 void with_interface(std::size_t i, F&& f) {
   [&]<std::size_t... I>(std::index_sequence<I...>) {
     ((I == i ? (f.template operator()<std::tuple_element_t<I, InterfaceTypes>>(), 0) : 0), ...);
-  }(std::make_index_sequence<kInterfaceCount>{});
+  }
+  (std::make_index_sequence<kInterfaceCount>{});
 }
 
 }  // namespace rbsim::fuzz

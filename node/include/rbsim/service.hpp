@@ -23,12 +23,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 
 #include "rbsim/bytes.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/interfaces.hpp"
 #include "rbsim/status.hpp"
 
 namespace rbsim::node {
@@ -120,6 +122,26 @@ class ServiceServer {
   explicit ServiceServer(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+// A ServiceServer::Handler from a typed function: the request decoded as `Req` (a request struct of
+// rbsim/interfaces.hpp), `answer(header, request)` returns the `Res` to send. A request that does not
+// decode gets `on_malformed(error)`'s reply instead, or none when that returns nullopt (a type with
+// no field to say so, such as GetParameters' response).
+template <class Req, class Res, class Answer, class OnMalformed>
+ServiceServer::Handler typed_handler(Answer answer, OnMalformed on_malformed) {
+  return [answer = std::move(answer), on_malformed = std::move(on_malformed)](
+             const RequestHeader& header, std::span<const std::byte> request, Bytes& reply) {
+    Req req;
+    if (Status st = msgs::decode(request, req); !st) {
+      const std::optional<Res> res = on_malformed(st.error());
+      if (!res) return false;
+      msgs::encode(*res, reply);
+      return true;
+    }
+    msgs::encode(static_cast<const Res&>(answer(header, req)), reply);
+    return true;
+  };
+}
 
 struct ClientOptions {
   // Appended to each endpoint's USER_DATA after "clientid=<id>;".
