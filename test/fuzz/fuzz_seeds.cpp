@@ -1,12 +1,14 @@
 // Writes seed inputs the fuzz targets cannot take from files in the repository as they are:
 //   <out>/cdr/<topic>-<step>   one byte naming the type (TopicId), then a CDR message rbsim encoded
 //   <out>/log/<scene>-<compression>.mcap   short recordings, one per chunk compression
+//   <out>/interfaces/<n>-<i>   one byte naming the type (interface_types.hpp), then its CDR
 // from the scenes given (a few steps each), so every seed is produced by the code it exercises.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "interface_types.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/msgs.hpp"
 #include "rbsim/scene.hpp"
@@ -16,6 +18,41 @@ int fail(const std::string& m) {
   std::fprintf(stderr, "rbsim_fuzz_seeds: %s\n", m.c_str());
   return 1;
 }
+
+// Each interface type empty, and the parameter messages with every kind of field filled.
+void interface_seeds(const std::filesystem::path& dir) {
+  namespace m = rbsim::msgs;
+  std::filesystem::create_directories(dir);
+  int n = 0;
+  const auto write = [&](std::size_t index, const auto& message) {
+    rbsim::Bytes bytes;
+    m::encode(message, bytes);
+    std::ofstream f(dir / (std::to_string(n++) + "-" + std::to_string(index)), std::ios::binary);
+    f.put(static_cast<char>(index));
+    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  };
+  for (std::size_t i = 0; i < rbsim::fuzz::kInterfaceCount; ++i) {
+    rbsim::fuzz::with_interface(i, [&]<class T>() { write(i, T{}); });
+  }
+  m::ParameterValue v;
+  v.type = static_cast<std::uint8_t>(m::ParameterType::StringArray);
+  v.string_value = "forces.0.fy";
+  v.byte_array_value = {1, 2};
+  v.bool_array_value = {true};
+  v.integer_array_value = {-1};
+  v.double_array_value = {0.5};
+  v.string_array_value = {"a", "bc"};
+  m::ParameterDescriptor d;
+  d.name = "rate";
+  d.floating_point_range = m::FloatingPointRange{0, 10, 0};
+  d.integer_range = m::IntegerRange{1, 5, 1};
+  m::ParameterEvent e;
+  e.node = "/rbsim";
+  e.changed_parameters = {{"rate", v}};
+  write(5, e);
+  write(10, m::SetParametersRequest{{{"rate", v}, {"paused", {}}}});
+  write(15, m::DescribeParametersResponse{{d}});
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -24,6 +61,7 @@ int main(int argc, char** argv) {
   const fs::path out(argv[1]);
   fs::create_directories(out / "cdr");
   fs::create_directories(out / "log");
+  interface_seeds(out / "interfaces");
   for (int i = 2; i < argc; ++i) {
     auto scene = rbsim::load_scene(argv[i]);
     if (!scene) return fail(scene.error().message);

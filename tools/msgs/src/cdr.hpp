@@ -38,6 +38,7 @@ class CdrWriter {
   void i32(std::int32_t v) { put(v); }
   void u32(std::uint32_t v) { put(v); }
   void u64(std::uint64_t v) { put(v); }
+  void i64(std::int64_t v) { put(v); }
   void f32(float v) { put(v); }
   void f64(double v) { put(v); }
   void string(std::string_view s) {

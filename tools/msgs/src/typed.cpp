@@ -1,61 +1,15 @@
 // Typed decoding of rbsim's own messages (for tools that draw or export a recording).
 #include <cmath>
 
+#include "cdr_reader.hpp"
 #include "rbsim/cdr.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
 
+using detail::Reader;
+
 namespace {
-
-// The typed decoders' reader: the CDR cursor with a sticky failure (the first one stops every
-// later read, which then return zeros).
-class Reader {
- public:
-  explicit Reader(std::span<const std::byte> data) : ok_(CdrCursor::plain_header(data)), at_(data) {}
-  bool ok() const { return ok_; }
-  template <class T>
-  T get() {
-    T v{};
-    if (ok_ && !at_.read(v)) ok_ = false;
-    return v;
-  }
-  std::string string() { return std::string(string_view()); }
-  void skip_string() { (void)string_view(); }
-  // A sequence length, bounded by the bytes left (every element takes at least `min_size`).
-  std::uint32_t length(std::size_t min_size) {
-    const auto n = get<std::uint32_t>();
-    if (ok_ && static_cast<std::uint64_t>(n) * min_size > at_.remaining()) ok_ = false;
-    return ok_ ? n : 0;
-  }
-  Vec2 vec2() {
-    const double x = get<double>();
-    return {x, get<double>()};
-  }
-  Color color() {
-    Color c;
-    c.r = get<float>();
-    c.g = get<float>();
-    c.b = get<float>();
-    (void)get<float>();  // alpha
-    return c;
-  }
-  Time time() {
-    Time t;
-    t.sec = get<std::int32_t>();
-    t.nanosec = get<std::uint32_t>();
-    return t;
-  }
-
- private:
-  std::string_view string_view() {
-    std::string_view s;
-    if (!ok_ || !at_.string(s)) ok_ = false;
-    return s;
-  }
-  bool ok_;
-  CdrCursor at_;  // used only while ok_ (the header checked)
-};
 
 Error bad(const char* type) {
   return Error{std::string("malformed or truncated ") + type + " message"};

@@ -1,0 +1,586 @@
+// ROS 2 services on Cyclone DDS, rmw_cyclonedds_cpp's way (rbsim/service.hpp): the raw-CDR sertype
+// under the service's request and response type names, the request header spliced before the body.
+#include "rbsim/service.hpp"
+
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
+#include <dds/ddsi/ddsi_sertype.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "raw_serdata.hpp"
+#include "rbsim/assert.hpp"
+#include "rbsim/cdr.hpp"
+
+namespace rbsim::node {
+
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+Error dds_error(const std::string& what, dds_return_t rc) {
+  return Error{what + ": " + dds_strretcode(rc)};
+}
+
+dds_duration_t to_dds(double seconds) {
+  return static_cast<dds_duration_t>(std::max(0.0, seconds) * 1e9);
+}
+
+// rmw_qos_profile_services_default as rmw_cyclonedds_cpp turns it into DDS QoS: reliable, volatile,
+// keep last 10, no autodispose, and the endpoint's USER_DATA. rmw_cyclonedds lets a reliable writer
+// block for ever; ours block at most `max_blocking` (keep-last writers seldom block at all), so a
+// stuck peer never stalls the node. Reliability's blocking time is not part of QoS matching.
+dds_qos_t* service_qos(const std::string& user_data, std::int32_t depth, dds_duration_t max_blocking) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_writer_data_lifecycle(qos, false);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, depth);
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, max_blocking);
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  dds_qset_liveliness(qos, DDS_LIVELINESS_AUTOMATIC, DDS_INFINITY);
+  dds_qset_userdata(qos, user_data.data(), user_data.size());
+  return qos;
+}
+
+// A topic of the raw-CDR sertype under `type_name`; `sertype` receives the one the topic uses.
+Result<dds_entity_t> make_topic(dds_entity_t participant, const std::string& name,
+                                const std::string& type_name, const ddsi_sertype** sertype) {
+  ddsi_sertype* type = make_raw_sertype(type_name.c_str());
+  const dds_entity_t topic =
+      dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
+  if (topic < 0) {
+    ddsi_sertype_unref(type);  // not taken over on failure
+    return dds_error("cannot create DDS topic " + name, topic);
+  }
+  if (sertype != nullptr) *sertype = type;
+  return topic;
+}
+
+// The id rmw_cyclonedds_cpp gives a client or a service (get_unique_csid, csid_to_string): the
+// participant's GUID prefix and a per-process counter, big endian, printed as hex bytes joined by
+// '.', the first one padded to two characters. Only equality matters: a server compares the id of a
+// client's request writer with those of the reply readers it matched.
+std::string endpoint_pair_id(dds_entity_t participant) {
+  static std::atomic<std::uint32_t> counter{0};
+  const std::uint32_t x = ++counter;
+  dds_guid_t guid{};
+  (void)dds_get_guid(participant, &guid);
+  std::array<std::uint8_t, 16> id{};
+  std::memcpy(id.data(), guid.v, 12);
+  for (int i = 0; i < 4; ++i) id[12 + i] = static_cast<std::uint8_t>(x >> (24 - 8 * i));
+  char buf[4];
+  std::snprintf(buf, sizeof buf, "%2x", id[0]);
+  std::string s = buf;
+  for (std::size_t i = 1; i < id.size(); ++i) {
+    std::snprintf(buf, sizeof buf, ".%x", id[i]);
+    s += buf;
+  }
+  return s;
+}
+
+// The value of `key` in USER_DATA of the form "k1=v1;k2=v2;" (rmw's key-value encoding).
+std::optional<std::string> user_data_value(const dds_qos_t* qos, std::string_view key) {
+  void* data = nullptr;
+  std::size_t size = 0;
+  if (qos == nullptr || !dds_qget_userdata(qos, &data, &size) || data == nullptr) return std::nullopt;
+  const std::string text(static_cast<const char*>(data), size);
+  dds_free(data);
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t end = std::min(text.find(';', at), text.size());
+    const std::string_view item(text.data() + at, end - at);
+    const std::size_t eq = item.find('=');
+    if (eq != std::string_view::npos && item.substr(0, eq) == key) return std::string(item.substr(eq + 1));
+    at = end + 1;
+  }
+  return std::nullopt;
+}
+
+EndpointId endpoint_id(dds_entity_t entity) {
+  EndpointId id;
+  dds_guid_t guid{};
+  if (dds_get_guid(entity, &guid) >= 0) std::memcpy(id.guid.data(), guid.v, id.guid.size());
+  dds_instance_handle_t ih = 0;
+  if (dds_get_instance_handle(entity, &ih) >= 0) id.instance_handle = ih;
+  return id;
+}
+
+// Copies a taken sample's bytes into `out` (replaced).
+void sample_bytes(ddsi_serdata* d, Bytes& out) {
+  const std::uint32_t size = ddsi_serdata_size(d);
+  out.resize(size);
+  if (size > 0) ddsi_serdata_to_ser(d, 0, size, out.data());
+}
+
+// A request and a reply topic with their endpoints, deleted together.
+struct Endpoints {
+  dds_entity_t writer_topic = 0, reader_topic = 0, writer = 0, reader = 0;
+  const ddsi_sertype* writer_type = nullptr;
+  void remove() {
+    // The reader first: deleting it waits for a listener call in progress.
+    for (dds_entity_t* e : {&reader, &writer, &reader_topic, &writer_topic}) {
+      if (*e > 0) dds_delete(*e);
+      *e = 0;
+    }
+  }
+};
+
+// Creates both topics and endpoints; `listener` (may be null) goes to the reader.
+Status make_endpoints(dds_entity_t participant, const std::string& writer_topic,
+                      const std::string& writer_type, const std::string& writer_user_data,
+                      const std::string& reader_topic, const std::string& reader_type,
+                      const std::string& reader_user_data, std::int32_t reader_depth,
+                      dds_duration_t writer_blocking, const dds_listener_t* listener, Endpoints& out) {
+  auto wt = make_topic(participant, writer_topic, writer_type, &out.writer_type);
+  if (!wt) return wt.error();
+  out.writer_topic = wt.value();
+  auto rt = make_topic(participant, reader_topic, reader_type, nullptr);
+  if (!rt) return rt.error();
+  out.reader_topic = rt.value();
+  dds_qos_t* wq = service_qos(writer_user_data, 10, writer_blocking);
+  out.writer = dds_create_writer(participant, out.writer_topic, wq, nullptr);
+  dds_delete_qos(wq);
+  if (out.writer < 0) return dds_error("cannot create DDS writer on " + writer_topic, out.writer);
+  dds_qos_t* rq = service_qos(reader_user_data, reader_depth, DDS_INFINITY);
+  out.reader = dds_create_reader(participant, out.reader_topic, rq, listener);
+  dds_delete_qos(rq);
+  if (out.reader < 0) return dds_error("cannot create DDS reader on " + reader_topic, out.reader);
+  return Ok{};
+}
+
+// Matched counts of an endpoint: a cache built from the matched endpoints stays valid while they
+// are unchanged (any match or unmatch changes the total or the current count).
+struct MatchState {
+  std::uint32_t total = UINT32_MAX;
+  std::uint32_t current = UINT32_MAX;
+  bool operator==(const MatchState&) const = default;
+};
+MatchState publication_state(dds_entity_t writer) {
+  dds_publication_matched_status_t st{};
+  if (dds_get_publication_matched_status(writer, &st) < 0) return {0, 0};
+  return {st.total_count, st.current_count};
+}
+MatchState subscription_state(dds_entity_t reader) {
+  dds_subscription_matched_status_t st{};
+  if (dds_get_subscription_matched_status(reader, &st) < 0) return {0, 0};
+  return {st.total_count, st.current_count};
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Names and the sample layout
+
+std::string service_request_topic(std::string_view service) {
+  return "rq" + std::string(service.starts_with('/') ? "" : "/") + std::string(service) + "Request";
+}
+std::string service_reply_topic(std::string_view service) {
+  return "rr" + std::string(service.starts_with('/') ? "" : "/") + std::string(service) + "Reply";
+}
+std::string service_request_type(std::string_view srv_type) {
+  return msgs::dds_type_name(std::string(srv_type) + "_Request");
+}
+std::string service_response_type(std::string_view srv_type) {
+  return msgs::dds_type_name(std::string(srv_type) + "_Response");
+}
+
+void wrap_service_sample(const RequestHeader& header, std::span<const std::byte> body, Bytes& out) {
+  RBSIM_ASSERT(body.size() >= msgs::CdrCursor::kHeader, "a service body is a CDR message");
+  // The encapsulation header stays the body's: its padding count (options) still holds, as the
+  // total grows by 16 bytes.
+  out.resize(body.size() + kRequestHeaderBytes);
+  std::memcpy(out.data(), body.data(), msgs::CdrCursor::kHeader);
+  std::memcpy(out.data() + 4, &header.guid, 8);
+  std::memcpy(out.data() + 12, &header.seq, 8);
+  std::memcpy(out.data() + 4 + kRequestHeaderBytes, body.data() + 4, body.size() - 4);
+}
+
+Result<RequestHeader> unwrap_service_sample(std::span<const std::byte> sample, Bytes& body) {
+  if (!msgs::CdrCursor::plain_header(sample)) {
+    return Error{"not a plain little-endian CDR sample (encapsulation header 00 01)", ErrorCode::Malformed};
+  }
+  msgs::CdrCursor at(sample);
+  RequestHeader h;
+  if (!at.read(h.guid) || !at.read(h.seq)) {
+    return Error{
+        "a service sample of " + std::to_string(sample.size()) + " bytes has no room for the request header",
+        ErrorCode::Truncated};
+  }
+  body.resize(sample.size() - kRequestHeaderBytes);
+  std::memcpy(body.data(), sample.data(), msgs::CdrCursor::kHeader);
+  std::memcpy(body.data() + 4, sample.data() + 4 + kRequestHeaderBytes, body.size() - 4);
+  return h;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Server
+
+struct ServiceServer::Impl {
+  std::string service;
+  ServiceOptions options;
+  dds_entity_t participant = 0;
+  Endpoints dds;  // writer: replies, reader: requests
+
+  // Filled by the listener on Cyclone's receive thread, emptied by serve(): a ring of slots whose
+  // buffers are reused, so a steady stream of requests does not allocate.
+  struct Slot {
+    RequestHeader header;
+    std::uint64_t publication = 0;  // the request writer's instance handle (the client)
+    Bytes body;
+  };
+  mutable std::mutex mu;
+  std::condition_variable arrived;
+  std::vector<Slot> ring;
+  std::size_t head = 0, count = 0;
+  ServiceStats stats;  // stats.pending: pending.size() as serve() left it
+
+  // The caller's thread only (serve()).
+  struct Pending {
+    RequestHeader header;
+    std::uint64_t publication = 0;
+    Bytes reply;
+    Clock::time_point deadline;
+  };
+  std::vector<Pending> pending;
+  Slot current;
+  Bytes reply, sample, taken;
+  // The clientid of each matched request writer (none: it sent none), and the clientids of the
+  // matched reply readers, each valid while the match counts they were read at hold.
+  std::unordered_map<std::uint64_t, std::optional<std::string>> writer_ids;
+  std::unordered_set<std::string> reader_ids;
+  MatchState writers_at, readers_at;
+
+  ~Impl() { dds.remove(); }
+
+  static void on_data(dds_entity_t reader, void* arg) { static_cast<Impl*>(arg)->take_all(reader); }
+
+  void take_all(dds_entity_t reader) {
+    while (true) {
+      ddsi_serdata* d = nullptr;
+      dds_sample_info_t info{};
+      if (dds_takecdr(reader, &d, 1, &info, DDS_ANY_STATE) <= 0) return;
+      if (info.valid_data) queue(d, info.publication_handle);
+      ddsi_serdata_unref(d);
+    }
+  }
+
+  void queue(ddsi_serdata* d, std::uint64_t publication) {
+    std::lock_guard lock(mu);
+    ++stats.received;
+    if (ddsi_serdata_size(d) > options.max_request_bytes) {
+      ++stats.dropped_large;  // never copied
+      return;
+    }
+    if (count == ring.size()) {
+      ++stats.dropped_full;
+      return;
+    }
+    sample_bytes(d, taken);
+    Slot& slot = ring[(head + count) % ring.size()];
+    auto header = unwrap_service_sample(taken, slot.body);
+    if (!header) {
+      ++stats.malformed;
+      return;
+    }
+    slot.header = header.value();
+    slot.publication = publication;
+    ++count;
+    arrived.notify_one();
+  }
+
+  enum class Client : std::uint8_t { Present, NotYet, Gone };
+  // Whether the client that sent a request (its request writer's handle) can get the reply, as
+  // rmw_cyclonedds's check_for_response_reader decides: gone when its request writer is no longer
+  // matched; present when it carries no clientid (older clients) or one of our reply writer's
+  // matched readers carries the same clientid; else not yet.
+  Client client(std::uint64_t publication) {
+    const MatchState w = subscription_state(dds.reader);
+    if (!(w == writers_at)) {
+      writer_ids.clear();
+      writers_at = w;
+    }
+    auto it = writer_ids.find(publication);
+    if (it == writer_ids.end()) {
+      dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(dds.reader, publication);
+      if (e == nullptr) return Client::Gone;
+      it = writer_ids.emplace(publication, user_data_value(e->qos, "clientid")).first;
+      dds_builtintopic_free_endpoint(e);
+    }
+    if (!it->second) return Client::Present;
+    const MatchState r = publication_state(dds.writer);
+    if (!(r == readers_at)) refresh_reader_ids(r);
+    return reader_ids.contains(*it->second) ? Client::Present : Client::NotYet;
+  }
+
+  void refresh_reader_ids(MatchState at) {
+    reader_ids.clear();
+    readers_at = at;
+    std::vector<dds_instance_handle_t> handles(std::size_t{at.current == UINT32_MAX ? 0 : at.current} + 8);
+    const dds_return_t n = dds_get_matched_subscriptions(dds.writer, handles.data(), handles.size());
+    for (dds_return_t i = 0; i < std::min<dds_return_t>(n, static_cast<dds_return_t>(handles.size())); ++i) {
+      dds_builtintopic_endpoint_t* e = dds_get_matched_subscription_data(dds.writer, handles[i]);
+      if (e == nullptr) continue;
+      if (auto id = user_data_value(e->qos, "clientid")) reader_ids.insert(*id);
+      dds_builtintopic_free_endpoint(e);
+    }
+    // More readers than room: the next call reads them again (the cache stays invalid).
+    if (n > static_cast<dds_return_t>(handles.size())) readers_at = {};
+  }
+
+  void count_one(std::uint64_t ServiceStats::*field) {
+    std::lock_guard lock(mu);
+    ++(stats.*field);
+  }
+
+  void write(const RequestHeader& header, std::span<const std::byte> body) {
+    if (body.size() < msgs::CdrCursor::kHeader) {  // the handler wrote no CDR message
+      count_one(&ServiceStats::write_failed);
+      return;
+    }
+    wrap_service_sample(header, body, sample);
+    ddsi_serdata* d = make_raw_serdata(dds.writer_type, sample);
+    const dds_return_t rc = dds_writecdr(dds.writer, d);  // takes the reference
+    count_one(rc < 0 ? &ServiceStats::write_failed : &ServiceStats::answered);
+  }
+
+  void deliver(const RequestHeader& header, std::uint64_t publication, const Bytes& body) {
+    switch (client(publication)) {
+      case Client::Present:
+        write(header, body);
+        return;
+      case Client::Gone:
+        count_one(&ServiceStats::client_gone);
+        return;
+      case Client::NotYet:
+        if (pending.size() >= options.queue_limit) {
+          count_one(&ServiceStats::client_unmatched);
+          return;
+        }
+        pending.push_back(
+            {header, publication, body,
+             Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                std::chrono::duration<double>(options.client_match_timeout_s))});
+        return;
+    }
+  }
+
+  void retry_pending() {
+    const auto now = Clock::now();
+    std::erase_if(pending, [&](const Pending& p) {
+      switch (client(p.publication)) {
+        case Client::Present:
+          write(p.header, p.reply);
+          return true;
+        case Client::Gone:
+          count_one(&ServiceStats::client_gone);
+          return true;
+        case Client::NotYet:
+          break;
+      }
+      if (now < p.deadline) return false;
+      count_one(&ServiceStats::client_unmatched);
+      return true;
+    });
+  }
+
+  bool pop() {
+    std::lock_guard lock(mu);
+    if (count == 0) return false;
+    Slot& slot = ring[head];
+    current.header = slot.header;
+    current.publication = slot.publication;
+    std::swap(current.body, slot.body);  // both buffers keep their storage
+    head = (head + 1) % ring.size();
+    --count;
+    return true;
+  }
+};
+
+ServiceServer::ServiceServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ServiceServer::ServiceServer(ServiceServer&&) noexcept = default;
+ServiceServer::~ServiceServer() = default;
+
+Result<ServiceServer> ServiceServer::create(const Participant& participant, std::string_view service,
+                                            std::string_view srv_type, const ServiceOptions& options) {
+  auto impl = std::make_unique<Impl>();
+  impl->service = std::string(service);
+  impl->options = options;
+  impl->options.queue_limit = std::max<std::size_t>(options.queue_limit, 1);
+  impl->ring.resize(impl->options.queue_limit);
+  impl->participant = participant.handle();
+  const std::string user_data = "serviceid=" + endpoint_pair_id(participant.handle()) + ";";
+  dds_listener_t* listener = dds_create_listener(impl.get());
+  dds_lset_data_available(listener, &Impl::on_data);
+  // The reader keeps as many requests as the queue: the listener drains it as they arrive, so the
+  // queue, where drops are counted, is where a flood is cut.
+  const auto depth = static_cast<std::int32_t>(std::min<std::size_t>(impl->options.queue_limit, INT32_MAX));
+  Status st = make_endpoints(
+      participant.handle(), service_reply_topic(service), service_response_type(srv_type),
+      user_data + options.reply_user_data, service_request_topic(service), service_request_type(srv_type),
+      user_data + options.request_user_data, std::max(depth, 10), DDS_MSECS(10), listener, impl->dds);
+  dds_delete_listener(listener);
+  if (!st) return Error{"service " + std::string(service) + ": " + st.error().message};
+  return ServiceServer(std::move(impl));
+}
+
+std::size_t ServiceServer::serve(const Handler& handler, std::size_t budget) {
+  Impl& s = *impl_;
+  if (!s.pending.empty()) s.retry_pending();
+  std::size_t handled = 0;
+  while (handled < budget && s.pop()) {
+    ++handled;
+    s.reply.clear();
+    if (!handler(s.current.header, s.current.body, s.reply)) {
+      s.count_one(&ServiceStats::unanswered);
+      continue;
+    }
+    s.deliver(s.current.header, s.current.publication, s.reply);
+  }
+  std::lock_guard lock(s.mu);
+  s.stats.pending = s.pending.size();  // for stats() from any thread
+  return handled;
+}
+
+bool ServiceServer::wait(double timeout_s) {
+  std::unique_lock lock(impl_->mu);
+  return impl_->arrived.wait_for(lock, std::chrono::duration<double>(std::max(0.0, timeout_s)),
+                                 [&] { return impl_->count > 0; });
+}
+
+ServiceStats ServiceServer::stats() const {
+  std::lock_guard lock(impl_->mu);
+  ServiceStats s = impl_->stats;
+  s.queued = impl_->count;
+  return s;
+}
+EndpointId ServiceServer::request_reader() const {
+  return endpoint_id(impl_->dds.reader);
+}
+EndpointId ServiceServer::reply_writer() const {
+  return endpoint_id(impl_->dds.writer);
+}
+const std::string& ServiceServer::service() const {
+  return impl_->service;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Client
+
+struct ServiceClient::Impl {
+  Endpoints dds;  // writer: requests, reader: replies
+  dds_entity_t waitset = 0, condition = 0;
+  std::uint64_t id = 0;
+  std::int64_t next_seq = 0;
+  Bytes sample, taken;
+  ~Impl() {
+    if (waitset > 0) dds_delete(waitset);
+    dds.remove();  // the read condition goes with its reader
+  }
+};
+
+ServiceClient::ServiceClient(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ServiceClient::ServiceClient(ServiceClient&&) noexcept = default;
+ServiceClient::~ServiceClient() = default;
+
+Result<ServiceClient> ServiceClient::create(const Participant& participant, std::string_view service,
+                                            std::string_view srv_type, const ClientOptions& options) {
+  auto impl = std::make_unique<Impl>();
+  const std::string user_data = "clientid=" + endpoint_pair_id(participant.handle()) + ";";
+  Status st = make_endpoints(participant.handle(), service_request_topic(service),
+                             service_request_type(srv_type), user_data + options.request_user_data,
+                             service_reply_topic(service), service_response_type(srv_type),
+                             user_data + options.reply_user_data, 10, DDS_SECS(1), nullptr, impl->dds);
+  if (!st) return Error{"client of " + std::string(service) + ": " + st.error().message};
+  impl->id = endpoint_id(impl->dds.writer).instance_handle;
+  impl->condition = dds_create_readcondition(impl->dds.reader, DDS_ANY_STATE);
+  impl->waitset = dds_create_waitset(participant.handle());
+  if (impl->condition < 0 || impl->waitset < 0 || dds_waitset_attach(impl->waitset, impl->condition, 0) < 0) {
+    return Error{"client of " + std::string(service) + ": cannot create its DDS wait set"};
+  }
+  return ServiceClient(std::move(impl));
+}
+
+bool ServiceClient::server_ready() const {
+  return publication_state(impl_->dds.writer).current > 0 &&
+         subscription_state(impl_->dds.reader).current > 0;
+}
+
+Status ServiceClient::wait_for_server(double timeout_s) {
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  while (!server_ready()) {
+    if (Clock::now() >= end) return Error{"no service server matched in time"};
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return Ok{};
+}
+
+Result<std::int64_t> ServiceClient::send(std::span<const std::byte> request) {
+  if (request.size() < msgs::CdrCursor::kHeader)
+    return Error{"a request must be a CDR message", ErrorCode::InvalidArgument};
+  const RequestHeader header{impl_->id, ++impl_->next_seq};
+  wrap_service_sample(header, request, impl_->sample);
+  ddsi_serdata* d = make_raw_serdata(impl_->dds.writer_type, impl_->sample);
+  const dds_return_t rc = dds_writecdr(impl_->dds.writer, d);
+  if (rc < 0) return dds_error("sending a request failed", rc);
+  return header.seq;
+}
+
+bool ServiceClient::take_reply(RequestHeader& header, Bytes& reply) {
+  while (true) {
+    ddsi_serdata* d = nullptr;
+    dds_sample_info_t info{};
+    if (dds_takecdr(impl_->dds.reader, &d, 1, &info, DDS_ANY_STATE) <= 0) return false;
+    if (info.valid_data) sample_bytes(d, impl_->taken);
+    ddsi_serdata_unref(d);
+    if (!info.valid_data) continue;
+    auto h = unwrap_service_sample(impl_->taken, reply);
+    if (!h || h.value().guid != impl_->id) continue;  // malformed, or another client's
+    header = h.value();
+    return true;
+  }
+}
+
+bool ServiceClient::wait_reply(double timeout_s) {
+  return dds_waitset_wait(impl_->waitset, nullptr, 0, to_dds(timeout_s)) > 0;
+}
+
+Result<Bytes> ServiceClient::call(std::span<const std::byte> request, double timeout_s) {
+  auto seq = send(request);
+  if (!seq) return seq.error();
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  Bytes reply;
+  RequestHeader header;
+  while (true) {
+    while (take_reply(header, reply)) {
+      if (header.seq == seq.value()) return reply;
+    }
+    const auto left = std::chrono::duration<double>(end - Clock::now()).count();
+    if (left <= 0) return Error{"no reply within " + std::to_string(timeout_s) + " s"};
+    wait_reply(left);
+  }
+}
+
+std::uint64_t ServiceClient::id() const {
+  return impl_->id;
+}
+EndpointId ServiceClient::request_writer() const {
+  return endpoint_id(impl_->dds.writer);
+}
+EndpointId ServiceClient::reply_reader() const {
+  return endpoint_id(impl_->dds.reader);
+}
+
+}  // namespace rbsim::node

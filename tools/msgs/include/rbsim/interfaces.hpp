@@ -1,0 +1,248 @@
+// ROS 2 service and parameter interfaces as plain structs with CDR codecs: rcl_interfaces' parameter
+// messages and its six parameter services, std_srvs/srv/Trigger, and rbsim_msgs' Step and
+// ApplyImpulse services. Field order and types follow the .msg/.srv definitions (ros2/rcl_interfaces,
+// ros2/common_interfaces, tools/msgs/definitions); the bytes are those of msgs.hpp's CDR (XCDR1,
+// little endian, 4-byte encapsulation header), the body of a service sample without the request
+// header rmw_cyclonedds_cpp puts before it (node/include/rbsim/service.hpp adds and strips that).
+//
+// decode() reads untrusted bytes: a truncated message, a length that runs past the data or a wrong
+// encapsulation header is an error naming the type and the byte offset, never a crash; every
+// sequence length is checked against the bytes left before anything is allocated, so memory stays
+// proportional to the input.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rbsim/msgs.hpp"
+
+namespace rbsim::msgs {
+
+// rcl_interfaces/msg/ParameterType: the values of ParameterValue::type.
+enum class ParameterType : std::uint8_t {
+  NotSet = 0,
+  Bool = 1,
+  Integer = 2,
+  Double = 3,
+  String = 4,
+  ByteArray = 5,
+  BoolArray = 6,
+  IntegerArray = 7,
+  DoubleArray = 8,
+  StringArray = 9,
+};
+
+// rcl_interfaces/msg/ParameterValue: `type` says which field holds the value (other values are
+// carried as received: a reader checks it).
+struct ParameterValue {
+  static constexpr std::string_view kType = "rcl_interfaces/msg/ParameterValue";
+  std::uint8_t type = 0;
+  bool bool_value = false;
+  std::int64_t integer_value = 0;
+  double double_value = 0.0;
+  std::string string_value;
+  std::vector<std::uint8_t> byte_array_value;
+  std::vector<bool> bool_array_value;
+  std::vector<std::int64_t> integer_array_value;
+  std::vector<double> double_array_value;
+  std::vector<std::string> string_array_value;
+  bool operator==(const ParameterValue&) const = default;
+};
+struct Parameter {
+  static constexpr std::string_view kType = "rcl_interfaces/msg/Parameter";
+  std::string name;
+  ParameterValue value;
+  bool operator==(const Parameter&) const = default;
+};
+struct FloatingPointRange {
+  double from_value = 0.0, to_value = 0.0, step = 0.0;
+  bool operator==(const FloatingPointRange&) const = default;
+};
+struct IntegerRange {
+  std::int64_t from_value = 0, to_value = 0;
+  std::uint64_t step = 0;
+  bool operator==(const IntegerRange&) const = default;
+};
+// rcl_interfaces/msg/ParameterDescriptor; the ranges are bounded sequences of at most one element
+// (FloatingPointRange[<=1]), here an optional (more than one on the wire is a decode error).
+struct ParameterDescriptor {
+  static constexpr std::string_view kType = "rcl_interfaces/msg/ParameterDescriptor";
+  std::string name;
+  std::uint8_t type = 0;
+  std::string description, additional_constraints;
+  bool read_only = false, dynamic_typing = false;
+  std::optional<FloatingPointRange> floating_point_range;
+  std::optional<IntegerRange> integer_range;
+  bool operator==(const ParameterDescriptor&) const = default;
+};
+struct SetParametersResult {
+  static constexpr std::string_view kType = "rcl_interfaces/msg/SetParametersResult";
+  bool successful = false;
+  std::string reason;
+  bool operator==(const SetParametersResult&) const = default;
+};
+struct ListParametersResult {
+  static constexpr std::string_view kType = "rcl_interfaces/msg/ListParametersResult";
+  std::vector<std::string> names, prefixes;
+  bool operator==(const ListParametersResult&) const = default;
+};
+// rcl_interfaces/msg/ParameterEvent (/parameter_events): `node` is the fully qualified node name.
+struct ParameterEvent {
+  static constexpr std::string_view kType = "rcl_interfaces/msg/ParameterEvent";
+  Time stamp;
+  std::string node;
+  std::vector<Parameter> new_parameters, changed_parameters, deleted_parameters;
+  bool operator==(const ParameterEvent& o) const {
+    return stamp.sec == o.stamp.sec && stamp.nanosec == o.stamp.nanosec && node == o.node &&
+           new_parameters == o.new_parameters && changed_parameters == o.changed_parameters &&
+           deleted_parameters == o.deleted_parameters;
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Services: kService is the service type ("pkg/srv/Name"), each half its own struct.
+
+struct ListParametersRequest {
+  static constexpr std::string_view kService = "rcl_interfaces/srv/ListParameters";
+  static constexpr std::uint64_t kDepthRecursive = 0;
+  std::vector<std::string> prefixes;
+  std::uint64_t depth = kDepthRecursive;
+  bool operator==(const ListParametersRequest&) const = default;
+};
+struct ListParametersResponse {
+  static constexpr std::string_view kService = ListParametersRequest::kService;
+  ListParametersResult result;
+  bool operator==(const ListParametersResponse&) const = default;
+};
+struct GetParametersRequest {
+  static constexpr std::string_view kService = "rcl_interfaces/srv/GetParameters";
+  std::vector<std::string> names;
+  bool operator==(const GetParametersRequest&) const = default;
+};
+struct GetParametersResponse {
+  static constexpr std::string_view kService = GetParametersRequest::kService;
+  std::vector<ParameterValue> values;
+  bool operator==(const GetParametersResponse&) const = default;
+};
+struct SetParametersRequest {
+  static constexpr std::string_view kService = "rcl_interfaces/srv/SetParameters";
+  std::vector<Parameter> parameters;
+  bool operator==(const SetParametersRequest&) const = default;
+};
+struct SetParametersResponse {
+  static constexpr std::string_view kService = SetParametersRequest::kService;
+  std::vector<SetParametersResult> results;
+  bool operator==(const SetParametersResponse&) const = default;
+};
+struct SetParametersAtomicallyRequest {
+  static constexpr std::string_view kService = "rcl_interfaces/srv/SetParametersAtomically";
+  std::vector<Parameter> parameters;
+  bool operator==(const SetParametersAtomicallyRequest&) const = default;
+};
+struct SetParametersAtomicallyResponse {
+  static constexpr std::string_view kService = SetParametersAtomicallyRequest::kService;
+  SetParametersResult result;
+  bool operator==(const SetParametersAtomicallyResponse&) const = default;
+};
+struct DescribeParametersRequest {
+  static constexpr std::string_view kService = "rcl_interfaces/srv/DescribeParameters";
+  std::vector<std::string> names;
+  bool operator==(const DescribeParametersRequest&) const = default;
+};
+struct DescribeParametersResponse {
+  static constexpr std::string_view kService = DescribeParametersRequest::kService;
+  std::vector<ParameterDescriptor> descriptors;
+  bool operator==(const DescribeParametersResponse&) const = default;
+};
+struct GetParameterTypesRequest {
+  static constexpr std::string_view kService = "rcl_interfaces/srv/GetParameterTypes";
+  std::vector<std::string> names;
+  bool operator==(const GetParameterTypesRequest&) const = default;
+};
+struct GetParameterTypesResponse {
+  static constexpr std::string_view kService = GetParameterTypesRequest::kService;
+  std::vector<std::uint8_t> types;
+  bool operator==(const GetParameterTypesResponse&) const = default;
+};
+// std_srvs/srv/Trigger. Its request has no fields: on the wire it is rosidl's one placeholder
+// member, `uint8 structure_needs_at_least_one_member` (written 0, read and ignored).
+struct TriggerRequest {
+  static constexpr std::string_view kService = "std_srvs/srv/Trigger";
+  bool operator==(const TriggerRequest&) const = default;
+};
+struct TriggerResponse {
+  static constexpr std::string_view kService = TriggerRequest::kService;
+  bool success = false;
+  std::string message;
+  bool operator==(const TriggerResponse&) const = default;
+};
+// rbsim_msgs/srv/Step: `steps` steps while paused.
+struct StepRequest {
+  static constexpr std::string_view kService = "rbsim_msgs/srv/Step";
+  std::uint32_t steps = 0;
+  bool operator==(const StepRequest&) const = default;
+};
+// The reply of Step and ApplyImpulse: `step` is the step the change shows at.
+struct StepResponse {
+  static constexpr std::string_view kService = StepRequest::kService;
+  bool success = false;
+  std::string message;
+  std::uint64_t step = 0;
+  bool operator==(const StepResponse&) const = default;
+};
+// rbsim_msgs/srv/ApplyImpulse: linear impulse (jx, jy) in world axes at the point (px, py) in the
+// body frame, relative to the centre of mass.
+struct ApplyImpulseRequest {
+  static constexpr std::string_view kService = "rbsim_msgs/srv/ApplyImpulse";
+  std::uint32_t body = 0;
+  double jx = 0.0, jy = 0.0, px = 0.0, py = 0.0;
+  bool operator==(const ApplyImpulseRequest&) const = default;
+};
+struct ApplyImpulseResponse {
+  static constexpr std::string_view kService = ApplyImpulseRequest::kService;
+  bool success = false;
+  std::string message;
+  std::uint64_t step = 0;
+  bool operator==(const ApplyImpulseResponse&) const = default;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Codecs: encode() replaces `out` with the message's CDR (encapsulation header included);
+// decode() fills `out` (replaced whole) or fails naming the type and the offset, `out` then
+// unspecified.
+
+#define RBSIM_INTERFACE_CODEC(T)             \
+  void encode(const T& message, Bytes& out); \
+  [[nodiscard]] Status decode(std::span<const std::byte> cdr, T& out);
+RBSIM_INTERFACE_CODEC(ParameterValue)
+RBSIM_INTERFACE_CODEC(Parameter)
+RBSIM_INTERFACE_CODEC(ParameterDescriptor)
+RBSIM_INTERFACE_CODEC(SetParametersResult)
+RBSIM_INTERFACE_CODEC(ListParametersResult)
+RBSIM_INTERFACE_CODEC(ParameterEvent)
+RBSIM_INTERFACE_CODEC(ListParametersRequest)
+RBSIM_INTERFACE_CODEC(ListParametersResponse)
+RBSIM_INTERFACE_CODEC(GetParametersRequest)
+RBSIM_INTERFACE_CODEC(GetParametersResponse)
+RBSIM_INTERFACE_CODEC(SetParametersRequest)
+RBSIM_INTERFACE_CODEC(SetParametersResponse)
+RBSIM_INTERFACE_CODEC(SetParametersAtomicallyRequest)
+RBSIM_INTERFACE_CODEC(SetParametersAtomicallyResponse)
+RBSIM_INTERFACE_CODEC(DescribeParametersRequest)
+RBSIM_INTERFACE_CODEC(DescribeParametersResponse)
+RBSIM_INTERFACE_CODEC(GetParameterTypesRequest)
+RBSIM_INTERFACE_CODEC(GetParameterTypesResponse)
+RBSIM_INTERFACE_CODEC(TriggerRequest)
+RBSIM_INTERFACE_CODEC(TriggerResponse)
+RBSIM_INTERFACE_CODEC(StepRequest)
+RBSIM_INTERFACE_CODEC(StepResponse)
+RBSIM_INTERFACE_CODEC(ApplyImpulseRequest)
+RBSIM_INTERFACE_CODEC(ApplyImpulseResponse)
+#undef RBSIM_INTERFACE_CODEC
+
+}  // namespace rbsim::msgs

@@ -1,0 +1,385 @@
+// CDR codecs of the service and parameter interfaces (rbsim/interfaces.hpp), on the one writer
+// (CdrWriter) and the one cursor (through detail::Reader).
+#include "rbsim/interfaces.hpp"
+
+#include "cdr.hpp"
+#include "cdr_reader.hpp"
+
+namespace rbsim::msgs {
+
+using detail::CdrWriter;
+using detail::Reader;
+
+namespace {
+
+// The fewest bytes one element can take on the wire, before any padding: what a sequence length is
+// checked against (detail::Reader::length), so a huge length in a short message fails before
+// anything is allocated. Never more than the real minimum, so no valid message is refused.
+constexpr std::size_t kMinString = 5;  // u32 length + the NUL
+// type, bool, int64, float64, string, five sequence lengths
+constexpr std::size_t kMinValue = 1 + 1 + 8 + 8 + kMinString + 5 * 4;
+constexpr std::size_t kMinParameter = kMinString + kMinValue;
+// name, type, description, additional_constraints, read_only, dynamic_typing, two sequence lengths
+constexpr std::size_t kMinDescriptor = 3 * kMinString + 3 + 2 * 4;
+constexpr std::size_t kMinResult = 1 + kMinString;
+
+void put_strings(CdrWriter& w, const std::vector<std::string>& v) {
+  w.sequence_length(v.size());
+  for (const std::string& s : v) w.string(s);
+}
+void get_strings(Reader& r, std::vector<std::string>& v) {
+  v.resize(r.length(kMinString));
+  for (std::string& s : v) s = r.string();
+}
+template <class T>
+void put_values(CdrWriter& w, const std::vector<T>& v) {
+  w.sequence_length(v.size());
+  for (const T x : v) {
+    if constexpr (std::is_same_v<T, bool>) {
+      w.boolean(x);
+    } else if constexpr (std::is_same_v<T, std::uint8_t>) {
+      w.u8(x);
+    } else if constexpr (std::is_same_v<T, std::int64_t>) {
+      w.i64(x);
+    } else {
+      w.f64(x);
+    }
+  }
+}
+template <class T>
+void get_values(Reader& r, std::vector<T>& v) {
+  v.resize(r.length(sizeof(T)));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if constexpr (std::is_same_v<T, bool>) {
+      v[i] = r.get<std::uint8_t>() != 0;
+    } else {
+      v[i] = r.get<T>();
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Each type once: put() writes its fields, get() reads them (nested types call each other).
+
+void put(CdrWriter& w, const ParameterValue& m) {
+  w.u8(m.type);
+  w.boolean(m.bool_value);
+  w.i64(m.integer_value);
+  w.f64(m.double_value);
+  w.string(m.string_value);
+  put_values(w, m.byte_array_value);
+  put_values(w, m.bool_array_value);
+  put_values(w, m.integer_array_value);
+  put_values(w, m.double_array_value);
+  put_strings(w, m.string_array_value);
+}
+void get(Reader& r, ParameterValue& m) {
+  m.type = r.get<std::uint8_t>();
+  m.bool_value = r.get<std::uint8_t>() != 0;
+  m.integer_value = r.get<std::int64_t>();
+  m.double_value = r.get<double>();
+  m.string_value = r.string();
+  get_values(r, m.byte_array_value);
+  get_values(r, m.bool_array_value);
+  get_values(r, m.integer_array_value);
+  get_values(r, m.double_array_value);
+  get_strings(r, m.string_array_value);
+}
+void put(CdrWriter& w, const Parameter& m) {
+  w.string(m.name);
+  put(w, m.value);
+}
+void get(Reader& r, Parameter& m) {
+  m.name = r.string();
+  get(r, m.value);
+}
+void put(CdrWriter& w, const ParameterDescriptor& m) {
+  w.string(m.name);
+  w.u8(m.type);
+  w.string(m.description);
+  w.string(m.additional_constraints);
+  w.boolean(m.read_only);
+  w.boolean(m.dynamic_typing);
+  w.sequence_length(m.floating_point_range ? 1 : 0);
+  if (const auto& f = m.floating_point_range) {
+    w.f64(f->from_value);
+    w.f64(f->to_value);
+    w.f64(f->step);
+  }
+  w.sequence_length(m.integer_range ? 1 : 0);
+  if (const auto& i = m.integer_range) {
+    w.i64(i->from_value);
+    w.i64(i->to_value);
+    w.u64(i->step);
+  }
+}
+void get(Reader& r, ParameterDescriptor& m) {
+  m.name = r.string();
+  m.type = r.get<std::uint8_t>();
+  m.description = r.string();
+  m.additional_constraints = r.string();
+  m.read_only = r.get<std::uint8_t>() != 0;
+  m.dynamic_typing = r.get<std::uint8_t>() != 0;
+  m.floating_point_range.reset();
+  m.integer_range.reset();
+  const std::uint32_t floats = r.length(24);
+  if (floats > 1) r.fail();  // a bounded sequence, [<=1]
+  if (floats == 1) {
+    FloatingPointRange f;
+    f.from_value = r.get<double>();
+    f.to_value = r.get<double>();
+    f.step = r.get<double>();
+    m.floating_point_range = f;
+  }
+  const std::uint32_t ints = r.ok() ? r.length(24) : 0;
+  if (ints > 1) r.fail();
+  if (ints == 1) {
+    IntegerRange i;
+    i.from_value = r.get<std::int64_t>();
+    i.to_value = r.get<std::int64_t>();
+    i.step = r.get<std::uint64_t>();
+    m.integer_range = i;
+  }
+}
+void put(CdrWriter& w, const SetParametersResult& m) {
+  w.boolean(m.successful);
+  w.string(m.reason);
+}
+void get(Reader& r, SetParametersResult& m) {
+  m.successful = r.get<std::uint8_t>() != 0;
+  m.reason = r.string();
+}
+void put(CdrWriter& w, const ListParametersResult& m) {
+  put_strings(w, m.names);
+  put_strings(w, m.prefixes);
+}
+void get(Reader& r, ListParametersResult& m) {
+  get_strings(r, m.names);
+  get_strings(r, m.prefixes);
+}
+template <class T>
+void put_all(CdrWriter& w, const std::vector<T>& v) {
+  w.sequence_length(v.size());
+  for (const T& x : v) put(w, x);
+}
+template <class T>
+void get_all(Reader& r, std::vector<T>& v, std::size_t min_size) {
+  v.resize(r.length(min_size));
+  for (T& x : v) {
+    if (!r.ok()) break;  // a failed element leaves the rest unread: no work on garbage
+    get(r, x);
+  }
+}
+void put(CdrWriter& w, const ParameterEvent& m) {
+  w.time(m.stamp);
+  w.string(m.node);
+  put_all(w, m.new_parameters);
+  put_all(w, m.changed_parameters);
+  put_all(w, m.deleted_parameters);
+}
+void get(Reader& r, ParameterEvent& m) {
+  m.stamp = r.time();
+  m.node = r.string();
+  get_all(r, m.new_parameters, kMinParameter);
+  get_all(r, m.changed_parameters, kMinParameter);
+  get_all(r, m.deleted_parameters, kMinParameter);
+}
+
+void put(CdrWriter& w, const ListParametersRequest& m) {
+  put_strings(w, m.prefixes);
+  w.u64(m.depth);
+}
+void get(Reader& r, ListParametersRequest& m) {
+  get_strings(r, m.prefixes);
+  m.depth = r.get<std::uint64_t>();
+}
+void put(CdrWriter& w, const ListParametersResponse& m) {
+  put(w, m.result);
+}
+void get(Reader& r, ListParametersResponse& m) {
+  get(r, m.result);
+}
+void put(CdrWriter& w, const GetParametersRequest& m) {
+  put_strings(w, m.names);
+}
+void get(Reader& r, GetParametersRequest& m) {
+  get_strings(r, m.names);
+}
+void put(CdrWriter& w, const GetParametersResponse& m) {
+  put_all(w, m.values);
+}
+void get(Reader& r, GetParametersResponse& m) {
+  get_all(r, m.values, kMinValue);
+}
+void put(CdrWriter& w, const SetParametersRequest& m) {
+  put_all(w, m.parameters);
+}
+void get(Reader& r, SetParametersRequest& m) {
+  get_all(r, m.parameters, kMinParameter);
+}
+void put(CdrWriter& w, const SetParametersResponse& m) {
+  put_all(w, m.results);
+}
+void get(Reader& r, SetParametersResponse& m) {
+  get_all(r, m.results, kMinResult);
+}
+void put(CdrWriter& w, const SetParametersAtomicallyRequest& m) {
+  put_all(w, m.parameters);
+}
+void get(Reader& r, SetParametersAtomicallyRequest& m) {
+  get_all(r, m.parameters, kMinParameter);
+}
+void put(CdrWriter& w, const SetParametersAtomicallyResponse& m) {
+  put(w, m.result);
+}
+void get(Reader& r, SetParametersAtomicallyResponse& m) {
+  get(r, m.result);
+}
+void put(CdrWriter& w, const DescribeParametersRequest& m) {
+  put_strings(w, m.names);
+}
+void get(Reader& r, DescribeParametersRequest& m) {
+  get_strings(r, m.names);
+}
+void put(CdrWriter& w, const DescribeParametersResponse& m) {
+  put_all(w, m.descriptors);
+}
+void get(Reader& r, DescribeParametersResponse& m) {
+  get_all(r, m.descriptors, kMinDescriptor);
+}
+void put(CdrWriter& w, const GetParameterTypesRequest& m) {
+  put_strings(w, m.names);
+}
+void get(Reader& r, GetParameterTypesRequest& m) {
+  get_strings(r, m.names);
+}
+void put(CdrWriter& w, const GetParameterTypesResponse& m) {
+  put_values(w, m.types);
+}
+void get(Reader& r, GetParameterTypesResponse& m) {
+  get_values(r, m.types);
+}
+
+void put(CdrWriter& w, const TriggerRequest&) {
+  w.u8(0);
+}  // structure_needs_at_least_one_member
+void get(Reader& r, TriggerRequest&) {
+  (void)r.get<std::uint8_t>();
+}
+void put(CdrWriter& w, const TriggerResponse& m) {
+  w.boolean(m.success);
+  w.string(m.message);
+}
+void get(Reader& r, TriggerResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+  m.message = r.string();
+}
+void put(CdrWriter& w, const StepRequest& m) {
+  w.u32(m.steps);
+}
+void get(Reader& r, StepRequest& m) {
+  m.steps = r.get<std::uint32_t>();
+}
+void put(CdrWriter& w, const StepResponse& m) {
+  w.boolean(m.success);
+  w.string(m.message);
+  w.u64(m.step);
+}
+void get(Reader& r, StepResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+  m.message = r.string();
+  m.step = r.get<std::uint64_t>();
+}
+void put(CdrWriter& w, const ApplyImpulseRequest& m) {
+  w.u32(m.body);
+  w.f64(m.jx);
+  w.f64(m.jy);
+  w.f64(m.px);
+  w.f64(m.py);
+}
+void get(Reader& r, ApplyImpulseRequest& m) {
+  m.body = r.get<std::uint32_t>();
+  m.jx = r.get<double>();
+  m.jy = r.get<double>();
+  m.px = r.get<double>();
+  m.py = r.get<double>();
+}
+void put(CdrWriter& w, const ApplyImpulseResponse& m) {
+  w.boolean(m.success);
+  w.string(m.message);
+  w.u64(m.step);
+}
+void get(Reader& r, ApplyImpulseResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+  m.message = r.string();
+  m.step = r.get<std::uint64_t>();
+}
+
+// "rcl_interfaces/msg/Parameter", or "std_srvs/srv/Trigger request" for a service half.
+template <class T>
+std::string name_of(std::string_view half) {
+  if constexpr (requires { T::kType; }) {
+    return std::string(T::kType);
+  } else {
+    return std::string(T::kService) + std::string(half);
+  }
+}
+
+template <class T>
+void encode_message(const T& m, Bytes& out) {
+  CdrWriter w(out);
+  put(w, m);
+}
+template <class T>
+Status decode_message(std::span<const std::byte> cdr, T& out, std::string_view half) {
+  Reader r(cdr);
+  if (!r.ok()) {
+    return Error{"malformed " + name_of<T>(half) + ": not plain little-endian CDR (a 4-byte header 00 01)",
+                 ErrorCode::Malformed};
+  }
+  out = T{};
+  get(r, out);
+  if (!r.ok()) {
+    return Error{"malformed or truncated " + name_of<T>(half) + ": bad or missing data at byte " +
+                     std::to_string(r.pos()) + " of " + std::to_string(cdr.size()),
+                 ErrorCode::Truncated};
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+#define RBSIM_INTERFACE_CODEC(T, half)                    \
+  void encode(const T& message, Bytes& out) {             \
+    encode_message(message, out);                         \
+  }                                                       \
+  Status decode(std::span<const std::byte> cdr, T& out) { \
+    return decode_message(cdr, out, half);                \
+  }
+RBSIM_INTERFACE_CODEC(ParameterValue, "")
+RBSIM_INTERFACE_CODEC(Parameter, "")
+RBSIM_INTERFACE_CODEC(ParameterDescriptor, "")
+RBSIM_INTERFACE_CODEC(SetParametersResult, "")
+RBSIM_INTERFACE_CODEC(ListParametersResult, "")
+RBSIM_INTERFACE_CODEC(ParameterEvent, "")
+RBSIM_INTERFACE_CODEC(ListParametersRequest, " request")
+RBSIM_INTERFACE_CODEC(ListParametersResponse, " response")
+RBSIM_INTERFACE_CODEC(GetParametersRequest, " request")
+RBSIM_INTERFACE_CODEC(GetParametersResponse, " response")
+RBSIM_INTERFACE_CODEC(SetParametersRequest, " request")
+RBSIM_INTERFACE_CODEC(SetParametersResponse, " response")
+RBSIM_INTERFACE_CODEC(SetParametersAtomicallyRequest, " request")
+RBSIM_INTERFACE_CODEC(SetParametersAtomicallyResponse, " response")
+RBSIM_INTERFACE_CODEC(DescribeParametersRequest, " request")
+RBSIM_INTERFACE_CODEC(DescribeParametersResponse, " response")
+RBSIM_INTERFACE_CODEC(GetParameterTypesRequest, " request")
+RBSIM_INTERFACE_CODEC(GetParameterTypesResponse, " response")
+RBSIM_INTERFACE_CODEC(TriggerRequest, " request")
+RBSIM_INTERFACE_CODEC(TriggerResponse, " response")
+RBSIM_INTERFACE_CODEC(StepRequest, " request")
+RBSIM_INTERFACE_CODEC(StepResponse, " response")
+RBSIM_INTERFACE_CODEC(ApplyImpulseRequest, " request")
+RBSIM_INTERFACE_CODEC(ApplyImpulseResponse, " response")
+#undef RBSIM_INTERFACE_CODEC
+
+}  // namespace rbsim::msgs
