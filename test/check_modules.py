@@ -25,7 +25,7 @@ MODULES = {
     "core": ("sim_core", set()),
     "scene": ("sim_core/scene", {"core"}),
     "io": ("tools/io", {"core", "scene"}),
-    "control": ("tools/control", {"core", "scene", "io"}),
+    "control": ("tools/control", {"core", "scene", "io", "msgs"}),
     "msgs": ("tools/msgs", {"core", "scene"}),
     "mcap": ("tools/mcap", set()),
     "mcap_tools": ("tools/mcap_tools", {"mcap"}),

@@ -41,7 +41,7 @@ bool get_parameters(const node::RequestHeader&, std::span<const std::byte> reque
   if (!msgs::decode(request, req).ok()) return false;  // nothing to say in this response type
   for (const std::string& name : req.names) {
     msgs::ParameterValue v;
-    v.type = static_cast<std::uint8_t>(msgs::ParameterType::Integer);
+    v.type = msgs::ParameterType::Integer;
     v.integer_value = static_cast<std::int64_t>(name.size());
     v.string_value = name;
     v.double_value = 0.5 * static_cast<double>(name.size());

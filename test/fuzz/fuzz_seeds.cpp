@@ -35,7 +35,7 @@ void interface_seeds(const std::filesystem::path& dir) {
     rbsim::fuzz::with_interface(i, [&]<class T>() { write(i, T{}); });
   }
   m::ParameterValue v;
-  v.type = static_cast<std::uint8_t>(m::ParameterType::StringArray);
+  v.type = m::ParameterType::StringArray;
   v.string_value = "forces.0.fy";
   v.byte_array_value = {1, 2};
   v.bool_array_value = {true};

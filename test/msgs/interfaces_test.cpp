@@ -23,14 +23,14 @@ Bytes bytes(std::initializer_list<int> v) {
 
 ParameterValue double_array_value() {
   ParameterValue v;
-  v.type = static_cast<std::uint8_t>(ParameterType::DoubleArray);
+  v.type = ParameterType::DoubleArray;
   v.double_array_value = {1.5, -0.0, std::numeric_limits<double>::infinity()};
   return v;
 }
 // A value with every field set, so a field read from the wrong place shows.
 ParameterValue full_value() {
   ParameterValue v;
-  v.type = static_cast<std::uint8_t>(ParameterType::StringArray);
+  v.type = ParameterType::StringArray;
   v.bool_value = true;
   v.integer_value = -1234567890123;
   v.double_value = 2.5e-300;
@@ -48,7 +48,7 @@ Parameter parameter(std::string name, ParameterValue v) {
 ParameterDescriptor descriptor() {
   ParameterDescriptor d;
   d.name = "rate";
-  d.type = static_cast<std::uint8_t>(ParameterType::Double);
+  d.type = ParameterType::Double;
   d.description = "steps per second";
   d.additional_constraints = ">= 0";
   d.read_only = false;
@@ -141,7 +141,7 @@ TEST(InterfacesCodec, ListParametersRequestAlignsDepthAfterTheStrings) {
 
 TEST(InterfacesCodec, ParameterValueLayoutWithASequenceOfStrings) {
   ParameterValue v;
-  v.type = 9;
+  v.type = ParameterType::StringArray;
   v.double_value = 1.0;
   v.string_array_value = {"a", "bc"};
   Bytes cdr;

@@ -338,7 +338,7 @@ CommandResult Controller::set_parameters(const Command& command, World& world, B
   }
   r.successful = changed == command.parameters.size();
   if (command.atomic) {
-    r.results = {SetParametersResult{}};
+    r.results = {SetParametersResult{true, {}}};
   } else {
     r.results = std::move(checks);
   }

@@ -35,7 +35,7 @@ ParameterDescriptor real(std::string name, std::string description, double from,
   d.name = std::move(name);
   d.type = ParameterType::Double;
   d.description = std::move(description);
-  d.floating_point_range.push_back({from, to, 0.0});
+  d.floating_point_range = FloatingPointRange{from, to, 0.0};
   d.additional_constraints = "finite";
   return d;
 }
@@ -45,7 +45,7 @@ ParameterDescriptor integer(std::string name, std::string description, std::int6
   d.name = std::move(name);
   d.type = ParameterType::Integer;
   d.description = std::move(description);
-  d.integer_range.push_back({from, to, 0});
+  d.integer_range = IntegerRange{from, to, 0};
   return d;
 }
 
@@ -129,31 +129,6 @@ const char* to_string(ParameterType type) {
       return "string_array";
   }
   return "unknown type";
-}
-
-ParameterValue ParameterValue::of_bool(bool v) {
-  ParameterValue p;
-  p.type = ParameterType::Bool;
-  p.bool_value = v;
-  return p;
-}
-ParameterValue ParameterValue::of_integer(std::int64_t v) {
-  ParameterValue p;
-  p.type = ParameterType::Integer;
-  p.integer_value = v;
-  return p;
-}
-ParameterValue ParameterValue::of_double(double v) {
-  ParameterValue p;
-  p.type = ParameterType::Double;
-  p.double_value = v;
-  return p;
-}
-ParameterValue ParameterValue::of_string(std::string v) {
-  ParameterValue p;
-  p.type = ParameterType::String;
-  p.string_value = std::move(v);
-  return p;
 }
 
 std::string to_string(const ParameterValue& v) {
@@ -271,7 +246,7 @@ SetParametersResult ParameterTable::check(const Parameter& p) const {
   }
   if (d.type == ParameterType::Double) {
     const double v = p.value.double_value;
-    const FloatingPointRange& r = d.floating_point_range.front();
+    const FloatingPointRange& r = *d.floating_point_range;  // every double has one
     if (!std::isfinite(v))
       return fail("Parameter {" + p.name + "} must be finite (got " + shortest(v) + ").");
     if (v < r.from_value || v > r.to_value) {
@@ -281,7 +256,7 @@ SetParametersResult ParameterTable::check(const Parameter& p) const {
   }
   if (d.type == ParameterType::Integer) {
     const std::int64_t v = p.value.integer_value;
-    const IntegerRange& r = d.integer_range.front();
+    const IntegerRange& r = *d.integer_range;  // every integer has one
     if (v < r.from_value || v > r.to_value) {
       return fail("Parameter {" + p.name + "} doesn't comply with integer range [" +
                   std::to_string(r.from_value) + ", " + std::to_string(r.to_value) + "] (got " +
@@ -291,7 +266,7 @@ SetParametersResult ParameterTable::check(const Parameter& p) const {
   if (entries_[*i].target.kind == ParameterTarget::Kind::UseSimTime && p.value.bool_value) {
     return fail("parameter 'use_sim_time' cannot be true: rbsim is the clock (it publishes /clock)");
   }
-  return {};
+  return SetParametersResult{true, {}};
 }
 
 void ParameterTable::refresh(const World& world, const RunSettings& settings) {

@@ -7,6 +7,31 @@
 
 namespace rbsim::msgs {
 
+ParameterValue ParameterValue::of_bool(bool v) {
+  ParameterValue p;
+  p.type = ParameterType::Bool;
+  p.bool_value = v;
+  return p;
+}
+ParameterValue ParameterValue::of_integer(std::int64_t v) {
+  ParameterValue p;
+  p.type = ParameterType::Integer;
+  p.integer_value = v;
+  return p;
+}
+ParameterValue ParameterValue::of_double(double v) {
+  ParameterValue p;
+  p.type = ParameterType::Double;
+  p.double_value = v;
+  return p;
+}
+ParameterValue ParameterValue::of_string(std::string v) {
+  ParameterValue p;
+  p.type = ParameterType::String;
+  p.string_value = std::move(v);
+  return p;
+}
+
 using detail::CdrWriter;
 using detail::Reader;
 
@@ -62,7 +87,7 @@ void get_values(Reader& r, std::vector<T>& v) {
 // Each type once: put() writes its fields, get() reads them (nested types call each other).
 
 void put(CdrWriter& w, const ParameterValue& m) {
-  w.u8(m.type);
+  w.u8(static_cast<std::uint8_t>(m.type));
   w.boolean(m.bool_value);
   w.i64(m.integer_value);
   w.f64(m.double_value);
@@ -74,7 +99,7 @@ void put(CdrWriter& w, const ParameterValue& m) {
   put_strings(w, m.string_array_value);
 }
 void get(Reader& r, ParameterValue& m) {
-  m.type = r.get<std::uint8_t>();
+  m.type = static_cast<ParameterType>(r.get<std::uint8_t>());  // any value, as received
   m.bool_value = r.get<std::uint8_t>() != 0;
   m.integer_value = r.get<std::int64_t>();
   m.double_value = r.get<double>();
@@ -95,7 +120,7 @@ void get(Reader& r, Parameter& m) {
 }
 void put(CdrWriter& w, const ParameterDescriptor& m) {
   w.string(m.name);
-  w.u8(m.type);
+  w.u8(static_cast<std::uint8_t>(m.type));
   w.string(m.description);
   w.string(m.additional_constraints);
   w.boolean(m.read_only);
@@ -115,7 +140,7 @@ void put(CdrWriter& w, const ParameterDescriptor& m) {
 }
 void get(Reader& r, ParameterDescriptor& m) {
   m.name = r.string();
-  m.type = r.get<std::uint8_t>();
+  m.type = static_cast<ParameterType>(r.get<std::uint8_t>());  // any value, as received
   m.description = r.string();
   m.additional_constraints = r.string();
   m.read_only = r.get<std::uint8_t>() != 0;

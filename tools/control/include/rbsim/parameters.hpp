@@ -30,89 +30,26 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
+#include "rbsim/interfaces.hpp"
 #include "rbsim/scene.hpp"
 
 namespace rbsim::control {
 
-// rcl_interfaces/msg/ParameterType: the values are the message's constants.
-enum class ParameterType : std::uint8_t {
-  NotSet = 0,
-  Bool = 1,
-  Integer = 2,
-  Double = 3,
-  String = 4,
-  ByteArray = 5,
-  BoolArray = 6,
-  IntegerArray = 7,
-  DoubleArray = 8,
-  StringArray = 9,
-};
+// The rcl_interfaces types are msgs's (rbsim/interfaces.hpp: one definition, with their CDR
+// codecs); the table reads and answers in them.
+using msgs::FloatingPointRange;
+using msgs::IntegerRange;
+using msgs::ListParametersResult;
+using msgs::Parameter;
+using msgs::ParameterDescriptor;
+using msgs::ParameterType;
+using msgs::ParameterValue;
+using msgs::SetParametersResult;
 // rclcpp's names: "not set", "bool", "integer", "double", "string", "byte_array", ...
 const char* to_string(ParameterType type);
-
-// rcl_interfaces/msg/ParameterValue: `type` says which field holds the value.
-struct ParameterValue {
-  ParameterType type = ParameterType::NotSet;
-  bool bool_value = false;
-  std::int64_t integer_value = 0;
-  double double_value = 0.0;
-  std::string string_value;
-  std::vector<std::uint8_t> byte_array_value;
-  std::vector<bool> bool_array_value;
-  std::vector<std::int64_t> integer_array_value;
-  std::vector<double> double_array_value;
-  std::vector<std::string> string_array_value;
-
-  static ParameterValue of_bool(bool v);
-  static ParameterValue of_integer(std::int64_t v);
-  static ParameterValue of_double(double v);
-  static ParameterValue of_string(std::string v);
-  bool operator==(const ParameterValue&) const = default;
-};
 // The value as a person reads it: 2.5 (shortest round trip), 7, true, 'text', [1, 2].
 std::string to_string(const ParameterValue& value);
 
-// rcl_interfaces/msg/Parameter.
-struct Parameter {
-  std::string name;
-  ParameterValue value;
-};
-
-// rcl_interfaces/msg/FloatingPointRange and IntegerRange (step 0: no step).
-struct FloatingPointRange {
-  double from_value = 0.0;
-  double to_value = 0.0;
-  double step = 0.0;
-};
-struct IntegerRange {
-  std::int64_t from_value = 0;
-  std::int64_t to_value = 0;
-  std::uint64_t step = 0;
-};
-
-// rcl_interfaces/msg/ParameterDescriptor (a range is a sequence of at most one, as there).
-struct ParameterDescriptor {
-  std::string name;
-  ParameterType type = ParameterType::NotSet;
-  std::string description;
-  std::string additional_constraints;
-  bool read_only = false;
-  bool dynamic_typing = false;
-  std::vector<FloatingPointRange> floating_point_range;
-  std::vector<IntegerRange> integer_range;
-};
-
-// rcl_interfaces/msg/SetParametersResult.
-struct SetParametersResult {
-  bool successful = true;
-  std::string reason;
-};
-
-// rcl_interfaces/msg/ListParametersResult.
-struct ListParametersResult {
-  std::vector<std::string> names;
-  std::vector<std::string> prefixes;
-};
 inline constexpr std::uint64_t kDepthRecursive = 0;  // ListParameters.Request.DEPTH_RECURSIVE
 
 // The run's own settings, beside the scene's parameters.

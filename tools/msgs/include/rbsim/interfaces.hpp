@@ -41,7 +41,7 @@ enum class ParameterType : std::uint8_t {
 // carried as received: a reader checks it).
 struct ParameterValue {
   static constexpr std::string_view kType = "rcl_interfaces/msg/ParameterValue";
-  std::uint8_t type = 0;
+  ParameterType type = ParameterType::NotSet;
   bool bool_value = false;
   std::int64_t integer_value = 0;
   double double_value = 0.0;
@@ -51,6 +51,10 @@ struct ParameterValue {
   std::vector<std::int64_t> integer_array_value;
   std::vector<double> double_array_value;
   std::vector<std::string> string_array_value;
+  static ParameterValue of_bool(bool v);
+  static ParameterValue of_integer(std::int64_t v);
+  static ParameterValue of_double(double v);
+  static ParameterValue of_string(std::string v);
   bool operator==(const ParameterValue&) const = default;
 };
 struct Parameter {
@@ -73,7 +77,7 @@ struct IntegerRange {
 struct ParameterDescriptor {
   static constexpr std::string_view kType = "rcl_interfaces/msg/ParameterDescriptor";
   std::string name;
-  std::uint8_t type = 0;
+  ParameterType type = ParameterType::NotSet;
   std::string description, additional_constraints;
   bool read_only = false, dynamic_typing = false;
   std::optional<FloatingPointRange> floating_point_range;
