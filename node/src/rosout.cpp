@@ -15,7 +15,8 @@ std::mutex g_current_mutex;
 Rosout* g_current = nullptr;
 
 std::int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 }  // namespace
@@ -60,7 +61,8 @@ Result<std::unique_ptr<Rosout>> Rosout::create(const Participant& participant, C
   constexpr QosSpec kQos{true, false, 1000};
   EndpointOptions options;
   options.lifespan_ns = 10'000'000'000;
-  auto pub = Publisher::create(participant, RawTopic{msgs::dds_topic_name("/rosout"), msgs::dds_type_name(msgs::kLogType)},
+  auto pub = Publisher::create(participant,
+                               RawTopic{msgs::dds_topic_name("/rosout"), msgs::dds_type_name(msgs::kLogType)},
                                kQos, options);
   if (!pub) return pub.error();
   std::unique_ptr<Rosout> rosout(

@@ -5,8 +5,8 @@
 // the node names of the commands. The raw-CDR type carries the bytes; they are decoded here with
 // the CDR cursor by the layout of the rmw_dds_common and rcl_interfaces .msg files.
 #include <dds/dds.h>
-#include <fcntl.h>
 #include <dds/ddsi/ddsi_serdata.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -118,7 +118,8 @@ class Observer {
   // A reliable, transient-local reader (late joiners get the writer's history).
   dds_entity_t reader(const char* topic_name, const char* type_name) {
     ddsi_sertype* type = make_raw_sertype(type_name);
-    const dds_entity_t topic = dds_create_topic_sertype(participant_, topic_name, &type, nullptr, nullptr, nullptr);
+    const dds_entity_t topic =
+        dds_create_topic_sertype(participant_, topic_name, &type, nullptr, nullptr, nullptr);
     EXPECT_GT(topic, 0) << dds_strretcode(topic);
     dds_qos_t* qos = dds_create_qos();
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
@@ -171,7 +172,8 @@ Endpoints discovered_endpoints(dds_entity_t observer, const std::vector<std::uin
   Endpoints out;
   for (const bool readers : {false, true}) {
     const dds_entity_t r = dds_create_reader(
-        observer, readers ? DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION : DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+        observer, readers ? DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION : DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr,
+        nullptr);
     void* samples[256] = {};
     dds_sample_info_t infos[256];
     const dds_return_t n = dds_read(r, samples, infos, 256, 256);
@@ -239,15 +241,18 @@ void check_entry_matches_discovery(std::uint32_t domain, std::size_t gid_size) {
   EXPECT_EQ(info->gid.size(), gid_size);
   // rmw_cyclonedds_cpp's GID: the GUID, zero-padded.
   for (const auto* gids : {&info->nodes[0].readers, &info->nodes[0].writers}) {
-    for (const auto& g : *gids) EXPECT_TRUE(std::all_of(g.begin() + 16, g.end(), [](auto b) { return b == 0; }));
+    for (const auto& g : *gids)
+      EXPECT_TRUE(std::all_of(g.begin() + 16, g.end(), [](auto b) { return b == 0; }));
   }
   EXPECT_TRUE(std::all_of(info->gid.begin() + 16, info->gid.end(), [](auto b) { return b == 0; }));
 
   Endpoints seen;
-  ASSERT_TRUE(eventually(10, [&] {
-    seen = discovered_endpoints(observer.participant(), info->gid);
-    return seen.writers.size() == sink_writers + 2 && seen.readers.size() == 1;
-  })) << "DDS discovery: " << seen.writers.size() << " writers, " << seen.readers.size() << " readers";
+  ASSERT_TRUE(eventually(10,
+                         [&] {
+                           seen = discovered_endpoints(observer.participant(), info->gid);
+                           return seen.writers.size() == sink_writers + 2 && seen.readers.size() == 1;
+                         }))
+      << "DDS discovery: " << seen.writers.size() << " writers, " << seen.readers.size() << " readers";
   EXPECT_EQ(guids_of(info->nodes[0].readers), seen.readers);
   // Every writer but ros_discovery_info's own (rmw does not list it either).
   auto listed = guids_of(info->nodes[0].writers);
@@ -256,7 +261,8 @@ void check_entry_matches_discovery(std::uint32_t domain, std::size_t gid_size) {
   for (const auto& w : seen.writers) unlisted += listed.count(w) == 0;
   EXPECT_EQ(unlisted, 1u);
   for (const auto& w : listed) EXPECT_EQ(seen.writers.count(w), 1u);
-  EXPECT_TRUE(seen.writer_topics.count("ros_discovery_info") == 1 && seen.writer_topics.count("rt/rosout") == 1);
+  EXPECT_TRUE(seen.writer_topics.count("ros_discovery_info") == 1 &&
+              seen.writer_topics.count("rt/rosout") == 1);
 
   // An endpoint that goes is unlisted.
   sub.reset();
@@ -307,7 +313,8 @@ TEST(Graph, ParticipantUserDataCarriesTheEnclave) {
   ASSERT_EQ(dds_get_guid(participant.value().handle(), &key), DDS_RETCODE_OK);
   std::optional<std::string> user_data;
   eventually(10, [&] {
-    const dds_entity_t r = dds_create_reader(observer.participant(), DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr);
+    const dds_entity_t r =
+        dds_create_reader(observer.participant(), DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr);
     void* samples[64] = {};
     dds_sample_info_t infos[64];
     const dds_return_t n = dds_read(r, samples, infos, 64, 64);
@@ -387,7 +394,8 @@ class Process {
 };
 
 // The node name and namespace a command announces.
-std::optional<std::pair<std::string, std::string>> announced(std::uint32_t domain, std::vector<std::string> args,
+std::optional<std::pair<std::string, std::string>> announced(std::uint32_t domain,
+                                                             std::vector<std::string> args,
                                                              const std::string& name) {
   Observer observer(domain);
   const dds_entity_t reader = observer.reader("ros_discovery_info", kInfoType);
@@ -410,19 +418,44 @@ std::string tmp_path(const char* name) {
 
 TEST(GraphCli, RecordIsRbsimRecorderAndNodeNameOverridesIt) {
   const std::string out = tmp_path("a.mcap");
-  auto got = announced(149, {RBSIM_BINARY, "record", "--domain", "149", "--wall-duration", "20", out}, "rbsim_recorder");
+  auto got = announced(149, {RBSIM_BINARY, "record", "--domain", "149", "--wall-duration", "20", out},
+                       "rbsim_recorder");
   ASSERT_TRUE(got.has_value());
   EXPECT_EQ(got->first, "/");
   const std::string out2 = tmp_path("b.mcap");
-  got = announced(150,
-                  {RBSIM_BINARY, "record", "--domain", "150", "--wall-duration", "20", "--node-name", "/tools/rec", out2},
-                  "rec");
+  got = announced(
+      150,
+      {RBSIM_BINARY, "record", "--domain", "150", "--wall-duration", "20", "--node-name", "/tools/rec", out2},
+      "rec");
   ASSERT_TRUE(got.has_value());
   EXPECT_EQ(got->first, "/tools");
 }
 
+TEST(GraphCli, ReplayIsRbsimPlayer) {
+  const std::string recording = tmp_path("replay.mcap");
+  const std::string run = std::string(RBSIM_BINARY) + " run " + RBSIM_SOURCE_DIR +
+                          "/scenes/chain.xml --steps 20 --record " + recording +
+                          " --overwrite > /dev/null 2>&1";
+  ASSERT_EQ(std::system(run.c_str()), 0) << run;
+  auto got = announced(153, {RBSIM_BINARY, "replay", recording, "--domain", "153", "--loop"}, "rbsim_player");
+  ASSERT_TRUE(got.has_value());
+  EXPECT_EQ(got->first, "/");
+  std::remove(recording.c_str());
+}
+
+TEST(GraphCli, NodeNameThatIsNoRosNameIsAUsageError) {
+  for (const char* bad : {"1recorder", "a//b", "rec-1", "/"}) {
+    const std::string cmd = std::string(RBSIM_BINARY) + " record --node-name '" + bad + "' " +
+                            tmp_path("bad.mcap") + " > /dev/null 2>&1";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << cmd;
+    EXPECT_EQ(WEXITSTATUS(status), 2) << cmd;
+  }
+}
+
 TEST(GraphCli, BridgeIsRbsimBridge) {
-  auto got = announced(151, {RBSIM_BINARY, "bridge", "--domain", "151", "--foxglove", "127.0.0.1:0"}, "rbsim_bridge");
+  auto got = announced(151, {RBSIM_BINARY, "bridge", "--domain", "151", "--foxglove", "127.0.0.1:0"},
+                       "rbsim_bridge");
   ASSERT_TRUE(got.has_value());
   EXPECT_EQ(got->first, "/");
 }
