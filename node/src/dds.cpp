@@ -13,6 +13,7 @@
 
 #include "graph.hpp"
 #include "raw_serdata.hpp"
+#include "rbsim/assert.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/rosout.hpp"
 #include "topics.hpp"
@@ -228,22 +229,32 @@ std::int32_t Publisher::matched() const {
 Result<Subscription> Subscription::create(const Participant& participant, const msgs::TopicSpec& spec,
                                           std::string_view ros_topic, const QosSpec& q,
                                           const EndpointOptions& options) {
-  auto topic = make_topic(participant.handle(), raw_topic(spec, ros_topic));
+  auto s = create(participant, raw_topic(spec, ros_topic), q, options);
+  if (s) {
+    s.value().ros_topic_ = std::string(ros_topic);
+    s.value().spec_ = &spec;
+  }
+  return s;
+}
+
+Result<Subscription> Subscription::create(const Participant& participant, const RawTopic& raw,
+                                          const QosSpec& q, const EndpointOptions& options) {
+  auto topic = make_topic(participant.handle(), raw);
   if (!topic) return topic.error();
   dds_qos_t* qos = make_qos(q, true, options, participant.distro());
   const dds_entity_t reader = dds_create_reader(participant.handle(), topic.value(), qos, nullptr);
   dds_delete_qos(qos);
   if (reader < 0) {
     dds_delete(topic.value());
-    return dds_error("cannot create DDS reader for " + std::string(ros_topic), reader);
+    return dds_error("cannot create DDS reader for " + raw.dds_name, reader);
   }
   dds_set_status_mask(reader,
                       DDS_DATA_AVAILABLE_STATUS | DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS);
   Subscription s;
   s.reader_ = reader;
   s.topic_ = topic.value();
-  s.ros_topic_ = std::string(ros_topic);
-  s.spec_ = &spec;
+  s.ros_topic_ = raw.dds_name;
+  s.q_ = q;
   s.graph_ = list_endpoint(participant, Graph::Kind::Reader, reader, options);
   return s;
 }
@@ -253,6 +264,7 @@ Subscription::Subscription(Subscription&& o) noexcept
       topic_(o.topic_),
       ros_topic_(std::move(o.ros_topic_)),
       spec_(o.spec_),
+      q_(o.q_),
       graph_(std::move(o.graph_)) {
   o.reader_ = o.topic_ = 0;
 }
@@ -287,7 +299,7 @@ bool Subscription::take(Received& out) {
     auto known = std::find_if(writers_.begin(), writers_.end(),
                               [&](const Writer& w) { return w.handle == info.publication_handle; });
     if (known == writers_.end()) {
-      Writer w{info.publication_handle, {}, msgs::offered_qos(*spec_)};
+      Writer w{info.publication_handle, {}, spec_ != nullptr ? msgs::offered_qos(*spec_) : q_};
       if (dds_builtintopic_endpoint_t* e =
               dds_get_matched_publication_data(reader_, info.publication_handle)) {
         std::memcpy(w.guid.data(), e->key.v, w.guid.size());
@@ -303,6 +315,11 @@ bool Subscription::take(Received& out) {
     out.offered = known->offered;
     return true;
   }
+}
+
+const msgs::TopicSpec& Subscription::spec() const {
+  RBSIM_ASSERT(spec_ != nullptr, "spec() of a Subscription created from a RawTopic");
+  return *spec_;
 }
 
 std::uint64_t Subscription::lost() const {

@@ -48,6 +48,14 @@ Status Graph::remove(const msgs::Guid& guid) {
   return publish_locked();
 }
 
+Graph::~Graph() {
+  std::lock_guard lock(mutex_);
+  info_.nodes.clear();
+  // Nobody to tell of a failure in a destructor. A short, bounded wait lets the entry reach the
+  // graph's readers before the participant goes (they drop it then anyway, on its disposal).
+  if (publish_locked()) static_cast<void>(writer_.flush(0.5));
+}
+
 msgs::ParticipantEntities Graph::entry() const {
   std::lock_guard lock(mutex_);
   return info_;

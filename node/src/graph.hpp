@@ -28,6 +28,10 @@ class Graph {
                                                RosDistro distro);
   // The DDS GUID of a participant, reader or writer: what rmw_cyclonedds_cpp makes its GID of.
   static msgs::Guid guid_of(dds_entity_t entity);
+  // Publishes the entry without the node, as rmw does when a node is destroyed (best effort).
+  ~Graph();
+  Graph(const Graph&) = delete;
+  Graph& operator=(const Graph&) = delete;
 
   // Lists an endpoint of the node and republishes. Thread-safe. A failed publication is reported
   // but the endpoint stays listed (the next change publishes it).

@@ -304,6 +304,29 @@ TEST(Graph, DiscoveryInfoListsTheEndpointsDiscoveryReportsHumble) {
   check_entry_matches_discovery(146, 24);
 }
 
+TEST(Graph, ParticipantThatGoesUnlistsItsNodeFirst) {
+  constexpr std::uint32_t kDomain = 154;
+  Observer observer(kDomain);
+  const dds_entity_t reader = observer.reader("ros_discovery_info", kInfoType);
+  std::vector<std::uint8_t> participant_gid;
+  {
+    auto participant = Participant::create(kDomain, NodeName{"/", "short_lived"});
+    ASSERT_TRUE(participant.ok()) << participant.error().message;
+    auto info = wait_for_entry(reader, 16, "short_lived", 0, 0);
+    ASSERT_TRUE(info.has_value());
+    participant_gid = info->gid;
+  }
+  std::optional<EntitiesInfo> last;
+  eventually(10, [&] {
+    for (const auto& cdr : Observer::take(reader)) {
+      if (auto i = decode_info(cdr, 16); i && i->gid == participant_gid) last = i;
+    }
+    return last && last->nodes.empty();
+  });
+  ASSERT_TRUE(last.has_value());
+  EXPECT_TRUE(last->nodes.empty()) << "the last entry still lists " << last->nodes.size() << " node(s)";
+}
+
 TEST(Graph, ParticipantUserDataCarriesTheEnclave) {
   constexpr std::uint32_t kDomain = 147;
   Observer observer(kDomain);

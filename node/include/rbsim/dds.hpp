@@ -141,6 +141,9 @@ class Subscription {
   static Result<Subscription> create(const Participant& participant, const msgs::TopicSpec& spec,
                                      std::string_view ros_topic, const QosSpec& qos,
                                      const EndpointOptions& options = {});
+  // A topic outside msgs::topics() (a service's requests): spec() is not available.
+  static Result<Subscription> create(const Participant& participant, const RawTopic& topic,
+                                     const QosSpec& qos, const EndpointOptions& options = {});
   Subscription(Subscription&&) noexcept;
   Subscription& operator=(Subscription&&) = delete;
   ~Subscription();
@@ -150,13 +153,14 @@ class Subscription {
   std::uint64_t lost() const;    // samples DDS reports lost or rejected
   std::int32_t matched() const;  // publications currently matched
   const std::string& ros_topic() const { return ros_topic_; }
-  const msgs::TopicSpec& spec() const { return *spec_; }
+  const msgs::TopicSpec& spec() const;  // only for one created with a TopicSpec
 
  private:
   Subscription() = default;
   std::int32_t reader_ = 0, topic_ = 0;
   std::string ros_topic_;
   const msgs::TopicSpec* spec_ = nullptr;
+  QosSpec q_;  // what it asked for: a writer's offer when discovery no longer knows it (no spec)
   std::weak_ptr<Graph> graph_;
   struct Writer {
     std::uint64_t handle = 0;  // DDS instance handle of the matched publication
