@@ -11,8 +11,11 @@
 #include <cstring>
 #include <optional>
 
+#include "graph.hpp"
 #include "raw_serdata.hpp"
+#include "rbsim/assert.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/rosout.hpp"
 #include "topics.hpp"
 
 namespace rbsim::node {
@@ -25,7 +28,7 @@ Error dds_error(const std::string& what, dds_return_t rc) {
   return Error{what + ": " + dds_strretcode(rc)};
 }
 
-dds_qos_t* make_qos(const QosSpec& q, bool reader) {
+dds_qos_t* make_qos(const QosSpec& q, bool reader, const EndpointOptions& options, RosDistro distro) {
   dds_qos_t* qos = dds_create_qos();
   // A reliable writer blocks when its readers fall behind: a slow recorder throttles the node
   // instead of losing samples. Each write blocks at most kWriteSlice; Publisher::publish retries
@@ -41,6 +44,18 @@ dds_qos_t* make_qos(const QosSpec& q, bool reader) {
     dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
   } else {
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.depth);
+  }
+  if (q.transient_local) {
+    // Cyclone keeps for late joiners what the durability service history says (by default the
+    // last 1); rmw_cyclonedds_cpp sets it to the history, so /rosout's late joiners get 1000.
+    dds_qset_durability_service(qos, 0, DDS_HISTORY_KEEP_LAST, q.depth, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+  }
+  if (options.lifespan_ns > 0) dds_qset_lifespan(qos, options.lifespan_ns);
+  // rmw_cyclonedds_cpp's endpoint USER_DATA: the type hash (REP 2011) where the distro has them.
+  if (!options.type_hash.empty() && has_type_hashes(distro)) {
+    const std::string user_data = "typehash=" + options.type_hash + ";";
+    dds_qset_userdata(qos, user_data.data(), user_data.size());
   }
   return qos;
 }
@@ -62,10 +77,10 @@ void offered_by(const dds_qos_t* qos, msgs::OfferedQos& out) {
 // The topic `ros_topic` with the raw CDR sertype under the ROS 2 type name (raw_serdata.hpp):
 // rbsim's writers send the bytes rbsim_msgs encoded as they are, its readers take them as they
 // came. `sertype` is the one the topic uses (Cyclone may swap in an equal one it already has).
-Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec& spec,
-                                std::string_view ros_topic, const ddsi_sertype** sertype = nullptr) {
-  ddsi_sertype* type = make_raw_sertype(descriptor(spec.id)->m_typename);
-  const std::string name = msgs::dds_topic_name(ros_topic);
+Result<dds_entity_t> make_topic(dds_entity_t participant, const RawTopic& raw,
+                                const ddsi_sertype** sertype = nullptr) {
+  ddsi_sertype* type = make_raw_sertype(raw.dds_type.c_str());
+  const std::string& name = raw.dds_name;
   const dds_entity_t topic =
       dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
   if (topic < 0) {
@@ -75,19 +90,40 @@ Result<dds_entity_t> make_topic(dds_entity_t participant, const msgs::TopicSpec&
   if (sertype != nullptr) *sertype = type;
   return topic;
 }
+
+RawTopic raw_topic(const msgs::TopicSpec& spec, std::string_view ros_topic) {
+  return {msgs::dds_topic_name(ros_topic), descriptor(spec.id)->m_typename};
+}
+
+// Lists a new endpoint in its participant's graph entry; returns where it is listed.
+std::weak_ptr<Graph> list_endpoint(const Participant& participant, Graph::Kind kind, dds_entity_t entity,
+                                   const EndpointOptions& options) {
+  const std::shared_ptr<Graph> graph = participant.shared_graph();
+  if (!options.in_graph || !graph) return {};
+  if (Status st = graph->add(kind, Graph::guid_of(entity)); !st) {
+    log(LogLevel::Warn, "rbsim: warning: ros_discovery_info not updated: " + st.error().message);
+  }
+  return graph;
+}
+void unlist_endpoint(const std::weak_ptr<Graph>& where, dds_entity_t entity) {
+  const std::shared_ptr<Graph> graph = where.lock();
+  if (!graph) return;
+  // A failure here has no one left to report to (a destructor); the next change republishes.
+  static_cast<void>(graph->remove(Graph::guid_of(entity)));
+}
 }  // namespace
 
 std::string_view loopback_config() {
   return kLoopbackConfig;
 }
 
-Result<Participant> Participant::create(std::uint32_t domain) {
+Result<Participant> Participant::create(std::uint32_t domain, const NodeName& node) {
   const RosEnvironment env = RosEnvironment::from_process();
   auto settings = resolve_dds_settings(
       env, domain == kDomainFromEnvironment ? std::nullopt : std::optional<std::uint32_t>(domain), getpid());
   if (!settings) return settings.error();
   const DdsSettings& s = settings.value();
-  for (const std::string& w : s.warnings) std::fprintf(stderr, "rbsim: warning: %s\n", w.c_str());
+  for (const std::string& w : s.warnings) log(LogLevel::Warn, "rbsim: warning: " + w);
   if (s.config) {
     // dds_create_domain fails harmlessly when the domain already exists in this process.
     const dds_entity_t d = dds_create_domain(s.domain, s.config->c_str());
@@ -96,7 +132,12 @@ Result<Participant> Participant::create(std::uint32_t domain) {
     }
   }
   // Otherwise Cyclone configures the domain itself: from CYCLONEDDS_URI, or its defaults.
-  const dds_entity_t p = dds_create_participant(s.domain, nullptr, nullptr);
+  // rmw_cyclonedds_cpp's participant USER_DATA: the security enclave, "/" without ROS security.
+  dds_qos_t* qos = dds_create_qos();
+  constexpr std::string_view kEnclave = "enclave=/;";
+  dds_qset_userdata(qos, kEnclave.data(), kEnclave.size());
+  const dds_entity_t p = dds_create_participant(s.domain, qos, nullptr);
+  dds_delete_qos(qos);
   if (p < 0) {
     const std::string where =
         s.from_cyclonedds_uri
@@ -104,40 +145,67 @@ Result<Participant> Participant::create(std::uint32_t domain) {
             : s.describe();
     return dds_error("cannot create a DDS participant on " + where, p);
   }
-  return Participant(p, s.domain, s.describe());
+  Participant participant(p, s.domain, s.describe(), node, s.distro);
+  auto graph = Graph::create(participant, node, s.distro);
+  if (!graph) return Error{"cannot publish the node on ros_discovery_info: " + graph.error().message};
+  participant.graph_ = std::move(graph.value());
+  return participant;
 }
 
 Participant::Participant(Participant&& o) noexcept
-    : handle_(o.handle_), domain_(o.domain_), description_(std::move(o.description_)) {
+    : handle_(o.handle_),
+      domain_(o.domain_),
+      description_(std::move(o.description_)),
+      node_(std::move(o.node_)),
+      distro_(o.distro_),
+      graph_(std::move(o.graph_)) {
   o.handle_ = 0;
 }
 Participant::~Participant() {
+  graph_.reset();  // its writer before the participant (Publishers still alive find it gone)
   if (handle_ > 0) dds_delete(handle_);
 }
 
 // ---------------------------------------------------------------------------------------------
 Result<Publisher> Publisher::create(const Participant& participant, const msgs::TopicSpec& spec,
-                                    std::string_view ros_topic, const QosSpec& q) {
+                                    std::string_view ros_topic, const QosSpec& q,
+                                    const EndpointOptions& options) {
+  auto p = create(participant, raw_topic(spec, ros_topic), q, options);
+  if (p) p.value().ros_topic_ = std::string(ros_topic);
+  return p;
+}
+
+Result<Publisher> Publisher::create(const Participant& participant, const RawTopic& raw, const QosSpec& q,
+                                    const EndpointOptions& options) {
   const ddsi_sertype* sertype = nullptr;
-  auto topic = make_topic(participant.handle(), spec, ros_topic, &sertype);
+  auto topic = make_topic(participant.handle(), raw, &sertype);
   if (!topic) return topic.error();
-  dds_qos_t* qos = make_qos(q, false);
+  dds_qos_t* qos = make_qos(q, false, options, participant.distro());
   const dds_entity_t writer = dds_create_writer(participant.handle(), topic.value(), qos, nullptr);
   dds_delete_qos(qos);
-  if (writer < 0) return dds_error("cannot create DDS writer for " + std::string(ros_topic), writer);
+  if (writer < 0) {
+    dds_delete(topic.value());
+    return dds_error("cannot create DDS writer for " + raw.dds_name, writer);
+  }
   Publisher p;
   p.writer_ = writer;
   p.topic_ = topic.value();
   p.sertype_ = sertype;
-  p.ros_topic_ = std::string(ros_topic);
+  p.ros_topic_ = raw.dds_name;
+  p.graph_ = list_endpoint(participant, Graph::Kind::Writer, writer, options);
   return p;
 }
 
 Publisher::Publisher(Publisher&& o) noexcept
-    : writer_(o.writer_), topic_(o.topic_), sertype_(o.sertype_), ros_topic_(std::move(o.ros_topic_)) {
+    : writer_(o.writer_),
+      topic_(o.topic_),
+      sertype_(o.sertype_),
+      ros_topic_(std::move(o.ros_topic_)),
+      graph_(std::move(o.graph_)) {
   o.writer_ = o.topic_ = 0;
 }
 Publisher::~Publisher() {
+  if (writer_ > 0) unlist_endpoint(graph_, writer_);
   if (writer_ > 0) dds_delete(writer_);
   if (topic_ > 0) dds_delete(topic_);
 }
@@ -181,28 +249,49 @@ std::int32_t Publisher::matched() const {
 
 // ---------------------------------------------------------------------------------------------
 Result<Subscription> Subscription::create(const Participant& participant, const msgs::TopicSpec& spec,
-                                          std::string_view ros_topic, const QosSpec& q) {
-  auto topic = make_topic(participant.handle(), spec, ros_topic);
+                                          std::string_view ros_topic, const QosSpec& q,
+                                          const EndpointOptions& options) {
+  auto s = create(participant, raw_topic(spec, ros_topic), q, options);
+  if (s) {
+    s.value().ros_topic_ = std::string(ros_topic);
+    s.value().spec_ = &spec;
+  }
+  return s;
+}
+
+Result<Subscription> Subscription::create(const Participant& participant, const RawTopic& raw,
+                                          const QosSpec& q, const EndpointOptions& options) {
+  auto topic = make_topic(participant.handle(), raw);
   if (!topic) return topic.error();
-  dds_qos_t* qos = make_qos(q, true);
+  dds_qos_t* qos = make_qos(q, true, options, participant.distro());
   const dds_entity_t reader = dds_create_reader(participant.handle(), topic.value(), qos, nullptr);
   dds_delete_qos(qos);
-  if (reader < 0) return dds_error("cannot create DDS reader for " + std::string(ros_topic), reader);
+  if (reader < 0) {
+    dds_delete(topic.value());
+    return dds_error("cannot create DDS reader for " + raw.dds_name, reader);
+  }
   dds_set_status_mask(reader,
                       DDS_DATA_AVAILABLE_STATUS | DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS);
   Subscription s;
   s.reader_ = reader;
   s.topic_ = topic.value();
-  s.ros_topic_ = std::string(ros_topic);
-  s.spec_ = &spec;
+  s.ros_topic_ = raw.dds_name;
+  s.q_ = q;
+  s.graph_ = list_endpoint(participant, Graph::Kind::Reader, reader, options);
   return s;
 }
 
 Subscription::Subscription(Subscription&& o) noexcept
-    : reader_(o.reader_), topic_(o.topic_), ros_topic_(std::move(o.ros_topic_)), spec_(o.spec_) {
+    : reader_(o.reader_),
+      topic_(o.topic_),
+      ros_topic_(std::move(o.ros_topic_)),
+      spec_(o.spec_),
+      q_(o.q_),
+      graph_(std::move(o.graph_)) {
   o.reader_ = o.topic_ = 0;
 }
 Subscription::~Subscription() {
+  if (reader_ > 0) unlist_endpoint(graph_, reader_);
   if (reader_ > 0) dds_delete(reader_);
   if (topic_ > 0) dds_delete(topic_);
 }
@@ -232,7 +321,7 @@ bool Subscription::take(Received& out) {
     auto known = std::find_if(writers_.begin(), writers_.end(),
                               [&](const Writer& w) { return w.handle == info.publication_handle; });
     if (known == writers_.end()) {
-      Writer w{info.publication_handle, {}, msgs::offered_qos(*spec_)};
+      Writer w{info.publication_handle, {}, spec_ != nullptr ? msgs::offered_qos(*spec_) : q_};
       if (dds_builtintopic_endpoint_t* e =
               dds_get_matched_publication_data(reader_, info.publication_handle)) {
         std::memcpy(w.guid.data(), e->key.v, w.guid.size());
@@ -248,6 +337,11 @@ bool Subscription::take(Received& out) {
     out.offered = known->offered;
     return true;
   }
+}
+
+const msgs::TopicSpec& Subscription::spec() const {
+  RBSIM_ASSERT(spec_ != nullptr, "spec() of a Subscription created from a RawTopic");
+  return *spec_;
 }
 
 std::uint64_t Subscription::lost() const {

@@ -106,8 +106,86 @@ RosEnvironment RosEnvironment::from_process() {
     const char* v = std::getenv(name);
     return v != nullptr ? std::optional<std::string>(v) : std::nullopt;
   };
-  return {get("ROS_DOMAIN_ID"), get("ROS_AUTOMATIC_DISCOVERY_RANGE"), get("ROS_STATIC_PEERS"),
-          get("ROS_LOCALHOST_ONLY"), get("CYCLONEDDS_URI")};
+  return {get("ROS_DOMAIN_ID"),    get("ROS_AUTOMATIC_DISCOVERY_RANGE"),
+          get("ROS_STATIC_PEERS"), get("ROS_LOCALHOST_ONLY"),
+          get("CYCLONEDDS_URI"),   get("ROS_DISTRO")};
+}
+
+std::size_t gid_size(RosDistro distro) {
+  return distro == RosDistro::Humble ? 24 : 16;
+}
+bool has_type_hashes(RosDistro distro) {
+  return distro != RosDistro::Humble;
+}
+
+DistroChoice resolve_ros_distro(const RosEnvironment& env) {
+  if (empty(env.ros_distro)) return {};
+  const std::string& v = *env.ros_distro;
+  // rmw_dds_common's Gid went from char[24] to char[16], and type hashes came, in Iron.
+  for (std::string_view old : {"foxy", "galactic", "humble"}) {
+    if (v == old) return {RosDistro::Humble, std::nullopt};
+  }
+  for (std::string_view recent : {"iron", "jazzy", "kilted", "lyrical", "rolling"}) {
+    if (v == recent) return {};
+  }
+  return {RosDistro::Jazzy,
+          quoted("ROS_DISTRO", v) +
+              " is not a ROS 2 distribution rbsim knows (humble, jazzy, ...): it speaks Jazzy's "
+              "graph format (16-byte GIDs, type hashes)"};
+}
+
+namespace {
+// rmw_validate_node_name / rmw_validate_namespace's token rule.
+std::string name_token_problem(std::string_view token) {
+  if (token.empty()) return "has an empty token (\"//\", or a '/' at the end)";
+  if (token.front() >= '0' && token.front() <= '9') return "has a token starting with a digit";
+  for (const char c : token) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+    if (!ok) return std::string("may hold only letters, digits, '_' and '/' (got '") + c + "')";
+  }
+  return {};
+}
+}  // namespace
+
+Result<NodeName> parse_node_name(std::string_view path) {
+  const std::string shown(path);
+  if (!path.empty() && path.front() == '/') path.remove_prefix(1);
+  // rmw's limits: 255 characters for the node name, 4096 for the fully qualified one (less
+  // rmw's topic prefix).
+  if (path.empty()) return Error{"\"" + shown + "\" is not a ROS 2 node name: it is empty"};
+  if (path.size() > 4000)
+    return Error{"\"" + shown.substr(0, 40) + "...\" is not a ROS 2 node name: too long"};
+  NodeName out;
+  out.ns.clear();
+  while (true) {
+    const auto slash = path.find('/');
+    const std::string_view token = path.substr(0, slash);
+    if (std::string problem = name_token_problem(token); !problem.empty()) {
+      return Error{"\"" + shown + "\" is not a ROS 2 node name: it " + problem};
+    }
+    if (slash == std::string_view::npos) {
+      if (token.size() > 255)
+        return Error{"\"" + shown + "\" is not a ROS 2 node name: its name is over 255 characters"};
+      out.name = std::string(token);
+      break;
+    }
+    out.ns += "/" + std::string(token);
+    path.remove_prefix(slash + 1);
+  }
+  if (out.ns.empty()) out.ns = "/";
+  return out;
+}
+
+std::string NodeName::fully_qualified() const {
+  return (ns == "/" ? "" : ns) + "/" + name;
+}
+
+// rcl_create_node_logger_name: the namespace without its leading '/', '/' -> '.', then the name.
+std::string NodeName::logger_name() const {
+  if (ns == "/") return name;
+  std::string s = ns.substr(1);
+  for (char& c : s) c = c == '/' ? '.' : c;
+  return s + "." + name;
 }
 
 std::string DdsSettings::describe() const {
@@ -131,6 +209,9 @@ Result<std::optional<std::uint32_t>> domain_from_environment(const RosEnvironmen
 Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
                                          std::optional<std::uint32_t> explicit_domain, std::int64_t pid) {
   DdsSettings s;
+  DistroChoice distro = resolve_ros_distro(env);
+  s.distro = distro.distro;
+  if (distro.warning) s.warnings.push_back(*distro.warning);
   // The domain: --domain, else ROS_DOMAIN_ID, else 0 (rcl_get_default_domain_id).
   if (explicit_domain) {
     if (*explicit_domain > kMaxDomainId) {

@@ -40,7 +40,7 @@ TEST(RosEnv, NothingSetIsDomainZeroOnTheLoopbackConfigurationExactly) {
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.describe(), "domain 0 (LOCALHOST)");
   // Empty values mean the same as unset (rcl).
-  const DdsSettings e = resolve_ok({"", "", "", "", ""});
+  const DdsSettings e = resolve_ok({"", "", "", "", "", ""});
   EXPECT_EQ(e.domain, 0u);
   EXPECT_EQ(*e.config, loopback_config());
 }
@@ -238,6 +238,79 @@ TEST(RosEnv, CycloneAcceptsTheLoopbackConfigurations) {
     if (p > 0) dds_delete(p);
     dds_delete(d);
   }
+}
+
+// ROS_DISTRO: the graph's wire format.
+RosEnvironment with_distro(std::optional<std::string> distro) {
+  RosEnvironment env;
+  env.ros_distro = std::move(distro);
+  return env;
+}
+
+TEST(RosDistro, UnsetOrEmptyIsJazzyWithoutWarning) {
+  for (const auto& v : {std::optional<std::string>{}, std::optional<std::string>{""}}) {
+    const DistroChoice c = resolve_ros_distro(with_distro(v));
+    EXPECT_EQ(c.distro, RosDistro::Jazzy);
+    EXPECT_FALSE(c.warning.has_value());
+  }
+}
+
+TEST(RosDistro, HumbleAndOlderUse24ByteGidsAndNoTypeHashes) {
+  for (const char* v : {"humble", "galactic", "foxy"}) {
+    const DistroChoice c = resolve_ros_distro(with_distro(v));
+    EXPECT_EQ(c.distro, RosDistro::Humble) << v;
+    EXPECT_FALSE(c.warning.has_value()) << v;
+  }
+  EXPECT_EQ(gid_size(RosDistro::Humble), 24u);
+  EXPECT_FALSE(has_type_hashes(RosDistro::Humble));
+}
+
+TEST(RosDistro, IronAndLaterUse16ByteGidsAndTypeHashes) {
+  for (const char* v : {"iron", "jazzy", "kilted", "rolling"}) {
+    const DistroChoice c = resolve_ros_distro(with_distro(v));
+    EXPECT_EQ(c.distro, RosDistro::Jazzy) << v;
+    EXPECT_FALSE(c.warning.has_value()) << v;
+  }
+  EXPECT_EQ(gid_size(RosDistro::Jazzy), 16u);
+  EXPECT_TRUE(has_type_hashes(RosDistro::Jazzy));
+}
+
+TEST(RosDistro, UnknownIsOneWarningAndJazzy) {
+  const DistroChoice c = resolve_ros_distro(with_distro("Humble"));  // names are lower case
+  EXPECT_EQ(c.distro, RosDistro::Jazzy);
+  ASSERT_TRUE(c.warning.has_value());
+  EXPECT_TRUE(has(*c.warning, "ROS_DISTRO='Humble'")) << *c.warning;
+  const DdsSettings s = resolve_ok(with_distro("Humble"));
+  EXPECT_EQ(s.distro, RosDistro::Jazzy);
+  EXPECT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(resolve_ok(with_distro("humble")).distro, RosDistro::Humble);
+}
+
+TEST(NodeName, LastTokenIsTheNameTheRestTheNamespace) {
+  auto n = parse_node_name("a/b/sim");
+  ASSERT_TRUE(n.ok()) << n.error().message;
+  EXPECT_EQ(n.value().ns, "/a/b");
+  EXPECT_EQ(n.value().name, "sim");
+  EXPECT_EQ(n.value().fully_qualified(), "/a/b/sim");
+  EXPECT_EQ(n.value().logger_name(), "a.b.sim");
+  n = parse_node_name("/rbsim");
+  ASSERT_TRUE(n.ok()) << n.error().message;
+  EXPECT_EQ(n.value().ns, "/");
+  EXPECT_EQ(n.value().name, "rbsim");
+  EXPECT_EQ(n.value().fully_qualified(), "/rbsim");
+  EXPECT_EQ(n.value().logger_name(), "rbsim");
+}
+
+TEST(NodeName, RejectsWhatIsNoRosName) {
+  for (const char* bad : {"", "/", "a//b", "a/b/", "1a", "a/2b", "a-b", "a b", "a/b.c"}) {
+    auto n = parse_node_name(bad);
+    EXPECT_FALSE(n.ok()) << bad;
+    if (!n.ok()) {
+      EXPECT_TRUE(has(n.error().message, "is not a ROS 2 node name")) << n.error().message;
+    }
+  }
+  EXPECT_FALSE(parse_node_name(std::string(256, 'a')).ok());
+  EXPECT_TRUE(parse_node_name(std::string(255, 'a')).ok());
 }
 
 }  // namespace

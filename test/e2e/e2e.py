@@ -1089,6 +1089,47 @@ def case_netns_link_flap(ctx):
     return 0
 
 
+def case_ros_graph(ctx):
+    """rbsim node on the ROS 2 graph as an independent observer (Python cyclonedds, graph_peer.py)
+    sees it: the ros_discovery_info entry names the node and lists the GIDs of exactly the
+    endpoints DDS discovery reports for its participant (but the entry's own writer), 16 bytes on
+    Jazzy and 24 (zero-padded) with ROS_DISTRO=humble; USER_DATA enclave=/; and the start line on
+    /rosout at simulated time 0."""
+    env = ctx.env(uri="file://" + ctx.loopback_xml)
+    peer = os.path.join(os.path.dirname(__file__), "graph_peer.py")
+    for distro, gid_size in ((None, 16), ("humble", 24)):
+        run_env = dict(env)
+        run_env.pop("ROS_DISTRO", None)
+        if distro:
+            run_env["ROS_DISTRO"] = distro
+        tag = distro or "jazzy"
+        node = ctx.rb(f"node-{tag}", "node", ctx.scene("chain.xml"), "--domain", ctx.domain, "--namespace",
+                      f"{ctx.ns}/sim", "--loop", env=run_env)
+        rc, out, err = ctx.run(f"peer-{tag}", [sys.executable, peer, "--domain", str(ctx.domain), "--name", "sim",
+                                               "--gid-size", str(gid_size), "--timeout", "30"], timeout=60, env=env)
+        node.signal(signal.SIGINT)
+        exited_ok(ctx, node, 30)
+        if not ctx.check(rc == 0, f"{tag}: graph peer exited with {rc}\n{out}{err}"):
+            continue
+        got = json.loads(out.strip().splitlines()[-1])
+        entry, log = got["entry"], got["log"]
+        ctx.check(entry["namespace"] == "/" + ctx.ns, f"{tag}: namespace {entry['namespace']!r}")
+        gids = entry["writers"] + entry["readers"] + [entry["participant"]]
+        ctx.check(all(len(g) == 2 * gid_size and g[32:] == "0" * (2 * gid_size - 32) for g in gids),
+                  f"{tag}: GIDs not {gid_size} bytes of GUID and zeros: {gids}")
+        listed = sorted(g[:32] for g in entry["writers"])
+        discovered = sorted(k for k, topic in got["writers"].items() if topic != "ros_discovery_info")
+        ctx.check(listed == discovered and len(listed) >= 8,
+                  f"{tag}: writers listed {listed} != discovered {got['writers']}")
+        ctx.check(sorted(g[:32] for g in entry["readers"]) == sorted(got["readers"]),
+                  f"{tag}: readers listed {entry['readers']} != discovered {got['readers']}")
+        ctx.check(got["user_data"] == "enclave=/;", f"{tag}: participant USER_DATA {got['user_data']!r}")
+        ctx.check(log["level"] == 20 and log["name"] == f"{ctx.ns}.sim" and log["msg"].startswith("rbsim node: ")
+                  and log["sec"] == 0, f"{tag}: /rosout start line {log}")
+        ctx.log(f"{tag}: node /{ctx.ns}/sim with {len(listed)} writers, GIDs of {gid_size} bytes, "
+                f"USER_DATA {got['user_data']!r}, /rosout {log['name']}: {log['msg'][:40]}...")
+
+
 def case_ros_env(ctx):
     """ROS 2's environment variables, on loopback only: ROS_DOMAIN_ID alone puts a node and a
     recorder on the same domain (the recorder gets everything), --domain wins over it, a recorder
@@ -1383,6 +1424,7 @@ CASES = {
     "netns_link_flap": case_netns_link_flap,
     "bad_input": case_bad_input,
     "ros_env": case_ros_env,
+    "ros_graph": case_ros_graph,
     "record_disk_full": case_record_disk_full,
     "record_sigkill": case_record_sigkill,
     "soak": case_soak,

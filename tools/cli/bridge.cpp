@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/relay.hpp"
+#include "rbsim/rosout.hpp"
 #include "validators.hpp"
 
 namespace rbsim::cli {
@@ -16,6 +17,7 @@ struct BridgeArgs {
   std::optional<std::string> foxglove;  // [ADDR:]PORT (required)
   std::string ns = "rbsim";
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
+  node::NodeName node{"/", "rbsim_bridge"};             // as foxglove_bridge names its node
   bool quiet = false;
 };
 
@@ -33,8 +35,10 @@ std::optional<std::uint64_t> sim_time(const msgs::TopicSpec& spec, std::span<con
 }
 
 int bridge_command(const BridgeArgs& a) {
-  auto participant = node::Participant::create(a.domain);
+  auto participant = node::Participant::create(a.domain, a.node);
   if (!participant) return fail("bridge", participant.error().message);
+  auto rosout = node::Rosout::create(participant.value());
+  if (!rosout) return fail("bridge", rosout.error().message);
   std::vector<foxglove::ChannelId> ids;
   msgs::TopicSet all;
   all.set();  // every topic a node may publish: the viewer chooses what to subscribe to
@@ -47,8 +51,8 @@ int bridge_command(const BridgeArgs& a) {
   foxglove::Server& server = *started.value();
   install_stop_handlers();
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim bridge: relaying /%s/* and /clock on %s (Ctrl-C stops)\n", a.ns.c_str(),
-                 participant.value().description().c_str());
+    RBSIM_LOG(Info, "rbsim bridge: relaying /%s/* and /clock on %s (Ctrl-C stops)\n", a.ns.c_str(),
+              participant.value().description().c_str());
   }
   std::uint64_t last_time = 0, scenes = 0;
   const node::Relay::OnSample on_sample = [&](const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
@@ -69,8 +73,8 @@ int bridge_command(const BridgeArgs& a) {
     if (!polled) return fail("bridge", polled.error().message);
   }
   if (!a.quiet) {
-    std::fprintf(
-        stderr, "rbsim bridge: stopped after %llu samples (%llu scene descriptions, %llu lost in DDS); %s\n",
+    RBSIM_LOG(
+        Info, "rbsim bridge: stopped after %llu samples (%llu scene descriptions, %llu lost in DDS); %s\n",
         static_cast<unsigned long long>(relay.value()->received()), static_cast<unsigned long long>(scenes),
         static_cast<unsigned long long>(relay.value()->lost()), foxglove_summary(server).c_str());
   }
@@ -85,6 +89,7 @@ Subcommand add_bridge_command(CLI::App& parent) {
       "Relay the DDS topics of a running rbsim node to Foxglove (its WebSocket protocol; no ROS needed)");
   add_foxglove_option(app, a->foxglove, true);
   add_domain_option(app, a->domain);
+  add_node_name_option(app, a->node);
   app->add_option("--namespace", a->ns, "ROS namespace of the node's topics")
       ->check(ros_namespace())
       ->default_str("rbsim");

@@ -6,6 +6,8 @@
 #include <csignal>
 #include <cstdio>
 
+#include "rbsim/rosout.hpp"
+
 namespace rbsim::cli {
 
 namespace {
@@ -92,8 +94,8 @@ Result<mcap::Compression> compression_option(const std::string& name, int level)
   return codec;
 }
 
-int fail(const char* command, const std::string& message, int exit_status) {
-  std::fprintf(stderr, "rbsim %s: error: %s\n", command, message.c_str());
+int fail(const char* command, const std::string& message, int exit_status, std::source_location where) {
+  node::log(node::LogLevel::Error, "rbsim " + std::string(command) + ": error: " + message, where);
   return exit_status;
 }
 

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <source_location>
 #include <string>
 
 #include "rbsim/core.hpp"
@@ -44,8 +45,10 @@ std::string format_seconds(double seconds);
 // the error names the option that is wrong.
 Result<mcap::Compression> compression_option(const std::string& name, int level = 0);
 
-// Prints "rbsim COMMAND: error: MESSAGE" on stderr; returns the exit status to end with.
-int fail(const char* command, const std::string& message, int exit_status = 1);
+// Prints "rbsim COMMAND: error: MESSAGE" on stderr (and, in a DDS command, on /rosout: the one
+// logging path, rbsim/rosout.hpp); returns the exit status to end with.
+int fail(const char* command, const std::string& message, int exit_status = 1,
+         std::source_location where = std::source_location::current());
 
 // "1 body", "2 bodies": a count with its noun in the right number.
 std::string count_of(std::int64_t n, const char* one, const char* many);

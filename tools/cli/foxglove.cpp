@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include "commands.hpp"
+#include "rbsim/rosout.hpp"
 
 #ifndef RBSIM_FOXGLOVE_LAYOUT
 #define RBSIM_FOXGLOVE_LAYOUT "docs/foxglove-layout.json"
@@ -54,16 +55,16 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
   if (!server) return server.error();
   const std::uint16_t port = server.value()->port();
   // The line tests and scripts read the port from (port 0 picks one).
-  std::fprintf(stderr, "%s: foxglove: listening on %s\n", command,
-               foxglove::websocket_url(options.address, port).c_str());
+  RBSIM_LOG(Info, "%s: foxglove: listening on %s\n", command,
+            foxglove::websocket_url(options.address, port).c_str());
   // A browser cannot connect to 0.0.0.0 (or ::): the link names this host's loopback instead.
   std::string host = options.address;
   if (host == "0.0.0.0") host = "127.0.0.1";
   if (host == "::") host = "::1";
-  std::fprintf(stderr, "%s: foxglove: open %s\n", command,
-               foxglove::foxglove_app_link(foxglove::websocket_url(host, port)).c_str());
-  std::fprintf(stderr, "%s: foxglove: layout %s (Foxglove: Layouts > Import from file)\n", command,
-               layout_path().c_str());
+  RBSIM_LOG(Info, "%s: foxglove: open %s\n", command,
+            foxglove::foxglove_app_link(foxglove::websocket_url(host, port)).c_str());
+  RBSIM_LOG(Info, "%s: foxglove: layout %s (Foxglove: Layouts > Import from file)\n", command,
+            layout_path().c_str());
   return server;
 }
 

@@ -8,6 +8,7 @@
 #include "rbsim/control.hpp"
 #include "rbsim/dds_sink.hpp"
 #include "rbsim/ros_args.hpp"
+#include "rbsim/rosout.hpp"
 #include "rbsim/run.hpp"
 #include "validators.hpp"
 
@@ -45,10 +46,21 @@ Status apply_ros_args(Scene& scene, std::int64_t steps, control::RunSettings& se
 }
 
 int node_command(const NodeArgs& a) {
+  // The node is /<namespace> on the graph: its topics /<namespace>/<name> are its private ones.
+  const Result<node::NodeName> name = node::parse_node_name(a.node.ns);
+  if (!name) return fail("node", name.error().message, 2);
+  auto participant = node::Participant::create(a.node.domain, name.value());
+  if (!participant) return fail("node", participant.error().message);
+  // The node's clock is the simulation's (it publishes /clock): 0 until there is a world.
+  const World* clock_world = nullptr;
+  auto rosout = node::Rosout::create(participant.value(), [&clock_world] {
+    return clock_world != nullptr ? static_cast<std::int64_t>(msgs::sim_time_ns(*clock_world)) : 0;
+  });
+  if (!rosout) return fail("node", rosout.error().message);
   Result<Scene> loaded = load_scene(a.scene);
   if (!loaded) return fail("node", loaded.error().message);
   Scene& scene = loaded.value();
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  for (const std::string& w : scene.warnings) RBSIM_LOG(Warn, "%s", w.c_str());
   const std::int64_t steps = steps_for(a.duration.value_or(scene.duration), scene.world.dt);
   control::RunSettings settings{a.node.rate, a.node.publish_every, false};
   if (Status st = apply_ros_args(scene, steps, settings, a.node.ns); !st) {
@@ -56,9 +68,6 @@ int node_command(const NodeArgs& a) {
                  st.error().message.c_str());
     return 2;
   }
-
-  auto participant = node::Participant::create(a.node.domain);
-  if (!participant) return fail("node", participant.error().message);
   // Each step is encoded once for DDS and the Foxglove server alike.
   node::NodeOptions node_options = a.node;
   node_options.stop = stop_requested;
@@ -88,23 +97,28 @@ int node_command(const NodeArgs& a) {
   }
   install_stop_handlers();
   if (!a.quiet) {
-    std::fprintf(stderr,
-                 "rbsim node: %s on domain %u, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
-                 scene.name.c_str(), a.node.domain, a.node.ns.c_str(),
-                 settings.rate > 0 ? (std::to_string(settings.rate) + "x").c_str() : "as fast as possible",
-                 static_cast<long long>(steps),
-                 a.loop            ? ", looping"
-                 : settings.paused ? ", paused"
-                                   : "");
+    RBSIM_LOG(Info,
+              "rbsim node: %s on domain %u, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
+              scene.name.c_str(), a.node.domain, a.node.ns.c_str(),
+              settings.rate > 0 ? (std::to_string(settings.rate) + "x").c_str() : "as fast as possible",
+              static_cast<long long>(steps),
+              a.loop            ? ", looping"
+              : settings.paused ? ", paused"
+                                : "");
   }
   if (a.wait_for > 0) {
-    if (!a.quiet) std::fprintf(stderr, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
+    if (!a.quiet) RBSIM_LOG(Info, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
     if (!sink.value()->wait_for_subscribers(a.wait_for, stop_requested)) return 128 + stop_signal();
   }
   const auto start = std::chrono::steady_clock::now();
   Result<Driver> created = Driver::create(scene);
   if (!created) return fail("node", created.error().message);
   Driver& driver = created.value();
+  clock_world = &driver.world();
+  struct ForgetWorld {  // the driver goes before the Rosout that reads its clock
+    const World*& world;
+    ~ForgetWorld() { world = nullptr; }
+  } forget_world{clock_world};
   node::Pacer pacer(settings.rate, settings.publish_every);
   driver.add(pacer);
   if (foxglove_sink) driver.add(*foxglove_sink);
@@ -141,8 +155,7 @@ int node_command(const NodeArgs& a) {
     const std::int64_t total_steps = driver.steps_done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const control::ControlCounters counted = controller.counters();
-    std::fprintf(stderr,
-                 "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s, %s%s\n",
+    RBSIM_LOG(Info, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s, %s%s\n",
                  stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
                  format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
                  static_cast<unsigned long long>(sink.value()->published()),

@@ -10,6 +10,7 @@
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/recorder.hpp"
+#include "rbsim/rosout.hpp"
 #include "validators.hpp"
 
 namespace rbsim::cli {
@@ -26,13 +27,14 @@ struct RecordArgs {
   bool quiet = false;
   bool overwrite = false;
   std::optional<double> wrong_duration;
+  node::NodeName node{"/", "rbsim_recorder"};  // as rosbag2's recorder names its node
 };
 
 int record_command(RecordArgs a) {
   if (a.wrong_duration) {
-    std::fprintf(stderr,
-                 "rbsim record: error: --duration: a recorder runs in wall-clock time: use --wall-duration "
-                 "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.\n");
+    RBSIM_LOG(Error,
+              "rbsim record: error: --duration: a recorder runs in wall-clock time: use --wall-duration "
+              "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.");
     return 2;
   }
   // A live recorder must keep up with what arrives: zstd at a fast negative level by default, which
@@ -47,15 +49,17 @@ int record_command(RecordArgs a) {
   std::signal(SIGXFSZ, SIG_IGN);
   if (Status st = check_outputs({{a.rec.path, "OUT"}}, {}, a.overwrite); !st)
     return fail("record", st.error().message);
-  auto participant = node::Participant::create(a.domain);
+  auto participant = node::Participant::create(a.domain, a.node);
   if (!participant) return fail("record", participant.error().message);
+  auto rosout = node::Rosout::create(participant.value());
+  if (!rosout) return fail("record", rosout.error().message);
   auto recorder = node::Recorder::create(participant.value(), a.rec);
   if (!recorder) return fail("record", recorder.error().message);
   install_stop_handlers();
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",
-                 a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(),
-                 participant.value().description().c_str(), a.rec.path.c_str());
+    RBSIM_LOG(Info, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",
+              a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(),
+              participant.value().description().c_str(), a.rec.path.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = a.duration ? start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -77,21 +81,20 @@ int record_command(RecordArgs a) {
   if (!a.quiet || failure) {
     std::uint64_t lost = 0, duplicates = 0;
     for (const auto& c : recorder.value()->counts()) {
-      std::fprintf(stderr, "  %-28s received %8llu  lost %llu%s\n", c.topic.c_str(),
-                   static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.lost),
-                   c.duplicates > 0 ? ("  delivered twice " + std::to_string(c.duplicates)).c_str() : "");
+      RBSIM_LOG(Info, "  %-28s received %8llu  lost %llu%s\n", c.topic.c_str(),
+                static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.lost),
+                c.duplicates > 0 ? ("  delivered twice " + std::to_string(c.duplicates)).c_str() : "");
       lost += c.lost;
       duplicates += c.duplicates;
     }
     if (duplicates > 0) {
-      std::fprintf(
-          stderr,
-          "rbsim record: %llu samples DDS delivered again (after a reconnection) were recorded once\n",
-          static_cast<unsigned long long>(duplicates));
+      RBSIM_LOG(Info,
+                "rbsim record: %llu samples DDS delivered again (after a reconnection) were recorded once\n",
+                static_cast<unsigned long long>(duplicates));
     }
-    std::fprintf(stderr, "rbsim record: %llu messages received, %llu lost, written to %s\n",
-                 static_cast<unsigned long long>(recorder.value()->received()),
-                 static_cast<unsigned long long>(lost), a.rec.path.c_str());
+    RBSIM_LOG(Info, "rbsim record: %llu messages received, %llu lost, written to %s\n",
+              static_cast<unsigned long long>(recorder.value()->received()),
+              static_cast<unsigned long long>(lost), a.rec.path.c_str());
   }
   if (failure) return fail("record", *failure + " (the file was finished up to that point)");
   if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
@@ -114,6 +117,7 @@ Subcommand add_record_command(CLI::App& parent) {
       ->delimiter(',')
       ->allow_extra_args(false);
   add_domain_option(app, a->domain);
+  add_node_name_option(app, a->node);
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")
       ->check(ros_namespace())
       ->default_str("rbsim");

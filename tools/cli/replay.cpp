@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/replay.hpp"
+#include "rbsim/rosout.hpp"
 #include "validators.hpp"
 
 namespace rbsim::cli {
@@ -15,6 +16,7 @@ struct ReplayArgs {
   node::ReplayOptions replay;
   std::string ns;
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
+  node::NodeName node{"/", "rbsim_player"};             // as rosbag2's player names its node
   bool loop = false;
   std::int32_t wait_for = 0;
   bool quiet = false;
@@ -23,13 +25,14 @@ struct ReplayArgs {
 
 int replay_command(ReplayArgs a) {
   if (!a.ns.empty()) a.replay.ns = a.ns;
-  auto participant = node::Participant::create(a.domain);
+  auto participant = node::Participant::create(a.domain, a.node);
   if (!participant) return fail("replay", participant.error().message);
+  auto rosout = node::Rosout::create(participant.value());
+  if (!rosout) return fail("replay", rosout.error().message);
   auto opened = node::Replay::open(participant.value(), a.replay);
   if (!opened) return fail("replay", opened.error().message);
   node::Replay& replay = *opened.value();
-  for (const std::string& w : replay.warnings())
-    std::fprintf(stderr, "rbsim replay: warning: %s\n", w.c_str());
+  for (const std::string& w : replay.warnings()) RBSIM_LOG(Warn, "rbsim replay: warning: %s\n", w.c_str());
   // --foxglove: one channel per replayed output with the recording's own schema; the replay's
   // pacing is the one clock, the server is fed from the tap as each message goes out over DDS.
   std::unique_ptr<foxglove::Server> server;
@@ -66,25 +69,25 @@ int replay_command(ReplayArgs a) {
     const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
     char rate[32] = "as fast as possible";
     if (a.replay.rate > 0) std::snprintf(rate, sizeof rate, "%gx", a.replay.rate);
-    std::fprintf(stderr, "rbsim replay: %s (%s of log time) on %s, rate %s%s:\n", a.replay.path.c_str(),
-                 format_seconds(span).c_str(), participant.value().description().c_str(), rate,
-                 a.loop ? ", looping" : "");
+    RBSIM_LOG(Info, "rbsim replay: %s (%s of log time) on %s, rate %s%s:\n", a.replay.path.c_str(),
+              format_seconds(span).c_str(), participant.value().description().c_str(), rate,
+              a.loop ? ", looping" : "");
     for (const auto& o : replay.outputs()) {
       if (o.recorded.empty()) {
-        std::fprintf(stderr, "  %-28s (log time of each message)\n", o.topic.c_str());
+        RBSIM_LOG(Info, "  %-28s (log time of each message)\n", o.topic.c_str());
       } else if (o.recorded == o.topic) {
-        std::fprintf(stderr, "  %-28s %llu messages\n", o.topic.c_str(),
-                     static_cast<unsigned long long>(o.messages));
+        RBSIM_LOG(Info, "  %-28s %llu messages\n", o.topic.c_str(),
+                  static_cast<unsigned long long>(o.messages));
       } else {
-        std::fprintf(stderr, "  %-28s %llu messages, as %s\n", o.recorded.c_str(),
-                     static_cast<unsigned long long>(o.messages), o.topic.c_str());
+        RBSIM_LOG(Info, "  %-28s %llu messages, as %s\n", o.recorded.c_str(),
+                  static_cast<unsigned long long>(o.messages), o.topic.c_str());
       }
     }
   }
   if (a.wait_for > 0) {
-    if (!a.quiet) std::fprintf(stderr, "rbsim replay: waiting for %d subscriber(s)...\n", a.wait_for);
+    if (!a.quiet) RBSIM_LOG(Info, "rbsim replay: waiting for %d subscriber(s)...\n", a.wait_for);
     if (!replay.wait_for_subscribers(a.wait_for, stop_requested)) {
-      if (!a.quiet) std::fprintf(stderr, "rbsim replay: stopped while waiting, nothing published\n");
+      if (!a.quiet) RBSIM_LOG(Info, "rbsim replay: stopped while waiting, nothing published\n");
       return 0;
     }
   }
@@ -101,10 +104,10 @@ int replay_command(ReplayArgs a) {
   }
   if (server) (void)server->flush(2.0);  // viewers that keep up get the end of the log
   if (!a.quiet) {
-    std::fprintf(stderr, "rbsim replay: %s after %llu complete pass%s, %llu messages published%s\n",
-                 complete ? "done" : "stopped", static_cast<unsigned long long>(passes),
-                 passes == 1 ? "" : "es", static_cast<unsigned long long>(replay.published()),
-                 server ? ("; " + foxglove_summary(*server)).c_str() : "");
+    RBSIM_LOG(Info, "rbsim replay: %s after %llu complete pass%s, %llu messages published%s\n",
+              complete ? "done" : "stopped", static_cast<unsigned long long>(passes), passes == 1 ? "" : "es",
+              static_cast<unsigned long long>(replay.published()),
+              server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;
 }
@@ -134,6 +137,7 @@ Subcommand add_replay_command(CLI::App& parent) {
       "Publish rosgraph_msgs/Clock on /clock carrying the log time of each message replayed (recorded "
       "/clock messages are then left out)");
   add_domain_option(app, a->domain);
+  add_node_name_option(app, a->node);
   app->add_option("--namespace", a->ns, "Republish under /<namespace>/<name> instead of the recorded names")
       ->check(ros_namespace());
   app->add_option("--wait-for-subscribers", a->wait_for,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "rbsim/msgs.hpp"
+#include "rbsim/ros_env.hpp"
 
 namespace rbsim::cli {
 
@@ -63,6 +64,21 @@ inline CLI::Validator ros_namespace() {
         return {};
       },
       "NAMESPACE");
+}
+
+// --node-name NAME: the node a DDS command is on the ROS 2 graph ("rbsim_recorder", or with a
+// namespace "tools/recorder"); a name that is not a ROS 2 node name is a usage error.
+inline CLI::Option* add_node_name_option(CLI::App* app, node::NodeName& out) {
+  return app
+      ->add_option_function<std::string>(
+          "--node-name",
+          [&out](const std::string& value) {
+            Result<node::NodeName> parsed = node::parse_node_name(value);
+            if (!parsed) throw CLI::ValidationError("--node-name", parsed.error().message);
+            out = parsed.value();
+          },
+          "Its ROS 2 node name ([NAMESPACE/]NAME) on the graph (ros_discovery_info, /rosout)")
+      ->default_str(out.fully_qualified());
 }
 
 // --topics LIST (msgs::parse_topic_set) on `app`, checked once the command line is parsed, so full

@@ -3,6 +3,11 @@
 // "pkg::msg::dds_::Name_", CDR with the 4-byte encapsulation header), so a ROS 2 system using
 // rmw_cyclonedds_cpp sees them. Payloads are the exact bytes rbsim_msgs encodes: the same bytes
 // go to DDS, to MCAP and back.
+//
+// Each participant is one ROS 2 node on the graph (as rmw_cyclonedds_cpp makes them): its
+// USER_DATA says "enclave=/;", and it publishes ros_discovery_info listing the node with every
+// reader and writer the wrappers below create (node/src/graph.hpp), in the GID format ROS_DISTRO
+// selects (rbsim/ros_env.hpp).
 #pragma once
 
 #include <array>
@@ -26,6 +31,8 @@ namespace rbsim::node {
 // Participant::create's domain argument for "ROS_DOMAIN_ID, else 0".
 inline constexpr std::uint32_t kDomainFromEnvironment = UINT32_MAX;
 
+class Graph;  // node/src/graph.hpp
+
 // A DDS participant, configured by ROS 2's environment variables (rbsim/ros_env.hpp): by default
 // (ROS_AUTOMATIC_DISCOVERY_RANGE unset or LOCALHOST, no ROS_STATIC_PEERS) the domain runs on
 // rbsim's loopback configuration (127.0.0.1 only, no multicast, ParticipantIndex auto); with
@@ -33,8 +40,8 @@ inline constexpr std::uint32_t kDomainFromEnvironment = UINT32_MAX;
 // ignored go to stderr.
 class Participant {
  public:
-  // `domain`: the explicit id (--domain), or kDomainFromEnvironment.
-  static Result<Participant> create(std::uint32_t domain = kDomainFromEnvironment);
+  // `domain`: the explicit id (--domain), or kDomainFromEnvironment; `node`: the node it is.
+  static Result<Participant> create(std::uint32_t domain = kDomainFromEnvironment, const NodeName& node = {});
   Participant(Participant&& other) noexcept;
   Participant& operator=(Participant&&) = delete;
   ~Participant();
@@ -42,13 +49,27 @@ class Participant {
   std::uint32_t domain() const { return domain_; }
   // How it was configured, e.g. "domain 7 (LOCALHOST)" (DdsSettings::describe).
   const std::string& description() const { return description_; }
+  const NodeName& node() const { return node_; }
+  RosDistro distro() const { return distro_; }
+  // The node's graph entry: endpoints created outside Publisher and Subscription (a service's
+  // request reader and reply writer) register there. Null only while the participant is created.
+  Graph* graph() const { return graph_.get(); }
+  std::shared_ptr<Graph> shared_graph() const { return graph_; }
 
  private:
-  Participant(std::int32_t handle, std::uint32_t domain, std::string description)
-      : handle_(handle), domain_(domain), description_(std::move(description)) {}
+  Participant(std::int32_t handle, std::uint32_t domain, std::string description, NodeName node,
+              RosDistro distro)
+      : handle_(handle),
+        domain_(domain),
+        description_(std::move(description)),
+        node_(std::move(node)),
+        distro_(distro) {}
   std::int32_t handle_ = 0;
   std::uint32_t domain_ = 0;
   std::string description_;
+  NodeName node_;
+  RosDistro distro_ = RosDistro::Jazzy;
+  std::shared_ptr<Graph> graph_;
 };
 
 // The loopback configuration compiled into rbsim (node/config/cyclonedds-loopback.xml).
@@ -60,11 +81,30 @@ inline QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0) 
   return msgs::offered_qos(spec, keep_last);
 }
 
+// A topic by its DDS names, for topics outside msgs::topics() (ros_discovery_info, /rosout).
+struct RawTopic {
+  std::string dds_name;  // "ros_discovery_info", "rt/rosout"
+  std::string dds_type;  // "rcl_interfaces::msg::dds_::Log_"
+};
+// What an endpoint carries besides its topic and QoS.
+struct EndpointOptions {
+  // REP 2011's "RIHS01_<64 hex>" of the endpoint's type: its USER_DATA then says
+  // "typehash=<it>;" as rmw_cyclonedds_cpp writes it, except on Humble (no type hashes). Empty
+  // (today, until the hashes are computed): USER_DATA is empty, as rmw writes it for a type
+  // without a hash.
+  std::string type_hash;
+  std::int64_t lifespan_ns = 0;  // > 0: samples expire that long after they were written (/rosout)
+  bool in_graph = true;          // listed in ros_discovery_info (not its own writer, as in rmw)
+};
+
 // Publishes pre-encoded CDR messages on one topic.
 class Publisher {
  public:
   static Result<Publisher> create(const Participant& participant, const msgs::TopicSpec& spec,
-                                  std::string_view ros_topic, const QosSpec& qos);
+                                  std::string_view ros_topic, const QosSpec& qos,
+                                  const EndpointOptions& options = {});
+  static Result<Publisher> create(const Participant& participant, const RawTopic& topic, const QosSpec& qos,
+                                  const EndpointOptions& options = {});
   Publisher(Publisher&&) noexcept;
   Publisher& operator=(Publisher&&) = delete;
   ~Publisher();
@@ -83,6 +123,7 @@ class Publisher {
   std::int32_t writer_ = 0, topic_ = 0;
   const ddsi_sertype* sertype_ = nullptr;  // the writer's (raw CDR) type, owned by the topic
   std::string ros_topic_;
+  std::weak_ptr<Graph> graph_;  // where it is listed (gone with the participant: nothing to unlist)
 };
 
 // Takes raw CDR samples from one topic.
@@ -101,7 +142,11 @@ struct Received {
 class Subscription {
  public:
   static Result<Subscription> create(const Participant& participant, const msgs::TopicSpec& spec,
-                                     std::string_view ros_topic, const QosSpec& qos);
+                                     std::string_view ros_topic, const QosSpec& qos,
+                                     const EndpointOptions& options = {});
+  // A topic outside msgs::topics() (a service's requests): spec() is not available.
+  static Result<Subscription> create(const Participant& participant, const RawTopic& topic,
+                                     const QosSpec& qos, const EndpointOptions& options = {});
   Subscription(Subscription&&) noexcept;
   Subscription& operator=(Subscription&&) = delete;
   ~Subscription();
@@ -111,13 +156,15 @@ class Subscription {
   std::uint64_t lost() const;    // samples DDS reports lost or rejected
   std::int32_t matched() const;  // publications currently matched
   const std::string& ros_topic() const { return ros_topic_; }
-  const msgs::TopicSpec& spec() const { return *spec_; }
+  const msgs::TopicSpec& spec() const;  // only for one created with a TopicSpec
 
  private:
   Subscription() = default;
   std::int32_t reader_ = 0, topic_ = 0;
   std::string ros_topic_;
   const msgs::TopicSpec* spec_ = nullptr;
+  QosSpec q_;  // what it asked for: a writer's offer when discovery no longer knows it (no spec)
+  std::weak_ptr<Graph> graph_;
   struct Writer {
     std::uint64_t handle = 0;  // DDS instance handle of the matched publication
     std::array<std::uint8_t, 16> guid{};

@@ -29,11 +29,39 @@ struct RosEnvironment {
   std::optional<std::string> ros_static_peers;               // ROS_STATIC_PEERS
   std::optional<std::string> ros_localhost_only;             // ROS_LOCALHOST_ONLY (deprecated in ROS 2)
   std::optional<std::string> cyclonedds_uri;                 // CYCLONEDDS_URI
+  std::optional<std::string> ros_distro;                     // ROS_DISTRO
   static RosEnvironment from_process();                      // reads the process environment
 };
 
+// The ROS 2 wire format rbsim speaks on the graph (ROS_DISTRO). Humble (and Foxy, Galactic):
+// 24-byte GIDs (rmw_dds_common/msg/Gid is char[24]), no type hashes in endpoint USER_DATA. Jazzy
+// (and Iron, Kilted, Rolling): 16-byte GIDs and "typehash=RIHS01_...;" (REP 2011). Both
+// rmw_cyclonedds_cpp versions make a GID of the entity's DDS GUID, zero-padded.
+enum class RosDistro : std::uint8_t { Humble, Jazzy };
+std::size_t gid_size(RosDistro distro);  // 24 or 16
+bool has_type_hashes(RosDistro distro);  // whether endpoints carry typehash= in USER_DATA
+struct DistroChoice {
+  RosDistro distro = RosDistro::Jazzy;
+  std::optional<std::string> warning;  // an unknown ROS_DISTRO: Jazzy's format is used
+};
+// Unset or empty: Jazzy, silently.
+DistroChoice resolve_ros_distro(const RosEnvironment& env);
+
+// A node's name as rcl splits a fully qualified name: "/a/b/sim" is node "sim" in namespace
+// "/a/b"; "/rbsim" is node "rbsim" in the root namespace "/".
+struct NodeName {
+  std::string ns = "/";
+  std::string name = "rbsim";
+  std::string fully_qualified() const;  // "/a/b/sim"
+  std::string logger_name() const;      // "a.b.sim", as rcl names the node's logger (rosout's name field)
+};
+// "a/b/sim" or "/a/b/sim": ROS 2 name tokens (letters, digits, '_', not starting with a digit)
+// separated by single '/'; the last one is the node name. Fails naming what is wrong.
+Result<NodeName> parse_node_name(std::string_view path);
+
 struct DdsSettings {
   std::uint32_t domain = 0;
+  RosDistro distro = RosDistro::Jazzy;  // ROS_DISTRO (resolve_ros_distro; an unknown one is a warning)
   DiscoveryRange range = DiscoveryRange::Localhost;
   std::vector<std::string> static_peers;  // the peers the configuration contains
   // The configuration to create the domain with (dds_create_domain); nullopt: none, Cyclone
