@@ -297,6 +297,7 @@ struct ServiceServer::Impl {
     slot.publication = publication;
     ++count;
     arrived.notify_one();
+    if (options.on_arrival) options.on_arrival();
   }
 
   enum class Client : std::uint8_t { Present, NotYet, Gone };

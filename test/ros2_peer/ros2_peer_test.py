@@ -164,8 +164,81 @@ def case_killed_peer(ctx):
     return 0
 
 
+def peer_json(ctx, net, name, *args, timeout=60):
+    """Runs rbsim-ros2-peer to completion in namespace b; its JSON lines (exit 0 required)."""
+    peer = net.peer(name, *args, "--timeout", timeout)
+    e2e.exited_ok(ctx, peer, timeout + 30, f"rbsim-ros2-peer {' '.join(map(str, args))}")
+    return lines(peer)
+
+
+def case_parameters(ctx):
+    """ros2-client lists, describes, gets and sets the node's parameters through the six
+    rcl_interfaces services (ServiceMapping::Cyclone); a change goes out on /parameter_events and
+    a bad set changes nothing."""
+    def body(net, node):
+        node_name = f"/{ctx.ns}"
+        names = [m for m in peer_json(ctx, net, "list", "params", node_name, "list") if "list" in m]
+        got = names[0]["list"] if names else []
+        for want in ("scene", "dt", "integrator", "bodies", "springs", "steps", "rate", "publish_every", "paused",
+                     "forces.0.fx", "forces.0.fy", "springs.0.k", "springs.0.l0", "use_sim_time"):
+            ctx.check(want in got, f"list_parameters lacks {want}: {got}")
+        desc = {m["describe"]: m for m in peer_json(ctx, net, "describe", "params", node_name, "describe", "dt", "rate",
+                                                  "publish_every")}
+        ctx.check(desc.get("dt", {}).get("read_only") is True, f"dt not read-only: {desc.get('dt')}")
+        ctx.check(desc.get("rate", {}).get("type") == 3 and desc["rate"]["read_only"] is False,
+                  f"rate not a writable double: {desc.get('rate')}")
+        ctx.check(desc.get("publish_every", {}).get("integer_range", [[0]])[0][0] == 1,
+                  f"publish_every's range does not start at 1: {desc.get('publish_every')}")
+        types = {m["types"]: m["type"] for m in peer_json(ctx, net, "types", "params", node_name, "types", "dt",
+                                                          "bodies", "paused", "scene")}
+        ctx.check(types == {"dt": 3, "bodies": 2, "paused": 1, "scene": 4}, f"get_parameter_types: {types}")
+        events = net.peer("events", "events", "forces.0.fy", "--timeout", 60)
+        import time
+        time.sleep(1.0)  # the events subscription matches first
+        sets = peer_json(ctx, net, "set", "params", node_name, "set", "forces.0.fy=-3.7", "rate=2")
+        ctx.check([m.get("set") for m in sets] == [True, False],
+                  f"set_parameters forces.0.fy=-3.7 (double) and rate=2 (integer for a double): {sets}")
+        if len(sets) == 2:
+            ctx.check("rate" in sets[1]["reason"], f"the refusal does not name the parameter: {sets[1]}")
+        got = {m["get"]: m["value"] for m in peer_json(ctx, net, "get", "params", node_name, "get", "forces.0.fy",
+                                                       "rate")}
+        ctx.check(got.get("forces.0.fy") == {"double": -3.7} and got.get("rate") == {"double": 1.0},
+                  f"after the set: {got}")
+        atomic = peer_json(ctx, net, "atomic", "params", node_name, "set-atomic", "forces.0.fx=1.5", "dt=0.5")
+        ctx.check([m.get("set-atomic") for m in atomic] == [False], f"atomic set with a read-only dt: {atomic}")
+        got = {m["get"]: m["value"] for m in peer_json(ctx, net, "get2", "params", node_name, "get", "forces.0.fx")}
+        ctx.check(got.get("forces.0.fx") == {"double": 0.0}, f"a refused atomic batch changed forces.0.fx: {got}")
+        e2e.exited_ok(ctx, events, 90, "rbsim-ros2-peer events")
+        ev = [m for m in lines(events) if m.get("event") == "forces.0.fy"]
+        ctx.check(bool(ev) and ev[0]["value"] == {"double": -3.7} and ev[0]["node"] == node_name,
+                  f"/parameter_events: {lines(events)}")
+    return with_node(ctx, body)
+
+
+def case_services(ctx):
+    """pause, step N, resume and apply_impulse called by ros2-client: each reply names its step,
+    and every published state equals an offline run with the same changes at those steps."""
+    def body(net, node):
+        svc = f"/{ctx.ns}"
+        r = peer_json(ctx, net, "pause", "call", f"{svc}/pause", "trigger")
+        ctx.check(r and r[0]["success"], f"pause: {r}")
+        r = peer_json(ctx, net, "step-running", "call", f"{svc}/step", "step", 0)
+        ctx.check(r and not r[0]["success"], f"step 0 accepted: {r}")
+        r = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 5)
+        ctx.check(r and r[0]["success"], f"step 5 while paused: {r}")
+        r = peer_json(ctx, net, "impulse-bad", "call", f"{svc}/apply_impulse", "impulse", 999, 1, 0, 0, 0)
+        ctx.check(r and not r[0]["success"] and "999" in r[0]["message"], f"impulse on body 999: {r}")
+        r = peer_json(ctx, net, "impulse", "call", f"{svc}/apply_impulse", "impulse", 1, 0.5, 2.0, 0.1, 0.0)
+        ctx.check(r and r[0]["success"], f"impulse on body 1: {r}")
+        r = peer_json(ctx, net, "resume", "call", f"{svc}/resume", "trigger")
+        ctx.check(r and r[0]["success"], f"resume: {r}")
+        r = peer_json(ctx, net, "running-step", "call", f"{svc}/step", "step", 3)
+        ctx.check(r and not r[0]["success"], f"step while running accepted: {r}")
+    return with_node(ctx, body)
+
+
 e2e.CASES.clear()
-e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer})
+e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer, "parameters": case_parameters, "services": case_services})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

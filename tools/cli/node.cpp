@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "rbsim/control.hpp"
 #include "rbsim/dds_sink.hpp"
+#include "rbsim/node_services.hpp"
 #include "rbsim/ros_args.hpp"
 #include "rbsim/rosout.hpp"
 #include "rbsim/run.hpp"
@@ -131,6 +132,15 @@ int node_command(const NodeArgs& a) {
     sink.value()->set_publish_every(s.publish_every);
     if (foxglove_sink) foxglove_sink->set_publish_every(s.publish_every);
   });
+  // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse)
+  // answer through the controller; every parameter change also goes out on /parameter_events.
+  auto services =
+      node::NodeServices::create(participant.value(), controller, {name->fully_qualified(), scene.world.dt});
+  if (!services) return fail("node", services.error().message);
+  controller.on_command(
+      [&applied = *services.value()](const control::Command& c, const control::CommandResult& r) {
+        applied.command_applied(c, r);
+      });
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;
@@ -155,17 +165,19 @@ int node_command(const NodeArgs& a) {
     const std::int64_t total_steps = driver.steps_done();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const control::ControlCounters counted = controller.counters();
-    RBSIM_LOG(Info, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s, %s%s\n",
-                 stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
-                 format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
-                 static_cast<unsigned long long>(sink.value()->published()),
-                 count_of(static_cast<std::int64_t>(counted.commands + counted.queries), "service call",
-                          "service calls")
-                     .c_str(),
-                 count_of(static_cast<std::int64_t>(counted.parameter_changes), "parameter change",
-                          "parameter changes")
-                     .c_str(),
-                 server ? ("; " + foxglove_summary(*server)).c_str() : "");
+    const node::NodeServiceCounters served = services.value()->counters();
+    const std::string dropped = served.dropped > 0 ? " (" + std::to_string(served.dropped) + " dropped)" : "";
+    RBSIM_LOG(Info,
+              "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s%s, %s%s\n",
+              stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
+              format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
+              static_cast<unsigned long long>(sink.value()->published()),
+              count_of(static_cast<std::int64_t>(served.received), "service call", "service calls").c_str(),
+              dropped.c_str(),
+              count_of(static_cast<std::int64_t>(counted.parameter_changes), "parameter change",
+                       "parameter changes")
+                  .c_str(),
+              server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;
 }

@@ -74,6 +74,9 @@ struct ServiceOptions {
   std::size_t max_request_bytes = 64 * 1024;  // larger requests are dropped unread
   // How long a reply waits (retried at each serve()) for the client's reply reader to match.
   double client_match_timeout_s = 0.1;
+  // Called (on Cyclone's receive thread, must not block) after a request was queued: one thread
+  // serving several servers waits for all of them at once.
+  std::function<void()> on_arrival;
 };
 
 // What a server did with the requests it received (every received request is counted once in

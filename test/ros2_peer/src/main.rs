@@ -133,14 +133,16 @@ fn main() -> ExitCode {
   let mut node = context
     .new_node(NodeName::new("/rbsim_test", "ros2_peer").unwrap(), NodeOptions::new().enable_rosout(false))
     .expect("node");
-  // The spinner first: ros2-client hands out graph events only to a node that spins.
+  // The spinner first: ros2-client hands out graph events only to a node that spins. The graph
+  // events receiver only for `graph`: an unread one fills up and stalls the spinner, and with it
+  // the matching that wait_for_service waits for.
   let spinner = node.spinner().expect("spinner");
-  let events = node.status_receiver().expect("status receiver");
+  let events = if args.verb == "graph" { node.status_receiver() } else { None };
   smol::spawn(spinner.spin()).detach();
 
   let found = match args.verb.as_str() {
     "graph" => within(args.timeout, async {
-      let mut events = Box::pin(events);
+      let mut events = Box::pin(events.expect("status receiver"));
       while let Some(event) = events.next().await {
         if let NodeEvent::ParticipantEntities(info) = event {
           for n in info.nodes() {
@@ -271,9 +273,9 @@ fn main() -> ExitCode {
     }
     "params" | "call" => {
       let result = if args.verb == "params" {
-        services::params(&mut node, &args.operand, &args.rest, args.timeout)
+        services::params(&context, &mut node, &args.operand, &args.rest, args.timeout)
       } else {
-        services::call_service(&mut node, &args.operand, &args.rest, args.timeout)
+        services::call_service(&context, &mut node, &args.operand, &args.rest, args.timeout)
       };
       if let Err(e) = &result {
         eprintln!("rbsim-ros2-peer: {e}");

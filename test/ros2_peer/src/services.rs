@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use ros2_client::{
-  Message, Name, Node, ParameterValue, QosProfile, ServiceMapping, ServiceTypeName,
+  Context, Message, Name, Node, ParameterValue, QosProfile, ServiceMapping, ServiceTypeName,
   parameters::raw,
   qos::{Durability, History, Reliability, WhenFull},
   rcl_interfaces::*,
@@ -28,8 +28,13 @@ fn service_name(full: &str) -> Result<Name, String> {
 }
 
 /// Calls `service` once (bounded by `timeout`, the wait for the server included).
+/// "rq", "/ns/node/pause", "Request" -> "rq/ns/node/pauseRequest", as rmw names a service's topics.
+fn service_topic(prefix: &str, service: &str, suffix: &str) -> String {
+  format!("{prefix}{service}{suffix}")
+}
+
 pub fn call<Req, Resp>(
-  node: &mut Node, service: &str, pkg: &str, ty: &str, request: Req, timeout: Duration,
+  context: &Context, node: &mut Node, service: &str, pkg: &str, ty: &str, request: Req, timeout: Duration,
 ) -> Result<Resp, String>
 where
   Req: Message + Clone + 'static,
@@ -44,10 +49,23 @@ where
       service_qos(),
     )
     .map_err(|e| format!("client {service}: {e:?}"))?;
-  let node: &Node = node;
+  // Wait for the server as discovery reports it. (Client::wait_for_service re-checks its match
+  // only when a new subscription is declared on the graph, so it never wakes for a server that
+  // was discovered before the client existed: the usual case for a test calling a running node.)
+  let dds = context.domain_participant();
+  let (rq, rr) = (service_topic("rq", service, "Request"), service_topic("rr", service, "Reply"));
   smol::block_on(smol::future::or(
     async {
-      client.wait_for_service(node).await;
+      loop {
+        let readers = dds.discovered_readers().iter().filter(|r| r.subscription_topic_data.topic_name == rq).count();
+        let writers = dds.discovered_writers().iter().filter(|w| w.publication_topic_data.topic_name == rr).count();
+        if readers > 0 && writers > 0 {
+          break;
+        }
+        smol::Timer::after(Duration::from_millis(50)).await;
+      }
+      // Discovery first, then the local match of our writer and reader: give it a moment.
+      smol::Timer::after(Duration::from_millis(300)).await;
       client.async_call_service(request).await.map_err(|e| format!("{service}: {e:?}"))
     },
     async {
@@ -127,21 +145,21 @@ fn number<T: std::str::FromStr>(word: &str) -> Result<T, String> {
 }
 
 /// `params NODE VERB ARGS...`: one JSON line per answer.
-pub fn params(node: &mut Node, target: &str, words: &[String], timeout: Duration) -> Result<(), String> {
+pub fn params(context: &Context, node: &mut Node, target: &str, words: &[String], timeout: Duration) -> Result<(), String> {
   let (verb, rest) = words.split_first().ok_or("params NODE list|get|describe|types|set|set-atomic ...")?;
   let names: Vec<String> = rest.to_vec();
   let svc = |s: &str| format!("{target}/{s}");
   match verb.as_str() {
     "list" => {
       let r: ListParametersResponse = call(
-        node, &svc("list_parameters"), "rcl_interfaces", "ListParameters",
+        context, node, &svc("list_parameters"), "rcl_interfaces", "ListParameters",
         ListParametersRequest { prefixes: names, depth: 0 }, timeout)?;
       let list: Vec<String> = r.result.names.iter().map(|n| json_string(n)).collect();
       println!("{{\"list\": [{}]}}", list.join(", "));
     }
     "get" => {
       let r: GetParametersResponse =
-        call(node, &svc("get_parameters"), "rcl_interfaces", "GetParameters", GetParametersRequest { names: names.clone() }, timeout)?;
+        call(context, node, &svc("get_parameters"), "rcl_interfaces", "GetParameters", GetParametersRequest { names: names.clone() }, timeout)?;
       for (n, v) in names.iter().zip(r.values.iter()) {
         println!("{{\"get\": {}, \"type\": {}, \"value\": {}}}", json_string(n), v.ptype, value_json(v));
       }
@@ -151,7 +169,7 @@ pub fn params(node: &mut Node, target: &str, words: &[String], timeout: Duration
     }
     "types" => {
       let r: GetParameterTypesResponse = call(
-        node, &svc("get_parameter_types"), "rcl_interfaces", "GetParameterTypes",
+        context, node, &svc("get_parameter_types"), "rcl_interfaces", "GetParameterTypes",
         GetParameterTypesRequest { names: names.clone() }, timeout)?;
       for (n, t) in names.iter().zip(r.values.iter()) {
         println!("{{\"types\": {}, \"type\": {t}}}", json_string(n));
@@ -159,7 +177,7 @@ pub fn params(node: &mut Node, target: &str, words: &[String], timeout: Duration
     }
     "describe" => {
       let r: DescribeParametersResponse = call(
-        node, &svc("describe_parameters"), "rcl_interfaces", "DescribeParameters",
+        context, node, &svc("describe_parameters"), "rcl_interfaces", "DescribeParameters",
         DescribeParametersRequest { names }, timeout)?;
       for d in &r.values {
         let fr: Vec<String> = d.floating_point_range.iter()
@@ -175,11 +193,11 @@ pub fn params(node: &mut Node, target: &str, words: &[String], timeout: Duration
       let parameter = rest.iter().map(|w| parse_assignment(w)).collect::<Result<Vec<_>, _>>()?;
       let results = if verb == "set" {
         let r: SetParametersResponse = call(
-          node, &svc("set_parameters"), "rcl_interfaces", "SetParameters", SetParametersRequest { parameter }, timeout)?;
+          context, node, &svc("set_parameters"), "rcl_interfaces", "SetParameters", SetParametersRequest { parameter }, timeout)?;
         r.results
       } else {
         let r: SetParametersAtomicallyResponse = call(
-          node, &svc("set_parameters_atomically"), "rcl_interfaces", "SetParametersAtomically",
+          context, node, &svc("set_parameters_atomically"), "rcl_interfaces", "SetParametersAtomically",
           SetParametersRequest { parameter }, timeout)?;
         vec![r.result]
       };
@@ -193,16 +211,16 @@ pub fn params(node: &mut Node, target: &str, words: &[String], timeout: Duration
 }
 
 /// `call SERVICE trigger | step N | impulse BODY JX JY PX PY`.
-pub fn call_service(node: &mut Node, service: &str, words: &[String], timeout: Duration) -> Result<(), String> {
+pub fn call_service(context: &Context, node: &mut Node, service: &str, words: &[String], timeout: Duration) -> Result<(), String> {
   let (kind, rest) = words.split_first().ok_or("call SERVICE trigger|step N|impulse BODY JX JY PX PY")?;
   match (kind.as_str(), rest.len()) {
     ("trigger", 0) => {
       let r: TriggerResponse = call(
-        node, service, "std_srvs", "Trigger", TriggerRequest { structure_needs_at_least_one_member: 0 }, timeout)?;
+        context, node, service, "std_srvs", "Trigger", TriggerRequest { structure_needs_at_least_one_member: 0 }, timeout)?;
       println!("{{\"call\": {}, \"success\": {}, \"message\": {}}}", json_string(service), r.success, json_string(&r.message));
     }
     ("step", 1) => {
-      let r: StepReply = call(node, service, "rbsim_msgs", "Step", StepRequest { steps: number(&rest[0])? }, timeout)?;
+      let r: StepReply = call(context, node, service, "rbsim_msgs", "Step", StepRequest { steps: number(&rest[0])? }, timeout)?;
       println!("{{\"call\": {}, \"success\": {}, \"message\": {}, \"step\": {}}}", json_string(service), r.success,
                json_string(&r.message), r.step);
     }
@@ -210,7 +228,7 @@ pub fn call_service(node: &mut Node, service: &str, words: &[String], timeout: D
       let req = ApplyImpulseRequest {
         body: number(&rest[0])?, jx: number(&rest[1])?, jy: number(&rest[2])?, px: number(&rest[3])?, py: number(&rest[4])?,
       };
-      let r: StepReply = call(node, service, "rbsim_msgs", "ApplyImpulse", req, timeout)?;
+      let r: StepReply = call(context, node, service, "rbsim_msgs", "ApplyImpulse", req, timeout)?;
       println!("{{\"call\": {}, \"success\": {}, \"message\": {}, \"step\": {}}}", json_string(service), r.success,
                json_string(&r.message), r.step);
     }

@@ -156,14 +156,22 @@ std::vector<std::uint32_t> triangulate(std::span<const Vec2> p) {
   return out;
 }
 
-std::uint64_t sim_time_ns(const World& world) {
-  const double ns = std::round(world.time() * 1e9);
+std::uint64_t sim_time_ns(std::int64_t step, double dt) {
+  const double ns = std::round(static_cast<double>(step) * dt * 1e9);
   return ns <= 0.0 ? 0 : static_cast<std::uint64_t>(ns);
 }
 
-Time sim_time(const World& world) {
-  const std::uint64_t ns = sim_time_ns(world);
+std::uint64_t sim_time_ns(const World& world) {
+  return sim_time_ns(world.step_index(), world.dt());
+}
+
+Time sim_time(std::int64_t step, double dt) {
+  const std::uint64_t ns = sim_time_ns(step, dt);
   return Time{static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
+}
+
+Time sim_time(const World& world) {
+  return sim_time(world.step_index(), world.dt());
 }
 
 Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene) {

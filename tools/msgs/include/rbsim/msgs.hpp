@@ -122,6 +122,9 @@ struct Time {
 // Simulated time of the world's current step, t = step * dt, rounded to the nanosecond.
 Time sim_time(const World& world);
 std::uint64_t sim_time_ns(const World& world);
+// The same for step `step` of a world stepping `dt` (t = step * dt, as World::time()).
+Time sim_time(std::int64_t step, double dt);
+std::uint64_t sim_time_ns(std::int64_t step, double dt);
 
 using rbsim::Bytes;
 

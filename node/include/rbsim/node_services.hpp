@@ -1,0 +1,56 @@
+// The node's services, the ROS 2 way: the six rcl_interfaces parameter services and rbsim's
+// controls (pause, resume, reset: std_srvs/srv/Trigger; step: rbsim_msgs/srv/Step; apply_impulse:
+// rbsim_msgs/srv/ApplyImpulse) under the node's name, on rmw_cyclonedds_cpp's wire format
+// (rbsim/service.hpp), and /parameter_events. Every request becomes a control::Command for the
+// run loop (rbsim/control.hpp), answered once it applied at a step boundary; reads answer at once
+// from the table as of the last boundary. Requests are served on one thread of this class, woken
+// by any server's arrival, so a paused run loop (idling in the controller) still answers.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "rbsim/control.hpp"
+#include "rbsim/dds.hpp"
+
+namespace rbsim::node {
+
+struct NodeServicesOptions {
+  std::string node = "/rbsim";  // the node's fully qualified name: services are <node>/<name>
+  double dt = 0.01;             // the scene's step (s): /parameter_events stamps are simulated time
+  // How long a request waits for its step boundary before it is answered unsuccessfully (a run
+  // that ended, or one stopped by Ctrl-C, answers at once).
+  double apply_timeout_s = 10.0;
+};
+
+// For the end line.
+struct NodeServiceCounters {
+  std::uint64_t received = 0;   // requests taken from DDS
+  std::uint64_t calls = 0;      // requests answered
+  std::uint64_t dropped = 0;    // not answered: queue full, too large, malformed, client gone
+  std::uint64_t events = 0;     // /parameter_events published
+};
+
+class NodeServices {
+ public:
+  // Creates the servers and starts serving. `controller` outlives this object.
+  static Result<std::unique_ptr<NodeServices>> create(const Participant& participant,
+                                                      control::Controller& controller,
+                                                      const NodeServicesOptions& options);
+  ~NodeServices();  // stops serving (a request in flight is answered first)
+  NodeServices(const NodeServices&) = delete;
+  NodeServices& operator=(const NodeServices&) = delete;
+
+  // The controller's observer (Controller::on_command): publishes /parameter_events for every
+  // parameter a command changed. Called on the run loop's thread.
+  void command_applied(const control::Command& command, const control::CommandResult& result);
+  NodeServiceCounters counters() const;
+
+ private:
+  struct Impl;
+  explicit NodeServices(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rbsim::node

@@ -1,0 +1,292 @@
+// The node's parameter and control services (rbsim/node_services.hpp).
+#include "rbsim/node_services.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <future>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "graph.hpp"
+#include "rbsim/interfaces.hpp"
+#include "rbsim/service.hpp"
+#include "rbsim/type_hash.hpp"
+
+namespace rbsim::node {
+
+namespace {
+
+using control::Command;
+using control::CommandKind;
+using control::CommandResult;
+
+constexpr std::size_t kBudgetPerServer = 8;  // requests one server handles before the next one's turn
+
+// rclcpp's parameter events QoS: reliable, volatile, keep last 1000.
+QosSpec parameter_events_qos() {
+  QosSpec q;
+  q.transient_local = false;
+  q.keep_all = false;
+  q.depth = 1000;
+  return q;
+}
+
+std::string hash_or_empty(const Participant& participant, std::string_view type) {
+  if (participant.distro() == RosDistro::Humble) return {};
+  Result<std::string> h = msgs::type_hash(type);
+  return h ? h.value() : std::string{};
+}
+
+}  // namespace
+
+struct NodeServices::Impl {
+  control::Controller& controller;
+  NodeServicesOptions options;
+  std::shared_ptr<Graph> graph;
+  std::vector<ServiceServer> servers;
+  std::vector<ServiceServer::Handler> handlers;
+  std::optional<Publisher> events;
+  Bytes event_cdr;
+
+  std::mutex mutex;  // guards `arrived` and `stopping`
+  std::condition_variable wake;
+  bool arrived = false, stopping = false;
+  std::atomic<std::uint64_t> event_count{0};
+  std::thread thread;
+
+  Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
+
+  // Submits `command` and waits (bounded) for the boundary that applies it.
+  CommandResult apply(Command command) {
+    command.source = "ros2 service";
+    std::future<CommandResult> done = controller.submit(std::move(command));
+    if (done.wait_for(std::chrono::duration<double>(options.apply_timeout_s)) != std::future_status::ready) {
+      CommandResult r;
+      r.message = "not applied within " + std::to_string(options.apply_timeout_s) + " s";
+      return r;
+    }
+    return done.get();
+  }
+
+  static std::uint64_t step_of(const CommandResult& r) { return r.step < 0 ? 0 : static_cast<std::uint64_t>(r.step); }
+
+  Status add(const Participant& participant, std::string_view name, std::string_view srv_type,
+             ServiceServer::Handler handler) {
+    ServiceOptions so;
+    if (participant.distro() != RosDistro::Humble) {
+      Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
+      if (!h) return h.error();
+      so.request_user_data = msgs::typehash_user_data(h->request);
+      so.reply_user_data = msgs::typehash_user_data(h->reply);
+    }
+    so.on_arrival = [this] {
+      { const std::lock_guard lock(mutex); arrived = true; }
+      wake.notify_one();
+    };
+    Result<ServiceServer> s = ServiceServer::create(participant, options.node + "/" + std::string(name), srv_type, so);
+    if (!s) return s.error();
+    if (graph) {
+      if (Status st = graph->add(Graph::Kind::Reader, s->request_reader().guid); !st) return st;
+      if (Status st = graph->add(Graph::Kind::Writer, s->reply_writer().guid); !st) return st;
+    }
+    servers.push_back(std::move(s.value()));
+    handlers.push_back(std::move(handler));
+    return Ok{};
+  }
+
+  void add_controls(std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>>& out) {
+    using msgs::TriggerRequest, msgs::TriggerResponse;
+    const auto trigger = [this](CommandKind kind) {
+      return typed_handler<TriggerRequest, TriggerResponse>(
+          [this, kind](const RequestHeader&, const TriggerRequest&) {
+            Command c;
+            c.kind = kind;
+            const CommandResult r = apply(std::move(c));
+            return TriggerResponse{r.successful, r.message};
+          },
+          [](const Error& e) { return std::optional<TriggerResponse>(TriggerResponse{false, e.message}); });
+    };
+    out.emplace_back("pause", "std_srvs/srv/Trigger", trigger(CommandKind::Pause));
+    out.emplace_back("resume", "std_srvs/srv/Trigger", trigger(CommandKind::Resume));
+    out.emplace_back("reset", "std_srvs/srv/Trigger", trigger(CommandKind::Reset));
+    out.emplace_back("step", "rbsim_msgs/srv/Step",
+                     typed_handler<msgs::StepRequest, msgs::StepResponse>(
+                         [this](const RequestHeader&, const msgs::StepRequest& req) {
+                           Command c;
+                           c.kind = CommandKind::Step;
+                           c.steps = req.steps;
+                           const CommandResult r = apply(std::move(c));
+                           return msgs::StepResponse{r.successful, r.message, step_of(r)};
+                         },
+                         [](const Error& e) {
+                           return std::optional<msgs::StepResponse>(msgs::StepResponse{false, e.message, 0});
+                         }));
+    out.emplace_back("apply_impulse", "rbsim_msgs/srv/ApplyImpulse",
+                     typed_handler<msgs::ApplyImpulseRequest, msgs::ApplyImpulseResponse>(
+                         [this](const RequestHeader&, const msgs::ApplyImpulseRequest& req) {
+                           Command c;
+                           c.kind = CommandKind::Impulse;
+                           c.impulse.body = req.body;
+                           c.impulse.impulse = Vec2(req.jx, req.jy);
+                           c.impulse.point = Vec2(req.px, req.py);
+                           const CommandResult r = apply(std::move(c));
+                           return msgs::ApplyImpulseResponse{r.successful, r.message, step_of(r)};
+                         },
+                         [](const Error& e) {
+                           return std::optional<msgs::ApplyImpulseResponse>(
+                               msgs::ApplyImpulseResponse{false, e.message, 0});
+                         }));
+  }
+
+  // rclcpp's parameter services: reads answer from the table as of the last boundary; a read
+  // naming an unknown parameter answers an empty list, as rclcpp's do; a malformed request gets no
+  // reply (these responses have no field to say so).
+  void add_parameters(std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>>& out) {
+    using namespace msgs;
+    out.emplace_back("list_parameters", "rcl_interfaces/srv/ListParameters",
+                     typed_handler<ListParametersRequest, ListParametersResponse>(
+                         [this](const RequestHeader&, const ListParametersRequest& req) {
+                           return ListParametersResponse{controller.list(req.prefixes, req.depth)};
+                         },
+                         [](const Error&) { return std::optional<ListParametersResponse>(); }));
+    out.emplace_back("get_parameters", "rcl_interfaces/srv/GetParameters",
+                     typed_handler<GetParametersRequest, GetParametersResponse>(
+                         [this](const RequestHeader&, const GetParametersRequest& req) {
+                           GetParametersResponse res;
+                           for (auto& v : controller.get(req.names)) {
+                             if (!v) return GetParametersResponse{};
+                             res.values.push_back(std::move(*v));
+                           }
+                           return res;
+                         },
+                         [](const Error&) { return std::optional<GetParametersResponse>(); }));
+    out.emplace_back("describe_parameters", "rcl_interfaces/srv/DescribeParameters",
+                     typed_handler<DescribeParametersRequest, DescribeParametersResponse>(
+                         [this](const RequestHeader&, const DescribeParametersRequest& req) {
+                           DescribeParametersResponse res;
+                           for (auto& d : controller.describe(req.names)) {
+                             if (!d) return DescribeParametersResponse{};
+                             res.descriptors.push_back(std::move(*d));
+                           }
+                           return res;
+                         },
+                         [](const Error&) { return std::optional<DescribeParametersResponse>(); }));
+    out.emplace_back("get_parameter_types", "rcl_interfaces/srv/GetParameterTypes",
+                     typed_handler<GetParameterTypesRequest, GetParameterTypesResponse>(
+                         [this](const RequestHeader&, const GetParameterTypesRequest& req) {
+                           GetParameterTypesResponse res;
+                           for (ParameterType t : controller.types(req.names))
+                             res.types.push_back(static_cast<std::uint8_t>(t));
+                           return res;
+                         },
+                         [](const Error&) { return std::optional<GetParameterTypesResponse>(); }));
+    out.emplace_back("set_parameters", "rcl_interfaces/srv/SetParameters",
+                     typed_handler<SetParametersRequest, SetParametersResponse>(
+                         [this](const RequestHeader&, const SetParametersRequest& req) {
+                           Command c;
+                           c.kind = CommandKind::SetParameters;
+                           c.atomic = false;
+                           c.parameters = req.parameters;
+                           CommandResult r = apply(std::move(c));
+                           if (r.results.size() != req.parameters.size()) {  // never applied
+                             r.results.assign(req.parameters.size(), SetParametersResult{false, r.message});
+                           }
+                           return SetParametersResponse{std::move(r.results)};
+                         },
+                         [](const Error&) { return std::optional<SetParametersResponse>(); }));
+    out.emplace_back("set_parameters_atomically", "rcl_interfaces/srv/SetParametersAtomically",
+                     typed_handler<SetParametersAtomicallyRequest, SetParametersAtomicallyResponse>(
+                         [this](const RequestHeader&, const SetParametersAtomicallyRequest& req) {
+                           Command c;
+                           c.kind = CommandKind::SetParameters;
+                           c.atomic = true;
+                           c.parameters = req.parameters;
+                           const CommandResult r = apply(std::move(c));
+                           SetParametersResult result{r.successful, r.successful ? std::string{} : r.message};
+                           if (!r.results.empty() && !r.results.front().successful) result = r.results.front();
+                           return SetParametersAtomicallyResponse{result};
+                         },
+                         [](const Error&) { return std::optional<SetParametersAtomicallyResponse>(); }));
+  }
+
+  void serve_loop() {
+    while (true) {
+      {
+        std::unique_lock lock(mutex);
+        // Bounded wait: replies waiting for their client's reader are retried at each serve().
+        wake.wait_for(lock, std::chrono::milliseconds(20), [this] { return arrived || stopping; });
+        if (stopping) return;
+        arrived = false;
+      }
+      for (std::size_t k = 0; k < servers.size(); ++k) servers[k].serve(handlers[k], kBudgetPerServer);
+    }
+  }
+};
+
+NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+NodeServices::~NodeServices() {
+  {
+    const std::lock_guard lock(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->wake.notify_one();
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& participant,
+                                                           control::Controller& controller,
+                                                           const NodeServicesOptions& options) {
+  auto impl = std::make_unique<Impl>(controller, options);
+  impl->graph = participant.shared_graph();
+  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services;
+  impl->add_controls(services);
+  impl->add_parameters(services);
+  for (auto& [name, type, handler] : services) {
+    if (Status st = impl->add(participant, name, type, std::move(handler)); !st) return st.error();
+  }
+  EndpointOptions eo;
+  eo.type_hash = hash_or_empty(participant, msgs::ParameterEvent::kType);
+  auto events = Publisher::create(
+      participant, RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType)},
+      parameter_events_qos(), eo);
+  if (!events) return events.error();
+  impl->events.emplace(std::move(events.value()));
+  Impl* raw = impl.get();
+  impl->thread = std::thread([raw] { raw->serve_loop(); });
+  return std::unique_ptr<NodeServices>(new NodeServices(std::move(impl)));
+}
+
+void NodeServices::command_applied(const Command& command, const CommandResult& result) {
+  if (command.kind != CommandKind::SetParameters || result.step < 0) return;
+  msgs::ParameterEvent event;
+  event.node = impl_->options.node;
+  event.stamp = msgs::sim_time(result.step, impl_->options.dt);
+  for (std::size_t k = 0; k < command.parameters.size(); ++k) {
+    const bool changed = command.atomic ? result.successful
+                                        : k < result.results.size() && result.results[k].successful;
+    if (changed) event.changed_parameters.push_back(command.parameters[k]);
+  }
+  if (event.changed_parameters.empty()) return;
+  impl_->event_cdr.clear();
+  msgs::encode(event, impl_->event_cdr);
+  if (impl_->events->publish(impl_->event_cdr)) ++impl_->event_count;
+}
+
+NodeServiceCounters NodeServices::counters() const {
+  NodeServiceCounters c;
+  for (const ServiceServer& s : impl_->servers) {
+    const ServiceStats st = s.stats();
+    c.received += st.received;
+    c.calls += st.answered;
+    c.dropped += st.dropped_full + st.dropped_large + st.malformed + st.client_gone + st.client_unmatched +
+                 st.unanswered + st.write_failed;
+  }
+  c.events = impl_->event_count.load();
+  return c;
+}
+
+}  // namespace rbsim::node
