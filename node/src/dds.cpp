@@ -16,6 +16,7 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/rosout.hpp"
+#include "rbsim/type_hash.hpp"
 #include "topics.hpp"
 
 namespace rbsim::node {
@@ -92,7 +93,19 @@ Result<dds_entity_t> make_topic(dds_entity_t participant, const RawTopic& raw,
 }
 
 RawTopic raw_topic(const msgs::TopicSpec& spec, std::string_view ros_topic) {
-  return {msgs::dds_topic_name(ros_topic), descriptor(spec.id)->m_typename};
+  return {msgs::dds_topic_name(ros_topic), descriptor(spec.id)->m_typename, std::string(spec.type)};
+}
+
+// The endpoint's options with the type hash of its topic's type filled in (every shipped type
+// hashes: a failure is a bug in the definitions, caught by msgs's tests).
+EndpointOptions with_type_hash(const EndpointOptions& options, const RawTopic& raw) {
+  EndpointOptions o = options;
+  if (o.type_hash.empty() && !raw.ros_type.empty()) {
+    Result<std::string> hash = msgs::type_hash(raw.ros_type);
+    RBSIM_ASSERT(hash, "a shipped type hashes");
+    if (hash) o.type_hash = hash.value();
+  }
+  return o;
 }
 
 // Lists a new endpoint in its participant's graph entry; returns where it is listed.
@@ -180,7 +193,7 @@ Result<Publisher> Publisher::create(const Participant& participant, const RawTop
   const ddsi_sertype* sertype = nullptr;
   auto topic = make_topic(participant.handle(), raw, &sertype);
   if (!topic) return topic.error();
-  dds_qos_t* qos = make_qos(q, false, options, participant.distro());
+  dds_qos_t* qos = make_qos(q, false, with_type_hash(options, raw), participant.distro());
   const dds_entity_t writer = dds_create_writer(participant.handle(), topic.value(), qos, nullptr);
   dds_delete_qos(qos);
   if (writer < 0) {
@@ -263,7 +276,7 @@ Result<Subscription> Subscription::create(const Participant& participant, const 
                                           const QosSpec& q, const EndpointOptions& options) {
   auto topic = make_topic(participant.handle(), raw);
   if (!topic) return topic.error();
-  dds_qos_t* qos = make_qos(q, true, options, participant.distro());
+  dds_qos_t* qos = make_qos(q, true, with_type_hash(options, raw), participant.distro());
   const dds_entity_t reader = dds_create_reader(participant.handle(), topic.value(), qos, nullptr);
   dds_delete_qos(qos);
   if (reader < 0) {

@@ -17,7 +17,8 @@ Result<std::unique_ptr<Graph>> Graph::create(const Participant& participant, con
                                              RosDistro distro) {
   // rmw_cyclonedds_cpp's discovery publisher: reliable, transient local, keep last 1, and no
   // ROS topic prefix (the DDS topic is "ros_discovery_info").
-  const RawTopic topic{"ros_discovery_info", msgs::dds_type_name(msgs::kParticipantEntitiesInfoType)};
+  const RawTopic topic{"ros_discovery_info", msgs::dds_type_name(msgs::kParticipantEntitiesInfoType),
+                       std::string(msgs::kParticipantEntitiesInfoType)};
   EndpointOptions options;
   options.in_graph = false;
   auto writer = Publisher::create(participant, topic, QosSpec{true, false, 1}, options);

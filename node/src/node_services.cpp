@@ -34,12 +34,6 @@ QosSpec parameter_events_qos() {
   return q;
 }
 
-std::string hash_or_empty(const Participant& participant, std::string_view type) {
-  if (participant.distro() == RosDistro::Humble) return {};
-  Result<std::string> h = msgs::type_hash(type);
-  return h ? h.value() : std::string{};
-}
-
 }  // namespace
 
 struct NodeServices::Impl {
@@ -71,22 +65,28 @@ struct NodeServices::Impl {
     return done.get();
   }
 
-  static std::uint64_t step_of(const CommandResult& r) { return r.step < 0 ? 0 : static_cast<std::uint64_t>(r.step); }
+  static std::uint64_t step_of(const CommandResult& r) {
+    return r.step < 0 ? 0 : static_cast<std::uint64_t>(r.step);
+  }
 
   Status add(const Participant& participant, std::string_view name, std::string_view srv_type,
              ServiceServer::Handler handler) {
     ServiceOptions so;
-    if (participant.distro() != RosDistro::Humble) {
+    if (has_type_hashes(participant.distro())) {
       Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
       if (!h) return h.error();
       so.request_user_data = msgs::typehash_user_data(h->request);
       so.reply_user_data = msgs::typehash_user_data(h->reply);
     }
     so.on_arrival = [this] {
-      { const std::lock_guard lock(mutex); arrived = true; }
+      {
+        const std::lock_guard lock(mutex);
+        arrived = true;
+      }
       wake.notify_one();
     };
-    Result<ServiceServer> s = ServiceServer::create(participant, options.node + "/" + std::string(name), srv_type, so);
+    Result<ServiceServer> s =
+        ServiceServer::create(participant, options.node + "/" + std::string(name), srv_type, so);
     if (!s) return s.error();
     if (graph) {
       if (Status st = graph->add(Graph::Kind::Reader, s->request_reader().guid); !st) return st;
@@ -107,7 +107,9 @@ struct NodeServices::Impl {
             const CommandResult r = apply(std::move(c));
             return TriggerResponse{r.successful, r.message};
           },
-          [](const Error& e) { return std::optional<TriggerResponse>(TriggerResponse{false, e.message}); });
+          [](const Error& e) {
+            return std::optional<TriggerResponse>(TriggerResponse{false, e.message});
+          });
     };
     out.emplace_back("pause", "std_srvs/srv/Trigger", trigger(CommandKind::Pause));
     out.emplace_back("resume", "std_srvs/srv/Trigger", trigger(CommandKind::Resume));
@@ -206,7 +208,8 @@ struct NodeServices::Impl {
                            c.parameters = req.parameters;
                            const CommandResult r = apply(std::move(c));
                            SetParametersResult result{r.successful, r.successful ? std::string{} : r.message};
-                           if (!r.results.empty() && !r.results.front().successful) result = r.results.front();
+                           if (!r.results.empty() && !r.results.front().successful)
+                             result = r.results.front();
                            return SetParametersAtomicallyResponse{result};
                          },
                          [](const Error&) { return std::optional<SetParametersAtomicallyResponse>(); }));
@@ -248,11 +251,11 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->add(participant, name, type, std::move(handler)); !st) return st.error();
   }
-  EndpointOptions eo;
-  eo.type_hash = hash_or_empty(participant, msgs::ParameterEvent::kType);
   auto events = Publisher::create(
-      participant, RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType)},
-      parameter_events_qos(), eo);
+      participant,
+      RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType),
+               std::string(msgs::ParameterEvent::kType)},
+      parameter_events_qos());
   if (!events) return events.error();
   impl->events.emplace(std::move(events.value()));
   Impl* raw = impl.get();
@@ -266,8 +269,8 @@ void NodeServices::command_applied(const Command& command, const CommandResult& 
   event.node = impl_->options.node;
   event.stamp = msgs::sim_time(result.step, impl_->options.dt);
   for (std::size_t k = 0; k < command.parameters.size(); ++k) {
-    const bool changed = command.atomic ? result.successful
-                                        : k < result.results.size() && result.results[k].successful;
+    const bool changed =
+        command.atomic ? result.successful : k < result.results.size() && result.results[k].successful;
     if (changed) event.changed_parameters.push_back(command.parameters[k]);
   }
   if (event.changed_parameters.empty()) return;

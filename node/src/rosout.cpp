@@ -62,7 +62,8 @@ Result<std::unique_ptr<Rosout>> Rosout::create(const Participant& participant, C
   EndpointOptions options;
   options.lifespan_ns = 10'000'000'000;
   auto pub = Publisher::create(participant,
-                               RawTopic{msgs::dds_topic_name("/rosout"), msgs::dds_type_name(msgs::kLogType)},
+                               RawTopic{msgs::dds_topic_name("/rosout"), msgs::dds_type_name(msgs::kLogType),
+                                        std::string(msgs::kLogType)},
                                kQos, options);
   if (!pub) return pub.error();
   std::unique_ptr<Rosout> rosout(

@@ -85,6 +85,9 @@ inline QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0) 
 struct RawTopic {
   std::string dds_name;  // "ros_discovery_info", "rt/rosout"
   std::string dds_type;  // "rcl_interfaces::msg::dds_::Log_"
+  // "rcl_interfaces/msg/Log": the endpoints' USER_DATA carries its REP 2011 type hash
+  // (msgs::type_hash) unless EndpointOptions::type_hash says otherwise; empty: no hash.
+  std::string ros_type;
 };
 // What an endpoint carries besides its topic and QoS.
 struct EndpointOptions {

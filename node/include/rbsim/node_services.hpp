@@ -26,10 +26,10 @@ struct NodeServicesOptions {
 
 // For the end line.
 struct NodeServiceCounters {
-  std::uint64_t received = 0;   // requests taken from DDS
-  std::uint64_t calls = 0;      // requests answered
-  std::uint64_t dropped = 0;    // not answered: queue full, too large, malformed, client gone
-  std::uint64_t events = 0;     // /parameter_events published
+  std::uint64_t received = 0;  // requests taken from DDS
+  std::uint64_t calls = 0;     // requests answered
+  std::uint64_t dropped = 0;   // not answered: queue full, too large, malformed, client gone
+  std::uint64_t events = 0;    // /parameter_events published
 };
 
 class NodeServices {
