@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -29,6 +30,7 @@
 #include "rbsim/dds.hpp"
 #include "rbsim/dds_sink.hpp"
 #include "rbsim/rosout.hpp"
+#include "rbsim/type_hash.hpp"
 
 extern char** environ;
 
@@ -167,6 +169,8 @@ bool eventually(double seconds, const std::function<bool()>& done) {
 struct Endpoints {
   std::set<std::vector<std::uint8_t>> readers, writers;
   std::set<std::string> writer_topics;
+  // Each writer's DDS type name and USER_DATA, by topic.
+  std::map<std::string, std::pair<std::string, std::string>> writer_user_data;
 };
 Endpoints discovered_endpoints(dds_entity_t observer, const std::vector<std::uint8_t>& participant) {
   Endpoints out;
@@ -183,7 +187,17 @@ Endpoints discovered_endpoints(dds_entity_t observer, const std::vector<std::uin
       if (std::memcmp(e->participant_key.v, participant.data(), 16) != 0) continue;
       std::vector<std::uint8_t> guid(e->key.v, e->key.v + 16);
       (readers ? out.readers : out.writers).insert(guid);
-      if (!readers) out.writer_topics.insert(e->topic_name);
+      if (!readers) {
+        out.writer_topics.insert(e->topic_name);
+        void* ud = nullptr;
+        std::size_t size = 0;
+        std::string user_data;
+        if (e->qos != nullptr && dds_qget_userdata(e->qos, &ud, &size) && ud != nullptr) {
+          user_data.assign(static_cast<const char*>(ud), size);
+          dds_free(ud);
+        }
+        out.writer_user_data[e->topic_name] = {e->type_name, user_data};
+      }
     }
     if (n > 0) dds_return_loan(r, samples, n);
     dds_delete(r);
@@ -263,6 +277,20 @@ void check_entry_matches_discovery(std::uint32_t domain, std::size_t gid_size) {
   for (const auto& w : listed) EXPECT_EQ(seen.writers.count(w), 1u);
   EXPECT_TRUE(seen.writer_topics.count("ros_discovery_info") == 1 &&
               seen.writer_topics.count("rt/rosout") == 1);
+  // Every writer's USER_DATA is rmw_cyclonedds_cpp's "typehash=RIHS01_<hex>;" of its type on
+  // Jazzy (REP 2011, msgs::type_hash), nothing on Humble.
+  for (const auto& [topic, typed] : seen.writer_user_data) {
+    std::string ros_type = typed.first;  // "pkg::msg::dds_::Name_" -> "pkg/msg/Name"
+    ros_type.replace(ros_type.find("::msg::dds_::"), 13, "/msg/");
+    ros_type.pop_back();
+    if (gid_size == 16) {
+      const Result<std::string> hash = msgs::type_hash(ros_type);
+      ASSERT_TRUE(hash.ok()) << ros_type;
+      EXPECT_EQ(typed.second, "typehash=" + hash.value() + ";") << topic;
+    } else {
+      EXPECT_EQ(typed.second, "") << topic;
+    }
+  }
 
   // An endpoint that goes is unlisted.
   sub.reset();
