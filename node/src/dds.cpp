@@ -25,10 +25,6 @@ namespace {
 constexpr dds_duration_t kWriteSlice = DDS_MSECS(100);
 constexpr dds_duration_t kMaxBlocked = DDS_SECS(30);
 
-Error dds_error(const std::string& what, dds_return_t rc) {
-  return Error{what + ": " + dds_strretcode(rc)};
-}
-
 dds_qos_t* make_qos(const QosSpec& q, bool reader, const EndpointOptions& options, RosDistro distro) {
   dds_qos_t* qos = dds_create_qos();
   // A reliable writer blocks when its readers fall behind: a slow recorder throttles the node
@@ -75,21 +71,9 @@ void offered_by(const dds_qos_t* qos, msgs::OfferedQos& out) {
   }
 }
 
-// The topic `ros_topic` with the raw CDR sertype under the ROS 2 type name (raw_serdata.hpp):
-// rbsim's writers send the bytes rbsim_msgs encoded as they are, its readers take them as they
-// came. `sertype` is the one the topic uses (Cyclone may swap in an equal one it already has).
 Result<dds_entity_t> make_topic(dds_entity_t participant, const RawTopic& raw,
                                 const ddsi_sertype** sertype = nullptr) {
-  ddsi_sertype* type = make_raw_sertype(raw.dds_type.c_str());
-  const std::string& name = raw.dds_name;
-  const dds_entity_t topic =
-      dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
-  if (topic < 0) {
-    ddsi_sertype_unref(type);  // not taken over on failure
-    return dds_error("cannot create DDS topic " + name, topic);
-  }
-  if (sertype != nullptr) *sertype = type;
-  return topic;
+  return make_raw_topic(participant, raw.dds_name, raw.dds_type, sertype);
 }
 
 RawTopic raw_topic(const msgs::TopicSpec& spec, std::string_view ros_topic) {

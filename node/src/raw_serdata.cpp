@@ -165,4 +165,21 @@ ddsi_serdata* make_raw_serdata(const ddsi_sertype* type, std::span<const std::by
   return ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, cdr.size());
 }
 
+Result<dds_entity_t> make_raw_topic(dds_entity_t participant, const std::string& name,
+                                    const std::string& type_name, const ddsi_sertype** sertype) {
+  ddsi_sertype* type = make_raw_sertype(type_name.c_str());
+  const dds_entity_t topic =
+      dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
+  if (topic < 0) {
+    ddsi_sertype_unref(type);  // not taken over on failure
+    return dds_error("cannot create DDS topic " + name, topic);
+  }
+  if (sertype != nullptr) *sertype = type;
+  return topic;
+}
+
+Error dds_error(const std::string& what, dds_return_t rc) {
+  return Error{what + ": " + dds_strretcode(rc)};
+}
+
 }  // namespace rbsim::node

@@ -11,6 +11,9 @@
 
 #include <cstddef>
 #include <span>
+#include <string>
+
+#include "rbsim/status.hpp"
 
 namespace rbsim::node {
 // A new sertype named `type_name` (the ROS 2 DDS type name) whose serdata are raw CDR, for
@@ -19,4 +22,12 @@ ddsi_sertype* make_raw_sertype(const char* type_name);
 // A new serdata of `type` (a raw sertype) holding a copy of `cdr` (the 4-byte encapsulation header
 // included); the caller owns one reference (dds_writecdr takes it over).
 ddsi_serdata* make_raw_serdata(const ddsi_sertype* type, std::span<const std::byte> cdr);
+// The topic `name` with a new raw sertype named `type_name`: rbsim's writers send the bytes
+// rbsim_msgs encoded as they are, its readers take them as they came. `sertype` (optional)
+// receives the sertype the topic uses (Cyclone may swap in an equal one it already has). The one
+// maker of rbsim's DDS topics: the DDS wrappers (dds.cpp) and the services (service.cpp).
+Result<dds_entity_t> make_raw_topic(dds_entity_t participant, const std::string& name,
+                                    const std::string& type_name, const ddsi_sertype** sertype = nullptr);
+// "<what>: <Cyclone's text for rc>".
+Error dds_error(const std::string& what, dds_return_t rc);
 }  // namespace rbsim::node

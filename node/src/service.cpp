@@ -30,10 +30,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-Error dds_error(const std::string& what, dds_return_t rc) {
-  return Error{what + ": " + dds_strretcode(rc)};
-}
-
 dds_duration_t to_dds(double seconds) {
   return static_cast<dds_duration_t>(std::max(0.0, seconds) * 1e9);
 }
@@ -51,20 +47,6 @@ dds_qos_t* service_qos(const std::string& user_data, std::int32_t depth, dds_dur
   dds_qset_liveliness(qos, DDS_LIVELINESS_AUTOMATIC, DDS_INFINITY);
   dds_qset_userdata(qos, user_data.data(), user_data.size());
   return qos;
-}
-
-// A topic of the raw-CDR sertype under `type_name`; `sertype` receives the one the topic uses.
-Result<dds_entity_t> make_topic(dds_entity_t participant, const std::string& name,
-                                const std::string& type_name, const ddsi_sertype** sertype) {
-  ddsi_sertype* type = make_raw_sertype(type_name.c_str());
-  const dds_entity_t topic =
-      dds_create_topic_sertype(participant, name.c_str(), &type, nullptr, nullptr, nullptr);
-  if (topic < 0) {
-    ddsi_sertype_unref(type);  // not taken over on failure
-    return dds_error("cannot create DDS topic " + name, topic);
-  }
-  if (sertype != nullptr) *sertype = type;
-  return topic;
 }
 
 // The id rmw_cyclonedds_cpp gives a client or a service (get_unique_csid, csid_to_string): the
@@ -142,10 +124,10 @@ Status make_endpoints(dds_entity_t participant, const std::string& writer_topic,
                       const std::string& reader_topic, const std::string& reader_type,
                       const std::string& reader_user_data, std::int32_t reader_depth,
                       dds_duration_t writer_blocking, const dds_listener_t* listener, Endpoints& out) {
-  auto wt = make_topic(participant, writer_topic, writer_type, &out.writer_type);
+  auto wt = make_raw_topic(participant, writer_topic, writer_type, &out.writer_type);
   if (!wt) return wt.error();
   out.writer_topic = wt.value();
-  auto rt = make_topic(participant, reader_topic, reader_type, nullptr);
+  auto rt = make_raw_topic(participant, reader_topic, reader_type, nullptr);
   if (!rt) return rt.error();
   out.reader_topic = rt.value();
   dds_qos_t* wq = service_qos(writer_user_data, 10, writer_blocking);
