@@ -105,6 +105,13 @@ void sample_bytes(ddsi_serdata* d, Bytes& out) {
   if (size > 0) ddsi_serdata_to_ser(d, 0, size, out.data());
 }
 
+}  // namespace
+
+// The types the servers' and clients' Impl hold live in a named namespace: a class with members of
+// anonymous-namespace types breaks -Wsubobject-linkage in a unity build (scripts/test's Release
+// stage), where this file is included into another.
+namespace service_detail {
+
 // A request and a reply topic with their endpoints, deleted together.
 struct Endpoints {
   dds_entity_t writer_topic = 0, reader_topic = 0, writer = 0, reader = 0;
@@ -159,7 +166,12 @@ MatchState subscription_state(dds_entity_t reader) {
   return {st.total_count, st.current_count};
 }
 
-}  // namespace
+}  // namespace service_detail
+using service_detail::Endpoints;
+using service_detail::make_endpoints;
+using service_detail::MatchState;
+using service_detail::publication_state;
+using service_detail::subscription_state;
 
 // ---------------------------------------------------------------------------------------------
 // Names and the sample layout

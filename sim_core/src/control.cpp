@@ -3,15 +3,13 @@
 #include <cmath>
 #include <string>
 
+#include "finite.hpp"
 #include "rbsim/core.hpp"
 #include "wind_moments.hpp"
 
 namespace rbsim {
 
 namespace {
-bool finite(const Vec2& v) {
-  return std::isfinite(v.x()) && std::isfinite(v.y());
-}
 Error refused(const std::string& what) {
   return Error{what, ErrorCode::InvalidArgument};
 }

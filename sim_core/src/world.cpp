@@ -11,6 +11,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "finite.hpp"
 #include "rbsim/core.hpp"
 #include "wind_moments.hpp"
 
@@ -34,10 +35,6 @@ namespace {
 
 Error invalid(const std::string& what) {
   return Error{"invalid world: " + what};
-}
-
-bool finite(const Vec2& v) {
-  return std::isfinite(v.x()) && std::isfinite(v.y());
 }
 
 // Hash of the exact bits of a body-space hull, so bit-identical hulls share one Shape.
