@@ -2,6 +2,7 @@
 // process: names and sample layout, our client against our server, two clients, a client that
 // vanishes, a client whose reply reader never matches, hostile samples from a raw writer, a flood.
 #include "rbsim/service.hpp"
+#include "step_handler.hpp"
 
 #include <dds/dds.h>
 #include <gtest/gtest.h>
@@ -40,21 +41,7 @@ std::string unique_service(std::string_view name) {
   return "/service_test_" + std::to_string(::getpid()) + "/" + std::string(name);
 }
 
-// The Step handler of these tests: steps -> step = 10 * steps, the header in the message; a
-// request that does not decode gets success false with the decoder's error.
-bool step_handler(const RequestHeader& h, std::span<const std::byte> request, Bytes& reply) {
-  msgs::StepRequest req;
-  msgs::StepResponse res;
-  if (Status st = msgs::decode(request, req); !st) {
-    res.message = st.error().message;
-  } else {
-    res.success = true;
-    res.step = 10ull * req.steps;
-    res.message = std::to_string(h.guid) + ":" + std::to_string(h.seq);
-  }
-  msgs::encode(res, reply);
-  return true;
-}
+using test::step_handler;
 
 // Serves until `done` holds, at most `seconds` (the node's loop: serve, then sleep a 1 ms step).
 template <class Done>

@@ -16,24 +16,11 @@
 
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
+#include "step_handler.hpp"
 
 namespace {
 
 using namespace rbsim;
-
-bool step(const node::RequestHeader& h, std::span<const std::byte> request, Bytes& reply) {
-  msgs::StepRequest req;
-  msgs::StepResponse res;
-  if (Status st = msgs::decode(request, req); !st) {
-    res.message = st.error().message;
-  } else {
-    res.success = true;
-    res.step = 10ull * req.steps;
-    res.message = std::to_string(h.guid) + ":" + std::to_string(h.seq);
-  }
-  msgs::encode(res, reply);
-  return true;
-}
 
 bool get_parameters(const node::RequestHeader&, std::span<const std::byte> request, Bytes& reply) {
   msgs::GetParametersRequest req;
@@ -83,7 +70,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < end && !stdin_closed()) {
-    step_server.value().serve(step, 64);
+    step_server.value().serve(node::test::step_handler, 64);
     params_server.value().serve(get_parameters, 64);
     step_server.value().wait(0.001);
   }
