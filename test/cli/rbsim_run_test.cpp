@@ -68,7 +68,7 @@ TEST(RbsimRun, HelpExitsZeroAndMentionsEveryOption) {
   const test::Outcome o = rbsim({"run", "--help"});
   ASSERT_EQ(o.exit_code, 0) << describe(o);
   for (const char* option : {"--steps", "--duration", "--csv", "--energy-csv", "--fosssim-out", "--progress",
-                             "--quiet", "--allow-nonfinite", "--help"}) {
+                             "--quiet", "--allow-nonfinite", "--commands", "--help"}) {
     EXPECT_NE(o.out.find(option), std::string::npos) << option << " not in help:\n" << o.out;
   }
   EXPECT_NE(o.out.find(kCsvHeader), std::string::npos) << "help should document the CSV columns";

@@ -234,8 +234,62 @@ def case_services(ctx):
     return with_node(ctx, body)
 
 
+def case_steered(ctx):
+    """A session steered by ros2-client (pause, a parameter, step N, an impulse, resume), recorded by
+    `rbsim record` over DDS, equals `rbsim run --commands` with the same changes at the steps the
+    replies name, every message; the run without them diverges first at the step after the first
+    change."""
+    if not PEER or not os.access(PEER, os.X_OK):
+        raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
+    scene, duration, dt = ctx.scene("chain.xml"), 6.0, 0.001
+    steps = round(duration / dt)
+    expected = len(e2e.LATCHED) + len(e2e.PER_STEP) * (steps + 1)
+    live = ctx.path("live.mcap")
+    with PeerNet(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return e2e.SKIP
+        rec = net.rb("record", "a", *e2e.record_args(ctx, live, "--max-messages", expected, "--wall-duration", 120))
+        node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1))
+        svc = f"/{ctx.ns}"
+        try:
+            pause = peer_json(ctx, net, "pause", "call", f"{svc}/pause", "trigger")
+            ctx.require(pause and pause[0]["success"], f"pause: {pause}")
+            s0 = int(pause[0]["message"].rsplit(" ", 1)[-1])  # "paused at step N"
+            sets = peer_json(ctx, net, "set", "params", svc, "set", "forces.0.fy=-3.7")
+            ctx.require([m.get("set") for m in sets] == [True], f"set forces.0.fy: {sets}")
+            stepped = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 5)
+            ctx.require(stepped and stepped[0]["success"] and stepped[0]["step"] == s0, f"step 5 at {s0}: {stepped}")
+            kick = peer_json(ctx, net, "impulse", "call", f"{svc}/apply_impulse", "impulse", 2, 0.5, 2.0, 0.1, 0.0)
+            ctx.require(kick and kick[0]["success"], f"impulse: {kick}")
+            s1 = kick[0]["step"]
+            ctx.check(s1 == s0 + 5, f"the impulse applied at step {s1}, want {s0 + 5} (paused after step 5)")
+            resume = peer_json(ctx, net, "resume", "call", f"{svc}/resume", "trigger")
+            ctx.require(resume and resume[0]["success"], f"resume: {resume}")
+        finally:
+            e2e.exited_ok(ctx, node, 60, "rbsim node")
+            e2e.exited_ok(ctx, rec, 60, "rbsim record")
+    ctx.log(f"ros2-client paused at step {s0}, set forces.0.fy, stepped 5, kicked body 2 at step {s1}, resumed")
+    script = ctx.path("commands.yaml")
+    with open(script, "w") as f:
+        f.write(f"- {{step: {s0}, pause: true}}\n- {{step: {s0}, set: {{forces.0.fy: -3.7}}}}\n"
+                f"- {{step: {s0}, steps: 5}}\n"
+                f"- {{step: {s1}, impulse: {{body: 2, j: [0.5, 2.0], p: [0.1, 0.0]}}}}\n"
+                f"- {{step: {s1}, resume: true}}\n")
+    rerun, plain = ctx.path("rerun.mcap"), ctx.path("plain.mcap")
+    ctx.rbrun("rerun", "run", scene, "--duration", duration, "--commands", script, "--record", rerun,
+              "--namespace", ctx.ns)
+    ctx.rbrun("plain", "run", scene, "--duration", duration, "--record", plain, "--namespace", ctx.ns)
+    e2e.rbsim_check(ctx, live, rerun, "check-rerun", live=True)
+    rc, out, err = ctx.rbrun("check-plain", "check", live, plain, "--ignore-log-time", ok=False)
+    ctx.check(rc == 1, f"the live session matched the run without its changes (exit {rc})\n{out}{err}")
+    ctx.check(f"step {s0 + 1}" in out, f"the first divergence is not at step {s0 + 1}\n{out}")
+    return 0
+
+
 e2e.CASES.clear()
-e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer, "parameters": case_parameters, "services": case_services})
+e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer, "parameters": case_parameters, "services": case_services,
+                  "steered": case_steered})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

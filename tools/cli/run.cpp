@@ -6,6 +6,8 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/command_script.hpp"
+#include "rbsim/control.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
@@ -23,6 +25,7 @@ struct RunOptions {
   std::optional<std::int64_t> steps;
   std::optional<double> duration;
   std::string csv, energy_csv, fosssim_out, record;
+  std::string commands;  // --commands FILE
   std::int64_t record_every = 1;
   std::string compression = "zstd";
   int compression_level = 0;
@@ -47,15 +50,35 @@ int run(const RunOptions& o) {
   if (o.duration) steps = steps_for(*o.duration, scene.world.dt);
   if (o.steps) steps = *o.steps;
 
+  std::vector<std::string> inputs{o.scene};
+  if (!o.commands.empty()) inputs.push_back(o.commands);
   // Every output path is checked before step 0: a run never ends by throwing its result away.
   if (Status st = check_outputs({{o.csv, "--csv"},
                                  {o.energy_csv, "--energy-csv"},
                                  {o.fosssim_out, "--fosssim-out"},
                                  {o.record, "--record"},
                                  {o.frames, "--frames", true}},
-                                {o.scene}, o.overwrite);
+                                inputs, o.overwrite);
       !st)
     return fail("run", st.error().message);
+
+  // The script is checked whole before step 0: a bad entry is a usage error naming its line.
+  std::optional<control::Controller> controller;
+  std::int64_t refused = 0;
+  if (!o.commands.empty()) {
+    Result<std::vector<control::Command>> script = control::load_command_script(o.commands, scene, steps);
+    if (!script)
+      return fail("run", script.error().message, script.error().code == ErrorCode::InvalidArgument ? 2 : 1);
+    controller.emplace(scene, steps, control::RunSettings{0.0, 1, false});
+    for (control::Command& c : script.value()) {
+      const std::string source = c.source;
+      controller->submit(std::move(c), [&refused, source](const control::CommandResult& r) {
+        if (r.successful) return;
+        ++refused;
+        std::fprintf(stderr, "rbsim run: %s: refused: %s\n", source.c_str(), r.message.c_str());
+      });
+    }
+  }
 
   Result<Driver> created = Driver::create(scene);
   if (!created) return fail("run", scene.path + ": " + created.error().message);
@@ -97,6 +120,7 @@ int run(const RunOptions& o) {
   options.allow_nonfinite = o.allow_nonfinite;
   options.stop = stop_requested;
   options.progress = [&progress](std::int64_t step) { progress.update(step); };
+  if (controller) options.control = &*controller;
   const auto start = std::chrono::steady_clock::now();
   const Result<PassEnd> end = driver.run(options);
   if (!end) return fail("run", end.error().message);
@@ -117,6 +141,15 @@ int run(const RunOptions& o) {
         scene.name.c_str(), count_of(world.body_count(), "body", "bodies").c_str(),
         count_of(world.spring_count(), "spring", "springs").c_str(), count_of(done, "step", "steps").c_str(),
         world.time(), format_seconds(wall).c_str(), rate, rate * world.body_count());
+  }
+  if (controller) {
+    controller->close("the run ended");
+    const control::ControlCounters counted = controller->counters();
+    if (refused > 0) {
+      return fail("run", o.commands + ": " + count_of(refused, "command was", "commands were") +
+                             " refused (of " + std::to_string(counted.commands) +
+                             " applied or refused); outputs hold the run");
+    }
   }
   if (stop_requested()) {
     std::fprintf(stderr, "rbsim run: interrupted at step %lld of %lld; outputs hold steps 0..%lld\n",
@@ -171,6 +204,11 @@ Subcommand add_run_command(CLI::App& parent) {
       ->default_str("rbsim")
       ->needs(record);
   add_topics_option(app, o->topics, o->ns, o->topic_set, "Topics to record")->needs(record);
+  app->add_option(
+      "--commands", o->commands,
+      "Apply a script of commands at step boundaries (YAML: - {step: 500, set: {forces.1.fx: 2.0}}, "
+      "- {t: 1.5, impulse: {body: 3, j: [0, 4], p: [0, 0]}}, pause, steps, resume, reset; see the "
+      "README), exactly as a live node applies them; checked whole before step 0");
   auto* frames =
       app->add_option("--frames", o->frames,
                       "Draw PNG frames into this folder during the run, as rbsim render draws them: "

@@ -196,23 +196,15 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     while (due(world.step_index())) {
       Pending p = std::move(schedule_.front());
       schedule_.erase(schedule_.begin());
-      const std::int64_t now = world.step_index();
-      CommandResult r;
-      if (p.command.step != Command::kNextStep && p.command.step < now) {
-        r = failed(std::string(to_string(p.command.kind)) + ": " + at(p.command.step) +
-                   " has passed (now at " + at(now) + ")");
-      } else {
-        r = execute(p.command, world, b);
-      }
-      r.step = now;
-      p.command.step = now;
+      apply_now(p, world, b);
       applied = true;
-      {
-        const std::lock_guard lock(mutex_);
-        ++counters_.commands;
-      }
-      if (observer_) observer_(p.command, r);
-      if (p.done) p.done(r);
+    }
+    if (resume_at_ && std::chrono::steady_clock::now() >= *resume_at_) {
+      Pending p;
+      p.command.kind = CommandKind::Resume;
+      p.command.source = "timed pause";
+      apply_now(p, world, b);
+      applied = true;
     }
     if (applied) publish_values(world);
     bool closed = false;
@@ -229,14 +221,35 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       b.stop = true;
       return b;
     }
+    auto wait = std::chrono::steady_clock::duration(kIdleWait);
+    if (resume_at_) wait = std::min(wait, *resume_at_ - std::chrono::steady_clock::now());
     std::unique_lock lock(mutex_);
-    wake_.wait_for(lock, kIdleWait, [this] { return !incoming_.empty() || closed_; });
+    wake_.wait_for(lock, wait, [this] { return !incoming_.empty() || closed_; });
     idled = true;
   }
   if (settings_.paused) --step_budget_;  // one step of a `step N`
   // Wall time went on while the loop idled: pacers start afresh from here.
   if (idled) b.timeline_changed = true;
   return b;
+}
+
+void Controller::apply_now(Pending& p, World& world, Boundary& b) {
+  const std::int64_t now = world.step_index();
+  CommandResult r;
+  if (p.command.step != Command::kNextStep && p.command.step < now) {
+    r = failed(std::string(to_string(p.command.kind)) + ": " + at(p.command.step) + " has passed (now at " +
+               at(now) + ")");
+  } else {
+    r = execute(p.command, world, b);
+  }
+  r.step = now;
+  p.command.step = now;
+  {
+    const std::lock_guard lock(mutex_);
+    ++counters_.commands;
+  }
+  if (observer_) observer_(p.command, r);
+  if (p.done) p.done(r);
 }
 
 void Controller::settings_changed(Boundary& boundary) {
@@ -253,6 +266,13 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       return set_parameters(command, world, boundary);
     case CommandKind::Pause:
       r.message = settings_.paused ? "already paused at " + at(now) : "paused at " + at(now);
+      resume_at_.reset();
+      if (command.pause_seconds > 0.0) {
+        resume_at_ = std::chrono::steady_clock::now() +
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(command.pause_seconds));
+        r.message += " for " + to_string(ParameterValue::of_double(command.pause_seconds)) + " s";
+      }
       if (!settings_.paused) {
         settings_.paused = true;
         table_.store(*table_.find("paused"), ParameterValue::of_bool(true));
@@ -262,6 +282,7 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
     case CommandKind::Resume:
       r.message = settings_.paused ? "resumed at " + at(now) : "already running at " + at(now);
       step_budget_ = 0;
+      resume_at_.reset();
       if (settings_.paused) {
         settings_.paused = false;
         table_.store(*table_.find("paused"), ParameterValue::of_bool(false));
@@ -321,7 +342,10 @@ CommandResult Controller::set_parameters(const Command& command, World& world, B
     const ParameterTarget t = table_.target(i);
     if (is_setting(t)) {
       apply(t, p.value, settings_);
-      if (t.kind == ParameterTarget::Kind::Paused && !p.value.bool_value) step_budget_ = 0;
+      if (t.kind == ParameterTarget::Kind::Paused) {
+        resume_at_.reset();
+        if (!p.value.bool_value) step_budget_ = 0;
+      }
       settings = true;
     } else {
       const Status st = apply(t, p.value, world);

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -52,6 +53,8 @@ struct Command {
   bool atomic = true;                 // SetParameters: all or nothing (set_parameters_atomically), or
                                       // each its own result (set_parameters)
   std::int64_t steps = 0;             // Step: how many, >= 1; only while paused
+  double pause_seconds = 0.0;         // Pause: resume by itself after this much wall time (0: stay
+                                      // paused until a Resume); wall time only, never the run
   ImpulseArgs impulse;                // Impulse
   std::string source;                 // "ros2 service", "foxglove", "script", ...
 };
@@ -130,6 +133,9 @@ class Controller final : public StepHook {
   CommandResult set_parameters(const Command& command, World& world, Boundary& boundary);
   CommandResult impulse(const Command& command, World& world);
   void settings_changed(Boundary& boundary);
+  // Applies one command now (from the schedule, or a timed pause's own resume): result, counters,
+  // observer and callback.
+  void apply_now(Pending& pending, World& world, Boundary& boundary);
   void publish_values(const World& world);
 
   const Scene& scene_;
@@ -151,6 +157,7 @@ class Controller final : public StepHook {
   RunSettings settings_;
   std::vector<Pending> schedule_;  // sorted by (step, sequence); kNextStep first
   std::int64_t step_budget_ = 0;   // steps left of a `step N` while paused
+  std::optional<std::chrono::steady_clock::time_point> resume_at_;  // a timed pause's end
   std::function<void(const RunSettings&)> settings_listener_;
   std::function<void(const Command&, const CommandResult&)> observer_;
 };

@@ -1,0 +1,74 @@
+// `rbsim run --commands FILE`: a script of commands applied at step boundaries, as a user runs it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "rbsim/subprocess.hpp"
+
+namespace rbsim {
+namespace {
+
+namespace fs = std::filesystem;
+using test::lines_of;
+using test::rbsim;
+using test::read_text;
+using test::TempDir;
+using test::write_text;
+
+const std::string kScene = std::string(RBSIM_TEST_DATA_DIR) + "/../../scenes/chain.xml";  // 5 bodies, dt 1 ms
+
+std::string describe(const test::Outcome& o) {
+  return "exit " + std::to_string(o.exit_code) + "\nstdout: " + o.out + "\nstderr: " + o.err;
+}
+
+// The CSV rows of one step (5 bodies a step, after the header).
+std::vector<std::string> rows_at(const std::vector<std::string>& csv, std::size_t step) {
+  return {csv.begin() + 1 + 5 * step, csv.begin() + 1 + 5 * (step + 1)};
+}
+
+TEST(RbsimRunCommands, EachCommandActsFromTheStepAfterItsBoundary) {
+  const TempDir dir;
+  write_text(dir / "c.yaml",
+             "- {step: 20, set: {forces.0.fy: -3.7}}\n"
+             "- {t: 0.05, impulse: {body: 2, j: [0.5, 2.0], p: [0.1, 0.0]}}\n"
+             "- {step: 60, pause: true}\n- {step: 60, steps: 3}\n- {step: 63, resume: true}\n");
+  const test::Outcome plain = rbsim({"run", kScene, "--steps", "100", "--csv", (dir / "plain.csv").string()});
+  ASSERT_EQ(plain.exit_code, 0) << describe(plain);
+  const test::Outcome only_set = rbsim({"run", kScene, "--steps", "100", "--csv", (dir / "set.csv").string(),
+                                        "--commands", (dir / "c.yaml").string()});
+  ASSERT_EQ(only_set.exit_code, 0) << describe(only_set);
+  const std::vector<std::string> a = lines_of(read_text(dir / "plain.csv"));
+  const std::vector<std::string> b = lines_of(read_text(dir / "set.csv"));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t step = 0; step <= 20; ++step) EXPECT_EQ(rows_at(a, step), rows_at(b, step)) << step;
+  EXPECT_NE(rows_at(a, 21), rows_at(b, 21));
+  // The same script again: the same bytes (pauses change wall time only).
+  const test::Outcome again = rbsim({"run", kScene, "--steps", "100", "--csv", (dir / "again.csv").string(),
+                                     "--commands", (dir / "c.yaml").string()});
+  ASSERT_EQ(again.exit_code, 0) << describe(again);
+  EXPECT_EQ(read_text(dir / "again.csv"), read_text(dir / "set.csv"));
+}
+
+TEST(RbsimRunCommands, ABadScriptIsAUsageErrorBeforeAnyOutput) {
+  const TempDir dir;
+  write_text(dir / "c.yaml", "- {step: 20, set: {forces.0.fy: -3.7}}\n- {step: 30, impulse: {body: 9, j: [0, 1]}}\n");
+  const test::Outcome o = rbsim({"run", kScene, "--steps", "100", "--csv", (dir / "out.csv").string(),
+                                 "--commands", (dir / "c.yaml").string()});
+  EXPECT_EQ(o.exit_code, 2) << describe(o);
+  EXPECT_NE(o.err.find("c.yaml:2: impulse.body: must be a body index in [0, 5)"), std::string::npos) << describe(o);
+  EXPECT_FALSE(fs::exists(dir / "out.csv"));
+  const test::Outcome missing = rbsim({"run", kScene, "--commands", (dir / "none.yaml").string()});
+  EXPECT_EQ(missing.exit_code, 1) << describe(missing);
+  EXPECT_NE(missing.err.find("none.yaml"), std::string::npos) << describe(missing);
+  // An output may not overwrite the script.
+  write_text(dir / "ok.yaml", "- {step: 1, resume: true}\n");
+  const test::Outcome clash = rbsim({"run", kScene, "--csv", (dir / "ok.yaml").string(), "--overwrite",
+                                     "--commands", (dir / "ok.yaml").string()});
+  EXPECT_NE(clash.exit_code, 0) << describe(clash);
+  EXPECT_EQ(read_text(dir / "ok.yaml"), "- {step: 1, resume: true}\n");
+}
+
+}  // namespace
+}  // namespace rbsim

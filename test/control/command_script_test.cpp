@@ -1,0 +1,157 @@
+// Command scripts (rbsim/command_script.hpp): every action read with its step and origin, errors
+// that name the file, line and field before anything runs, and a scripted run that equals the
+// same commands given live.
+#include "rbsim/command_script.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <future>
+#include <string>
+
+#include "control_test_util.hpp"
+
+namespace rbsim::control {
+namespace {
+
+using test::Snapshot;
+using V = ParameterValue;
+
+constexpr std::int64_t kSteps = 120;  // the control scene: dt 0.01, 2 bodies
+
+std::vector<Command> parse(const std::string& text) {
+  const Scene scene = test::control_scene();
+  Result<std::vector<Command>> r = parse_command_script(text, "c.yaml", scene, kSteps);
+  if (!r) throw std::runtime_error(r.error().message);
+  return std::move(r.value());
+}
+
+std::string error_of(const std::string& text) {
+  const Scene scene = test::control_scene();
+  Result<std::vector<Command>> r = parse_command_script(text, "c.yaml", scene, kSteps);
+  if (r) return "(no error)";
+  EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << r.error().message;
+  return r.error().message;
+}
+
+TEST(ParseCommandScript, ReadsEveryActionWithItsStepAndOrigin) {
+  const std::vector<Command> c = parse(
+      "- {step: 5, set: {forces.0.fy: -3.7, springs: {1: {k: 40.0}}}}\n"
+      "- {t: 0.3, impulse: {body: 1, j: [0.5, -2], p: [0.1, 0]}}\n"
+      "- {step: 40, impulse: {body: 0, j: [1.0, 0.0]}}\n"
+      "- {step: 50, pause: true}\n"
+      "- {step: 50, steps: 5}\n"
+      "- {step: 55, resume: true}\n"
+      "- {step: 60, pause: 0.25}\n"
+      "- {step: 70, reset: yes}\n");
+  ASSERT_EQ(c.size(), 8u);
+  EXPECT_EQ(c[0].kind, CommandKind::SetParameters);
+  EXPECT_EQ(c[0].step, 5);
+  EXPECT_TRUE(c[0].atomic);
+  ASSERT_EQ(c[0].parameters.size(), 2u);
+  EXPECT_EQ(c[0].parameters[0], (Parameter{"forces.0.fy", V::of_double(-3.7)}));
+  EXPECT_EQ(c[0].parameters[1], (Parameter{"springs.1.k", V::of_double(40.0)}));  // nested keys join with '.'
+  EXPECT_EQ(c[0].source, "script c.yaml:1");
+  EXPECT_EQ(c[1].kind, CommandKind::Impulse);
+  EXPECT_EQ(c[1].step, steps_for(0.3, 0.01));  // t: the first step at or after it, as --duration
+  EXPECT_EQ(c[1].impulse.body, 1);
+  EXPECT_EQ(c[1].impulse.impulse, Vec2(0.5, -2.0));
+  EXPECT_EQ(c[1].impulse.point, Vec2(0.1, 0.0));
+  EXPECT_EQ(c[1].source, "script c.yaml:2");
+  EXPECT_EQ(c[2].impulse.point, Vec2(0.0, 0.0));  // p defaults to the centre of mass
+  EXPECT_EQ(c[3].kind, CommandKind::Pause);
+  EXPECT_EQ(c[3].pause_seconds, 0.0);
+  EXPECT_EQ(c[4].kind, CommandKind::Step);
+  EXPECT_EQ(c[4].steps, 5);
+  EXPECT_EQ(c[5].kind, CommandKind::Resume);
+  EXPECT_EQ(c[6].pause_seconds, 0.25);
+  EXPECT_EQ(c[7].kind, CommandKind::Reset);
+  EXPECT_TRUE(parse("").empty());
+}
+
+TEST(ParseCommandScript, ErrorsNameTheFileLineAndField) {
+  const std::string ok = "- {step: 1, resume: true}\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"step: 1", "c.yaml:1: expected a list of commands"},
+      {"- [1, 2]", "c.yaml:1: entry: must be a map"},
+      {ok + "- {set: {forces.0.fy: 1.0}}", "c.yaml:2: step: each entry needs step: N or t: SECONDS"},
+      {ok + "- {step: 1, t: 0.5, resume: true}", "c.yaml:2: t: give step or t, not both"},
+      {ok + "- {step: 1.5, resume: true}", "c.yaml:2: step: must be an integer"},
+      {ok + "- {step: 120, resume: true}", "c.yaml:2: step: step 120 is outside the run"},
+      {ok + "- {step: -1, resume: true}", "c.yaml:2: step: step -1 is outside the run"},
+      {ok + "- {t: .nan, resume: true}", "c.yaml:2: t: must be a finite number of seconds >= 0"},
+      {ok + "- {step: 1}", "c.yaml:2: action: missing"},
+      {ok + "- {step: 1, resume: true, reset: true}", "c.yaml:2: reset: one action per entry"},
+      {ok + "- {step: 1, jump: 3}", "c.yaml:2: jump: unknown field"},
+      {ok + "- {step: 1,\n   set: {forces.9.fy: 1.0}}", "c.yaml:3: set.forces.9.fy: parameter 'forces.9.fy' is not declared"},
+      {ok + "- {step: 1, set: {forces.0.fy: 1}}", "c.yaml:2: set.forces.0.fy: Wrong parameter type"},
+      {ok + "- {step: 1, set: {dt: 0.5}}", "c.yaml:2: set.dt: parameter 'dt' cannot be set because it is read-only"},
+      {ok + "- {step: 1, set: {springs.0.k: -.inf}}", "c.yaml:2: set.springs.0.k: Parameter {springs.0.k} must be finite"},
+      {ok + "- {step: 1, set: {}}", "c.yaml:2: set: must be a map of parameters"},
+      {ok + "- {step: 1, impulse: {body: 2, j: [0, 1]}}", "c.yaml:2: impulse.body: must be a body index in [0, 2)"},
+      {ok + "- {step: 1, impulse: {body: 0}}", "c.yaml:2: impulse.j: missing"},
+      {ok + "- {step: 1, impulse: {body: 0, j: [0, .inf]}}", "c.yaml:2: impulse.j: must be two finite numbers"},
+      {ok + "- {step: 1, impulse: {body: 0, j: [0]}}", "c.yaml:2: impulse.j: must be [x, y]"},
+      {ok + "- {step: 1, impulse: {body: 0, j: [0, 1], q: 1}}", "c.yaml:2: impulse.q: unknown field"},
+      {ok + "- {step: 1, pause: -2}", "c.yaml:2: pause: must be true (until a resume) or wall-clock seconds > 0"},
+      {ok + "- {step: 1, resume: false}", "c.yaml:2: resume: must be true"},
+      {ok + "- {step: 1, steps: 0}", "c.yaml:2: steps: must be an integer >= 1"},
+      {ok + "- {step: 3, steps: 2}", "c.yaml:2: steps: only while paused"},
+      {ok + "- {step: 9, pause: true}\n- {step: 8, resume: true}", "c.yaml:2: pause: no resume follows"},
+      {ok + "- {step: 1, set: {forces.0.fy: [1.0, }", "c.yaml:2: not valid YAML"},
+  };
+  for (const auto& [text, want] : cases) {
+    EXPECT_NE(error_of(text).find(want), std::string::npos) << text << "\n -> " << error_of(text);
+  }
+}
+
+TEST(LoadCommandScript, NamesAFileItCannotRead) {
+  const Scene scene = test::control_scene();
+  Result<std::vector<Command>> r = load_command_script("/nonexistent/c.yaml", scene, kSteps);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::IoError);
+  EXPECT_NE(r.error().message.find("/nonexistent/c.yaml"), std::string::npos) << r.error().message;
+}
+
+// A script's commands through the Controller: the run equals the same commands submitted one by
+// one (as a live session gives them), pauses included, and differs from the run without them
+// from the first step after the first change.
+TEST(ParseCommandScript, AScriptedRunEqualsTheSameCommandsGivenLive) {
+  const Scene scene = test::control_scene();
+  const std::vector<Command> script = parse(
+      "- {step: 30, set: {forces.0.fy: -3.7}}\n"
+      "- {step: 50, pause: true}\n"
+      "- {step: 50, steps: 4}\n"
+      "- {step: 54, impulse: {body: 1, j: [0.5, 2.0], p: [0.1, 0.0]}}\n"
+      "- {step: 54, resume: true}\n"
+      "- {step: 80, pause: 0.05}\n");
+  Controller scripted(scene, kSteps, RunSettings{0.0, 1, false});
+  for (const Command& c : script) scripted.submit(c, nullptr);
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<Snapshot> run = test::run(scene, kSteps, &scripted);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(50));  // the timed pause
+  EXPECT_EQ(scripted.counters().commands, 7u);  // six and the timed pause's own resume
+  EXPECT_FALSE(scripted.settings().paused);
+
+  Controller live(scene, kSteps, RunSettings{0.0, 1, false});
+  Command set;
+  set.step = 30;
+  set.kind = CommandKind::SetParameters;
+  set.parameters = {{"forces.0.fy", V::of_double(-3.7)}};
+  Command kick;
+  kick.step = 54;
+  kick.kind = CommandKind::Impulse;
+  kick.impulse = ImpulseArgs{1, Vec2(0.5, 2.0), Vec2(0.1, 0.0)};
+  live.submit(set, nullptr);
+  live.submit(kick, nullptr);
+  const std::vector<Snapshot> given = test::run(scene, kSteps, &live);
+  ASSERT_EQ(run.size(), given.size());
+  for (std::size_t i = 0; i < run.size(); ++i) EXPECT_TRUE(test::same_bits(run[i].state, given[i].state)) << i;
+
+  const std::vector<Snapshot> plain = test::run(scene, kSteps);
+  EXPECT_TRUE(test::same_bits(run[30].state, plain[30].state));
+  EXPECT_FALSE(test::same_bits(run[31].state, plain[31].state));
+}
+
+}  // namespace
+}  // namespace rbsim::control

@@ -1,0 +1,41 @@
+// A script of commands for an offline run (rbsim run SCENE --commands FILE): YAML, one list entry
+// per command, applied at step boundaries through the Controller exactly as live commands are.
+//
+//   - {step: 500, set: {forces.1.fx: 2.0, springs.0.k: 40.0}}     parameters, as one atomic batch
+//   - {t: 1.5, impulse: {body: 3, j: [0, 4], p: [0, 0]}}           J (N s, world axes) at p (m, body
+//                                                                  frame; optional, default [0, 0])
+//   - {step: 900, pause: 0.5}      pause, resuming by itself after 0.5 s of wall time
+//   - {step: 900, pause: true}     pause until a later `resume` entry (one must follow)
+//   - {step: 900, steps: 5}        while paused: step 5 times, then pause again
+//   - {step: 905, resume: true}
+//   - {step: 1000, reset: true}    back to step 0 with the run's initial parameters
+//
+// Each entry names its boundary by `step` (an integer in [0, run steps): a command at step k acts
+// on the steps after k) or `t` (seconds >= 0: the first step whose time is at or after t, as
+// --duration counts steps), not both. Entries of one
+// step apply in file order. Values are typed as ROS 2 types parameters (2.0 double, 2 integer,
+// true bool; rbsim/ros_args.hpp). Every name, type, range, body and number is checked when the
+// file is read, so a bad script is an error naming the file, line and field before step 0;
+// pauses change wall time only, never the simulated run.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rbsim/control.hpp"
+#include "rbsim/scene.hpp"
+#include "rbsim/status.hpp"
+
+namespace rbsim::control {
+
+// The commands of a script, in file order, each with its step set and `source` naming where it
+// came from ("script FILE:LINE"). `scene` holds the run's initial parameters; `steps` is its
+// length. Errors are "FILE:LINE: FIELD: RULE" (ErrorCode::InvalidArgument), or the read error.
+[[nodiscard]] Result<std::vector<Command>> load_command_script(const std::string& path, const Scene& scene,
+                                                               std::int64_t steps);
+[[nodiscard]] Result<std::vector<Command>> parse_command_script(std::string_view text, const std::string& path,
+                                                                const Scene& scene, std::int64_t steps);
+
+}  // namespace rbsim::control

@@ -1,0 +1,244 @@
+// Command scripts (rbsim/command_script.hpp): YAML entries -> Commands, checked before step 0.
+#include "rbsim/command_script.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include "rbsim/read_file.hpp"
+#include "yaml_value.hpp"
+
+namespace rbsim::control {
+
+namespace {
+
+constexpr const char* kActions = "set, impulse, pause, resume, steps or reset";
+
+// The entry being read: its place in the file for every message.
+struct Entry {
+  const std::string& path;
+  const YAML::Node& node;
+
+  Error error(const YAML::Node& at, const std::string& field, const std::string& rule) const {
+    return Error{yaml_line(path, at) + ": " + field + ": " + rule, ErrorCode::InvalidArgument};
+  }
+};
+
+std::optional<double> number(const YAML::Node& n) {
+  if (!n.IsScalar()) return std::nullopt;
+  const ParameterValue v = yaml_scalar(n);
+  if (v.type == ParameterType::Double) return v.double_value;
+  if (v.type == ParameterType::Integer) return static_cast<double>(v.integer_value);
+  return std::nullopt;
+}
+
+std::optional<std::int64_t> integer(const YAML::Node& n) {
+  if (!n.IsScalar()) return std::nullopt;
+  const ParameterValue v = yaml_scalar(n);
+  if (v.type != ParameterType::Integer) return std::nullopt;
+  return v.integer_value;
+}
+
+// [x, y], two finite numbers.
+Result<Vec2> vector(const Entry& e, const YAML::Node& n, const std::string& field) {
+  if (!n.IsSequence() || n.size() != 2) return e.error(n, field, "must be [x, y]");
+  const std::optional<double> x = number(n[0]), y = number(n[1]);
+  if (!x || !y || !std::isfinite(*x) || !std::isfinite(*y)) return e.error(n, field, "must be two finite numbers");
+  return Vec2{*x, *y};
+}
+
+// The boundary an entry names: `step: N` or `t: SECONDS`, exactly one.
+Result<std::int64_t> boundary(const Entry& e, double dt, std::int64_t steps) {
+  const YAML::Node step = e.node["step"], t = e.node["t"];
+  if (step && t) return e.error(t, "t", "give step or t, not both");
+  if (!step && !t) return e.error(e.node, "step", "each entry needs step: N or t: SECONDS");
+  std::int64_t k = 0;
+  if (step) {
+    const std::optional<std::int64_t> v = integer(step);
+    if (!v) return e.error(step, "step", "must be an integer");
+    k = *v;
+  } else {
+    const std::optional<double> v = number(t);
+    if (!v || !std::isfinite(*v) || *v < 0.0) return e.error(t, "t", "must be a finite number of seconds >= 0");
+    k = steps_for(*v, dt);
+  }
+  // A command at boundary k acts on the steps after k: the last step has none after it.
+  if (k < 0 || k >= steps) {
+    return e.error(step ? step : t, step ? "step" : "t",
+                   "step " + std::to_string(k) + " is outside the run (a command at step k acts on the steps after "
+                   "it: k in 0.." + std::to_string(steps - 1) + ")");
+  }
+  return k;
+}
+
+// Nested maps joined with '.' ({forces: {0: {fy: -3.7}}} is forces.0.fy), as parameters files.
+Status parameters(const Entry& e, const YAML::Node& map, const std::string& prefix,
+                  const ParameterTable& table, std::vector<Parameter>& out) {
+  for (const auto& kv : map) {
+    const std::string name = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
+    if (kv.second.IsMap()) {
+      if (Status st = parameters(e, kv.second, name, table, out); !st) return st;
+      continue;
+    }
+    Result<ParameterValue> value = yaml_value(kv.second);
+    if (!value) return e.error(kv.second.IsNull() ? kv.first : kv.second, "set." + name, value.error().message);
+    Parameter p{name, std::move(value.value())};
+    if (SetParametersResult r = table.check(p); !r.successful) {
+      return e.error(kv.second, "set." + name, r.reason);
+    }
+    out.push_back(std::move(p));
+  }
+  return Ok{};
+}
+
+Status impulse(const Entry& e, const YAML::Node& n, std::int64_t bodies, ImpulseArgs& out) {
+  if (!n.IsMap()) return e.error(n, "impulse", "must be a map {body: I, j: [x, y], p: [x, y]}");
+  for (const auto& kv : n) {
+    const std::string key = kv.first.Scalar();
+    if (key != "body" && key != "j" && key != "p") {
+      return e.error(kv.first, "impulse." + key, "unknown field (want body, j and optionally p)");
+    }
+  }
+  const YAML::Node body = n["body"], j = n["j"], p = n["p"];
+  if (!body) return e.error(n, "impulse.body", "missing");
+  const std::optional<std::int64_t> b = integer(body);
+  if (!b || *b < 0 || *b >= bodies) {
+    return e.error(body, "impulse.body", "must be a body index in [0, " + std::to_string(bodies) + ")");
+  }
+  if (!j) return e.error(n, "impulse.j", "missing");
+  Result<Vec2> jv = vector(e, j, "impulse.j");
+  if (!jv) return jv.error();
+  Vec2 pv{0.0, 0.0};
+  if (p) {
+    Result<Vec2> read = vector(e, p, "impulse.p");
+    if (!read) return read.error();
+    pv = read.value();
+  }
+  out = ImpulseArgs{*b, jv.value(), pv};
+  return Ok{};
+}
+
+bool is_true(const YAML::Node& n) {
+  if (!n.IsScalar()) return false;
+  const ParameterValue v = yaml_scalar(n);
+  return v.type == ParameterType::Bool && v.bool_value;
+}
+
+// The entry's one action into `c`.
+Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, Command& c) {
+  std::optional<std::string> name;
+  for (const auto& kv : e.node) {
+    const std::string key = kv.first.Scalar();
+    if (key == "step" || key == "t") continue;
+    if (key != "set" && key != "impulse" && key != "pause" && key != "resume" && key != "steps" && key != "reset") {
+      return e.error(kv.first, key, std::string("unknown field (want step or t, and one of ") + kActions + ")");
+    }
+    if (name) return e.error(kv.first, key, "one action per entry (this one also has " + *name + ")");
+    name = key;
+  }
+  if (!name) return e.error(e.node, "action", std::string("missing: one of ") + kActions);
+  const YAML::Node v = e.node[*name];
+  if (*name == "set") {
+    if (!v.IsMap() || v.size() == 0) return e.error(v, "set", "must be a map of parameters {NAME: VALUE}");
+    c.kind = CommandKind::SetParameters;
+    c.atomic = true;
+    return parameters(e, v, "", table, c.parameters);
+  }
+  if (*name == "impulse") {
+    c.kind = CommandKind::Impulse;
+    return impulse(e, v, bodies, c.impulse);
+  }
+  if (*name == "steps") {
+    const std::optional<std::int64_t> n = integer(v);
+    if (!n || *n < 1) return e.error(v, "steps", "must be an integer >= 1");
+    c.kind = CommandKind::Step;
+    c.steps = *n;
+    return Ok{};
+  }
+  if (*name == "pause") {
+    c.kind = CommandKind::Pause;
+    if (is_true(v)) return Ok{};
+    const std::optional<double> s = number(v);
+    if (!s || !std::isfinite(*s) || *s <= 0.0) {
+      return e.error(v, "pause", "must be true (until a resume) or wall-clock seconds > 0");
+    }
+    c.pause_seconds = *s;
+    return Ok{};
+  }
+  if (!is_true(v)) return e.error(v, *name, "must be true");
+  c.kind = *name == "resume" ? CommandKind::Resume : CommandKind::Reset;
+  return Ok{};
+}
+
+// An offline run has no one to resume it: a `pause: true` needs a later resume, and `steps` is
+// only meaningful while such a pause holds. Walks the commands in the order they apply.
+Status check_pauses(const std::vector<Command>& commands, const std::vector<YAML::Node>& nodes,
+                    const std::string& path) {
+  std::vector<std::size_t> order(commands.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return commands[a].step < commands[b].step; });
+  std::optional<std::size_t> open;  // the pause: true in effect
+  for (std::size_t i : order) {
+    const Command& c = commands[i];
+    const Entry e{path, nodes[i]};
+    if (c.kind == CommandKind::Pause && c.pause_seconds == 0.0 && !open) open = i;
+    if (c.kind == CommandKind::Resume || c.kind == CommandKind::Reset) open.reset();
+    if (c.kind == CommandKind::Step && !open) {
+      return e.error(nodes[i], "steps", "only while paused (a pause: true at or before this step, not resumed)");
+    }
+  }
+  if (open) {
+    return Entry{path, nodes[*open]}.error(nodes[*open], "pause",
+                                           "no resume follows: the run would stay paused for ever (add a "
+                                           "resume entry, or pause for SECONDS of wall time)");
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<std::vector<Command>> parse_command_script(std::string_view text, const std::string& path,
+                                                  const Scene& scene, std::int64_t steps) {
+  const ParameterTable table(scene, steps, RunSettings{});
+  const auto bodies = static_cast<std::int64_t>(scene.world.bodies.size());
+  std::vector<Command> out;
+  std::vector<YAML::Node> nodes;
+  try {
+    const YAML::Node root = YAML::Load(std::string(text));
+    if (root.IsNull()) return out;  // an empty script: no commands
+    if (!root.IsSequence()) {
+      return Error{yaml_line(path, root) + ": expected a list of commands (- {step: N, set: {...}})",
+                   ErrorCode::InvalidArgument};
+    }
+    for (const YAML::Node& node : root) {
+      const Entry e{path, node};
+      if (!node.IsMap()) return e.error(node, "entry", "must be a map ({step: N, ACTION: ...})");
+      Command c;
+      Result<std::int64_t> k = boundary(e, scene.world.dt, steps);
+      if (!k) return k.error();
+      c.step = k.value();
+      if (Status st = action(e, table, bodies, c); !st) return st.error();
+      c.source = "script " + yaml_line(path, node);
+      out.push_back(std::move(c));
+      nodes.push_back(node);
+    }
+  } catch (const YAML::Exception& e) {
+    return Error{path + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg,
+                 ErrorCode::InvalidArgument};
+  }
+  if (Status st = check_pauses(out, nodes, path); !st) return st.error();
+  return out;
+}
+
+Result<std::vector<Command>> load_command_script(const std::string& path, const Scene& scene,
+                                                 std::int64_t steps) {
+  Result<std::string> text = read_text_file(path, "the commands file");
+  if (!text) return text.error();
+  return parse_command_script(text.value(), path, scene, steps);
+}
+
+}  // namespace rbsim::control
