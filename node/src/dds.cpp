@@ -37,16 +37,18 @@ dds_qos_t* make_qos(const QosSpec& q, bool reader, const EndpointOptions& option
   // acknowledged once `depth` newer ones exist, so a recorder that falls behind loses steps;
   // keep-all makes the node wait instead (scripts/soak reports losses). A reader keeps all it is
   // sent.
-  if (!q.transient_local && (reader || q.keep_all)) {
+  if ((!q.transient_local && reader) || q.keep_all) {
     dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
   } else {
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.depth);
   }
   if (q.transient_local) {
     // Cyclone keeps for late joiners what the durability service history says (by default the
-    // last 1); rmw_cyclonedds_cpp sets it to the history, so /rosout's late joiners get 1000.
-    dds_qset_durability_service(qos, 0, DDS_HISTORY_KEEP_LAST, q.depth, DDS_LENGTH_UNLIMITED,
-                                DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+    // last 1); rmw_cyclonedds_cpp sets it to the history, so /rosout's late joiners get 1000, and
+    // a transient-local keep-all writer (/<ns>/commands) gives a late joiner everything.
+    dds_qset_durability_service(qos, 0, q.keep_all ? DDS_HISTORY_KEEP_ALL : DDS_HISTORY_KEEP_LAST,
+                                q.keep_all ? 0 : q.depth, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
   }
   if (options.lifespan_ns > 0) dds_qset_lifespan(qos, options.lifespan_ns);
   // rmw_cyclonedds_cpp's endpoint USER_DATA: the type hash (REP 2011) where the distro has them.

@@ -34,6 +34,15 @@ QosSpec parameter_events_qos() {
   return q;
 }
 
+// /<ns>/commands: every command reaches a late joiner (a recorder started after the first
+// command), reliable, transient local, keep all.
+QosSpec commands_qos() {
+  QosSpec q;
+  q.transient_local = true;
+  q.keep_all = true;
+  return q;
+}
+
 }  // namespace
 
 struct NodeServices::Impl {
@@ -43,12 +52,16 @@ struct NodeServices::Impl {
   std::vector<ServiceServer> servers;
   std::vector<ServiceServer::Handler> handlers;
   std::optional<Publisher> events;
+  std::optional<Publisher> commands;  // /<ns>/commands
+  Bytes command_cdr;                  // the run loop's thread only
+  std::uint64_t next_sequence = 0;    // the run loop's thread only
   Bytes event_cdr;
 
   std::mutex mutex;  // guards `arrived` and `stopping`
   std::condition_variable wake;
   bool arrived = false, stopping = false;
   std::atomic<std::uint64_t> event_count{0};
+  std::atomic<std::uint64_t> command_count{0};
   std::thread thread;
 
   Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
@@ -258,12 +271,25 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
       parameter_events_qos());
   if (!events) return events.error();
   impl->events.emplace(std::move(events.value()));
+  const std::string commands_topic = options.node + "/" + std::string(msgs::CommandMessage::kSuffix);
+  auto commands = Publisher::create(
+      participant,
+      RawTopic{msgs::dds_topic_name(commands_topic), msgs::dds_type_name(msgs::CommandMessage::kType),
+               std::string(msgs::CommandMessage::kType)},
+      commands_qos());
+  if (!commands) return commands.error();
+  impl->commands.emplace(std::move(commands.value()));
   Impl* raw = impl.get();
   impl->thread = std::thread([raw] { raw->serve_loop(); });
   return std::unique_ptr<NodeServices>(new NodeServices(std::move(impl)));
 }
 
 void NodeServices::command_applied(const Command& command, const CommandResult& result) {
+  // Every command, applied or refused, as data on /<ns>/commands, numbered without gaps.
+  impl_->command_cdr.clear();
+  msgs::encode(control::to_message(command, result, impl_->next_sequence++, impl_->options.dt),
+               impl_->command_cdr);
+  if (impl_->commands->publish(impl_->command_cdr)) ++impl_->command_count;
   if (command.kind != CommandKind::SetParameters || result.step < 0) return;
   msgs::ParameterEvent event;
   event.node = impl_->options.node;
@@ -289,6 +315,7 @@ NodeServiceCounters NodeServices::counters() const {
                  st.unanswered + st.write_failed;
   }
   c.events = impl_->event_count.load();
+  c.commands = impl_->command_count.load();
   return c;
 }
 

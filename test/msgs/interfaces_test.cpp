@@ -76,6 +76,24 @@ void expect_round_trip(const T& m) {
   EXPECT_EQ(again, cdr);
 }
 
+CommandMessage command_message() {
+  CommandMessage c;
+  c.seq = 7;
+  c.step = 1234;
+  c.stamp = {1, 234000000};
+  c.kind = CommandMessage::SetParameters;
+  c.source = "script steer.yaml:3";
+  c.parameters = {parameter("forces.0.fy", full_value())};
+  c.atomic = false;
+  c.steps = 5;
+  c.pause_seconds = 0.25;
+  c.body = 3;
+  c.jx = 0.5, c.jy = -2.0, c.px = 0.1, c.py = 1e-300;
+  c.success = true;
+  c.message = "set 1 of 1 parameters at step 1234";
+  return c;
+}
+
 TEST(InterfacesCodec, EveryTypeRoundTrips) {
   expect_round_trip(full_value());
   expect_round_trip(ParameterValue{});
@@ -108,6 +126,8 @@ TEST(InterfacesCodec, EveryTypeRoundTrips) {
   expect_round_trip(GetParameterTypesResponse{{1, 2, 3, 9, 0}});
   expect_round_trip(TriggerRequest{});
   expect_round_trip(TriggerResponse{true, "paused at step 120"});
+  expect_round_trip(command_message());
+  expect_round_trip(CommandMessage{});
   expect_round_trip(StepRequest{4000000000u});
   expect_round_trip(StepResponse{true, "stepped", 1ull << 40});
   expect_round_trip(ApplyImpulseRequest{7, 1.0, -2.0, 0.25, -0.125});
@@ -161,6 +181,33 @@ TEST(InterfacesCodec, ParameterValueLayoutWithASequenceOfStrings) {
   EXPECT_EQ(cdr, expected);
 }
 
+TEST(InterfacesCodec, CommandMessageLayout) {
+  CommandMessage c;
+  c.seq = 2;
+  c.step = 9;
+  c.kind = CommandMessage::ApplyImpulse;
+  c.source = "ab";  // u32 length 3, "ab\0"
+  c.body = 4;
+  c.jx = 1.0;
+  c.success = true;
+  Bytes cdr;
+  encode(c, cdr);
+  // Offsets after the 4-byte header: sequence 0, step 8, stamp 16 (int32, uint32), kind 24, source
+  // length 28 and text 32..34, parameters length 36, atomic 40, steps 48, pause_seconds 56, body 64,
+  // jx 72, jy 80, px 88, py 96, success 104, message length 108 (0 + its nul: 1).
+  ASSERT_EQ(cdr.size(), 4u + 116);
+  EXPECT_EQ(cdr[4 + 0], std::byte{2});
+  EXPECT_EQ(cdr[4 + 8], std::byte{9});
+  EXPECT_EQ(cdr[4 + 24], std::byte{5});
+  EXPECT_EQ(cdr[4 + 28], std::byte{3});
+  EXPECT_EQ(cdr[4 + 32], std::byte{'a'});
+  EXPECT_EQ(cdr[4 + 40], std::byte{1});  // atomic: true by default
+  EXPECT_EQ(cdr[4 + 64], std::byte{4});
+  EXPECT_EQ(cdr[4 + 79], std::byte{0x3f});  // jx = 1.0: top byte
+  EXPECT_EQ(cdr[4 + 104], std::byte{1});
+  EXPECT_EQ(cdr[4 + 108], std::byte{1});
+}
+
 TEST(InterfacesCodec, TriggerRequestIsOnePlaceholderByte) {
   Bytes cdr;
   encode(TriggerRequest{}, cdr);
@@ -208,6 +255,7 @@ TEST(InterfacesCodec, EveryTruncationOfAValidMessageFails) {
   e.node = "/rbsim";
   e.changed_parameters = {parameter("rate", full_value())};
   expect_every_truncation_fails(e, "rcl_interfaces/msg/ParameterEvent");
+  expect_every_truncation_fails(command_message(), "rbsim_msgs/msg/Command");
 }
 
 TEST(InterfacesCodec, ErrorNamesTheOffset) {

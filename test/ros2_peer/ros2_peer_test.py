@@ -235,7 +235,8 @@ def case_services(ctx):
 
 
 def case_steered(ctx):
-    """A session steered by ros2-client (pause, a parameter, step N, an impulse, resume), recorded by
+    """A session steered by ros2-client (pause, a parameter, step N, an impulse, resume), each command
+    on /NS/commands with its step, read back by ros2-client; the session recorded by
     `rbsim record` over DDS, equals `rbsim run --commands` with the same changes at the steps the
     replies name, every message; the run without them diverges first at the step after the first
     change."""
@@ -266,6 +267,14 @@ def case_steered(ctx):
             ctx.check(s1 == s0 + 5, f"the impulse applied at step {s1}, want {s0 + 5} (paused after step 5)")
             resume = peer_json(ctx, net, "resume", "call", f"{svc}/resume", "trigger")
             ctx.require(resume and resume[0]["success"], f"resume: {resume}")
+            # Every command as data on /NS/commands, read by a late subscriber (transient local).
+            got = peer_json(ctx, net, "commands", "commands", f"{svc}/commands", 5)
+            want = [(0, 1, s0, 0), (1, 0, s0, 0), (2, 3, s0, 5), (3, 5, s1, 0), (4, 2, s1, 0)]  # seq, kind, step, steps
+            ctx.check([(c["seq"], c["kind"], c["step"], c["steps"]) for c in got] == want,
+                      f"/NS/commands: {got}, want (seq, kind, step, steps) {want}")
+            ctx.check(all(c["success"] and c["source"] == "ros2 service" for c in got), f"/NS/commands: {got}")
+            ctx.check(got[1:2] and got[1]["parameters"] == ["forces.0.fy"] and got[3]["body"] == 2
+                      and got[3]["j"] == [0.5, 2.0] and got[3]["p"] == [0.1, 0.0], f"/NS/commands arguments: {got}")
         finally:
             e2e.exited_ok(ctx, node, 60, "rbsim node")
             e2e.exited_ok(ctx, rec, 60, "rbsim record")

@@ -1,10 +1,10 @@
 // The node's services, the ROS 2 way: the six rcl_interfaces parameter services and rbsim's
 // controls (pause, resume, reset: std_srvs/srv/Trigger; step: rbsim_msgs/srv/Step; apply_impulse:
 // rbsim_msgs/srv/ApplyImpulse) under the node's name, on rmw_cyclonedds_cpp's wire format
-// (rbsim/service.hpp), and /parameter_events. Every request becomes a control::Command for the
-// run loop (rbsim/control.hpp), answered once it applied at a step boundary; reads answer at once
-// from the table as of the last boundary. Requests are served on one thread of this class, woken
-// by any server's arrival, so a paused run loop (idling in the controller) still answers.
+// (rbsim/service.hpp), /parameter_events and <node>/commands. Every request becomes a control::Command for
+// the run loop (rbsim/control.hpp), answered once it applied at a step boundary; reads answer at once from
+// the table as of the last boundary. Requests are served on one thread of this class, woken by any server's
+// arrival, so a paused run loop (idling in the controller) still answers.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +30,7 @@ struct NodeServiceCounters {
   std::uint64_t calls = 0;     // requests answered
   std::uint64_t dropped = 0;   // not answered: queue full, too large, malformed, client gone
   std::uint64_t events = 0;    // /parameter_events published
+  std::uint64_t commands = 0;  // /<ns>/commands published
 };
 
 class NodeServices {
@@ -42,8 +43,10 @@ class NodeServices {
   NodeServices(const NodeServices&) = delete;
   NodeServices& operator=(const NodeServices&) = delete;
 
-  // The controller's observer (Controller::on_command): publishes /parameter_events for every
-  // parameter a command changed. Called on the run loop's thread.
+  // The controller's observer (Controller::on_command): publishes every command with its outcome
+  // on <node>/commands (rbsim_msgs/msg/Command, numbered from 0 without gaps; reliable, transient
+  // local, keep all) and /parameter_events for every parameter a command changed. Called on the
+  // run loop's thread.
   void command_applied(const control::Command& command, const control::CommandResult& result);
   NodeServiceCounters counters() const;
 

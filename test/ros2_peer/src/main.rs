@@ -8,6 +8,7 @@
 //!   rbsim-ros2-peer events NAME [--timeout S]      wait for NAME on /parameter_events
 //!   rbsim-ros2-peer params NODE list|get|describe|types|set|set-atomic ARGS...
 //!   rbsim-ros2-peer call SERVICE trigger | step N | impulse BODY JX JY PX PY
+//!   rbsim-ros2-peer commands /NS/commands COUNT     take COUNT commands (the node's history too)
 use std::{process::ExitCode, time::Duration};
 
 use futures::StreamExt;
@@ -18,6 +19,7 @@ use ros2_client::{
 };
 use serde::{Deserialize, Serialize};
 
+mod commands;
 mod services;
 
 mod tf {
@@ -103,7 +105,7 @@ pub(crate) fn json_string(s: &str) -> String {
 }
 
 /// Runs `work` until it returns true or `timeout` passes.
-fn within(timeout: Duration, work: impl std::future::Future<Output = bool>) -> bool {
+pub(crate) fn within(timeout: Duration, work: impl std::future::Future<Output = bool>) -> bool {
   smol::block_on(smol::future::or(work, async {
     smol::Timer::after(timeout).await;
     false
@@ -271,6 +273,16 @@ fn main() -> ExitCode {
         false
       })
     }
+    "commands" => {
+      let want: usize = args.rest.first().and_then(|w| w.parse().ok()).unwrap_or(0);
+      match commands::take(&mut node, &args.operand, want.max(1), args.timeout) {
+        Ok(found) => found,
+        Err(e) => {
+          eprintln!("rbsim-ros2-peer: {e}");
+          false
+        }
+      }
+    }
     "params" | "call" => {
       let result = if args.verb == "params" {
         services::params(&context, &mut node, &args.operand, &args.rest, args.timeout)
@@ -283,7 +295,7 @@ fn main() -> ExitCode {
       result.is_ok()
     }
     other => {
-      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, params, call)");
+      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, commands, params, call)");
       return ExitCode::from(2);
     }
   };

@@ -210,6 +210,43 @@ void get(Reader& r, ParameterEvent& m) {
   get_all(r, m.deleted_parameters, kMinParameter);
 }
 
+void put(CdrWriter& w, const CommandMessage& m) {
+  w.u64(m.seq);
+  w.u64(m.step);
+  w.time(m.stamp);
+  w.u8(m.kind);
+  w.string(m.source);
+  put_all(w, m.parameters);
+  w.boolean(m.atomic);
+  w.u64(m.steps);
+  w.f64(m.pause_seconds);
+  w.u32(m.body);
+  w.f64(m.jx);
+  w.f64(m.jy);
+  w.f64(m.px);
+  w.f64(m.py);
+  w.boolean(m.success);
+  w.string(m.message);
+}
+void get(Reader& r, CommandMessage& m) {
+  m.seq = r.get<std::uint64_t>();
+  m.step = r.get<std::uint64_t>();
+  m.stamp = r.time();
+  m.kind = r.get<std::uint8_t>();
+  m.source = r.string();
+  get_all(r, m.parameters, kMinParameter);
+  m.atomic = r.get<std::uint8_t>() != 0;
+  m.steps = r.get<std::uint64_t>();
+  m.pause_seconds = r.get<double>();
+  m.body = r.get<std::uint32_t>();
+  m.jx = r.get<double>();
+  m.jy = r.get<double>();
+  m.px = r.get<double>();
+  m.py = r.get<double>();
+  m.success = r.get<std::uint8_t>() != 0;
+  m.message = r.string();
+}
+
 void put(CdrWriter& w, const ListParametersRequest& m) {
   put_strings(w, m.prefixes);
   w.u64(m.depth);
@@ -387,6 +424,7 @@ RBSIM_INTERFACE_CODEC(ParameterDescriptor, "")
 RBSIM_INTERFACE_CODEC(SetParametersResult, "")
 RBSIM_INTERFACE_CODEC(ListParametersResult, "")
 RBSIM_INTERFACE_CODEC(ParameterEvent, "")
+RBSIM_INTERFACE_CODEC(CommandMessage, "")
 RBSIM_INTERFACE_CODEC(ListParametersRequest, " request")
 RBSIM_INTERFACE_CODEC(ListParametersResponse, " response")
 RBSIM_INTERFACE_CODEC(GetParametersRequest, " request")

@@ -59,6 +59,15 @@ struct Command {
   std::string source;                 // "ros2 service", "foxglove", "script", ...
 };
 
+struct CommandResult;
+// A command and its outcome as rbsim_msgs/msg/Command (/<ns>/commands, recordings): `sequence` is
+// the node's count of commands, `dt` stamps the step in simulated time.
+msgs::CommandMessage to_message(const Command& command, const CommandResult& result, std::uint64_t sequence,
+                                double dt);
+// The command a message records, to apply again at its step (a re-simulation); an unknown kind
+// or a body past int64 is an error naming the sequence number.
+[[nodiscard]] Result<Command> from_message(const msgs::CommandMessage& message);
+
 struct CommandResult {
   bool successful = false;
   std::string message;

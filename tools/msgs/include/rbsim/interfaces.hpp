@@ -108,6 +108,39 @@ struct ParameterEvent {
   }
 };
 
+// rbsim_msgs/msg/Command (/<ns>/commands): one control input as data, with its outcome.
+struct CommandMessage {
+  static constexpr std::string_view kType = "rbsim_msgs/msg/Command";
+  static constexpr std::string_view kSuffix = "commands";  // /<ns>/commands
+  enum Kind : std::uint8_t {
+    SetParameters = 0,
+    Pause = 1,
+    Resume = 2,
+    Step = 3,
+    Reset = 4,
+    ApplyImpulse = 5
+  };
+  std::uint64_t seq = 0;  // the sequence number (`sequence` is an IDL keyword)
+  std::uint64_t step = 0;
+  Time stamp;
+  std::uint8_t kind = SetParameters;  // as received: a reader checks it
+  std::string source;
+  std::vector<Parameter> parameters;
+  bool atomic = true;
+  std::uint64_t steps = 0;
+  double pause_seconds = 0.0;
+  std::uint32_t body = 0;
+  double jx = 0.0, jy = 0.0, px = 0.0, py = 0.0;
+  bool success = false;
+  std::string message;
+  bool operator==(const CommandMessage& o) const {
+    return seq == o.seq && step == o.step && stamp.sec == o.stamp.sec && stamp.nanosec == o.stamp.nanosec &&
+           kind == o.kind && source == o.source && parameters == o.parameters && atomic == o.atomic &&
+           steps == o.steps && pause_seconds == o.pause_seconds && body == o.body && jx == o.jx &&
+           jy == o.jy && px == o.px && py == o.py && success == o.success && message == o.message;
+  }
+};
+
 // ---------------------------------------------------------------------------------------------
 // Services: kService is the service type ("pkg/srv/Name"), each half its own struct.
 
@@ -229,6 +262,7 @@ RBSIM_INTERFACE_CODEC(ParameterDescriptor)
 RBSIM_INTERFACE_CODEC(SetParametersResult)
 RBSIM_INTERFACE_CODEC(ListParametersResult)
 RBSIM_INTERFACE_CODEC(ParameterEvent)
+RBSIM_INTERFACE_CODEC(CommandMessage)
 RBSIM_INTERFACE_CODEC(ListParametersRequest)
 RBSIM_INTERFACE_CODEC(ListParametersResponse)
 RBSIM_INTERFACE_CODEC(GetParametersRequest)
