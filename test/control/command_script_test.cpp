@@ -160,5 +160,47 @@ TEST(ParseCommandScript, AScriptedRunEqualsTheSameCommandsGivenLive) {
   EXPECT_FALSE(test::same_bits(run[31].state, plain[31].state));
 }
 
+// Commands as rbsim_msgs/msg/Command and back: every kind keeps what a re-run applies.
+TEST(CommandMessage, ToMessageAndBackKeepsEveryCommand) {
+  const std::vector<Command> script = parse(
+      "- {step: 5, set: {forces.0.fy: -3.7, springs.0.k: 40.0}}\n"
+      "- {step: 7, impulse: {body: 1, j: [0.5, -2], p: [0.1, 0]}}\n"
+      "- {step: 9, pause: true}\n- {step: 9, steps: 3}\n- {step: 12, resume: true}\n"
+      "- {step: 20, pause: 0.5}\n- {step: 30, reset: true}\n");
+  std::uint64_t seq = 0;
+  for (const Command& c : script) {
+    CommandResult r;
+    r.successful = true;
+    r.step = c.step;
+    r.message = "done";
+    const msgs::CommandMessage m = to_message(c, r, seq, 0.01);
+    EXPECT_EQ(m.seq, seq++);
+    EXPECT_EQ(m.stamp.sec, 0);
+    EXPECT_EQ(m.stamp.nanosec, static_cast<std::uint32_t>(c.step) * 10000000u);
+    Bytes cdr;
+    msgs::encode(m, cdr);
+    msgs::CommandMessage decoded;
+    ASSERT_TRUE(msgs::decode(cdr, decoded).ok());
+    Result<Command> back = from_message(decoded);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->step, c.step);
+    EXPECT_EQ(back->kind, c.kind);
+    EXPECT_EQ(back->parameters, c.parameters);
+    EXPECT_EQ(back->atomic, c.atomic);
+    EXPECT_EQ(back->steps, c.steps);
+    EXPECT_EQ(back->pause_seconds, c.pause_seconds);
+    EXPECT_EQ(back->impulse.body, c.impulse.body);
+    EXPECT_EQ(back->impulse.impulse, c.impulse.impulse);
+    EXPECT_EQ(back->impulse.point, c.impulse.point);
+    EXPECT_EQ(back->source, c.source);
+  }
+  msgs::CommandMessage bad;
+  bad.seq = 4;
+  bad.kind = 6;
+  Result<Command> refused = from_message(bad);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("command 4: unknown kind 6"), std::string::npos) << refused.error().message;
+}
+
 }  // namespace
 }  // namespace rbsim::control
