@@ -79,8 +79,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
     if (!sub) return sub.error();
     dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
     r->topics_.push_back(Topic{std::move(sub.value()), 0, 0, Gaps{}});
-    r->latched_pending_.push_back(!spec->per_step);
-    if (!spec->per_step) r->holding_ = true;
+    r->latched_pending_.push_back(spec->latched());
+    if (spec->latched()) r->holding_ = true;
   }
   return r;
 }
@@ -114,7 +114,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       }
       const std::uint64_t now = wall_ns();
       const std::size_t index = static_cast<std::size_t>(&t - topics_.data());
-      const bool latched = !t.subscription.spec().per_step;
+      const bool latched = t.subscription.spec().latched();
       // Held: per-step samples while a latched topic is outstanding, and the markers while the
       // scene description is (it goes first).
       if (holding_ && (!latched || (t.subscription.spec().id != msgs::TopicId::Scene && scene_pending()))) {
@@ -162,7 +162,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
   if (id == msgs::TopicId::Scene) {
     if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
   } else if (!t.subscription.spec().per_step) {
-    // latched: no per-step sequence to check for gaps
+    // latched or an event: no per-step sequence to check for gaps
   } else if (const auto stamp = msgs::decode_stamp(id, sample.cdr)) {
     t.gaps.add(static_cast<std::int64_t>(stamp->sec) * 1'000'000'000 + stamp->nanosec, dt_);
   }
@@ -198,7 +198,7 @@ Status Recorder::release_held() {
   for (const bool latched : {true, false}) {
     for (Held& h : held_) {
       Topic& t = topics_[h.topic];
-      if (t.subscription.spec().per_step == latched) continue;
+      if (t.subscription.spec().latched() != latched) continue;
       if (Status st = write(t, h.sample, latched ? first : h.log_time); !st) return st;
     }
   }

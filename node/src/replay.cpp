@@ -131,13 +131,13 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     auto index = publisher_for(*c->spec, topic);
     if (!index) return index.error();
     im.route.emplace(c->channel->id, index.value());
-    if (c->spec->transient_local) im.latched_channels.insert(c->channel->id);
+    if (c->spec->latched()) im.latched_channels.insert(c->channel->id);
     if (c->spec->id == msgs::TopicId::BodyStates && !states_publisher) states_publisher = index.value();
     im.topics.push_back(c->channel->topic);
     im.output_of.emplace(c->channel->id, r->outputs_.size());
     im.topic_of.emplace(c->channel->id, c->spec->id);
     r->outputs_.push_back({c->channel->topic, topic, c->message_count.value_or(0), std::string(c->spec->type),
-                           std::string(c->schema_text()), c->spec->transient_local});
+                           std::string(c->schema_text()), c->spec->latched()});
   }
   if (options.clock) {
     const msgs::TopicSpec& spec = msgs::topic(msgs::TopicId::Clock);

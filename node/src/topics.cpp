@@ -2,6 +2,7 @@
 
 #include "geometry_msgs/msg/PoseArray.h"
 #include "rbsim_msgs/msg/BodyStates.h"
+#include "rbsim_msgs/msg/Command.h"
 #include "rbsim_msgs/msg/EnergyTerms.h"
 #include "rbsim_msgs/msg/SceneDescription.h"
 #include "rbsim_msgs/msg/SpringStates.h"
@@ -31,6 +32,8 @@ const dds_topic_descriptor_t* descriptor(msgs::TopicId id) {
       return &visualization_msgs_msg_dds__Marker__desc;
     case msgs::TopicId::Clock:
       return &rosgraph_msgs_msg_dds__Clock__desc;
+    case msgs::TopicId::Commands:
+      return &rbsim_msgs_msg_dds__Command__desc;
   }
   return nullptr;
 }

@@ -199,7 +199,8 @@ TEST(CommandMessage, ToMessageAndBackKeepsEveryCommand) {
   bad.kind = 6;
   Result<Command> refused = from_message(bad);
   ASSERT_FALSE(refused);
-  EXPECT_NE(refused.error().message.find("command 4: unknown kind 6"), std::string::npos) << refused.error().message;
+  EXPECT_NE(refused.error().message.find("command 4: unknown kind 6"), std::string::npos)
+      << refused.error().message;
 }
 
 }  // namespace

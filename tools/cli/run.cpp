@@ -11,6 +11,7 @@
 #include "rbsim/csv.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
+#include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/sink.hpp"
@@ -40,6 +41,46 @@ struct RunOptions {
   bool overwrite = false;
 };
 
+// A command to apply and the outcome it must have: success for a script's, the recorded one for a
+// re-run of a recording's.
+struct Scripted {
+  control::Command command;
+  bool expect_success = true;
+  std::string origin;  // "steer.yaml:3", "live.mcap: command 4"
+};
+
+bool is_recording(const std::string& path) {
+  return path.ends_with(".mcap");
+}
+
+Result<std::vector<Scripted>> load_commands(const std::string& path, const Scene& scene, std::int64_t steps) {
+  std::vector<Scripted> out;
+  if (!is_recording(path)) {
+    Result<std::vector<control::Command>> script = control::load_command_script(path, scene, steps);
+    if (!script) return script.error();
+    for (control::Command& c : script.value()) {
+      std::string origin = c.source.substr(c.source.find(' ') + 1);  // "script FILE:LINE" -> "FILE:LINE"
+      out.push_back({std::move(c), true, std::move(origin)});
+    }
+    return out;
+  }
+  log::RecordingOptions ro;
+  ro.require_scene = false;
+  Result<std::unique_ptr<log::Recording>> recording = log::Recording::open(path, ro);
+  if (!recording) return recording.error();
+  Result<std::vector<msgs::CommandMessage>> recorded = log::read_commands(*recording.value());
+  if (!recorded) return recorded.error();
+  if (recording.value()->topic(msgs::TopicId::Commands).empty()) {
+    return Error{path + ": no commands topic (rbsim_msgs/msg/Command): not a recording of a steered session"};
+  }
+  for (const msgs::CommandMessage& m : recorded.value()) {
+    Result<control::Command> c = control::from_message(m);
+    if (!c) return Error{path + ": " + c.error().message};
+    out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq)});
+  }
+  return out;
+}
+
 int run(const RunOptions& o) {
   Result<Scene> loaded = load_scene(o.scene);
   if (!loaded) return fail("run", loaded.error().message);
@@ -62,20 +103,25 @@ int run(const RunOptions& o) {
       !st)
     return fail("run", st.error().message);
 
-  // The script is checked whole before step 0: a bad entry is a usage error naming its line.
+  // The commands are read whole before step 0: a bad script entry is a usage error naming its line,
+  // a recording that lost commands an error naming the first missing one.
   std::optional<control::Controller> controller;
   std::int64_t refused = 0;
   if (!o.commands.empty()) {
-    Result<std::vector<control::Command>> script = control::load_command_script(o.commands, scene, steps);
+    Result<std::vector<Scripted>> script = load_commands(o.commands, scene, steps);
     if (!script)
       return fail("run", script.error().message, script.error().code == ErrorCode::InvalidArgument ? 2 : 1);
     controller.emplace(scene, steps, control::RunSettings{0.0, 1, false});
-    for (control::Command& c : script.value()) {
-      const std::string source = c.source;
-      controller->submit(std::move(c), [&refused, source](const control::CommandResult& r) {
-        if (r.successful) return;
+    controller->end_when_idle(true);
+    for (Scripted& s : script.value()) {
+      controller->submit(std::move(s.command), [&refused, origin = s.origin,
+                                                expect = s.expect_success](const control::CommandResult& r) {
+        // A re-run matches the session when each command has the outcome it had there.
+        if (r.successful == expect) return;
         ++refused;
-        std::fprintf(stderr, "rbsim run: %s: refused: %s\n", source.c_str(), r.message.c_str());
+        std::fprintf(stderr, "rbsim run: %s: %s: %s\n", origin.c_str(),
+                     r.successful ? "applied here but refused in the recording" : "refused",
+                     r.message.c_str());
       });
     }
   }
@@ -85,6 +131,7 @@ int run(const RunOptions& o) {
   Driver& driver = created.value();
 
   std::vector<std::unique_ptr<Sink>> sinks;
+  log::McapSink* recorder = nullptr;
   if (!o.csv.empty()) sinks.push_back(make_csv_sink(o.csv));
   if (!o.energy_csv.empty()) sinks.push_back(make_energy_csv_sink(o.energy_csv));
   if (!o.fosssim_out.empty()) sinks.push_back(make_fosssim_sink(o.fosssim_out));
@@ -97,7 +144,21 @@ int run(const RunOptions& o) {
     if (!codec) return fail("run", codec.error().message);
     ro.compression = codec.value();
     ro.compression_level = o.compression_level;
-    sinks.push_back(log::make_mcap_sink(o.record, ro));
+    std::unique_ptr<log::McapSink> mcap = log::make_mcap_sink(o.record, ro);
+    recorder = mcap.get();
+    sinks.push_back(std::move(mcap));
+  }
+  // A steered run records its commands as the node publishes them (/<ns>/commands), so it can be
+  // re-run in turn.
+  Status recorded = Ok{};
+  Bytes command_cdr;
+  if (controller && recorder != nullptr) {
+    controller->on_command(
+        [&, seq = std::uint64_t{0}](const control::Command& c, const control::CommandResult& r) mutable {
+          command_cdr.clear();
+          msgs::encode(control::to_message(c, r, seq++, scene.world.dt), command_cdr);
+          if (Status st = recorder->record_command(command_cdr, r.step); !st && recorded) recorded = st;
+        });
   }
   if (!o.frames.empty()) {
     int width = 0, height = 0;
@@ -144,6 +205,13 @@ int run(const RunOptions& o) {
   }
   if (controller) {
     controller->close("the run ended");
+    if (!recorded) return fail("run", recorded.error().message);
+    if (const std::optional<std::int64_t> k = controller->ended_paused()) {
+      std::fprintf(
+          stderr,
+          "rbsim run: %s left the run paused at step %lld with nothing to resume it: outputs end there\n",
+          o.commands.c_str(), static_cast<long long>(*k));
+    }
     const control::ControlCounters counted = controller->counters();
     if (refused > 0) {
       return fail("run", o.commands + ": " + count_of(refused, "command was", "commands were") +

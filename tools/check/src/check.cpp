@@ -288,13 +288,14 @@ class Comparer {
           for (Pending& p : t.queue[si]) p.step = step_of_message(t, si, p.data);
         }
       }
-      if (is_type(g.schema_name, msgs::TopicId::Scene)) {
+      const bool scene = is_type(g.schema_name, msgs::TopicId::Scene);
+      if (scene || is_type(g.schema_name, msgs::TopicId::Commands)) {
         const auto& groups = t.layout->groups();
         t.tally.meta.assign(groups.size(), 0);
         t.tally.meta_reported.assign(groups.size(), 0);
         for (std::size_t gi = 0; gi < groups.size(); ++gi) {
           const std::string& path = groups[gi].path;
-          if (msgs::is_scene_metadata(path)) {
+          if (scene ? msgs::is_scene_metadata(path) : msgs::is_command_metadata(path)) {
             t.tally.meta[gi] = 1;
             t.tally.has_meta = true;
           }

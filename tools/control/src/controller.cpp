@@ -217,6 +217,12 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       return b;
     }
     if (!settings_.paused || step_budget_ > 0) break;
+    if (end_when_idle_ && schedule_.empty() && !resume_at_ &&
+        !has_incoming_.load(std::memory_order_acquire)) {
+      ended_paused_ = world.step_index();
+      b.stop = true;
+      return b;
+    }
     if (stop != nullptr && stop()) {
       b.stop = true;
       return b;

@@ -15,7 +15,7 @@ Result<std::vector<ChannelSpec>> ros2_channels(const msgs::TopicSet& topics, std
     c.topic = msgs::topic_name(spec, ns);
     c.schema_name = std::string(spec.type);
     c.schema = std::move(schema.value());
-    c.latched = spec.transient_local;
+    c.latched = spec.latched();
     channels.push_back(std::move(c));
     if (ids != nullptr) (*ids)[static_cast<std::size_t>(spec.id)] = static_cast<ChannelId>(channels.size());
   }
@@ -32,7 +32,7 @@ void FoxgloveSink::publish(const msgs::TopicSpec& spec, const World& world) {
   const ChannelId ch = ids_[static_cast<std::size_t>(spec.id)];
   if (ch == 0 || !options_.topics.test(static_cast<std::size_t>(spec.id))) return;
   // Nothing is encoded for a channel nobody watches; a latched one is kept for later subscribers.
-  if (!spec.transient_local && !server_->subscribed(ch)) return;
+  if (!spec.latched() && !server_->subscribed(ch)) return;
   server_->publish(ch, msgs::sim_time_ns(world), messages_->get(spec.id, world));
 }
 
@@ -41,7 +41,7 @@ Status FoxgloveSink::begin(const Scene& scene, const World& world) {
       options_.messages ? options_.messages : std::make_shared<msgs::StepMessages>(scene, options_.ns);
   server_->new_session();
   for (const msgs::TopicSpec& spec : msgs::topics()) {
-    if (spec.transient_local) publish(spec, world);
+    if (spec.latched()) publish(spec, world);
   }
   return write(world);
 }

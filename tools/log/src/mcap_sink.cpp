@@ -14,9 +14,9 @@ Error fail(const std::string& path, const Error& error) {
   return Error{path + ": " + error.message};
 }
 
-class McapSink final : public Sink {
+class McapFileSink final : public McapSink {
  public:
-  McapSink(std::string path, RecordOptions options)
+  McapFileSink(std::string path, RecordOptions options)
       : path_(std::move(path)), options_(std::move(options)), ids_(msgs::topic_ids(options_.topics)) {}
 
   Status begin(const Scene& scene, const World& world) override {
@@ -24,6 +24,7 @@ class McapSink final : public Sink {
       return Error{path_ + ": record every " + std::to_string(options_.every) + " steps: must be at least 1"};
     }
     encoder_ = std::make_unique<msgs::Encoder>(scene, options_.ns);
+    dt_ = scene.world.dt;
     // Written under a temporary name and renamed into place by finish(): a killed run leaves the
     // temporary (`<path>.tmp.<pid>`), which `rbsim log recover` turns into a recording.
     file_.open_external(path_);
@@ -43,6 +44,20 @@ class McapSink final : public Sink {
   Status write(const World& world) override {
     if (world.step_index() % options_.every != 0) return Ok{};
     return record(world, false);
+  }
+
+  Status record_command(std::span<const std::byte> cdr, std::int64_t step) override {
+    constexpr auto k = static_cast<std::size_t>(msgs::TopicId::Commands);
+    if (channels_[k] == 0) {  // added with the first command: a run without any has no such channel
+      auto channel = add_topic(writer_, msgs::topic(msgs::TopicId::Commands), options_.ns);
+      if (!channel.ok()) return fail(path_, channel.error());
+      channels_[k] = channel.value();
+    }
+    const mcap::Timestamp t = msgs::sim_time_ns(step, dt_);
+    if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, t, cdr); !st.ok()) {
+      return fail(path_, st.error());
+    }
+    return Ok{};
   }
 
   Status finish() override {
@@ -71,6 +86,7 @@ class McapSink final : public Sink {
   AtomicFile file_;  // declared before writer_: the writer closes before the temporary is removed
   mcap::Writer writer_;
   std::unique_ptr<msgs::Encoder> encoder_;
+  double dt_ = 0.0;
   std::array<std::uint16_t, msgs::kTopicCount> channels_{};
   std::array<std::uint32_t, msgs::kTopicCount> sequence_{};
   msgs::Bytes buffer_;
@@ -110,8 +126,8 @@ Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spe
       {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}, {"topic_type_hash", hash.value()}});
 }
 
-std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options) {
-  return std::make_unique<McapSink>(std::move(path), std::move(options));
+std::unique_ptr<McapSink> make_mcap_sink(std::string path, RecordOptions options) {
+  return std::make_unique<McapFileSink>(std::move(path), std::move(options));
 }
 
 }  // namespace rbsim::log

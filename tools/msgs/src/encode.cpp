@@ -4,6 +4,7 @@
 #include <numeric>
 
 #include "cdr.hpp"
+#include "rbsim/assert.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
@@ -432,7 +433,10 @@ void Encoder::encode(TopicId id, const World& world, Bytes& out) const {
       return markers(world, out);
     case TopicId::Clock:
       return clock(world, out);
+    case TopicId::Commands:
+      break;  // an event topic: the controller's, never encoded from a World
   }
+  RBSIM_ASSERT(false, "Encoder::encode: not a topic of the world");
 }
 
 StepMessages::StepMessages(const Scene& scene, std::string_view ns) : encoder_(scene, ns) {

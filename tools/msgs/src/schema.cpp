@@ -20,6 +20,7 @@ constexpr TopicSpec kTopics[kTopicCount] = {
     {TopicId::Springs, "springs", "visualization_msgs/msg/Marker", false, true},
     {TopicId::Clock, "clock", "rosgraph_msgs/msg/Clock", false, true},
     {TopicId::Poses, "poses", "geometry_msgs/msg/PoseArray", false, true},
+    {TopicId::Commands, "commands", "rbsim_msgs/msg/Command", true, false, true},
 };
 static_assert([] {
   for (std::size_t i = 0; i < kTopicCount; ++i) {
@@ -101,6 +102,7 @@ TopicSet default_topics() {
   TopicSet set;
   set.set();
   set.reset(static_cast<std::size_t>(TopicId::Poses));
+  set.reset(static_cast<std::size_t>(TopicId::Commands));  // an event topic: no World encodes it
   return set;
 }
 
@@ -118,11 +120,14 @@ Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns) {
     any = true;
     const TopicSpec* found = nullptr;
     for (const TopicSpec& spec : kTopics) {
+      if (spec.event) continue;
       if (names_topic(name, topic_name(spec, ns)) || name == spec.suffix) found = &spec;
     }
     if (found == nullptr) {
       std::string known;
-      for (const TopicSpec& spec : kTopics) known += (known.empty() ? "" : ", ") + std::string(spec.suffix);
+      for (const TopicSpec& spec : kTopics) {
+        if (!spec.event) known += (known.empty() ? "" : ", ") + std::string(spec.suffix);
+      }
       return Error{"unknown topic \"" + std::string(name) + "\" (topics: " + known + ")"};
     }
     set.set(static_cast<std::size_t>(found->id));
@@ -161,8 +166,8 @@ std::string dds_type_name(std::string_view ros_type) {
 OfferedQos offered_qos(const TopicSpec& spec, std::int32_t keep_last) {
   OfferedQos q;
   q.transient_local = spec.transient_local;
-  q.keep_all = !spec.transient_local && keep_last <= 0;
-  q.depth = spec.transient_local ? 1 : q.keep_all ? 0 : keep_last;
+  q.keep_all = spec.event || (!spec.transient_local && keep_last <= 0);
+  q.depth = q.keep_all ? 0 : spec.transient_local ? 1 : keep_last;
   return q;
 }
 

@@ -248,6 +248,10 @@ std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr) {
   if (id == TopicId::Scene) return std::nullopt;
   Reader r(cdr);
   if ((id == TopicId::Markers || id == TopicId::Tf) && r.get<std::uint32_t>() == 0) return std::nullopt;
+  if (id == TopicId::Commands) {  // seq, step, then the stamp
+    r.get<std::uint64_t>();
+    r.get<std::uint64_t>();
+  }
   const Time t = r.time();
   if (!r.ok()) return std::nullopt;
   return t;
@@ -262,6 +266,13 @@ std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte>
     if (!r.ok()) return std::nullopt;
     return step;
   }
+  if (id == TopicId::Commands) {  // seq, then the step it applied at
+    Reader r(cdr);
+    r.get<std::uint64_t>();
+    const auto step = r.get<std::uint64_t>();
+    if (!r.ok()) return std::nullopt;
+    return step;
+  }
   const std::optional<Time> stamp = decode_stamp(id, cdr);
   if (!stamp || !std::isfinite(dt) || !(dt > 0.0)) return std::nullopt;
   // Stamps are written as sec + nanosec of step * dt; rounding undoes the nanosecond truncation.
@@ -269,6 +280,11 @@ std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte>
   const double k = std::round(ns / (dt * 1e9));
   if (!(k > 0.0)) return 0;
   return k >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(k);
+}
+
+bool is_command_metadata(std::string_view field_path) {
+  // Command.msg's words about a command, not the command: where it came from and its reply text.
+  return field_path == "source" || field_path == "message";
 }
 
 bool is_scene_metadata(std::string_view field_path) {

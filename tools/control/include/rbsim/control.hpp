@@ -118,6 +118,11 @@ class Controller final : public StepHook {
   void on_settings(std::function<void(const RunSettings&)> listener) {
     settings_listener_ = std::move(listener);
   }
+  // An offline run (rbsim run --commands): a pause that nothing queued can end (no resume, no
+  // step, no timer; nobody else submits) ends the pass there instead of idling for ever.
+  void end_when_idle(bool on) { end_when_idle_ = on; }
+  // Whether a pass ended that way, and at which step.
+  std::optional<std::int64_t> ended_paused() const { return ended_paused_; }
   // Called on the loop's thread for every command applied or refused at a boundary, with its
   // step filled in (the record of commands as data).
   void on_command(std::function<void(const Command&, const CommandResult&)> observer) {
@@ -169,6 +174,8 @@ class Controller final : public StepHook {
   std::optional<std::chrono::steady_clock::time_point> resume_at_;  // a timed pause's end
   std::function<void(const RunSettings&)> settings_listener_;
   std::function<void(const Command&, const CommandResult&)> observer_;
+  bool end_when_idle_ = false;
+  std::optional<std::int64_t> ended_paused_;
 };
 
 }  // namespace rbsim::control

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,14 @@ struct RecordOptions {
 // A Sink that records a run: every selected latched topic (scene description, markers) once at
 // step 0, then every selected per-step topic at step 0 and every k-th step after it.
 // log_time = publish_time = simulated time in ns, so a recording is deterministic.
-std::unique_ptr<Sink> make_mcap_sink(std::string path, RecordOptions options = {});
+class McapSink : public Sink {
+ public:
+  // A steered run's commands: one rbsim_msgs/msg/Command (CDR) on /<ns>/commands at the simulated
+  // time of the step it applied at, written between steps (after that step's messages); the
+  // channel is added with the first. Every command is recorded, whatever --record-every says.
+  [[nodiscard]] virtual Status record_command(std::span<const std::byte> cdr, std::int64_t step) = 0;
+};
+std::unique_ptr<McapSink> make_mcap_sink(std::string path, RecordOptions options = {});
 
 // Adds the schema and channel of `spec` to a writer in the rosbag2 layout; returns the channel id.
 // The channel's offered_qos_profiles say `offered` (by default what rbsim's node offers); its

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
+#include "rbsim/interfaces.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/msgs.hpp"
 
@@ -159,5 +160,11 @@ class Recording {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The commands a steered session recorded (rbsim_msgs/msg/Command on topic(TopicId::Commands)), in
+// sequence order, each once; none when the file has no such topic. The node numbers its commands
+// from 0 without gaps, so a missing number is an error naming it (a recorder that joined late or
+// lost some: the file is not the whole session), as is a message that does not decode.
+[[nodiscard]] Result<std::vector<msgs::CommandMessage>> read_commands(Recording& recording);
 
 }  // namespace rbsim::log

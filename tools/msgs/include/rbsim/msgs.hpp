@@ -31,7 +31,10 @@ namespace rbsim::msgs {
 // Topics
 
 // In publishing order: the latched topics first, so every sink that walks topics() in order sends
-// the scene description and the body shapes before the first per-step message.
+// the scene description and the body shapes before the first per-step message. The last one,
+// commands, is an event topic: what the node's controller did (rbsim_msgs/msg/Command), never
+// encoded from a World, so no sink's --topics selects it; the node publishes it, the recorder,
+// replay and bridge carry it like any topic.
 enum class TopicId : std::uint8_t {
   Scene,
   Markers,
@@ -41,16 +44,20 @@ enum class TopicId : std::uint8_t {
   Tf,
   Springs,
   Clock,
-  Poses
+  Poses,
+  Commands
 };
-inline constexpr std::size_t kTopicCount = 9;
+inline constexpr std::size_t kTopicCount = 10;
 
 struct TopicSpec {
   TopicId id;
   std::string_view suffix;  // "body_states": the ROS name is /<namespace>/<suffix>
   std::string_view type;    // "rbsim_msgs/msg/BodyStates"
-  bool transient_local;     // latched: late subscribers get the last sample
+  bool transient_local;     // late subscribers get the last sample (every sample, for an event topic)
   bool per_step;            // published every (published) step
+  bool event = false;       // published as things happen, kept all (transient local, keep all)
+  // Latched: transient local, keep last 1, sent once at the start of a run (scene, markers).
+  constexpr bool latched() const { return transient_local && !event; }
 };
 std::span<const TopicSpec> topics();
 const TopicSpec& topic(TopicId id);
@@ -313,6 +320,10 @@ inline constexpr std::string_view kStepField = "step";
 // Whether a field of the scene description (its path, "background.r") is metadata rather than
 // physics: the scene's name, description, viewport and background, which rbsim check reports apart.
 bool is_scene_metadata(std::string_view field_path);
+// Whether a field of a command (rbsim_msgs/msg/Command) is metadata: its source ("ros2 service",
+// "script steer.yaml:3") and message text; a re-run of a session has the same commands with
+// other sources.
+bool is_command_metadata(std::string_view field_path);
 
 // ---------------------------------------------------------------------------------------------
 // Schema-driven decoding: any CDR message whose ros2msg schema is known (e.g. read from an MCAP
