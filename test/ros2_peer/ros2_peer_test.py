@@ -10,8 +10,10 @@ multicast). Cases share e2e.py's harness (processes, domains, cleanup) and its e
 """
 import json
 import os
+import re
 import signal
 import sys
+import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
 import e2e  # noqa: E402
@@ -49,12 +51,13 @@ class PeerNet(e2e.TwoHosts):
             f.write(namespace_config("10.231.0.1"))
         return self
 
-    def peer(self, name, *args):
-        """Starts rbsim-ros2-peer in namespace b on the case's domain."""
+    def peer(self, name, *args, side="b"):
+        """Starts rbsim-ros2-peer in namespace `side` (b unless said; a is the node's) on the case's domain."""
         env = self.ctx.env()
         env["ROS_DOMAIN_ID"] = str(self.ctx.domain)
         env.setdefault("RUST_LOG", "warn")
-        return self.ctx.start(name, ["ip", "netns", "exec", self.b, PEER, *map(str, args)], env=env)
+        ns = self.a if side == "a" else self.b
+        return self.ctx.start(name, ["ip", "netns", "exec", ns, PEER, *map(str, args)], env=env)
 
 
 def lines(proc):
@@ -67,16 +70,17 @@ def lines(proc):
     return out
 
 
-def with_node(ctx, body):
-    """Runs `body(net, node)` with rbsim node looping a scene in namespace a at real time; then
-    stops the node (SIGINT, a clean exit within 30 s) unless `body` already did."""
+def with_node(ctx, body, *node_extra):
+    """Runs `body(net, node)` with rbsim node looping a scene in namespace a at real time (more
+    node options in `node_extra`); then stops the node (SIGINT, a clean exit within 30 s) unless
+    `body` already did."""
     if not PEER or not os.access(PEER, os.X_OK):
         raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
     with PeerNet(ctx) as net:
         if net.skip:
             print(f"SKIP: {net.skip}")
             return e2e.SKIP
-        node = net.rb("node-in-a", "a", *e2e.node_args(ctx, ctx.scene("chain.xml"), "--loop"))
+        node = net.rb("node-in-a", "a", *e2e.node_args(ctx, ctx.scene("chain.xml"), "--loop", *node_extra))
         try:
             body(net, node)
         finally:
@@ -144,8 +148,6 @@ def case_killed_peer(ctx):
     """A ros2-client subscriber killed (SIGKILL: it never says goodbye, and stays matched until its
     lease expires) while the node publishes reliably to it: Ctrl-C still ends the node at once,
     cleanly (exit 0), instead of after 30 s of blocked writes."""
-    import time
-
     def body(net, node):
         peer = net.peer("peer-tf", "tf", 10**9, "--timeout", 120)
         peer.wait_for_text('"tf": 10,', 60)
@@ -190,7 +192,6 @@ def case_parameters(ctx):
                                                           "bodies", "paused", "scene")}
         ctx.check(types == {"dt": 3, "bodies": 2, "paused": 1, "scene": 4}, f"get_parameter_types: {types}")
         events = net.peer("events", "events", "forces.0.fy", "--timeout", 60)
-        import time
         time.sleep(1.0)  # the events subscription matches first
         sets = peer_json(ctx, net, "set", "params", node_name, "set", "forces.0.fy=-3.7", "rate=2")
         ctx.check([m.get("set") for m in sets] == [True, False],
@@ -244,7 +245,7 @@ def case_steered(ctx):
         raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
     scene, duration, dt = ctx.scene("chain.xml"), 6.0, 0.001
     steps = round(duration / dt)
-    expected = len(e2e.LATCHED) + len(e2e.PER_STEP) * (steps + 1)
+    expected = len(e2e.LATCHED) + len(e2e.PER_STEP) * (steps + 1) + 5  # and the 5 commands
     live = ctx.path("live.mcap")
     with PeerNet(ctx) as net:
         if net.skip:
@@ -257,8 +258,8 @@ def case_steered(ctx):
             pause = peer_json(ctx, net, "pause", "call", f"{svc}/pause", "trigger")
             ctx.require(pause and pause[0]["success"], f"pause: {pause}")
             s0 = int(pause[0]["message"].rsplit(" ", 1)[-1])  # "paused at step N"
-            sets = peer_json(ctx, net, "set", "params", svc, "set", "forces.0.fy=-3.7")
-            ctx.require([m.get("set") for m in sets] == [True], f"set forces.0.fy: {sets}")
+            sets = peer_json(ctx, net, "set", "params", svc, "set-atomic", "forces.0.fy=-3.7")
+            ctx.require([m.get("set-atomic") for m in sets] == [True], f"set forces.0.fy: {sets}")
             stepped = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 5)
             ctx.require(stepped and stepped[0]["success"] and stepped[0]["step"] == s0, f"step 5 at {s0}: {stepped}")
             kick = peer_json(ctx, net, "impulse", "call", f"{svc}/apply_impulse", "impulse", 2, 0.5, 2.0, 0.1, 0.0)
@@ -290,15 +291,227 @@ def case_steered(ctx):
               "--namespace", ctx.ns)
     ctx.rbrun("plain", "run", scene, "--duration", duration, "--record", plain, "--namespace", ctx.ns)
     e2e.rbsim_check(ctx, live, rerun, "check-rerun", live=True)
+    # The recording re-simulated from its own commands: every message equal, commands included.
+    again = ctx.path("again.mcap")
+    ctx.rbrun("again", "run", scene, "--duration", duration, "--commands", live, "--record", again, "--namespace", ctx.ns)
+    e2e.rbsim_check(ctx, live, again, "check-again", live=True)
+    e2e.rbsim_check(ctx, again, rerun, "check-again-rerun", live=False)
     rc, out, err = ctx.rbrun("check-plain", "check", live, plain, "--ignore-log-time", ok=False)
     ctx.check(rc == 1, f"the live session matched the run without its changes (exit {rc})\n{out}{err}")
     ctx.check(f"step {s0 + 1}" in out, f"the first divergence is not at step {s0 + 1}\n{out}")
     return 0
 
 
+# ---------------------------------------------------------------------------------------------
+# Hostile clients (issue 22 point 4), all through ros2-client
+
+
+def end_line(ctx, node):
+    """(service calls received, dropped) from the node's end line (tools/cli/node.cpp)."""
+    for line in node.stderr().splitlines():
+        m = re.search(r"rbsim node: (?:stopped|done) after .*, (\d+) service calls?(?: \((\d+) dropped\))?, ", line)
+        if m:
+            return int(m.group(1)), int(m.group(2) or 0)
+    ctx.check(False, f"no end line counting service calls\n{node.output()}")
+    return None, None
+
+
+def stop_node(ctx, node):
+    """SIGINT: a clean exit within 30 s; its end line's (received, dropped)."""
+    node.signal(signal.SIGINT)
+    e2e.exited_ok(ctx, node, 30, "rbsim node after SIGINT")
+    return end_line(ctx, node)
+
+
+def sim_rate(tf, t0, t1, span=1.0):
+    """The slowest pace of simulated time against wall time over any `span` seconds of the /tf lines
+    received between wall times t0 and t1 (ns): simulated seconds per wall second (a node that
+    stalls and then catches up shows the stall), and how many lines there were."""
+    got = [m for m in tf if t0 <= m.get("wall_ns", -1) <= t1]
+    worst, j = None, 0
+    for i, m in enumerate(got):
+        while j < len(got) and got[j]["wall_ns"] - m["wall_ns"] < span * 1e9:
+            j += 1
+        if j == len(got):
+            break
+        rate = (got[j]["stamp_ns"] - m["stamp_ns"]) / (got[j]["wall_ns"] - m["wall_ns"])
+        worst = rate if worst is None else min(worst, rate)
+    return worst, len(got)
+
+
+FLOOD = (("resume", "trigger"), ("get_parameters", "get"), ("step", "step"))  # (service, peer kind)
+FLOOD_CALLS = 500
+
+
+def case_flood(ctx):
+    """Three ros2-client peers at once each send 500 requests back to back without waiting (resume,
+    get_parameters, step while running; after one answered call, so their writer is matched), with
+    request and reply QoS deep enough that nothing is lost on their side: every request reaches the node and is answered once or dropped by the
+    node's bounded queue (its end line counts both), the node keeps real time meanwhile (its /tf
+    stamps against their wall arrival), a normal call right after is answered, Ctrl-C ends it."""
+    def body(net, node):
+        svc = f"/{ctx.ns}"
+        tf = net.peer("peer-tf", "tf", 10**9, "--timeout", 120)
+        tf.wait_for_text('"tf": 10,', 60)
+        floods = [net.peer(f"flood-{name}", "flood", f"{svc}/{name}", kind, FLOOD_CALLS, "--timeout", 30)
+                  for name, kind in FLOOD]
+        got = {}
+        for (name, _), p in zip(FLOOD, floods):
+            e2e.exited_ok(ctx, p, 90, f"rbsim-ros2-peer flood {name}")
+            r = [m for m in lines(p) if "flood" in m]
+            if ctx.check(len(r) == 1, f"flood {name} printed {len(r)} results\n{p.output()}"):
+                got[name] = r[0]
+                ctx.log(f"flood {name}: {r[0]}")
+        time.sleep(0.5)
+        tf.signal(signal.SIGTERM)
+        tf.wait(10)
+        ctx.require(len(got) == len(FLOOD), "a flood peer gave no result")
+        for name, r in got.items():
+            ctx.check(r["sent"] == FLOOD_CALLS and r["send_errors"] == 0,
+                      f"flood {name}: sent {r['sent']} of {FLOOD_CALLS} ({r['send_errors']} send errors)")
+            ctx.check(0 < r["answered"] <= r["sent"], f"flood {name}: {r['answered']} answered of {r['sent']}")
+            ctx.check(r["duplicates"] == 0 and r["unknown"] == 0,
+                      f"flood {name}: {r['duplicates']} duplicate replies, {r['unknown']} to requests never sent")
+        # What each answer says: resume while running succeeds ("already running"), step while
+        # running never does, every get_parameters reply holds the one value asked for.
+        ctx.check(got["resume"]["successes"] == got["resume"]["answered"], f"resume replies: {got['resume']}")
+        ctx.check(got["step"]["successes"] == 0, f"step while running accepted: {got['step']}")
+        ctx.check(got["get_parameters"]["successes"] == got["get_parameters"]["answered"],
+                  f"get_parameters replies: {got['get_parameters']}")
+        t0 = min(r["start_ns"] for r in got.values())
+        t1 = max(r["end_ns"] for r in got.values())
+        rate, n = sim_rate(lines(tf), t0, t1)
+        ctx.log(f"during the flood ({(t1 - t0) / 1e9:.2f} s, {n} /tf messages): at worst {rate} simulated s "
+                f"per wall s over 1 s")
+        ctx.check(rate is not None and rate >= 0.8,
+                  f"the node fell behind real time during the flood: {rate} simulated s per wall s over 1 s "
+                  f"at worst ({n} /tf)")
+        r = peer_json(ctx, net, "after", "call", f"{svc}/resume", "trigger")
+        ctx.check(r and r[0]["success"], f"resume right after the flood: {r}")
+        values = {m["get"]: m["value"] for m in peer_json(ctx, net, "after-get", "params", svc, "get", "rate")}
+        ctx.check(values.get("rate") == {"double": 1.0}, f"get_parameters right after the flood: {values}")
+        received, dropped = stop_node(ctx, node)
+        if received is None:
+            return
+        sent = sum(r["sent"] + r["probes"] for r in got.values())
+        answered = sum(r["answered"] + 1 for r in got.values())  # a probe's one reply is the last of them
+        ctx.log(f"node: {received} service calls, {dropped} dropped; peers: {sent} sent, {answered} answered")
+        ctx.check(received == sent + 2, f"the node received {received} requests, the peers sent {sent} + 2")
+        ctx.check(dropped > 0, f"the node dropped none of {received} requests: its queue bound was never reached")
+        ctx.check(answered + dropped == sent,
+                  f"{answered} answered + {dropped} dropped != {sent} sent: a request went neither way")
+        ctx.check(all(r["probes"] == 1 for r in got.values()), f"a probe was not answered at once: {got}")
+    return with_node(ctx, body, "--publish-every", 10)
+
+
+def peer_no_reply(ctx, net, name, *args, timeout=8):
+    """A call that must get no reply: the peer gives up after `timeout` (exit 1, "no reply")."""
+    peer = net.peer(name, *args, "--timeout", timeout)
+    rc = peer.wait(timeout + 30)
+    ctx.check(rc == 1 and "no reply within" in peer.stderr(), f"{' '.join(map(str, args))}: want no reply\n"
+              f"{peer.output()}")
+
+
+def case_bad_requests(ctx):
+    """Every bad request of issue 22 through ros2-client: an unknown body, NaN and inf in an
+    impulse, step while running, step 0, step past the run's last step, and requests shorter than
+    their type (the node receives truncated CDR): each gets an unsuccessful reply naming the
+    problem, or none (a parameter request has no field to say so), the node never stops, and good
+    calls after them are answered."""
+    def body(net, node):
+        svc = f"/{ctx.ns}"
+
+        def refused(name, service, *args, says=""):
+            r = peer_json(ctx, net, name, "call", f"{svc}/{service}", *args)
+            ctx.check(r and not r[0]["success"] and says in r[0]["message"],
+                      f"{service} {' '.join(map(str, args))}: want a refusal saying {says!r}, got {r}")
+            ctx.check(node.alive(), f"the node stopped after {name}\n{node.output()}")
+        refused("unknown-body", "apply_impulse", "impulse", 999, 1, 0, 0, 0, says="no body 999")
+        refused("nan", "apply_impulse", "impulse", 1, "NaN", 0, 0, 0, says="finite")
+        refused("inf", "apply_impulse", "impulse", 1, 0, 0, "inf", 0, says="finite")
+        refused("step-running", "step", "step", 3, says="only while paused")
+        refused("short-impulse", "apply_impulse", "impulse-short", 1, says="malformed or truncated")
+        refused("short-step-running", "step", "step-short", says="malformed or truncated")
+        peer_no_reply(ctx, net, "short-get", "call", f"{svc}/get_parameters", "get-short")
+        ctx.check(node.alive(), f"the node stopped after a truncated get_parameters\n{node.output()}")
+        r = peer_json(ctx, net, "pause", "call", f"{svc}/pause", "trigger")
+        ctx.check(r and r[0]["success"], f"pause: {r}")
+        refused("step-0", "step", "step", 0, says="must be >= 1")
+        refused("step-past", "step", "step", 4_000_000_000, says="past the run's last step")
+        refused("short-step", "step", "step-short", says="malformed or truncated")
+        # Good calls are still answered, and do what they say.
+        r = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 5)
+        ctx.check(r and r[0]["success"], f"step 5 after the bad requests: {r}")
+        r = peer_json(ctx, net, "impulse", "call", f"{svc}/apply_impulse", "impulse", 1, 0.5, 2.0, 0.1, 0.0)
+        ctx.check(r and r[0]["success"], f"impulse after the bad requests: {r}")
+        values = {m["get"]: m["value"] for m in peer_json(ctx, net, "get", "params", svc, "get", "rate", "paused")}
+        ctx.check(values == {"rate": {"double": 1.0}, "paused": True}, f"get_parameters after the bad requests: {values}")
+        r = peer_json(ctx, net, "resume", "call", f"{svc}/resume", "trigger")
+        ctx.check(r and r[0]["success"], f"resume: {r}")
+        received, dropped = stop_node(ctx, node)
+        ctx.check(received == 15 and dropped == 1,
+                  f"end line: {received} service calls ({dropped} dropped), want 15 (1 dropped: the truncated get)")
+    return with_node(ctx, body)
+
+
+def case_killed_client(ctx):
+    """Clients that send requests and are SIGKILLed before they read a reply, while the node runs
+    and while it is paused with a `step` in progress: a fresh client is answered promptly after
+    each, the node goes on stepping and ends on Ctrl-C."""
+    def body(net, node):
+        svc = f"/{ctx.ns}"
+
+        sent = []
+
+        def killed(name, service, kind, n):
+            p = net.peer(name, "send", f"{svc}/{service}", kind, n, "--timeout", 60)
+            p.wait_for_text('"sent"', 60)
+            p.signal(signal.SIGKILL)
+            p.wait(10)
+            sent.extend(m["sent"] + m["probes"] for m in lines(p) if "sent" in m)
+
+        def fresh(name, service="pause"):
+            r = peer_json(ctx, net, name, "call", f"{svc}/{service}", "trigger")
+            ctx.check(r and r[0]["success"] and r[0]["took_ms"] < 1000,
+                      f"{service} from a fresh client after killed ones: want a prompt success, got {r}")
+            return r[0]["message"] if r else ""
+        for name, service, kind, n in (("get", "get_parameters", "get", 200), ("resume", "resume", "trigger", 100),
+                                       ("step", "step", "step", 100)):
+            killed(f"killed-{name}", service, kind, n)
+        fresh("fresh-running", "resume")
+        fresh("pause")
+        r = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 30000)  # 30 s at --rate 1
+        ctx.check(r and r[0]["success"], f"step 30000 while paused: {r}")
+        at = r[0]["step"] if r else 0
+        for name, service, kind, n in (("step-paused", "step", "step", 50), ("pause-paused", "pause", "trigger", 50),
+                                       ("get-paused", "get_parameters", "get", 100)):
+            killed(f"killed-{name}", service, kind, n)
+        # While the step is in progress, a fresh pause ("already paused at step K") names a later
+        # step each time: the node steps on.
+        first = re.search(r"step (\d+)", fresh("fresh-stepping-1"))
+        time.sleep(0.5)
+        second = re.search(r"step (\d+)", fresh("fresh-stepping-2"))
+        ctx.check(first and second and at < int(first.group(1)) < int(second.group(1)),
+                  f"not stepping after killed clients: step call at {at}, then {first and first.group(0)}, "
+                  f"{second and second.group(0)}")
+        fresh("resume-after", "resume")
+        tf = peer_json(ctx, net, "tf", "tf", 20)
+        stamps = [m["stamp_ns"] for m in tf if "tf" in m]
+        ctx.check(len(stamps) == 20 and stamps == sorted(stamps) and stamps[-1] > stamps[0],
+                  f"/tf after resuming: {stamps}")
+        received, dropped = stop_node(ctx, node)
+        ctx.log(f"end line: {received} service calls, {dropped} dropped; the killed clients sent {sum(sent)}")
+        # The killed clients' requests reached the node (most of them: a client killed right after
+        # its last write may take some of them with it), 7 calls besides.
+        ctx.check(len(sent) == 6 and received is not None and sum(sent) // 2 + 7 <= received <= sum(sent) + 7,
+                  f"the node counted {received} service calls; the killed clients sent {sent}, and 7 more")
+    return with_node(ctx, body)
+
+
 e2e.CASES.clear()
-e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer, "parameters": case_parameters, "services": case_services,
-                  "steered": case_steered})
+e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer,
+                  "parameters": case_parameters, "services": case_services, "flood": case_flood,
+                  "bad_requests": case_bad_requests, "killed_client": case_killed_client, "steered": case_steered})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

@@ -9,6 +9,14 @@
 //!   rbsim-ros2-peer params NODE list|get|describe|types|set|set-atomic ARGS...
 //!   rbsim-ros2-peer call SERVICE trigger | step N | impulse BODY JX JY PX PY
 //!   rbsim-ros2-peer commands /NS/commands COUNT     take COUNT commands (the node's history too)
+//!                        | impulse-short BODY | step-short | get-short   (requests shorter than their type)
+//!   rbsim-ros2-peer flood SERVICE trigger|get|step N    one call answered, then N requests without waiting;
+//!                                                       count the replies (one JSON line: sent, answered, ...)
+//!   rbsim-ros2-peer send SERVICE trigger|get|step N     the same N requests, "sent", then sleep unread (to be killed)
+//!   rbsim-ros2-peer serve SERVICE                       a Trigger server of our own, answering at once
+//!   rbsim-ros2-peer bench SERVICE N WARMUP              N sequential Trigger calls timed: median, p99
+//! /tf lines carry the wall time of their arrival (wall_ns); flood prints the wall times of its
+//! start, last send, last reply and end, so a test can line them up.
 use std::{process::ExitCode, time::Duration};
 
 use futures::StreamExt;
@@ -20,6 +28,7 @@ use ros2_client::{
 use serde::{Deserialize, Serialize};
 
 mod commands;
+mod hostile;
 mod services;
 
 mod tf {
@@ -83,7 +92,7 @@ fn parse_args() -> Result<Args, String> {
   if words.len() < 2 {
     return Err(
       "usage: rbsim-ros2-peer graph NODE | tf COUNT | rosout TEXT | events NAME | params NODE ... | call SERVICE ... \
-       [--timeout S]"
+       | flood|send SERVICE KIND N | serve SERVICE | bench SERVICE N WARMUP [--timeout S]"
         .into(),
     );
   }
@@ -190,13 +199,14 @@ fn main() -> ExitCode {
           seen += 1;
           let first = msg.transforms.first();
           println!(
-            "{{\"tf\": {seen}, \"transforms\": {}, \"stamp_ns\": {}, \"frame\": {}, \"child\": {}, \"x\": {:?}, \"y\": {:?}}}",
+            "{{\"tf\": {seen}, \"transforms\": {}, \"stamp_ns\": {}, \"frame\": {}, \"child\": {}, \"x\": {:?}, \"y\": {:?}, \"wall_ns\": {}}}",
             msg.transforms.len(),
             first.map(|t| t.header.stamp.to_nanos()).unwrap_or(-1),
             json_string(first.map(|t| t.header.frame_id.as_str()).unwrap_or("")),
             json_string(first.map(|t| t.child_frame_id.as_str()).unwrap_or("")),
             first.map(|t| t.transform.translation.x).unwrap_or(f64::NAN),
-            first.map(|t| t.transform.translation.y).unwrap_or(f64::NAN)
+            first.map(|t| t.transform.translation.y).unwrap_or(f64::NAN),
+            hostile::wall_ns()
           );
           if seen >= want {
             return true;
@@ -283,11 +293,14 @@ fn main() -> ExitCode {
         }
       }
     }
-    "params" | "call" => {
-      let result = if args.verb == "params" {
-        services::params(&context, &mut node, &args.operand, &args.rest, args.timeout)
-      } else {
-        services::call_service(&context, &mut node, &args.operand, &args.rest, args.timeout)
+    "params" | "call" | "flood" | "send" | "serve" | "bench" => {
+      let (target, rest, timeout) = (&args.operand, &args.rest, args.timeout);
+      let result = match args.verb.as_str() {
+        "params" => services::params(&context, &mut node, target, rest, timeout),
+        "call" => services::call_service(&context, &mut node, target, rest, timeout),
+        "flood" | "send" => hostile::flood(&context, &mut node, target, rest, args.verb == "send", timeout),
+        "serve" => hostile::serve(&mut node, target, timeout),
+        _ => hostile::bench(&context, &mut node, target, rest, timeout),
       };
       if let Err(e) = &result {
         eprintln!("rbsim-ros2-peer: {e}");
@@ -295,7 +308,7 @@ fn main() -> ExitCode {
       result.is_ok()
     }
     other => {
-      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, commands, params, call)");
+      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, commands, params, call, flood, send, serve, bench)");
       return ExitCode::from(2);
     }
   };

@@ -1,10 +1,10 @@
 //! Parameter services and rbsim's own services, called the way rmw_cyclonedds_cpp's clients call
 //! them: ServiceMapping::Cyclone (its request header: client GUID half and sequence number). A
 //! test that passed with ros2-client's default Enhanced mapping would prove the wrong wire format.
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use ros2_client::{
-  Context, Message, Name, Node, ParameterValue, QosProfile, ServiceMapping, ServiceTypeName,
+  Client, Context, Message, Name, Node, ParameterValue, QosProfile, ServiceMapping, ServiceTypeName,
   parameters::raw,
   qos::{Durability, History, Reliability, WhenFull},
   rcl_interfaces::*,
@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use crate::json_string;
 
 /// rmw_qos_profile_services_default: reliable, volatile, keep last 10.
-fn service_qos() -> QosProfile {
+pub fn service_qos() -> QosProfile {
   QosProfile::subscription_default()
     .reliability(Reliability::Reliable { when_full: WhenFull::Block })
     .durability(Durability::Volatile)
@@ -22,15 +22,69 @@ fn service_qos() -> QosProfile {
 }
 
 /// "/ns/node/get_parameters" -> Name("/ns/node", "get_parameters").
-fn service_name(full: &str) -> Result<Name, String> {
+pub fn service_name(full: &str) -> Result<Name, String> {
   let (ns, base) = full.rsplit_once('/').ok_or(format!("{full}: not a fully qualified name"))?;
   Name::new(if ns.is_empty() { "/" } else { ns }, base).map_err(|e| format!("{full}: {e:?}"))
 }
 
-/// Calls `service` once (bounded by `timeout`, the wait for the server included).
 /// "rq", "/ns/node/pause", "Request" -> "rq/ns/node/pauseRequest", as rmw names a service's topics.
 fn service_topic(prefix: &str, service: &str, suffix: &str) -> String {
   format!("{prefix}{service}{suffix}")
+}
+
+/// A client of `service` (type pkg/srv/ty), its request writer and reply reader with `qos`.
+pub fn client<Req, Resp>(node: &mut Node, service: &str, pkg: &str, ty: &str, qos: QosProfile) -> Result<Client<Req, Resp>, String>
+where
+  Req: Message + Clone + 'static,
+  Resp: Message + 'static,
+{
+  node
+    .create_client::<Req, Resp>(
+      ServiceMapping::Cyclone, &service_name(service)?, &ServiceTypeName::new(pkg, ty), qos.clone(), qos)
+    .map_err(|e| format!("client {service}: {e:?}"))
+}
+
+/// Waits for a server of `service` as discovery reports it: a reader of its requests and a writer
+/// of its replies. (Client::wait_for_service re-checks its match only when a new subscription is
+/// declared on the graph, so it never wakes for a server that was discovered before the client
+/// existed: the usual case for a test calling a running node.)
+pub async fn wait_for_server(context: &Context, service: &str) {
+  let dds = context.domain_participant();
+  let (rq, rr) = (service_topic("rq", service, "Request"), service_topic("rr", service, "Reply"));
+  loop {
+    let readers = dds.discovered_readers().iter().filter(|r| r.subscription_topic_data.topic_name == rq).count();
+    let writers = dds.discovered_writers().iter().filter(|w| w.publication_topic_data.topic_name == rr).count();
+    if readers > 0 && writers > 0 {
+      break;
+    }
+    smol::Timer::after(Duration::from_millis(50)).await;
+  }
+  // Discovery first, then the local match of our writer and reader: give it a moment.
+  smol::Timer::after(Duration::from_millis(300)).await;
+}
+
+/// Calls `service` once (bounded by `timeout`, the wait for the server included); the reply and
+/// the time from request to reply.
+pub fn call_timed<Req, Resp>(
+  context: &Context, node: &mut Node, service: &str, pkg: &str, ty: &str, request: Req, timeout: Duration,
+) -> Result<(Resp, Duration), String>
+where
+  Req: Message + Clone + 'static,
+  Resp: Message + DeserializeOwned + 'static,
+{
+  let client = client::<Req, Resp>(node, service, pkg, ty, service_qos())?;
+  smol::block_on(smol::future::or(
+    async {
+      wait_for_server(context, service).await;
+      let t0 = Instant::now();
+      let r = client.async_call_service(request).await.map_err(|e| format!("{service}: {e:?}"))?;
+      Ok((r, t0.elapsed()))
+    },
+    async {
+      smol::Timer::after(timeout).await;
+      Err(format!("{service}: no reply within {timeout:?}"))
+    },
+  ))
 }
 
 pub fn call<Req, Resp>(
@@ -40,39 +94,7 @@ where
   Req: Message + Clone + 'static,
   Resp: Message + DeserializeOwned + 'static,
 {
-  let client = node
-    .create_client::<Req, Resp>(
-      ServiceMapping::Cyclone,
-      &service_name(service)?,
-      &ServiceTypeName::new(pkg, ty),
-      service_qos(),
-      service_qos(),
-    )
-    .map_err(|e| format!("client {service}: {e:?}"))?;
-  // Wait for the server as discovery reports it. (Client::wait_for_service re-checks its match
-  // only when a new subscription is declared on the graph, so it never wakes for a server that
-  // was discovered before the client existed: the usual case for a test calling a running node.)
-  let dds = context.domain_participant();
-  let (rq, rr) = (service_topic("rq", service, "Request"), service_topic("rr", service, "Reply"));
-  smol::block_on(smol::future::or(
-    async {
-      loop {
-        let readers = dds.discovered_readers().iter().filter(|r| r.subscription_topic_data.topic_name == rq).count();
-        let writers = dds.discovered_writers().iter().filter(|w| w.publication_topic_data.topic_name == rr).count();
-        if readers > 0 && writers > 0 {
-          break;
-        }
-        smol::Timer::after(Duration::from_millis(50)).await;
-      }
-      // Discovery first, then the local match of our writer and reader: give it a moment.
-      smol::Timer::after(Duration::from_millis(300)).await;
-      client.async_call_service(request).await.map_err(|e| format!("{service}: {e:?}"))
-    },
-    async {
-      smol::Timer::after(timeout).await;
-      Err(format!("{service}: no reply within {timeout:?}"))
-    },
-  ))
+  call_timed(context, node, service, pkg, ty, request, timeout).map(|(r, _)| r)
 }
 
 pub fn value_json(raw: &raw::ParameterValue) -> String {
@@ -105,7 +127,7 @@ pub fn parse_assignment(item: &str) -> Result<raw::Parameter, String> {
 /// std_srvs/srv/Trigger.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct TriggerRequest {
-  structure_needs_at_least_one_member: u8,
+  pub structure_needs_at_least_one_member: u8,
 }
 impl Message for TriggerRequest {}
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -210,29 +232,68 @@ pub fn params(context: &Context, node: &mut Node, target: &str, words: &[String]
   Ok(())
 }
 
-/// `call SERVICE trigger | step N | impulse BODY JX JY PX PY`.
+/// Requests shorter than their type, sent under its name: the server receives truncated CDR.
+/// On rbsim_msgs/srv/ApplyImpulse: the body and no impulse; on rbsim_msgs/srv/Step: nothing (one
+/// to three bytes would not do: a sample is padded with zeros to four, a valid u32); on
+/// rcl_interfaces/srv/GetParameters: a list of one name without the name.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShortImpulse {
+  pub body: u32,
+}
+impl Message for ShortImpulse {}
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShortStep {}
+impl Message for ShortStep {}
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShortGet {
+  pub count: u32,
+}
+impl Message for ShortGet {}
+
+fn print_reply(service: &str, success: bool, message: &str, step: Option<u64>, took: std::time::Duration) {
+  let step = step.map(|s| format!(", \"step\": {s}")).unwrap_or_default();
+  println!(
+    "{{\"call\": {}, \"success\": {success}, \"message\": {}{step}, \"took_ms\": {:.3}}}",
+    json_string(service), json_string(message), took.as_secs_f64() * 1e3);
+}
+
+/// `call SERVICE trigger | step N | impulse BODY JX JY PX PY | impulse-short BODY | step-short | get-short`.
 pub fn call_service(context: &Context, node: &mut Node, service: &str, words: &[String], timeout: Duration) -> Result<(), String> {
-  let (kind, rest) = words.split_first().ok_or("call SERVICE trigger|step N|impulse BODY JX JY PX PY")?;
+  let usage = "call SERVICE trigger|step N|impulse BODY JX JY PX PY|impulse-short BODY|step-short|get-short";
+  let (kind, rest) = words.split_first().ok_or(usage)?;
   match (kind.as_str(), rest.len()) {
     ("trigger", 0) => {
-      let r: TriggerResponse = call(
+      let (r, took): (TriggerResponse, _) = call_timed(
         context, node, service, "std_srvs", "Trigger", TriggerRequest { structure_needs_at_least_one_member: 0 }, timeout)?;
-      println!("{{\"call\": {}, \"success\": {}, \"message\": {}}}", json_string(service), r.success, json_string(&r.message));
+      print_reply(service, r.success, &r.message, None, took);
     }
     ("step", 1) => {
-      let r: StepReply = call(context, node, service, "rbsim_msgs", "Step", StepRequest { steps: number(&rest[0])? }, timeout)?;
-      println!("{{\"call\": {}, \"success\": {}, \"message\": {}, \"step\": {}}}", json_string(service), r.success,
-               json_string(&r.message), r.step);
+      let (r, took): (StepReply, _) =
+        call_timed(context, node, service, "rbsim_msgs", "Step", StepRequest { steps: number(&rest[0])? }, timeout)?;
+      print_reply(service, r.success, &r.message, Some(r.step), took);
     }
     ("impulse", 5) => {
       let req = ApplyImpulseRequest {
         body: number(&rest[0])?, jx: number(&rest[1])?, jy: number(&rest[2])?, px: number(&rest[3])?, py: number(&rest[4])?,
       };
-      let r: StepReply = call(context, node, service, "rbsim_msgs", "ApplyImpulse", req, timeout)?;
-      println!("{{\"call\": {}, \"success\": {}, \"message\": {}, \"step\": {}}}", json_string(service), r.success,
-               json_string(&r.message), r.step);
+      let (r, took): (StepReply, _) = call_timed(context, node, service, "rbsim_msgs", "ApplyImpulse", req, timeout)?;
+      print_reply(service, r.success, &r.message, Some(r.step), took);
     }
-    _ => return Err(format!("call {service}: want trigger | step N | impulse BODY JX JY PX PY")),
+    ("impulse-short", 1) => {
+      let req = ShortImpulse { body: number(&rest[0])? };
+      let (r, took): (StepReply, _) = call_timed(context, node, service, "rbsim_msgs", "ApplyImpulse", req, timeout)?;
+      print_reply(service, r.success, &r.message, Some(r.step), took);
+    }
+    ("step-short", 0) => {
+      let (r, took): (StepReply, _) = call_timed(context, node, service, "rbsim_msgs", "Step", ShortStep {}, timeout)?;
+      print_reply(service, r.success, &r.message, Some(r.step), took);
+    }
+    ("get-short", 0) => {
+      let (r, took): (GetParametersResponse, _) =
+        call_timed(context, node, service, "rcl_interfaces", "GetParameters", ShortGet { count: 1 }, timeout)?;
+      print_reply(service, true, &format!("{} values", r.values.len()), None, took);
+    }
+    _ => return Err(format!("{usage} (got {})", words.join(" "))),
   }
   Ok(())
 }
