@@ -9,6 +9,7 @@
 #include "rbsim/builders.hpp"
 #include "rbsim/cdr.hpp"
 #include "rbsim/cdr_builder.hpp"
+#include "rbsim/interfaces.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace {
@@ -512,6 +513,7 @@ TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {
   const rbsim::msgs::Encoder encoder(scene);
   rbsim::msgs::Bytes out;
   for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
+    if (spec.event) continue;  // not encoded from a World: below
     encoder.encode(spec.id, w.value(), out);
     const auto got = rbsim::msgs::decode_stamp(spec.id, out);
     if (spec.id == TopicId::Scene) {
@@ -530,6 +532,17 @@ TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {
   const std::byte empty[] = {std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0},
                              std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0}};
   EXPECT_FALSE(rbsim::msgs::decode_stamp(TopicId::Markers, empty).has_value());
+  // A command carries the stamp of the step it applied at, after its seq and step.
+  rbsim::msgs::CommandMessage c;
+  c.seq = 9;
+  c.step = 1234;
+  c.stamp = want;
+  rbsim::msgs::encode(c, out);
+  const auto got = rbsim::msgs::decode_stamp(TopicId::Commands, out);
+  ASSERT_TRUE(got.has_value());
+  EXPECT_EQ(got->sec, want.sec);
+  EXPECT_EQ(got->nanosec, want.nanosec);
+  EXPECT_FALSE(rbsim::msgs::decode_stamp(TopicId::Commands, std::span(out).first(23)).has_value());
 }
 
 // The one step rule: the step field where a type has one (even against its stamp), else
@@ -543,6 +556,7 @@ TEST(MessageStep, UsesTheStepFieldElseTheStampOverDt) {
   const rbsim::msgs::Encoder encoder(scene);
   rbsim::msgs::Bytes out;
   for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
+    if (spec.event) continue;  // not encoded from a World: below
     encoder.encode(spec.id, w.value(), out);
     const auto step = rbsim::msgs::message_step(spec.id, out, dt);
     if (spec.id == TopicId::Scene) {
@@ -563,6 +577,15 @@ TEST(MessageStep, UsesTheStepFieldElseTheStampOverDt) {
   const std::byte empty[] = {std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0},
                              std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0}};
   EXPECT_FALSE(rbsim::msgs::message_step(TopicId::Markers, empty, dt).has_value());
+  // A command's step is its step field, whatever its stamp says.
+  rbsim::msgs::CommandMessage c;
+  c.seq = 9;
+  c.step = 77;
+  c.stamp = rbsim::msgs::sim_time(w.value());
+  rbsim::msgs::encode(c, out);
+  EXPECT_EQ(rbsim::msgs::message_step(TopicId::Commands, out, dt), 77u);
+  EXPECT_EQ(rbsim::msgs::message_step(TopicId::Commands, out, 0.0), 77u);
+  EXPECT_FALSE(rbsim::msgs::message_step(TopicId::Commands, std::span(out).first(15), dt).has_value());
 }
 
 // Metadata is what a scene description says about itself, not its physics: every field of the

@@ -296,9 +296,14 @@ def case_steered(ctx):
     ctx.rbrun("again", "run", scene, "--duration", duration, "--commands", live, "--record", again, "--namespace", ctx.ns)
     e2e.rbsim_check(ctx, live, again, "check-again", live=True)
     e2e.rbsim_check(ctx, again, rerun, "check-again-rerun", live=False)
+    # Against the run without the changes: the commands are the first divergence; the states first
+    # differ at the step after the first change.
     rc, out, err = ctx.rbrun("check-plain", "check", live, plain, "--ignore-log-time", ok=False)
     ctx.check(rc == 1, f"the live session matched the run without its changes (exit {rc})\n{out}{err}")
-    ctx.check(f"step {s0 + 1}" in out, f"the first divergence is not at step {s0 + 1}\n{out}")
+    ctx.check(f"first divergence: topic /{ctx.ns}/commands" in out, f"the commands are not the first divergence\n{out}")
+    rc, out, err = ctx.rbrun("check-states", "check", live, plain, "--ignore-log-time", "--topics", "body_states",
+                             ok=False)
+    ctx.check(rc == 1 and f"body_states, step {s0 + 1}," in out, f"the states do not first differ at step {s0 + 1}\n{out}")
     return 0
 
 

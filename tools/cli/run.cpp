@@ -214,9 +214,9 @@ int run(const RunOptions& o) {
     }
     const control::ControlCounters counted = controller->counters();
     if (refused > 0) {
-      return fail("run", o.commands + ": " + count_of(refused, "command was", "commands were") +
-                             " refused (of " + std::to_string(counted.commands) +
-                             " applied or refused); outputs hold the run");
+      return fail("run", o.commands + ": " + count_of(refused, "command", "commands") + " (of " +
+                             std::to_string(counted.commands) + ") did not apply as " +
+                             (is_recording(o.commands) ? "recorded" : "written") + "; outputs hold the run");
     }
   }
   if (stop_requested()) {

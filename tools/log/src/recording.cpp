@@ -123,7 +123,10 @@ struct Recording::Impl {
       if (c.spec == nullptr) continue;
       const msgs::TopicId id = c.spec->id;
       const int i = per_step_index(id);
-      if (id == msgs::TopicId::Scene ? !options.scene : (i < 0 || !read[static_cast<std::size_t>(i)]))
+      // The scene description when asked for, the per-step topics read, and the commands (an event
+      // topic, read whole by read_commands).
+      const bool commands = id == msgs::TopicId::Commands;
+      if (id == msgs::TopicId::Scene ? !options.scene : !commands && (i < 0 || !read[static_cast<std::size_t>(i)]))
         continue;
       if (!options.ns.empty() && c.channel->topic != msgs::topic_name(*c.spec, options.ns)) continue;
       std::string& topic = topics[static_cast<std::size_t>(id)];
@@ -132,7 +135,7 @@ struct Recording::Impl {
                     "): choose one recording with --namespace");
       }
       if (!c.problem.empty()) {
-        if (id == msgs::TopicId::Scene && !options.require_scene) continue;
+        if ((id == msgs::TopicId::Scene && !options.require_scene) || commands) continue;
         return fail("topic " + c.channel->topic + ": " + c.problem + ": cannot read it");
       }
       topic = c.channel->topic;
