@@ -83,17 +83,23 @@ TEST(ParseCommandScript, ErrorsNameTheFileLineAndField) {
       {ok + "- {step: 1}", "c.yaml:2: action: missing"},
       {ok + "- {step: 1, resume: true, reset: true}", "c.yaml:2: reset: one action per entry"},
       {ok + "- {step: 1, jump: 3}", "c.yaml:2: jump: unknown field"},
-      {ok + "- {step: 1,\n   set: {forces.9.fy: 1.0}}", "c.yaml:3: set.forces.9.fy: parameter 'forces.9.fy' is not declared"},
+      {ok + "- {step: 1,\n   set: {forces.9.fy: 1.0}}",
+       "c.yaml:3: set.forces.9.fy: parameter 'forces.9.fy' is not declared"},
       {ok + "- {step: 1, set: {forces.0.fy: 1}}", "c.yaml:2: set.forces.0.fy: Wrong parameter type"},
-      {ok + "- {step: 1, set: {dt: 0.5}}", "c.yaml:2: set.dt: parameter 'dt' cannot be set because it is read-only"},
-      {ok + "- {step: 1, set: {springs.0.k: -.inf}}", "c.yaml:2: set.springs.0.k: Parameter {springs.0.k} must be finite"},
+      {ok + "- {step: 1, set: {dt: 0.5}}",
+       "c.yaml:2: set.dt: parameter 'dt' cannot be set because it is read-only"},
+      {ok + "- {step: 1, set: {springs.0.k: -.inf}}",
+       "c.yaml:2: set.springs.0.k: Parameter {springs.0.k} must be finite"},
       {ok + "- {step: 1, set: {}}", "c.yaml:2: set: must be a map of parameters"},
-      {ok + "- {step: 1, impulse: {body: 2, j: [0, 1]}}", "c.yaml:2: impulse.body: must be a body index in [0, 2)"},
+      {ok + "- {step: 1, impulse: {body: 2, j: [0, 1]}}",
+       "c.yaml:2: impulse.body: must be a body index in [0, 2)"},
       {ok + "- {step: 1, impulse: {body: 0}}", "c.yaml:2: impulse.j: missing"},
-      {ok + "- {step: 1, impulse: {body: 0, j: [0, .inf]}}", "c.yaml:2: impulse.j: must be two finite numbers"},
+      {ok + "- {step: 1, impulse: {body: 0, j: [0, .inf]}}",
+       "c.yaml:2: impulse.j: must be two finite numbers"},
       {ok + "- {step: 1, impulse: {body: 0, j: [0]}}", "c.yaml:2: impulse.j: must be [x, y]"},
       {ok + "- {step: 1, impulse: {body: 0, j: [0, 1], q: 1}}", "c.yaml:2: impulse.q: unknown field"},
-      {ok + "- {step: 1, pause: -2}", "c.yaml:2: pause: must be true (until a resume) or wall-clock seconds > 0"},
+      {ok + "- {step: 1, pause: -2}",
+       "c.yaml:2: pause: must be true (until a resume) or wall-clock seconds > 0"},
       {ok + "- {step: 1, resume: false}", "c.yaml:2: resume: must be true"},
       {ok + "- {step: 1, steps: 0}", "c.yaml:2: steps: must be an integer >= 1"},
       {ok + "- {step: 3, steps: 2}", "c.yaml:2: steps: only while paused"},
@@ -146,7 +152,8 @@ TEST(ParseCommandScript, AScriptedRunEqualsTheSameCommandsGivenLive) {
   live.submit(kick, nullptr);
   const std::vector<Snapshot> given = test::run(scene, kSteps, &live);
   ASSERT_EQ(run.size(), given.size());
-  for (std::size_t i = 0; i < run.size(); ++i) EXPECT_TRUE(test::same_bits(run[i].state, given[i].state)) << i;
+  for (std::size_t i = 0; i < run.size(); ++i)
+    EXPECT_TRUE(test::same_bits(run[i].state, given[i].state)) << i;
 
   const std::vector<Snapshot> plain = test::run(scene, kSteps);
   EXPECT_TRUE(test::same_bits(run[30].state, plain[30].state));

@@ -46,7 +46,8 @@ std::optional<std::int64_t> integer(const YAML::Node& n) {
 Result<Vec2> vector(const Entry& e, const YAML::Node& n, const std::string& field) {
   if (!n.IsSequence() || n.size() != 2) return e.error(n, field, "must be [x, y]");
   const std::optional<double> x = number(n[0]), y = number(n[1]);
-  if (!x || !y || !std::isfinite(*x) || !std::isfinite(*y)) return e.error(n, field, "must be two finite numbers");
+  if (!x || !y || !std::isfinite(*x) || !std::isfinite(*y))
+    return e.error(n, field, "must be two finite numbers");
   return Vec2{*x, *y};
 }
 
@@ -62,14 +63,17 @@ Result<std::int64_t> boundary(const Entry& e, double dt, std::int64_t steps) {
     k = *v;
   } else {
     const std::optional<double> v = number(t);
-    if (!v || !std::isfinite(*v) || *v < 0.0) return e.error(t, "t", "must be a finite number of seconds >= 0");
+    if (!v || !std::isfinite(*v) || *v < 0.0)
+      return e.error(t, "t", "must be a finite number of seconds >= 0");
     k = steps_for(*v, dt);
   }
   // A command at boundary k acts on the steps after k: the last step has none after it.
   if (k < 0 || k >= steps) {
     return e.error(step ? step : t, step ? "step" : "t",
-                   "step " + std::to_string(k) + " is outside the run (a command at step k acts on the steps after "
-                   "it: k in 0.." + std::to_string(steps - 1) + ")");
+                   "step " + std::to_string(k) +
+                       " is outside the run (a command at step k acts on the steps after "
+                       "it: k in 0.." +
+                       std::to_string(steps - 1) + ")");
   }
   return k;
 }
@@ -84,7 +88,8 @@ Status parameters(const Entry& e, const YAML::Node& map, const std::string& pref
       continue;
     }
     Result<ParameterValue> value = yaml_value(kv.second);
-    if (!value) return e.error(kv.second.IsNull() ? kv.first : kv.second, "set." + name, value.error().message);
+    if (!value)
+      return e.error(kv.second.IsNull() ? kv.first : kv.second, "set." + name, value.error().message);
     Parameter p{name, std::move(value.value())};
     if (SetParametersResult r = table.check(p); !r.successful) {
       return e.error(kv.second, "set." + name, r.reason);
@@ -133,8 +138,10 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
   for (const auto& kv : e.node) {
     const std::string key = kv.first.Scalar();
     if (key == "step" || key == "t") continue;
-    if (key != "set" && key != "impulse" && key != "pause" && key != "resume" && key != "steps" && key != "reset") {
-      return e.error(kv.first, key, std::string("unknown field (want step or t, and one of ") + kActions + ")");
+    if (key != "set" && key != "impulse" && key != "pause" && key != "resume" && key != "steps" &&
+        key != "reset") {
+      return e.error(kv.first, key,
+                     std::string("unknown field (want step or t, and one of ") + kActions + ")");
     }
     if (name) return e.error(kv.first, key, "one action per entry (this one also has " + *name + ")");
     name = key;
@@ -188,7 +195,8 @@ Status check_pauses(const std::vector<Command>& commands, const std::vector<YAML
     if (c.kind == CommandKind::Pause && c.pause_seconds == 0.0 && !open) open = i;
     if (c.kind == CommandKind::Resume || c.kind == CommandKind::Reset) open.reset();
     if (c.kind == CommandKind::Step && !open) {
-      return e.error(nodes[i], "steps", "only while paused (a pause: true at or before this step, not resumed)");
+      return e.error(nodes[i], "steps",
+                     "only while paused (a pause: true at or before this step, not resumed)");
     }
   }
   if (open) {

@@ -35,7 +35,8 @@ namespace rbsim::control {
 // length. Errors are "FILE:LINE: FIELD: RULE" (ErrorCode::InvalidArgument), or the read error.
 [[nodiscard]] Result<std::vector<Command>> load_command_script(const std::string& path, const Scene& scene,
                                                                std::int64_t steps);
-[[nodiscard]] Result<std::vector<Command>> parse_command_script(std::string_view text, const std::string& path,
-                                                                const Scene& scene, std::int64_t steps);
+[[nodiscard]] Result<std::vector<Command>> parse_command_script(std::string_view text,
+                                                                const std::string& path, const Scene& scene,
+                                                                std::int64_t steps);
 
 }  // namespace rbsim::control
