@@ -53,11 +53,13 @@ TEST(RbsimRunCommands, EachCommandActsFromTheStepAfterItsBoundary) {
 
 TEST(RbsimRunCommands, ABadScriptIsAUsageErrorBeforeAnyOutput) {
   const TempDir dir;
-  write_text(dir / "c.yaml", "- {step: 20, set: {forces.0.fy: -3.7}}\n- {step: 30, impulse: {body: 9, j: [0, 1]}}\n");
+  write_text(dir / "c.yaml",
+             "- {step: 20, set: {forces.0.fy: -3.7}}\n- {step: 30, impulse: {body: 9, j: [0, 1]}}\n");
   const test::Outcome o = rbsim({"run", kScene, "--steps", "100", "--csv", (dir / "out.csv").string(),
                                  "--commands", (dir / "c.yaml").string()});
   EXPECT_EQ(o.exit_code, 2) << describe(o);
-  EXPECT_NE(o.err.find("c.yaml:2: impulse.body: must be a body index in [0, 5)"), std::string::npos) << describe(o);
+  EXPECT_NE(o.err.find("c.yaml:2: impulse.body: must be a body index in [0, 5)"), std::string::npos)
+      << describe(o);
   EXPECT_FALSE(fs::exists(dir / "out.csv"));
   const test::Outcome missing = rbsim({"run", kScene, "--commands", (dir / "none.yaml").string()});
   EXPECT_EQ(missing.exit_code, 1) << describe(missing);

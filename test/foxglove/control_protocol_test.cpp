@@ -28,8 +28,8 @@ std::string le32(std::uint32_t v) {
 std::string call_frame(std::uint32_t service, std::uint32_t call, const std::string& encoding,
                        const std::string& payload, std::uint32_t encoding_size = UINT32_MAX) {
   return "\x02" + le32(service) + le32(call) +
-         le32(encoding_size == UINT32_MAX ? static_cast<std::uint32_t>(encoding.size()) : encoding_size) + encoding +
-         payload;
+         le32(encoding_size == UINT32_MAX ? static_cast<std::uint32_t>(encoding.size()) : encoding_size) +
+         encoding + payload;
 }
 
 Json only_reply(const ClientProtocol::Outcome& o) {
@@ -47,7 +47,8 @@ TEST(FoxgloveControlProtocol, ServerInfoOffersSteeringOnlyWithAController) {
 }
 
 TEST(FoxgloveControlProtocol, AdvertiseServicesGivesBothSchemaForms) {
-  const std::vector<ServiceSpec> specs = {{"/ns/step", "rbsim_msgs/srv/Step", "uint32 steps\n", "bool success\n"}};
+  const std::vector<ServiceSpec> specs = {
+      {"/ns/step", "rbsim_msgs/srv/Step", "uint32 steps\n", "bool success\n"}};
   const Json j = Json::parse(advertise_services_json(specs));
   EXPECT_EQ(j["op"], "advertiseServices");
   ASSERT_EQ(j["services"].size(), 1u);
@@ -74,11 +75,15 @@ TEST(FoxgloveControlProtocol, ParameterValuesTypeDoublesAsTheSdkDoes) {
   V ints;
   ints.type = msgs::ParameterType::IntegerArray;
   ints.integer_array_value = {1, 2};
-  std::vector<msgs::Parameter> ps = {{"d", V::of_double(2.0)}, {"i", V::of_integer(7)}, {"b", V::of_bool(true)},
-                                     {"s", V::of_string("x")}, {"ba", bytes},           {"da", doubles},
+  std::vector<msgs::Parameter> ps = {{"d", V::of_double(2.0)},
+                                     {"i", V::of_integer(7)},
+                                     {"b", V::of_bool(true)},
+                                     {"s", V::of_string("x")},
+                                     {"ba", bytes},
+                                     {"da", doubles},
                                      {"ia", ints}};
-  for (const auto& [raw, encoded] :
-       std::vector<std::pair<std::string, std::string>>{{"", ""}, {"A", "QQ=="}, {"AB", "QUI="}, {"ABC", "QUJD"}}) {
+  for (const auto& [raw, encoded] : std::vector<std::pair<std::string, std::string>>{
+           {"", ""}, {"A", "QQ=="}, {"AB", "QUI="}, {"ABC", "QUJD"}}) {
     ps[4].value.byte_array_value.assign(raw.begin(), raw.end());
     const Json j = Json::parse(parameter_values_json(ps, "req-1"));
     EXPECT_EQ(j["op"], "parameterValues");
@@ -163,9 +168,9 @@ TEST(FoxgloveControlProtocol, BadSetEntriesAreNamedAndTheRestStillApplies) {
   const Json s = only_reply(o);
   EXPECT_EQ(s["level"], 2);
   const std::string m = s["message"];
-  for (const char* says : {"\"unset\": no value: parameters cannot be unset", "\"obj\": value",
-                           "\"mix\": an array must hold", "\"b64\": type byte_array: not valid base64",
-                           "\"hint\": unknown type \"int64\"", "and 3 more"}) {
+  for (const char* says :
+       {"\"unset\": no value: parameters cannot be unset", "\"obj\": value", "\"mix\": an array must hold",
+        "\"b64\": type byte_array: not valid base64", "\"hint\": unknown type \"int64\"", "and 3 more"}) {
     EXPECT_NE(m.find(says), std::string::npos) << says << " in " << m;
   }
 }
@@ -186,14 +191,16 @@ TEST(FoxgloveControlProtocol, MalformedParameterOpsGetOneStatusError) {
     EXPECT_FALSE(o.parameters) << frame;
     const Json s = only_reply(o);
     EXPECT_EQ(s["level"], 2) << frame;
-    EXPECT_NE(s["message"].get<std::string>().find(says), std::string::npos) << s["message"] << " for " << frame;
+    EXPECT_NE(s["message"].get<std::string>().find(says), std::string::npos)
+        << s["message"] << " for " << frame;
   }
 }
 
 TEST(FoxgloveControlProtocol, WithoutAControllerTheOpsAreNotSupported) {
   ClientProtocol p(1);
   ClientProtocol::Outcome o;
-  for (const char* op : {"getParameters", "setParameters", "subscribeParameterUpdates", "unsubscribeParameterUpdates"}) {
+  for (const char* op :
+       {"getParameters", "setParameters", "subscribeParameterUpdates", "unsubscribeParameterUpdates"}) {
     p.handle_text(std::string(R"({"op":")") + op + R"(","parameterNames":[],"parameters":[]})", o);
     EXPECT_FALSE(o.parameters);
     const Json s = only_reply(o);

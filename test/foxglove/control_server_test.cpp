@@ -29,7 +29,8 @@ std::string le32(std::uint32_t v) {
 }
 std::string call_frame(std::uint32_t service, std::uint32_t call, const std::string& encoding,
                        const std::string& payload) {
-  return "\x02" + le32(service) + le32(call) + le32(static_cast<std::uint32_t>(encoding.size())) + encoding + payload;
+  return "\x02" + le32(service) + le32(call) + le32(static_cast<std::uint32_t>(encoding.size())) + encoding +
+         payload;
 }
 std::string cdr_text(const Bytes& b) {
   return {reinterpret_cast<const char*>(b.data()), b.size()};
@@ -96,7 +97,8 @@ struct Response {
   std::string encoding, payload;
 };
 std::optional<Response> next_response(WsClient& c) {
-  auto f = read_until(c, [](const WsClient::Frame& g) { return g.opcode == 2 && !g.data.empty() && g.data[0] == 3; });
+  auto f = read_until(
+      c, [](const WsClient::Frame& g) { return g.opcode == 2 && !g.data.empty() && g.data[0] == 3; });
   if (!f || f->data.size() < 13) return std::nullopt;
   Response r;
   std::uint32_t n = 0;
@@ -138,7 +140,8 @@ TEST(FoxgloveSteering, AdvertisesTheCapabilitiesAndTheFiveServices) {
   EXPECT_NE(services[3]["request"]["schema"].get<std::string>().find("uint32 steps"), std::string::npos);
   EXPECT_EQ(services[3]["request"]["schema"].get<std::string>().find("---"), std::string::npos);
   EXPECT_NE(services[3]["response"]["schema"].get<std::string>().find("uint64 step"), std::string::npos);
-  EXPECT_EQ(services[0]["requestSchema"].get<std::string>().find("bool"), std::string::npos);  // Trigger: empty
+  EXPECT_EQ(services[0]["requestSchema"].get<std::string>().find("bool"),
+            std::string::npos);  // Trigger: empty
   EXPECT_NE(services[0]["responseSchema"].get<std::string>().find("string message"), std::string::npos);
 }
 
@@ -153,7 +156,8 @@ TEST(FoxgloveSteering, GetsSetsAndUpdatesParameters) {
   const Json all = next_op(c, "parameterValues");
   EXPECT_EQ(all["id"], "all");
   EXPECT_EQ(all["parameters"].size(), s.controller.list({}, 0).names.size());
-  EXPECT_EQ(value_of(all, "forces.0.fy"), (Json{{"name", "forces.0.fy"}, {"value", -9.81}, {"type", "float64"}}));
+  EXPECT_EQ(value_of(all, "forces.0.fy"),
+            (Json{{"name", "forces.0.fy"}, {"value", -9.81}, {"type", "float64"}}));
   EXPECT_EQ(value_of(all, "bodies"), (Json{{"name", "bodies"}, {"value", 2}}));
   EXPECT_EQ(value_of(all, "paused")["value"], true);
 
@@ -161,10 +165,12 @@ TEST(FoxgloveSteering, GetsSetsAndUpdatesParameters) {
   ASSERT_TRUE(watcher.send_text(R"({"op":"getParameters","parameterNames":["forces.0.fy"],"id":"sync"})"));
   ASSERT_EQ(next_op(watcher, "parameterValues")["id"], "sync");  // the subscription is in place
   // -3 is a JSON integer: for the double forces.0.fy it is -3.0.
-  ASSERT_TRUE(c.send_text(R"({"op":"setParameters","parameters":[{"name":"forces.0.fy","value":-3}],"id":"set"})"));
+  ASSERT_TRUE(
+      c.send_text(R"({"op":"setParameters","parameters":[{"name":"forces.0.fy","value":-3}],"id":"set"})"));
   const Json set = next_op(c, "parameterValues");
   EXPECT_EQ(set["id"], "set");
-  EXPECT_EQ(set["parameters"], Json::array({{{"name", "forces.0.fy"}, {"value", -3.0}, {"type", "float64"}}}));
+  EXPECT_EQ(set["parameters"],
+            Json::array({{{"name", "forces.0.fy"}, {"value", -3.0}, {"type", "float64"}}}));
   const Json update = next_op(watcher, "parameterValues");
   EXPECT_FALSE(update.contains("id"));
   EXPECT_EQ(update["parameters"], set["parameters"]);
@@ -175,7 +181,8 @@ TEST(FoxgloveSteering, GetsSetsAndUpdatesParameters) {
   EXPECT_EQ(next_op(other, "parameterValues")["id"], "mine");
   // Unsubscribed: no update for the next change.
   ASSERT_TRUE(watcher.send_text(R"({"op":"unsubscribeParameterUpdates","parameterNames":[]})"));
-  ASSERT_TRUE(c.send_text(R"({"op":"setParameters","parameters":[{"name":"forces.0.fy","value":-2.5}],"id":"2"})"));
+  ASSERT_TRUE(
+      c.send_text(R"({"op":"setParameters","parameters":[{"name":"forces.0.fy","value":-2.5}],"id":"2"})"));
   EXPECT_EQ(next_op(c, "parameterValues")["id"], "2");
   ASSERT_TRUE(watcher.send_text(R"({"op":"getParameters","parameterNames":["forces.0.fy"],"id":"after"})"));
   const Json after = next_op(watcher, "parameterValues");
@@ -207,7 +214,8 @@ TEST(FoxgloveSteering, RefusedSetsAreNamedAndTheRestApplies) {
   // Unknown names in a read are named too; the known ones still come.
   ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt","ghost"],"id":"g"})"));
   EXPECT_EQ(next_op(c, "parameterValues")["parameters"].size(), 1u);
-  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("no parameter 'ghost'"), std::string::npos);
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("no parameter 'ghost'"),
+            std::string::npos);
 }
 
 TEST(FoxgloveSteering, ServicesInCdrAndJsonMoveTheRun) {
@@ -224,7 +232,8 @@ TEST(FoxgloveSteering, ServicesInCdrAndJsonMoveTheRun) {
   EXPECT_EQ(r->call, 11u);
   EXPECT_EQ(r->encoding, "cdr");
   msgs::StepResponse step;
-  ASSERT_TRUE(msgs::decode({reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, step).ok());
+  ASSERT_TRUE(
+      msgs::decode({reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, step).ok());
   EXPECT_TRUE(step.success) << step.message;
   EXPECT_EQ(step.step, 0u);
   // An impulse in json: applied at step 5, the boundary the run waits at.
@@ -286,7 +295,8 @@ TEST(FoxgloveSteering, BadCallsGetAServiceCallFailureOrAnUnsuccessfulReply) {
   ASSERT_TRUE(c.send_binary(call_frame(4, 9, "json", R"({"steps":0})")));
   r = next_response(c);
   ASSERT_TRUE(r);
-  EXPECT_NE(Json::parse(r->payload)["message"].get<std::string>().find("steps must be >= 1"), std::string::npos);
+  EXPECT_NE(Json::parse(r->payload)["message"].get<std::string>().find("steps must be >= 1"),
+            std::string::npos);
   // The connection still serves.
   ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt"],"id":"ok"})"));
   EXPECT_EQ(next_op(c, "parameterValues")["id"], "ok");
@@ -299,7 +309,8 @@ TEST(FoxgloveSteering, CommandsInFlightAreBoundedPerClient) {
   ASSERT_TRUE(s.server);
   WsClient c;
   connect(c, s.server->port());
-  for (std::uint32_t call = 1; call <= 3; ++call) ASSERT_TRUE(c.send_binary(call_frame(1, call, "json", "{}")));
+  for (std::uint32_t call = 1; call <= 3; ++call)
+    ASSERT_TRUE(c.send_binary(call_frame(1, call, "json", "{}")));
   const Json refused = next_op(c, "serviceCallFailure");
   EXPECT_EQ(refused["callId"], 3);
   EXPECT_NE(refused["message"].get<std::string>().find("too many requests in flight (2 per client)"),
@@ -334,7 +345,8 @@ TEST(FoxgloveSteering, AClientThatDoesNotReadItsRepliesIsRefusedNotBuffered) {
     if (!c.send_text(get)) break;
   }
   EXPECT_TRUE([&] {
-    for (int k = 0; k < 500 && s.server->stats().refused_requests == 0; ++k) std::this_thread::sleep_for(10ms);
+    for (int k = 0; k < 500 && s.server->stats().refused_requests == 0; ++k)
+      std::this_thread::sleep_for(10ms);
     return s.server->stats().refused_requests > 0;
   }());
   const ServerStats st = s.server->stats();
@@ -354,7 +366,8 @@ TEST(FoxgloveSteering, AClientThatDoesNotReadItsRepliesIsRefusedNotBuffered) {
     const Json j = Json::parse(f->data, nullptr, false);
     if (j.value("op", "") != "status") continue;
     ++errors;
-    EXPECT_NE(j["message"].get<std::string>().find("requests refused until this client reads"), std::string::npos);
+    EXPECT_NE(j["message"].get<std::string>().find("requests refused until this client reads"),
+              std::string::npos);
   }
   EXPECT_GE(errors, 1);  // one per backlog: more when reading lets a new one build up
   EXPECT_LE(static_cast<std::uint64_t>(errors), s.server->stats().refused_requests);

@@ -65,7 +65,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (out.call->encoding != "cdr" && out.call->encoding != "json") __builtin_trap();
       if (!out.replies.empty()) __builtin_trap();  // a call is carried out or refused, not both
     }
-    if (out.parameters && out.parameters->values.size() != out.parameters->untyped_integer.size()) __builtin_trap();
+    if (out.parameters && out.parameters->values.size() != out.parameters->untyped_integer.size())
+      __builtin_trap();
     for (fox::ChannelId ch = 1; ch <= kChannels; ++ch) {
       if (const auto sub = protocol.subscription(ch)) {
         const std::byte payload[64]{};

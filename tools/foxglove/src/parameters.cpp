@@ -92,7 +92,8 @@ nlohmann::json parameter_json(const msgs::Parameter& p) {
 }
 }  // namespace
 
-std::string parameter_values_json(std::span<const msgs::Parameter> parameters, const std::optional<std::string>& id) {
+std::string parameter_values_json(std::span<const msgs::Parameter> parameters,
+                                  const std::optional<std::string>& id) {
   nlohmann::json list = nlohmann::json::array();
   for (const msgs::Parameter& p : parameters) list.push_back(parameter_json(p));
   nlohmann::json j = {{"op", "parameterValues"}, {"parameters", std::move(list)}};
@@ -151,7 +152,8 @@ std::string typed_value(const nlohmann::json& v, const std::string& hint, msgs::
       out.type = T::BoolArray;
       for (const nlohmann::json& e : v) out.bool_array_value.push_back(e.get<bool>());
     } else if (all([](const nlohmann::json& e) {
-                 return e.is_number_integer() && !(e.is_number_unsigned() && e.get<std::uint64_t>() > INT64_MAX);
+                 return e.is_number_integer() &&
+                        !(e.is_number_unsigned() && e.get<std::uint64_t>() > INT64_MAX);
                })) {
       out.type = T::IntegerArray;
       for (const nlohmann::json& e : v) out.integer_array_value.push_back(e.get<std::int64_t>());
@@ -174,13 +176,15 @@ std::string typed_value(const nlohmann::json& v, const std::string& hint, msgs::
 
 }  // namespace
 
-void parameter_op(const std::string& op, const nlohmann::json& j, ClientProtocol::Outcome& out, Problems& problems) {
+void parameter_op(const std::string& op, const nlohmann::json& j, ClientProtocol::Outcome& out,
+                  Problems& problems) {
   ParameterRequest r;
-  r.op = op == "getParameters"   ? ParameterRequest::Op::Get
-         : op == "setParameters" ? ParameterRequest::Op::Set
+  r.op = op == "getParameters"               ? ParameterRequest::Op::Get
+         : op == "setParameters"             ? ParameterRequest::Op::Set
          : op == "subscribeParameterUpdates" ? ParameterRequest::Op::Subscribe
                                              : ParameterRequest::Op::Unsubscribe;
-  if (const auto id = j.find("id"); id != j.end() && (r.op == ParameterRequest::Op::Get || r.op == ParameterRequest::Op::Set)) {
+  if (const auto id = j.find("id");
+      id != j.end() && (r.op == ParameterRequest::Op::Get || r.op == ParameterRequest::Op::Set)) {
     if (!id->is_string()) {
       problems.add(op + ": \"id\" must be a string");
       return;
@@ -223,8 +227,9 @@ void parameter_op(const std::string& op, const nlohmann::json& j, ClientProtocol
     const auto value = e.find("value");
     msgs::Parameter p{name->get<std::string>(), {}};
     bool untyped = false;
-    const std::string bad = typed_value(value == e.end() ? nlohmann::json() : *value,
-                                        type == e.end() ? std::string() : type->get<std::string>(), p.value, untyped);
+    const std::string bad =
+        typed_value(value == e.end() ? nlohmann::json() : *value,
+                    type == e.end() ? std::string() : type->get<std::string>(), p.value, untyped);
     if (!bad.empty()) {
       problems.add("setParameters: parameter " + shown(*name) + ": " + bad);
       continue;

@@ -172,9 +172,9 @@ bool member_id(const nlohmann::json& object, const char* key, std::uint32_t& out
 }
 
 // The ops of the protocol this server never offers, and those it offers with a controller only.
-constexpr std::string_view kUnofferedOps[] = {"advertise",           "unadvertise",
-                                              "subscribeConnectionGraph", "unsubscribeConnectionGraph",
-                                              "fetchAsset",          "advertiseServices"};
+constexpr std::string_view kUnofferedOps[] = {
+    "advertise",  "unadvertise",      "subscribeConnectionGraph", "unsubscribeConnectionGraph",
+    "fetchAsset", "advertiseServices"};
 constexpr std::string_view kParameterOps[] = {"getParameters", "setParameters", "subscribeParameterUpdates",
                                               "unsubscribeParameterUpdates"};
 
@@ -204,8 +204,8 @@ void ClientProtocol::handle_binary(std::string_view frame, Outcome& out) {
     return;
   }
   if (frame.size() < kServiceCallHeader) {
-    error("service call request of " + size + " refused: its header alone is " + std::to_string(kServiceCallHeader) +
-          " bytes");
+    error("service call request of " + size + " refused: its header alone is " +
+          std::to_string(kServiceCallHeader) + " bytes");
     return;
   }
   ServiceCall c;
@@ -218,7 +218,8 @@ void ClientProtocol::handle_binary(std::string_view frame, Outcome& out) {
   if (frame.size() > kMaxClientFrame) {
     fail("request of " + size + " refused: the limit is " + std::to_string(kMaxClientFrame));
   } else if (c.service == 0 || c.service > service_count_) {
-    fail("unknown service " + std::to_string(c.service) + " (services are 1.." + std::to_string(service_count_) + ")");
+    fail("unknown service " + std::to_string(c.service) + " (services are 1.." +
+         std::to_string(service_count_) + ")");
   } else if (encoding_size > frame.size() - kServiceCallHeader) {
     fail("encoding length " + std::to_string(encoding_size) + " runs past the " + size + " message");
   } else {
@@ -322,7 +323,8 @@ void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
   } else if (std::find(std::begin(kUnofferedOps), std::end(kUnofferedOps), op) != std::end(kUnofferedOps) ||
              std::find(std::begin(kParameterOps), std::end(kParameterOps), op) != std::end(kParameterOps)) {
     error("op " + shown(*op_it) + " is not supported by this server (capabilities: time" +
-          (parameters_ ? ", parameters, parametersSubscribe" : "") + (service_count_ > 0 ? ", services" : "") + ")");
+          (parameters_ ? ", parameters, parametersSubscribe" : "") +
+          (service_count_ > 0 ? ", services" : "") + ")");
     return;
   } else {
     error("unknown op " + shown(*op_it));

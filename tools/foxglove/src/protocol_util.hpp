@@ -37,6 +37,7 @@ struct Problems {
 
 // getParameters, setParameters, subscribeParameterUpdates or unsubscribeParameterUpdates (`op`)
 // into `out.parameters`; problems are added to `problems` (one status error for the frame).
-void parameter_op(const std::string& op, const nlohmann::json& j, ClientProtocol::Outcome& out, Problems& problems);
+void parameter_op(const std::string& op, const nlohmann::json& j, ClientProtocol::Outcome& out,
+                  Problems& problems);
 
 }  // namespace rbsim::foxglove::detail

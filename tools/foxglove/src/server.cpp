@@ -173,9 +173,9 @@ struct Server::Impl {
       ++totals.refused_requests;
       if (!c.backlog_told) {
         c.backlog_told = true;
-        c.queue.push_text(status_json(StatusLevel::Error,
-                                      "rbsim: requests refused until this client reads its replies (" +
-                                          std::to_string(backlog) + " bytes waiting)"));
+        c.queue.push_text(
+            status_json(StatusLevel::Error, "rbsim: requests refused until this client reads its replies (" +
+                                                std::to_string(backlog) + " bytes waiting)"));
       }
       return false;
     }
@@ -210,8 +210,7 @@ struct Server::Impl {
       if (l.has) c->queue.push_message(ClientQueue::Kind::Latched, s.id, l.log_time, l.payload);
     }
     for (const std::string& r : outcome.replies) c->queue.push_text(r);
-    if (outcome.parameters &&
-        !admit(*c, outcome.parameters->op == ParameterRequest::Op::Set, nullptr)) {
+    if (outcome.parameters && !admit(*c, outcome.parameters->op == ParameterRequest::Op::Set, nullptr)) {
       outcome.parameters.reset();
     }
     if (outcome.call && !admit(*c, true, &*outcome.call)) outcome.call.reset();
@@ -316,7 +315,8 @@ void ReplyLink::changed(const std::vector<msgs::Parameter>& parameters) {
 
 namespace {
 // One status error naming the problems of a request ("" when none).
-void add_problems(std::vector<Reply>& replies, const std::string& op, const std::vector<std::string>& problems) {
+void add_problems(std::vector<Reply>& replies, const std::string& op,
+                  const std::vector<std::string>& problems) {
   if (problems.empty()) return;
   std::string m = op + ": ";
   for (std::size_t k = 0; k < problems.size() && k < 5; ++k) m += (k ? "; " : "") + problems[k];
@@ -355,7 +355,8 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
     const std::lock_guard lock(mu);
     if (Client* c = find(id)) {
       c->parameter_updates.resize(parameter_names.size());
-      for (const msgs::Parameter& p : known) c->parameter_updates[parameter_index.at(p.name)] = r.op == Op::Subscribe;
+      for (const msgs::Parameter& p : known)
+        c->parameter_updates[parameter_index.at(p.name)] = r.op == Op::Subscribe;
     }
   }
   add_problems(replies, op, problems);
@@ -377,28 +378,29 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
   command.atomic = false;  // each its own result, as set_parameters
   command.parameters = r.values;
   command.source = "foxglove";
-  controller.submit(std::move(command), [link = link, id, answer = r.id, values = r.values,
-                                         known = std::move(known)](const control::CommandResult& result) mutable {
-    std::vector<Reply> out;
-    std::vector<std::string> refused;
-    if (result.results.size() != values.size()) {
-      refused.push_back(result.message);  // never applied (the run ended)
-    } else {
-      for (std::size_t k = 0; k < values.size(); ++k) {
-        if (!result.results[k].successful) refused.push_back(result.results[k].reason);
-      }
-    }
-    if (answer) {
-      for (msgs::Parameter& p : known) {
-        for (const msgs::Parameter& c : result.changed) {
-          if (c.name == p.name) p.value = c.value;
-        }
-      }
-      out.push_back({parameter_values_json(known, answer), false});
-    }
-    add_problems(out, "setParameters", refused);
-    link->deliver(id, out, true);
-  });
+  controller.submit(std::move(command),
+                    [link = link, id, answer = r.id, values = r.values,
+                     known = std::move(known)](const control::CommandResult& result) mutable {
+                      std::vector<Reply> out;
+                      std::vector<std::string> refused;
+                      if (result.results.size() != values.size()) {
+                        refused.push_back(result.message);  // never applied (the run ended)
+                      } else {
+                        for (std::size_t k = 0; k < values.size(); ++k) {
+                          if (!result.results[k].successful) refused.push_back(result.results[k].reason);
+                        }
+                      }
+                      if (answer) {
+                        for (msgs::Parameter& p : known) {
+                          for (const msgs::Parameter& c : result.changed) {
+                            if (c.name == p.name) p.value = c.value;
+                          }
+                        }
+                        out.push_back({parameter_values_json(known, answer), false});
+                      }
+                      add_problems(out, "setParameters", refused);
+                      link->deliver(id, out, true);
+                    });
 }
 
 void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
@@ -409,15 +411,15 @@ void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
     return;
   }
   command->source = "foxglove";
-  options.controller->submit(
-      std::move(command.value()), [link = link, id, call = std::move(call)](const control::CommandResult& result) {
-        const control::ControlService& s = control::control_services()[call.service - 1];
-        const std::string payload = detail::encode_response(s, call.encoding, result);
-        Reply r{{}, true};
-        append_service_call_response(r.data, call.service, call.call, call.encoding,
-                                     {reinterpret_cast<const std::byte*>(payload.data()), payload.size()});
-        link->deliver(id, {r}, true);
-      });
+  options.controller->submit(std::move(command.value()), [link = link, id, call = std::move(call)](
+                                                             const control::CommandResult& result) {
+    const control::ControlService& s = control::control_services()[call.service - 1];
+    const std::string payload = detail::encode_response(s, call.encoding, result);
+    Reply r{{}, true};
+    append_service_call_response(r.data, call.service, call.call, call.encoding,
+                                 {reinterpret_cast<const std::byte*>(payload.data()), payload.size()});
+    link->deliver(id, {r}, true);
+  });
 }
 
 Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
@@ -462,9 +464,10 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   }
   if (options.controller != nullptr) {
     im.link->server = &im;
-    options.controller->on_command([link = im.link](const control::Command&, const control::CommandResult& r) {
-      link->changed(r.changed);
-    });
+    options.controller->on_command(
+        [link = im.link](const control::Command&, const control::CommandResult& r) {
+          link->changed(r.changed);
+        });
   }
   im.transport->run();
   return s;

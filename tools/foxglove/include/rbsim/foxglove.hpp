@@ -140,7 +140,8 @@ struct ServiceCall {
 // an encoding not offered or a payload over the limit gets a serviceCallFailure instead.
 class ClientProtocol {
  public:
-  explicit ClientProtocol(std::uint32_t channel_count, bool parameters = false, std::uint32_t service_count = 0);
+  explicit ClientProtocol(std::uint32_t channel_count, bool parameters = false,
+                          std::uint32_t service_count = 0);
 
   struct Subscription {
     SubscriptionId id = 0;
@@ -148,9 +149,9 @@ class ClientProtocol {
     bool operator==(const Subscription&) const = default;
   };
   struct Outcome {
-    std::vector<Subscription> subscribed;    // new, in request order
-    std::vector<Subscription> unsubscribed;  // ended, in request order
-    std::vector<std::string> replies;        // JSON text frames to send back (status, serviceCallFailure)
+    std::vector<Subscription> subscribed;        // new, in request order
+    std::vector<Subscription> unsubscribed;      // ended, in request order
+    std::vector<std::string> replies;            // JSON text frames to send back (status, serviceCallFailure)
     std::optional<ParameterRequest> parameters;  // a parameter op to carry out
     std::optional<ServiceCall> call;             // a service call to carry out
     void clear() {
@@ -282,13 +283,13 @@ std::string foxglove_app_link(std::string_view url);
 
 // Counts over the server's life.
 struct ServerStats {
-  std::uint64_t clients = 0;       // connections accepted
-  std::uint64_t refused = 0;       // handshakes refused (no foxglove subprotocol)
-  std::uint64_t dropped = 0;       // per-step frames dropped for slow clients
-  std::uint64_t warnings = 0;      // overflow bursts warned about
-  std::uint64_t disconnected = 0;  // clients disconnected for not reading
-  std::uint64_t published = 0;     // messages handed to the server (publish calls that queued)
-  std::uint64_t requests = 0;      // parameter requests and service calls carried out
+  std::uint64_t clients = 0;           // connections accepted
+  std::uint64_t refused = 0;           // handshakes refused (no foxglove subprotocol)
+  std::uint64_t dropped = 0;           // per-step frames dropped for slow clients
+  std::uint64_t warnings = 0;          // overflow bursts warned about
+  std::uint64_t disconnected = 0;      // clients disconnected for not reading
+  std::uint64_t published = 0;         // messages handed to the server (publish calls that queued)
+  std::uint64_t requests = 0;          // parameter requests and service calls carried out
   std::uint64_t refused_requests = 0;  // refused for a client's backlog or commands in flight
 };
 
