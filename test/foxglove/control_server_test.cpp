@@ -211,6 +211,13 @@ TEST(FoxgloveSteering, RefusedSetsAreNamedAndTheRestApplies) {
   }
   EXPECT_EQ(m.find("springs.0.k"), std::string::npos) << m;
   EXPECT_EQ(s.controller.get({"springs.0.k"})[0], msgs::ParameterValue::of_double(7.5));
+  // A request naming more values than the node has parameters is refused whole.
+  std::string many = R"({"op":"setParameters","id":"many","parameters":[)";
+  for (int k = 0; k < 10000; ++k) many += std::string(k ? "," : "") + R"({"name":"rate","value":2.0})";
+  ASSERT_TRUE(c.send_text(many + "]}"));
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("10000 values in one request, more than"),
+            std::string::npos);
+  EXPECT_EQ(s.controller.get({"rate"})[0], msgs::ParameterValue::of_double(0.0));
   // Unknown names in a read are named too; the known ones still come.
   ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt","ghost"],"id":"g"})"));
   EXPECT_EQ(next_op(c, "parameterValues")["parameters"].size(), 1u);

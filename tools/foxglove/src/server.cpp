@@ -335,6 +335,31 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
   std::vector<Reply> replies;
   std::vector<std::string> problems;
   if (r.op == Op::Set) {
+    // Checked here, not on the run loop: a name the node does not have, and a request naming more
+    // parameters than the node has (it repeats names; the run loop's work stays bounded).
+    if (r.values.size() > parameter_names.size()) {
+      reply(id,
+            {{status_json(StatusLevel::Error, "setParameters: " + std::to_string(r.values.size()) +
+                                                  " values in one request, more than the node's " +
+                                                  std::to_string(parameter_names.size()) + " parameters"),
+              false}},
+            true);
+      return;
+    }
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < r.values.size(); ++k) {
+      if (parameter_index.count(r.values[k].name) == 0) {
+        problems.push_back("no parameter '" + r.values[k].name.substr(0, 200) + "'");
+        continue;
+      }
+      if (kept != k) {
+        r.values[kept] = std::move(r.values[k]);
+        r.untyped_integer[kept] = r.untyped_integer[k];
+      }
+      ++kept;
+    }
+    r.values.resize(kept);
+    r.untyped_integer.resize(kept);
     for (const msgs::Parameter& p : r.values) r.names.push_back(p.name);
   } else if (r.names.empty()) {
     r.names = parameter_names;  // every parameter
@@ -359,8 +384,8 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
         c->parameter_updates[parameter_index.at(p.name)] = r.op == Op::Subscribe;
     }
   }
-  add_problems(replies, op, problems);
   if (r.op != Op::Set) {
+    add_problems(replies, op, problems);
     reply(id, replies, false);
     return;
   }
@@ -379,10 +404,9 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
   command.parameters = r.values;
   command.source = "foxglove";
   controller.submit(std::move(command),
-                    [link = link, id, answer = r.id, values = r.values,
-                     known = std::move(known)](const control::CommandResult& result) mutable {
+                    [link = link, id, answer = r.id, values = r.values, known = std::move(known),
+                     refused = std::move(problems)](const control::CommandResult& result) mutable {
                       std::vector<Reply> out;
-                      std::vector<std::string> refused;
                       if (result.results.size() != values.size()) {
                         refused.push_back(result.message);  // never applied (the run ended)
                       } else {
