@@ -35,7 +35,7 @@ MODULES = {
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "node": ("node", {"core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
     "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden"}),
-    "foxglove": ("tools/foxglove", {"core", "scene", "io", "msgs"}),
+    "foxglove": ("tools/foxglove", {"core", "scene", "io", "control", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"rbsim/([A-Za-z0-9_]+\.hpp)"', re.M)

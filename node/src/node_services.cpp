@@ -78,10 +78,6 @@ struct NodeServices::Impl {
     return done.get();
   }
 
-  static std::uint64_t step_of(const CommandResult& r) {
-    return r.step < 0 ? 0 : static_cast<std::uint64_t>(r.step);
-  }
-
   Status add(const Participant& participant, std::string_view name, std::string_view srv_type,
              ServiceServer::Handler handler) {
     ServiceOptions so;
@@ -110,50 +106,38 @@ struct NodeServices::Impl {
     return Ok{};
   }
 
+  // The control services through the control module's one mapping (control::control_services()).
   void add_controls(std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>>& out) {
-    using msgs::TriggerRequest, msgs::TriggerResponse;
-    const auto trigger = [this](CommandKind kind) {
-      return typed_handler<TriggerRequest, TriggerResponse>(
-          [this, kind](const RequestHeader&, const TriggerRequest&) {
-            Command c;
-            c.kind = kind;
-            const CommandResult r = apply(std::move(c));
-            return TriggerResponse{r.successful, r.message};
-          },
-          [](const Error& e) {
-            return std::optional<TriggerResponse>(TriggerResponse{false, e.message});
-          });
-    };
-    out.emplace_back("pause", "std_srvs/srv/Trigger", trigger(CommandKind::Pause));
-    out.emplace_back("resume", "std_srvs/srv/Trigger", trigger(CommandKind::Resume));
-    out.emplace_back("reset", "std_srvs/srv/Trigger", trigger(CommandKind::Reset));
-    out.emplace_back("step", "rbsim_msgs/srv/Step",
-                     typed_handler<msgs::StepRequest, msgs::StepResponse>(
-                         [this](const RequestHeader&, const msgs::StepRequest& req) {
-                           Command c;
-                           c.kind = CommandKind::Step;
-                           c.steps = req.steps;
-                           const CommandResult r = apply(std::move(c));
-                           return msgs::StepResponse{r.successful, r.message, step_of(r)};
-                         },
-                         [](const Error& e) {
-                           return std::optional<msgs::StepResponse>(msgs::StepResponse{false, e.message, 0});
-                         }));
-    out.emplace_back("apply_impulse", "rbsim_msgs/srv/ApplyImpulse",
-                     typed_handler<msgs::ApplyImpulseRequest, msgs::ApplyImpulseResponse>(
-                         [this](const RequestHeader&, const msgs::ApplyImpulseRequest& req) {
-                           Command c;
-                           c.kind = CommandKind::Impulse;
-                           c.impulse.body = req.body;
-                           c.impulse.impulse = Vec2(req.jx, req.jy);
-                           c.impulse.point = Vec2(req.px, req.py);
-                           const CommandResult r = apply(std::move(c));
-                           return msgs::ApplyImpulseResponse{r.successful, r.message, step_of(r)};
-                         },
-                         [](const Error& e) {
-                           return std::optional<msgs::ApplyImpulseResponse>(
-                               msgs::ApplyImpulseResponse{false, e.message, 0});
-                         }));
+    using namespace msgs;
+    for (const control::ControlService& s : control::control_services()) {
+      ServiceServer::Handler h;
+      if (s.kind == CommandKind::Step) {
+        h = typed_handler<StepRequest, StepResponse>(
+            [this](const RequestHeader&, const StepRequest& req) {
+              return control::step_response(apply(control::command_for(req)));
+            },
+            [](const Error& e) {
+              return std::optional<StepResponse>(StepResponse{false, e.message, 0});
+            });
+      } else if (s.kind == CommandKind::Impulse) {
+        h = typed_handler<ApplyImpulseRequest, ApplyImpulseResponse>(
+            [this](const RequestHeader&, const ApplyImpulseRequest& req) {
+              return control::impulse_response(apply(control::command_for(req)));
+            },
+            [](const Error& e) {
+              return std::optional<ApplyImpulseResponse>(ApplyImpulseResponse{false, e.message, 0});
+            });
+      } else {
+        h = typed_handler<TriggerRequest, TriggerResponse>(
+            [this, kind = s.kind](const RequestHeader&, const TriggerRequest& req) {
+              return control::trigger_response(apply(control::command_for(kind, req)));
+            },
+            [](const Error& e) {
+              return std::optional<TriggerResponse>(TriggerResponse{false, e.message});
+            });
+      }
+      out.emplace_back(std::string(s.name), std::string(s.type), std::move(h));
+    }
   }
 
   // rclcpp's parameter services: reads answer from the table as of the last boundary; a read
@@ -290,16 +274,11 @@ void NodeServices::command_applied(const Command& command, const CommandResult& 
   msgs::encode(control::to_message(command, result, impl_->next_sequence++, impl_->options.dt),
                impl_->command_cdr);
   if (impl_->commands->publish(impl_->command_cdr)) ++impl_->command_count;
-  if (command.kind != CommandKind::SetParameters || result.step < 0) return;
+  if (result.changed.empty() || result.step < 0) return;
   msgs::ParameterEvent event;
   event.node = impl_->options.node;
   event.stamp = msgs::sim_time(result.step, impl_->options.dt);
-  for (std::size_t k = 0; k < command.parameters.size(); ++k) {
-    const bool changed =
-        command.atomic ? result.successful : k < result.results.size() && result.results[k].successful;
-    if (changed) event.changed_parameters.push_back(command.parameters[k]);
-  }
-  if (event.changed_parameters.empty()) return;
+  event.changed_parameters = result.changed;
   impl_->event_cdr.clear();
   msgs::encode(event, impl_->event_cdr);
   if (impl_->events->publish(impl_->event_cdr)) ++impl_->event_count;

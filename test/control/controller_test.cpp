@@ -321,6 +321,60 @@ TEST(ControllerCommands, ForABoundaryThatHasPassedFail) {
   running.get();
 }
 
+TEST(ControllerObservers, EveryObserverSeesWhatEachCommandChanged) {
+  const Scene scene = test::control_scene();
+  Controller controller(scene, kSteps, RunSettings{0.0, 1, false});
+  std::vector<std::string> first, second;
+  std::vector<std::vector<Parameter>> changed;
+  controller.on_command([&](const Command& c, const CommandResult& r) {
+    first.push_back(to_string(c.kind));
+    changed.push_back(r.changed);
+  });
+  controller.on_command([&](const Command& c, const CommandResult&) { second.push_back(to_string(c.kind)); });
+  controller.submit(set(2, {{"forces.0.fy", V::of_double(-3.0)}, {"bodies", V::of_integer(5)}}, false));
+  controller.submit(simple(4, CommandKind::Pause, 0));
+  controller.submit(simple(4, CommandKind::Pause, 0));  // already paused: nothing changed
+  controller.submit(simple(4, CommandKind::Step, 3));
+  controller.submit(simple(7, CommandKind::Resume));
+  controller.submit(simple(9, CommandKind::Reset));
+  test::run(scene, 12, &controller);
+  EXPECT_EQ(first, (std::vector<std::string>{"set_parameters", "pause", "pause", "step", "resume", "reset"}));
+  EXPECT_EQ(second, first);
+  ASSERT_EQ(changed.size(), 6u);
+  EXPECT_EQ(changed[0], (std::vector<Parameter>{{"forces.0.fy", V::of_double(-3.0)}}));  // bodies refused
+  EXPECT_EQ(changed[1], (std::vector<Parameter>{{"paused", V::of_bool(true)}}));
+  EXPECT_TRUE(changed[2].empty());
+  EXPECT_TRUE(changed[3].empty());
+  EXPECT_EQ(changed[4], (std::vector<Parameter>{{"paused", V::of_bool(false)}}));
+  EXPECT_EQ(changed[5],
+            (std::vector<Parameter>{{"forces.0.fy", V::of_double(-9.81)}}));  // back to the scene's
+}
+
+TEST(ControlServices, OneMappingOfRequestsAndReplies) {
+  const auto services = control_services();
+  ASSERT_EQ(services.size(), 5u);
+  EXPECT_EQ(services[0].name, "pause");
+  EXPECT_EQ(services[3].type, "rbsim_msgs/srv/Step");
+  EXPECT_EQ(services[4].kind, CommandKind::Impulse);
+  EXPECT_EQ(command_for(CommandKind::Reset, msgs::TriggerRequest{}).kind, CommandKind::Reset);
+  const Command step = command_for(msgs::StepRequest{7});
+  EXPECT_EQ(step.kind, CommandKind::Step);
+  EXPECT_EQ(step.steps, 7);
+  const Command impulse = command_for(msgs::ApplyImpulseRequest{3, 1.0, 2.0, 0.5, -0.5});
+  EXPECT_EQ(impulse.impulse.body, 3);
+  EXPECT_EQ(impulse.impulse.impulse, Vec2(1.0, 2.0));
+  EXPECT_EQ(impulse.impulse.point, Vec2(0.5, -0.5));
+  CommandResult r;
+  r.successful = true;
+  r.message = "done";
+  r.step = 12;
+  EXPECT_EQ(step_response(r), (msgs::StepResponse{true, "done", 12}));
+  EXPECT_EQ(impulse_response(r), (msgs::ApplyImpulseResponse{true, "done", 12}));
+  EXPECT_EQ(trigger_response(r), (msgs::TriggerResponse{true, "done"}));
+  r.step = Command::kNextStep;  // never applied
+  EXPECT_EQ(step_response(r).step, 0u);
+}
+
 TEST(ControllerClose, AnswersWhatIsQueuedAndRefusesLaterCommands) {
   const Scene scene = test::control_scene();
   std::future<CommandResult> never;

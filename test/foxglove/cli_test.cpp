@@ -212,6 +212,8 @@ struct Seen {
   int server_infos = 0;                            // after the first
   std::set<std::string> sessions;
   int statuses = 0;
+  nlohmann::json capabilities;        // the first serverInfo's
+  std::vector<std::string> services;  // advertised
 };
 Seen watch(std::uint16_t port, int frames, const std::string& stop_topic = "", int stop_count = 0) {
   Seen seen;
@@ -221,6 +223,7 @@ Seen watch(std::uint16_t port, int frames, const std::string& stop_topic = "", i
   EXPECT_TRUE(info);
   if (!info) return seen;
   seen.sessions.insert(nlohmann::json::parse(info->data).value("sessionId", ""));
+  seen.capabilities = nlohmann::json::parse(info->data).value("capabilities", nlohmann::json());
   auto adv = c.read();
   EXPECT_TRUE(adv);
   if (!adv) return seen;
@@ -247,6 +250,8 @@ Seen watch(std::uint16_t port, int frames, const std::string& stop_topic = "", i
         ++seen.server_infos;
         seen.sessions.insert(j.value("sessionId", ""));
         seen.last_time.clear();
+      } else if (j.value("op", "") == "advertiseServices") {
+        for (const auto& sv : j.at("services")) seen.services.push_back(sv.at("name").get<std::string>());
       } else {
         ++seen.statuses;
       }
@@ -283,6 +288,11 @@ TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
   EXPECT_LE(seen.max_time.at("/fox_e2e/body_states"), 3'000'000'000ull) << "log time is simulated time";
   EXPECT_NE(node.err().find("rbsim node: stopped after"), std::string::npos) << node.err();
   EXPECT_NE(node.err().find("foxglove: 1 client,"), std::string::npos) << node.err();
+  // Steered through its controller: parameters and the node's five services.
+  EXPECT_EQ(seen.capabilities,
+            nlohmann::json::array({"time", "parameters", "parametersSubscribe", "services"}));
+  EXPECT_EQ(seen.services, (std::vector<std::string>{"/fox_e2e/pause", "/fox_e2e/resume", "/fox_e2e/reset",
+                                                     "/fox_e2e/step", "/fox_e2e/apply_impulse"}));
 }
 
 TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {
@@ -305,6 +315,8 @@ TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {
       << "log times increase within a pass: " << testing::PrintToString(seen.decreasing);
   EXPECT_LE(seen.max_time.at("/fox_rp/body_states"), 100'000'000ull) << "log time is simulated time";
   EXPECT_NE(replay.err().find("rbsim replay: foxglove: open https://app.foxglove.dev/"), std::string::npos);
+  EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time"})) << "nothing to steer in a replay";
+  EXPECT_TRUE(seen.services.empty());
 }
 
 TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {
@@ -327,6 +339,9 @@ TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {
     EXPECT_LE(seen.max_time.at("/fox_br/body_states"), 20'000'000'000ull) << "log time is simulated time";
   }
   EXPECT_NE(bridge.err().find("rbsim bridge: stopped after"), std::string::npos) << bridge.err();
+  // Relaying steering to the node over DDS is not done yet: the bridge offers none.
+  EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time"}));
+  EXPECT_TRUE(seen.services.empty());
 }
 
 }  // namespace

@@ -268,7 +268,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(FoxgloveClient, BinaryFramesAreRefused) {
   ClientProtocol p(1);
   ClientProtocol::Outcome o;
-  p.handle_binary(13, o);
+  p.handle_binary(std::string("\x02\x01\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00", 13), o);
   const auto s = statuses(o);
   ASSERT_EQ(s.size(), 1u);
   EXPECT_EQ(s[0].first, 2);

@@ -9,7 +9,8 @@
 // Cases: bytes (every payload equals what `rbsim run --record` writes), late_joiner (latched
 // topics at once; a new session per loop), hostile (bad input gets a status error or a clean close),
 // slow_client (one that stops reading loses messages and is disconnected, another loses nothing),
-// faults (killed, cycling and stalled clients do not slow the node; another loses nothing).
+// faults (killed, cycling and stalled clients do not slow the node; another loses nothing), steer
+// (parameters and services through the client's own calls: values, updates, pause/step/resume).
 // Messages are matched by log time, which is simulated time. Only 127.0.0.1; every loop bounded.
 const fs = require("fs");
 const path = require("path");
@@ -393,8 +394,113 @@ async function caseFaults(check) {
   }
 }
 
+// Steering through Foxglove's own client: the parameters listed and set (the update reaches a
+// subscriber), then pause, step and resume called over cdr (and step over json), each reply
+// checked and the published body_states stopping, advancing and going on as the replies say.
+async function caseSteer(check) {
+  const [node, url] = await start("node", nodeArgs(scene("cantilever.xml"), "--rate", 1, "--duration", 120));
+  const c = new Client(need, url, { name: "steer", subscribeAll: false });
+  const values = [];
+  const responses = new Map();
+  const failures = [];
+  let services;
+  c.client.on("parameterValues", (m) => values.push(m));
+  c.client.on("advertiseServices", (s) => (services = s));
+  c.client.on("serviceCallResponse", (r) => responses.set(r.callId, r));
+  c.client.on("serviceCallFailure", (f) => failures.push(f));
+  await c.ready();
+  const caps = c.serverInfo.capabilities;
+  check(["time", "parameters", "parametersSubscribe", "services"].every((k) => caps.includes(k)), `capabilities ${caps}`);
+  check(JSON.stringify(c.serverInfo.supportedEncodings) === JSON.stringify(["cdr", "json"]),
+    `supportedEncodings ${c.serverInfo.supportedEncodings}`);
+  await until("advertiseServices", 5000, () => services);
+  const svc = (name) => services.find((s) => s.name === `/${ns}/${name}`);
+  check(["pause", "resume", "reset", "step", "apply_impulse"].every(svc), `services ${services.map((s) => s.name)}`);
+  const states = [...c.channels.values()].find((ch) => ch.topic === `/${ns}/body_states`);
+  if (!states) throw new Failure(`no /${ns}/body_states channel`);
+  c.subscribe(states);
+  const lastStep = () => {
+    const m = c.messages.at(-1);
+    return m ? Number(m.decoded.step) : -1;
+  };
+  await until("body_states", 5000, () => lastStep() > 0);
+
+  // Parameters: all of them, typed; a set answered and seen by the subscription.
+  const answer = (id) => until(`parameterValues ${id}`, 5000, () => values.find((v) => v.id === id));
+  c.client.getParameters([], "all");
+  const all = await answer("all");
+  const param = (m, name) => m.parameters.find((p) => p.name === name);
+  check(param(all, "forces.0.fy")?.type === "float64", `forces.0.fy: ${JSON.stringify(param(all, "forces.0.fy"))}`);
+  check(param(all, "bodies")?.type === undefined && Number.isInteger(param(all, "bodies")?.value),
+    `bodies: ${JSON.stringify(param(all, "bodies"))}`);
+  check(param(all, "paused")?.value === false, `paused: ${JSON.stringify(param(all, "paused"))}`);
+  log(`${all.parameters.length} parameters: ${all.parameters.map((p) => p.name).join(", ")}`);
+  c.client.subscribeParameterUpdates(["forces.0.fy", "paused"]);
+  c.client.getParameters(["paused"], "sync");  // answered after the subscription took effect
+  await answer("sync");
+  c.client.setParameters([{ name: "forces.0.fy", value: -3.7 }], "set");
+  const set = await answer("set");
+  check(param(set, "forces.0.fy")?.value === -3.7, `set answer ${JSON.stringify(set)}`);
+  const update = (name, value) => until(`an update of ${name} to ${value}`, 5000,
+    () => values.find((v) => v.id === undefined && param(v, name)?.value === value));
+  await update("forces.0.fy", -3.7);
+  c.client.setParameters([{ name: "bodies", value: 9 }, { name: "rate", value: "fast" }], "bad");
+  await answer("bad");
+  const refusal = await until("a status error naming the refused parameters", 5000,
+    () => c.statuses.find((s) => s.level === 2 && /bodies/.test(s.message) && /rate/.test(s.message)));
+  log(`refused: ${refusal.message}`);
+
+  // Services over cdr with the advertised schemas (and json), as Foxglove Studio calls them.
+  const { parse } = need("@foxglove/rosmsg");
+  const { MessageWriter, MessageReader } = need("@foxglove/rosmsg2-serialization");
+  let callId = 0;
+  const call = async (name, request, encoding = "cdr") => {
+    const s = svc(name);
+    const id = ++callId;
+    const data = encoding === "cdr"
+      ? new MessageWriter(parse(s.request.schema, { ros2: true })).writeMessage(request)
+      : new TextEncoder().encode(JSON.stringify(request));
+    c.client.sendServiceCallRequest({ serviceId: s.id, callId: id, encoding, data: new DataView(data.buffer, data.byteOffset, data.byteLength) });
+    const r = await until(`the reply to ${name}`, 10000, () => responses.get(id) ?? failures.find((f) => f.callId === id));
+    if (r.op === "serviceCallFailure") throw new Failure(`${name}: serviceCallFailure ${r.message}`);
+    check(r.serviceId === s.id && r.encoding === encoding, `${name}: reply for service ${r.serviceId} in ${r.encoding}`);
+    return encoding === "cdr"
+      ? new MessageReader(parse(s.response.schema, { ros2: true })).readMessage(r.data)
+      : JSON.parse(new TextDecoder().decode(r.data));
+  };
+  const steady = async (what, want) => {
+    await until(`${what}: body_states at step ${want}`, 5000, () => lastStep() >= want);
+    await sleep(400);
+    check(lastStep() === want, `${what}: published up to step ${lastStep()}, want ${want}`);
+  };
+  const paused = await call("pause", {});
+  const at = Number(/paused at step (\d+)/.exec(paused.message)?.[1]);
+  check(paused.success === true && at > 0, `pause: ${JSON.stringify(paused)}`);
+  await update("paused", true);
+  await steady("paused", at);
+  const stepped = await call("step", { steps: 5 });
+  check(stepped.success === true && Number(stepped.step) === at, `step: ${JSON.stringify(stepped, (k, v) => (typeof v === "bigint" ? Number(v) : v))}`);
+  await steady("stepped 5", at + 5);
+  const jsonStep = await call("step", { steps: 2 }, "json");
+  check(jsonStep.success === true && jsonStep.step === at + 5, `step (json): ${JSON.stringify(jsonStep)}`);
+  await steady("stepped 2 more", at + 7);
+  const resumed = await call("resume", {});
+  check(resumed.success === true, `resume: ${JSON.stringify(resumed)}`);
+  await update("paused", false);
+  await until("body_states after the resume", 5000, () => lastStep() > at + 100);
+  log(`paused at ${at}, stepped to ${at + 7}, resumed: now at ${lastStep()}`);
+  // A call of a service that does not exist.
+  c.client.sendServiceCallRequest({ serviceId: 999, callId: 4242, encoding: "cdr", data: new DataView(new ArrayBuffer(0)) });
+  const unknown = await until("a serviceCallFailure", 5000, () => failures.find((f) => f.callId === 4242));
+  check(/unknown service 999/.test(unknown.message), `unknown service: ${unknown.message}`);
+  c.close();
+  node.kill("SIGINT");
+  check((await node.wait(15000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  check(/foxglove: .*\d+ requests/.test(node.err), `the end line counts no requests\n${node.err}`);
+}
+
 const cases = { bytes: caseBytes, late_joiner: caseLateJoiner, hostile: caseHostile, slow_client: caseSlowClient,
-  faults: caseFaults };
+  faults: caseFaults, steer: caseSteer };
 if (A.case === "child") caseChild();
 else if (!cases[A.case]) throw new Error(`unknown case ${A.case}`);
 else runMain(`foxglove_client.${A.case}`, cases[A.case]);

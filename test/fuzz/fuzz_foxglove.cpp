@@ -1,9 +1,12 @@
-// libFuzzer target: the Foxglove server's client-message handler (ClientProtocol) and the queue
-// its replies go into. The input is a sequence of client frames separated by a 0x00 byte; a frame
-// whose first byte is 0x01 is handed over as a binary frame, any other as a text frame, all to one
-// ClientProtocol, so subscribe/unsubscribe sequences build up state. After every frame the
-// bookkeeping must agree with itself and every reply must be a JSON status; the replies and a
-// message per subscription go through a small ClientQueue, whose limits must hold.
+// libFuzzer target: the Foxglove server's client-message handler (ClientProtocol, with the
+// parameter ops and 5 services offered) and the queue its replies go into. The input is a sequence
+// of client frames separated by a 0x00 byte; a frame whose first byte is 0x01 is handed over as a
+// binary frame without that byte (a service call when it then starts with 0x02), any other as a
+// text frame, all to one ClientProtocol, so subscribe/unsubscribe sequences build up state. After
+// every frame the bookkeeping must agree with itself, every reply must be a JSON status or
+// serviceCallFailure, and a service call handed over must name an offered service and encoding;
+// the replies and a message per subscription go through a small ClientQueue, whose limits must
+// hold.
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
@@ -16,7 +19,8 @@ namespace fox = rbsim::foxglove;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   constexpr std::uint32_t kChannels = 7;
-  fox::ClientProtocol protocol(kChannels);
+  constexpr std::uint32_t kServices = 5;
+  fox::ClientProtocol protocol(kChannels, true, kServices);
   fox::ClientQueue queue(fox::QueueLimits{8, 4096});
   fox::ClientProtocol::Outcome out;
   fox::ClientQueue::Frame frame;
@@ -29,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (end == std::string_view::npos) end = input.size();
     const std::string_view f = input.substr(start, end - start);
     if (!f.empty() && f[0] == '\x01') {
-      protocol.handle_binary(f.size(), out);
+      protocol.handle_binary(f.substr(1), out);
     } else {
       protocol.handle_text(f, out);
     }
@@ -51,9 +55,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (out.replies.size() > 1) __builtin_trap();  // one status per frame at most
     for (const std::string& r : out.replies) {
       const auto j = nlohmann::json::parse(r, nullptr, false);
-      if (j.is_discarded() || j.value("op", "") != "status") __builtin_trap();
+      if (j.is_discarded()) __builtin_trap();
+      const std::string op = j.value("op", "");
+      if (op != "status" && op != "serviceCallFailure") __builtin_trap();
       queue.push_text(r);
     }
+    if (out.call) {
+      if (out.call->service == 0 || out.call->service > kServices) __builtin_trap();
+      if (out.call->encoding != "cdr" && out.call->encoding != "json") __builtin_trap();
+      if (!out.replies.empty()) __builtin_trap();  // a call is carried out or refused, not both
+    }
+    if (out.parameters && out.parameters->values.size() != out.parameters->untyped_integer.size())
+      __builtin_trap();
     for (fox::ChannelId ch = 1; ch <= kChannels; ++ch) {
       if (const auto sub = protocol.subscription(ch)) {
         const std::byte payload[64]{};

@@ -48,9 +48,13 @@ CLI::Option* add_foxglove_option(CLI::App* app, std::optional<std::string>& addr
 }
 
 Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const std::string& address,
-                                                         std::vector<foxglove::ChannelSpec> channels) {
+                                                         std::vector<foxglove::ChannelSpec> channels,
+                                                         control::Controller* controller,
+                                                         const std::string& node) {
   foxglove::ServerOptions options;
   if (Status st = foxglove::parse_listen_address(address, options); !st) return st.error();
+  options.controller = controller;
+  options.node = node;
   auto server = foxglove::Server::start(options, std::move(channels));
   if (!server) return server.error();
   const std::uint16_t port = server.value()->port();
@@ -75,6 +79,9 @@ std::string foxglove_summary(const foxglove::Server& server) {
                      " dropped for slow clients";
   if (s.disconnected > 0) line += ", " + std::to_string(s.disconnected) + " disconnected for not reading";
   if (s.refused > 0) line += ", " + std::to_string(s.refused) + " handshakes refused";
+  if (s.requests > 0)
+    line += ", " + std::to_string(s.requests) + (s.requests == 1 ? " request" : " requests");
+  if (s.refused_requests > 0) line += ", " + std::to_string(s.refused_requests) + " requests refused";
   return line;
 }
 

@@ -77,9 +77,12 @@ int node_command(const NodeArgs& a) {
   node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
   auto sink = node::DdsSink::create(participant.value(), node_options);
   if (!sink) return fail("node", sink.error().message);
-  // The Foxglove server serves beside DDS. The pacer releases each step when it is due; the
-  // Foxglove sink's hand-off to the server's thread (a copy and a wake-up) goes first, so
-  // viewers do not wait for the DDS writes.
+  // Commands (parameters, pause, step, reset, impulses) apply at step boundaries. The controller
+  // outlives every front end that submits to it (the Foxglove server, the node's services).
+  control::Controller controller(scene, steps, settings);
+  // The Foxglove server serves beside DDS, steered through the controller. The pacer releases
+  // each step when it is due; the Foxglove sink's hand-off to the server's thread (a copy and a
+  // wake-up) goes first, so viewers do not wait for the DDS writes.
   std::unique_ptr<foxglove::Server> server;
   std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
   if (a.foxglove) {
@@ -91,7 +94,8 @@ int node_command(const NodeArgs& a) {
     std::vector<foxglove::ChannelId> ids;
     auto channels = foxglove::ros2_channels(fo.topics, a.node.ns, &ids);
     if (!channels) return fail("node", channels.error().message);
-    auto started = start_foxglove("rbsim node", *a.foxglove, std::move(channels.value()));
+    auto started = start_foxglove("rbsim node", *a.foxglove, std::move(channels.value()), &controller,
+                                  name->fully_qualified());
     if (!started) return fail("node", started.error().message);
     server = std::move(started.value());
     foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);
@@ -124,16 +128,15 @@ int node_command(const NodeArgs& a) {
   driver.add(pacer);
   if (foxglove_sink) driver.add(*foxglove_sink);
   driver.add(*sink.value());
-  // Commands (parameters, pause, step, reset, impulses) apply at step boundaries; rate and
-  // publish_every changes reach the pacer and the publishers there.
-  control::Controller controller(scene, steps, settings);
+  // Rate and publish_every changes reach the pacer and the publishers at a step boundary.
   controller.on_settings([&](const control::RunSettings& s) {
     pacer.set_pace(s.rate, s.publish_every);
     sink.value()->set_publish_every(s.publish_every);
     if (foxglove_sink) foxglove_sink->set_publish_every(s.publish_every);
   });
   // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse)
-  // answer through the controller; every parameter change also goes out on /parameter_events.
+  // answer through the controller; every parameter change also goes out on /parameter_events
+  // (an observer beside the Foxglove server's parameter updates).
   auto services =
       node::NodeServices::create(participant.value(), controller, {name->fully_qualified(), scene.world.dt});
   if (!services) return fail("node", services.error().message);

@@ -254,7 +254,7 @@ void Controller::apply_now(Pending& p, World& world, Boundary& b) {
     const std::lock_guard lock(mutex_);
     ++counters_.commands;
   }
-  if (observer_) observer_(p.command, r);
+  for (const auto& observer : observers_) observer(p.command, r);
   if (p.done) p.done(r);
 }
 
@@ -282,6 +282,7 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       if (!settings_.paused) {
         settings_.paused = true;
         table_.store(*table_.find("paused"), ParameterValue::of_bool(true));
+        r.changed.push_back({"paused", ParameterValue::of_bool(true)});
         settings_changed(boundary);
       }
       return r;
@@ -292,6 +293,7 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       if (settings_.paused) {
         settings_.paused = false;
         table_.store(*table_.find("paused"), ParameterValue::of_bool(false));
+        r.changed.push_back({"paused", ParameterValue::of_bool(false)});
         settings_changed(boundary);
       }
       return r;
@@ -312,7 +314,12 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       if (!fresh) return failed("reset: " + fresh.error().message);
       world = std::move(fresh.value());
       step_budget_ = 0;
+      const ParameterTable before = table_;
       table_.refresh(world, settings_);
+      for (std::size_t i = 0; i < table_.size(); ++i) {
+        if (!(table_.value(i) == before.value(i)))
+          r.changed.push_back({table_.descriptor(i).name, table_.value(i)});
+      }
       boundary.state_changed = true;
       boundary.timeline_changed = true;
       r.message = "reset at " + at(now) + " to step 0";
@@ -359,6 +366,7 @@ CommandResult Controller::set_parameters(const Command& command, World& world, B
       boundary.state_changed = true;
     }
     table_.store(i, p.value);
+    r.changed.push_back(p);
     ++changed;
   }
   if (settings) settings_changed(boundary);

@@ -163,6 +163,7 @@ std::string to_string(const ParameterValue& v) {
 }
 
 void ParameterTable::add(ParameterDescriptor descriptor, ParameterValue value, ParameterTarget target) {
+  index_.emplace(descriptor.name, entries_.size());
   entries_.push_back({std::move(descriptor), std::move(value), target});
 }
 
@@ -224,10 +225,9 @@ ParameterTable::ParameterTable(const Scene& scene, std::int64_t steps, const Run
 }
 
 std::optional<std::size_t> ParameterTable::find(std::string_view name) const {
-  for (std::size_t i = 0; i < entries_.size(); ++i) {
-    if (entries_[i].descriptor.name == name) return i;
-  }
-  return std::nullopt;
+  const auto it = index_.find(name);
+  if (it == index_.end()) return std::nullopt;
+  return it->second;
 }
 
 SetParametersResult ParameterTable::check(const Parameter& p) const {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "protocol_util.hpp"
 #include "rbsim/foxglove.hpp"
 
 namespace rbsim::foxglove {
@@ -18,13 +19,47 @@ std::optional<std::string_view> choose_subprotocol(std::span<const std::string> 
   return std::nullopt;
 }
 
-std::string server_info_json(std::string_view name, std::string_view session_id) {
+std::string server_info_json(std::string_view name, std::string_view session_id, bool control) {
   nlohmann::json j = {{"op", "serverInfo"},
                       {"name", std::string(name)},
                       {"capabilities", nlohmann::json::array({"time"})},
                       {"metadata", nlohmann::json::object()},
                       {"sessionId", std::string(session_id)}};
+  if (control) {
+    for (const char* c : {"parameters", "parametersSubscribe", "services"}) j["capabilities"].push_back(c);
+    j["supportedEncodings"] = nlohmann::json::array();
+    for (std::string_view e : kServiceEncodings) j["supportedEncodings"].push_back(std::string(e));
+  }
   return j.dump();
+}
+
+std::string advertise_services_json(std::span<const ServiceSpec> services) {
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t i = 0; i < services.size(); ++i) {
+    const ServiceSpec& s = services[i];
+    const auto part = [&](const char* suffix, const std::string& schema) {
+      return nlohmann::json{{"encoding", "cdr"},
+                            {"schemaName", s.type + suffix},
+                            {"schemaEncoding", "ros2msg"},
+                            {"schema", schema}};
+    };
+    list.push_back({{"id", i + 1},
+                    {"name", s.name},
+                    {"type", s.type},
+                    {"request", part("_Request", s.request_schema)},
+                    {"response", part("_Response", s.response_schema)},
+                    {"requestSchema", s.request_schema},
+                    {"responseSchema", s.response_schema}});
+  }
+  return nlohmann::json{{"op", "advertiseServices"}, {"services", std::move(list)}}.dump();
+}
+
+std::string service_call_failure_json(ServiceId service, CallId call, std::string_view message) {
+  return nlohmann::json{{"op", "serviceCallFailure"},
+                        {"serviceId", service},
+                        {"callId", call},
+                        {"message", std::string(message)}}
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string advertise_json(std::span<const ChannelSpec> channels) {
@@ -68,8 +103,22 @@ void append_time(std::string& out, std::uint64_t time_ns) {
   append_le(out, time_ns, 8);
 }
 
+void append_service_call_response(std::string& out, ServiceId service, CallId call, std::string_view encoding,
+                                  std::span<const std::byte> payload) {
+  out.push_back('\x03');
+  append_le(out, service, 4);
+  append_le(out, call, 4);
+  append_le(out, encoding.size(), 4);
+  out.append(encoding);
+  out.append(reinterpret_cast<const char*>(payload.data()), payload.size());
+}
+
 // ---------------------------------------------------------------------------------------------
 // ClientProtocol
+
+using detail::parameter_op;
+using detail::Problems;
+using detail::shown;
 
 namespace {
 // nlohmann's parser keeps its own stack, but a deeply nested value is still walked recursively
@@ -122,55 +171,67 @@ bool member_id(const nlohmann::json& object, const char* key, std::uint32_t& out
   return it != object.end() && as_id(*it, out);
 }
 
-std::string shown(const nlohmann::json& j) {
-  std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  if (s.size() > 40) s = s.substr(0, 37) + "...";
-  return s;
+// The ops of the protocol this server never offers, and those it offers with a controller only.
+constexpr std::string_view kUnofferedOps[] = {
+    "advertise",  "unadvertise",      "subscribeConnectionGraph", "unsubscribeConnectionGraph",
+    "fetchAsset", "advertiseServices"};
+constexpr std::string_view kParameterOps[] = {"getParameters", "setParameters", "subscribeParameterUpdates",
+                                              "unsubscribeParameterUpdates"};
+
+std::uint32_t read_u32(std::string_view b, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(b[at + static_cast<std::size_t>(i)]);
+  return v;
 }
-
-// Collects the problems of one frame into one status error, naming the first few.
-struct Problems {
-  std::vector<std::string> list;
-  std::size_t count = 0;
-  void add(std::string p) {
-    if (list.size() < 5) list.push_back(std::move(p));
-    ++count;
-  }
-  void flush(std::vector<std::string>& replies) const {
-    if (count == 0) return;
-    std::string m;
-    for (const std::string& p : list) m += (m.empty() ? "" : "; ") + p;
-    if (count > list.size()) m += "; and " + std::to_string(count - list.size()) + " more";
-    replies.push_back(status_json(StatusLevel::Error, m));
-  }
-};
-
-// The ops of the protocol this server does not offer (its serverInfo advertises only `time`).
-constexpr std::string_view kUnofferedOps[] = {"advertise",
-                                              "unadvertise",
-                                              "getParameters",
-                                              "setParameters",
-                                              "subscribeParameterUpdates",
-                                              "unsubscribeParameterUpdates",
-                                              "subscribeConnectionGraph",
-                                              "unsubscribeConnectionGraph",
-                                              "fetchAsset",
-                                              "advertiseServices"};
 }  // namespace
 
-ClientProtocol::ClientProtocol(std::uint32_t channel_count) : by_channel_(channel_count) {}
+ClientProtocol::ClientProtocol(std::uint32_t channel_count, bool parameters, std::uint32_t service_count)
+    : by_channel_(channel_count), parameters_(parameters), service_count_(service_count) {}
 
 std::optional<SubscriptionId> ClientProtocol::subscription(ChannelId channel) const {
   if (channel == 0 || channel > by_channel_.size()) return std::nullopt;
   return by_channel_[channel - 1];
 }
 
-void ClientProtocol::handle_binary(std::size_t size, Outcome& out) {
+void ClientProtocol::handle_binary(std::string_view frame, Outcome& out) {
   out.clear();
-  out.replies.push_back(
-      status_json(StatusLevel::Error,
-                  "binary message of " + std::to_string(size) +
-                      " bytes refused: this server does not accept client publishing or service calls"));
+  const auto error = [&](const std::string& m) { out.replies.push_back(status_json(StatusLevel::Error, m)); };
+  const std::string size = std::to_string(frame.size()) + " bytes";
+  if (service_count_ == 0 || frame.empty() || frame[0] != '\x02') {
+    error("binary message of " + size + " refused: this server accepts " +
+          (service_count_ == 0 ? std::string("no client publishing or service calls")
+                               : "service call requests (opcode 0x02) only, no client publishing"));
+    return;
+  }
+  if (frame.size() < kServiceCallHeader) {
+    error("service call request of " + size + " refused: its header alone is " +
+          std::to_string(kServiceCallHeader) + " bytes");
+    return;
+  }
+  ServiceCall c;
+  c.service = read_u32(frame, 1);
+  c.call = read_u32(frame, 5);
+  const std::uint32_t encoding_size = read_u32(frame, 9);
+  const auto fail = [&](const std::string& m) {
+    out.replies.push_back(service_call_failure_json(c.service, c.call, m));
+  };
+  if (frame.size() > kMaxClientFrame) {
+    fail("request of " + size + " refused: the limit is " + std::to_string(kMaxClientFrame));
+  } else if (c.service == 0 || c.service > service_count_) {
+    fail("unknown service " + std::to_string(c.service) + " (services are 1.." +
+         std::to_string(service_count_) + ")");
+  } else if (encoding_size > frame.size() - kServiceCallHeader) {
+    fail("encoding length " + std::to_string(encoding_size) + " runs past the " + size + " message");
+  } else {
+    c.encoding = std::string(frame.substr(kServiceCallHeader, encoding_size));
+    if (std::find(std::begin(kServiceEncodings), std::end(kServiceEncodings), c.encoding) ==
+        std::end(kServiceEncodings)) {
+      fail("unsupported encoding " + shown(c.encoding) + " (this server takes cdr or json)");
+      return;
+    }
+    c.payload = std::string(frame.substr(kServiceCallHeader + encoding_size));
+    out.call = std::move(c);
+  }
 }
 
 void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
@@ -256,8 +317,14 @@ void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
       --count_;
       out.unsubscribed.push_back({id, static_cast<ChannelId>(it - by_channel_.begin() + 1)});
     }
-  } else if (std::find(std::begin(kUnofferedOps), std::end(kUnofferedOps), op) != std::end(kUnofferedOps)) {
-    error("op \"" + shown(*op_it) + "\" is not supported by this server (capabilities: time)");
+  } else if (std::find(std::begin(kParameterOps), std::end(kParameterOps), op) != std::end(kParameterOps) &&
+             parameters_) {
+    parameter_op(op, j, out, problems);
+  } else if (std::find(std::begin(kUnofferedOps), std::end(kUnofferedOps), op) != std::end(kUnofferedOps) ||
+             std::find(std::begin(kParameterOps), std::end(kParameterOps), op) != std::end(kParameterOps)) {
+    error("op " + shown(*op_it) + " is not supported by this server (capabilities: time" +
+          (parameters_ ? ", parameters, parametersSubscribe" : "") +
+          (service_count_ > 0 ? ", services" : "") + ")");
     return;
   } else {
     error("unknown op " + shown(*op_it));
@@ -291,9 +358,19 @@ void ClientQueue::recycle(std::string&& buffer) {
   pool_.push_back(std::move(buffer));
 }
 
+void ClientQueue::count_in(const Frame& f) {
+  bytes_ += f.data.size();
+  if (f.kind != Kind::PerStep) kept_bytes_ += f.data.size();
+}
+
+void ClientQueue::count_out(const Frame& f) {
+  bytes_ -= f.data.size();
+  if (f.kind != Kind::PerStep) kept_bytes_ -= f.data.size();
+}
+
 void ClientQueue::erase_at(std::size_t i) {
   Frame& f = slot(i);
-  bytes_ -= f.data.size();
+  count_out(f);
   recycle(std::move(f.data));
   f.data = std::string();
   // Shift the older frames up by one: drops happen near the front, so this is short.
@@ -321,7 +398,7 @@ void ClientQueue::make_room(std::size_t incoming, bool droppable, bool& drop_inc
             " MiB); latched topics are kept");
     Frame& f = emplace(Kind::Control);
     f.data.assign(m);
-    bytes_ += f.data.size();
+    count_in(f);
   }
   std::size_t i = first_droppable;
   while (over()) {
@@ -354,11 +431,16 @@ ClientQueue::Frame& ClientQueue::emplace(Kind kind) {
 }
 
 void ClientQueue::push_text(std::string_view json) {
+  push_control(json, false);
+}
+
+void ClientQueue::push_control(std::string_view data, bool binary) {
   bool drop = false;
-  make_room(json.size(), false, drop);
+  make_room(data.size(), false, drop);
   Frame& f = emplace(Kind::Control);
-  f.data.assign(json);
-  bytes_ += f.data.size();
+  f.binary = binary;
+  f.data.assign(data);
+  count_in(f);
 }
 
 void ClientQueue::push_message(Kind kind, SubscriptionId subscription, std::uint64_t log_time_ns,
@@ -371,7 +453,7 @@ void ClientQueue::push_message(Kind kind, SubscriptionId subscription, std::uint
   f.binary = true;
   f.subscription = subscription;
   append_message_data(f.data, subscription, log_time_ns, payload);
-  bytes_ += f.data.size();
+  count_in(f);
 }
 
 void ClientQueue::push_time(std::uint64_t time_ns) {
@@ -381,13 +463,13 @@ void ClientQueue::push_time(std::uint64_t time_ns) {
   Frame& f = emplace(Kind::PerStep);
   f.binary = true;
   append_time(f.data, time_ns);
-  bytes_ += f.data.size();
+  count_in(f);
 }
 
 bool ClientQueue::pop(Frame& out) {
   if (count_ == 0) return false;
   Frame& f = slot(0);
-  bytes_ -= f.data.size();
+  count_out(f);
   recycle(std::move(out.data));
   out.kind = f.kind;
   out.binary = f.binary;

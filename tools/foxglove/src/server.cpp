@@ -5,6 +5,11 @@
 // client frames, sending, stall detection) runs on the I/O thread. The producer never waits on a
 // socket, nor on websocketpp: the I/O thread holds `mu` only to take frames out of the queues
 // (moves, no copies) and hands them to websocketpp after releasing it.
+//
+// Steering: the I/O thread reads the controller and submits commands without holding `mu` (a
+// closed controller answers inside submit()); the answers and the parameter updates come from the
+// controller's callbacks on the run loop's thread, through a ReplyLink that the server empties when
+// it stops, so a callback after the server is gone does nothing.
 #include <arpa/inet.h>
 
 #include <atomic>
@@ -13,7 +18,10 @@
 #include <mutex>
 #include <thread>
 
+#include <unordered_map>
+
 #include "rbsim/foxglove.hpp"
+#include "services.hpp"
 #include "transport.hpp"
 
 namespace rbsim::foxglove {
@@ -38,8 +46,28 @@ struct Client {
   // to the queue's pool at the next take, or to websocketpp when sent.
   std::vector<ClientQueue::Frame> outgoing;
   std::size_t taken = 0;
-  Client(detail::ConnectionId id, std::uint32_t channels, const QueueLimits& limits)
-      : connection(id), protocol(channels), queue(limits) {}
+  // Steering.
+  std::vector<bool> parameter_updates;  // by parameter index: subscribed to its updates
+  std::uint32_t pending = 0;            // commands submitted, not answered
+  bool backlog_told = false;            // told its requests are refused for its backlog
+  Client(detail::ConnectionId id, std::uint32_t channels, bool parameters, std::uint32_t services,
+         const QueueLimits& limits)
+      : connection(id), protocol(channels, parameters, services), queue(limits) {}
+};
+
+struct Reply {
+  std::string data;
+  bool binary = false;
+};
+
+// How the controller's callbacks reach the server: empty once the server stops.
+struct ReplyLink {
+  std::mutex mu;
+  Server::Impl* server = nullptr;
+  // Queues `replies` for connection `id` (gone: dropped); `answered`: one of its commands is done.
+  void deliver(detail::ConnectionId id, const std::vector<Reply>& replies, bool answered);
+  // The controller's observer: parameterValues to each client subscribed to a changed parameter.
+  void changed(const std::vector<msgs::Parameter>& parameters);
 };
 
 struct Server::Impl {
@@ -65,6 +93,13 @@ struct Server::Impl {
   // I/O thread scratch, reused.
   ClientProtocol::Outcome outcome;
 
+  // Steering (options.controller set): fixed for the server's life.
+  std::vector<ServiceSpec> services;
+  std::string advertise_services;
+  std::vector<std::string> parameter_names;  // the controller's table, in order
+  std::unordered_map<std::string, std::size_t> parameter_index;
+  std::shared_ptr<ReplyLink> link = std::make_shared<ReplyLink>();
+
   Client* find(detail::ConnectionId id) {
     for (auto& c : clients) {
       if (c->connection == id) return c.get();
@@ -77,16 +112,20 @@ struct Server::Impl {
     const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
                         std::chrono::system_clock::now().time_since_epoch())
                         .count();
-    server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions));
+    server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions),
+                                   options.controller != nullptr);
     for (Latched& l : latched) l.has = false;
   }
 
   void opened(detail::ConnectionId id) {
     {
       std::lock_guard lock(mu);
-      auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()), options.queue);
+      auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()),
+                                        options.controller != nullptr,
+                                        static_cast<std::uint32_t>(services.size()), options.queue);
       c->queue.push_text(server_info);
       c->queue.push_text(advertise);
+      if (!services.empty()) c->queue.push_text(advertise_services);
       c->last_progress_ns = monotonic_ns();
       ++totals.clients;
       clients.push_back(std::move(c));
@@ -112,18 +151,52 @@ struct Server::Impl {
   }
 
   void message(detail::ConnectionId id, const std::string& payload, bool binary) {
+    std::optional<ParameterRequest> parameters;
+    std::optional<ServiceCall> call;
     {
       std::lock_guard lock(mu);
       if (!handle(id, payload, binary)) return;
+      parameters = std::move(outcome.parameters);
+      call = std::move(outcome.call);
     }
+    // Without `mu`: the controller may answer inside submit(), through the link.
+    if (parameters) serve_parameters(id, std::move(*parameters));
+    if (call) serve_call(id, std::move(*call));
     pump_all();
+  }
+
+  // Under `mu`: whether `c` may make a request now (false: refused, and told so once per backlog).
+  bool admit(Client& c, bool command, const ServiceCall* call) {
+    const std::size_t backlog = c.queue.kept_bytes();
+    if (backlog < options.max_reply_backlog_bytes / 2) c.backlog_told = false;
+    if (backlog >= options.max_reply_backlog_bytes) {
+      ++totals.refused_requests;
+      if (!c.backlog_told) {
+        c.backlog_told = true;
+        c.queue.push_text(
+            status_json(StatusLevel::Error, "rbsim: requests refused until this client reads its replies (" +
+                                                std::to_string(backlog) + " bytes waiting)"));
+      }
+      return false;
+    }
+    if (command && c.pending >= options.max_pending_commands) {
+      ++totals.refused_requests;
+      const std::string m = "too many requests in flight (" + std::to_string(options.max_pending_commands) +
+                            " per client): wait for their answers";
+      c.queue.push_text(call ? service_call_failure_json(call->service, call->call, m)
+                             : status_json(StatusLevel::Error, "setParameters: " + m));
+      return false;
+    }
+    ++totals.requests;
+    if (command) ++c.pending;
+    return true;
   }
 
   bool handle(detail::ConnectionId id, const std::string& payload, bool binary) {
     Client* c = find(id);
     if (c == nullptr) return false;
     if (binary) {
-      c->protocol.handle_binary(payload.size(), outcome);
+      c->protocol.handle_binary(payload, outcome);
     } else {
       c->protocol.handle_text(payload, outcome);
     }
@@ -137,8 +210,20 @@ struct Server::Impl {
       if (l.has) c->queue.push_message(ClientQueue::Kind::Latched, s.id, l.log_time, l.payload);
     }
     for (const std::string& r : outcome.replies) c->queue.push_text(r);
+    if (outcome.parameters && !admit(*c, outcome.parameters->op == ParameterRequest::Op::Set, nullptr)) {
+      outcome.parameters.reset();
+    }
+    if (outcome.call && !admit(*c, true, &*outcome.call)) outcome.call.reset();
     return true;
   }
+
+  void reply(detail::ConnectionId id, const std::vector<Reply>& replies, bool answered) {
+    link->deliver(id, replies, answered);
+  }
+
+  // I/O thread, without `mu`.
+  void serve_parameters(detail::ConnectionId id, ParameterRequest r);
+  void serve_call(detail::ConnectionId id, ServiceCall call);
 
   // Under `mu`: takes the frames websocketpp may have now (while less than max_in_flight_bytes is
   // buffered there) and notes whether the client read anything since the last pump.
@@ -189,6 +274,178 @@ struct Server::Impl {
   }
 };
 
+// ---------------------------------------------------------------------------------------------
+// Steering
+
+void ReplyLink::deliver(detail::ConnectionId id, const std::vector<Reply>& replies, bool answered) {
+  const std::lock_guard link_lock(mu);
+  if (server == nullptr) return;
+  {
+    const std::lock_guard lock(server->mu);
+    Client* c = server->find(id);
+    if (c == nullptr) return;
+    if (answered && c->pending > 0) --c->pending;
+    for (const Reply& r : replies) c->queue.push_control(r.data, r.binary);
+  }
+  server->transport->wake();
+}
+
+void ReplyLink::changed(const std::vector<msgs::Parameter>& parameters) {
+  if (parameters.empty()) return;
+  const std::lock_guard link_lock(mu);
+  if (server == nullptr) return;
+  bool queued = false;
+  {
+    const std::lock_guard lock(server->mu);
+    std::vector<msgs::Parameter> subset;
+    for (auto& c : server->clients) {
+      if (c->parameter_updates.empty()) continue;
+      subset.clear();
+      for (const msgs::Parameter& p : parameters) {
+        const auto it = server->parameter_index.find(p.name);
+        if (it != server->parameter_index.end() && c->parameter_updates[it->second]) subset.push_back(p);
+      }
+      if (subset.empty()) continue;
+      c->queue.push_text(parameter_values_json(subset));
+      queued = true;
+    }
+  }
+  if (queued) server->transport->wake();
+}
+
+namespace {
+// One status error naming the problems of a request ("" when none).
+void add_problems(std::vector<Reply>& replies, const std::string& op,
+                  const std::vector<std::string>& problems) {
+  if (problems.empty()) return;
+  std::string m = op + ": ";
+  for (std::size_t k = 0; k < problems.size() && k < 5; ++k) m += (k ? "; " : "") + problems[k];
+  if (problems.size() > 5) m += "; and " + std::to_string(problems.size() - 5) + " more";
+  replies.push_back({status_json(StatusLevel::Error, m), false});
+}
+}  // namespace
+
+void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r) {
+  using Op = ParameterRequest::Op;
+  control::Controller& controller = *options.controller;
+  const char* op = r.op == Op::Get         ? "getParameters"
+                   : r.op == Op::Set       ? "setParameters"
+                   : r.op == Op::Subscribe ? "subscribeParameterUpdates"
+                                           : "unsubscribeParameterUpdates";
+  std::vector<Reply> replies;
+  std::vector<std::string> problems;
+  if (r.op == Op::Set) {
+    // Checked here, not on the run loop: a name the node does not have, and a request naming more
+    // parameters than the node has (it repeats names; the run loop's work stays bounded).
+    if (r.values.size() > parameter_names.size()) {
+      reply(id,
+            {{status_json(StatusLevel::Error, "setParameters: " + std::to_string(r.values.size()) +
+                                                  " values in one request, more than the node's " +
+                                                  std::to_string(parameter_names.size()) + " parameters"),
+              false}},
+            true);
+      return;
+    }
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < r.values.size(); ++k) {
+      if (parameter_index.count(r.values[k].name) == 0) {
+        problems.push_back("no parameter '" + r.values[k].name.substr(0, 200) + "'");
+        continue;
+      }
+      if (kept != k) {
+        r.values[kept] = std::move(r.values[k]);
+        r.untyped_integer[kept] = r.untyped_integer[k];
+      }
+      ++kept;
+    }
+    r.values.resize(kept);
+    r.untyped_integer.resize(kept);
+    for (const msgs::Parameter& p : r.values) r.names.push_back(p.name);
+  } else if (r.names.empty()) {
+    r.names = parameter_names;  // every parameter
+  }
+  // The values now: a get's answer, and a set's answer for what it does not change.
+  std::vector<std::optional<msgs::ParameterValue>> now = controller.get(r.names);
+  std::vector<msgs::Parameter> known;
+  for (std::size_t k = 0; k < r.names.size(); ++k) {
+    if (now[k]) {
+      known.push_back({r.names[k], *now[k]});
+    } else if (r.op != Op::Set) {
+      problems.push_back("no parameter '" + r.names[k].substr(0, 200) + "'");
+    }
+  }
+  if (r.op == Op::Get) {
+    replies.push_back({parameter_values_json(known, r.id), false});
+  } else if (r.op == Op::Subscribe || r.op == Op::Unsubscribe) {
+    const std::lock_guard lock(mu);
+    if (Client* c = find(id)) {
+      c->parameter_updates.resize(parameter_names.size());
+      for (const msgs::Parameter& p : known)
+        c->parameter_updates[parameter_index.at(p.name)] = r.op == Op::Subscribe;
+    }
+  }
+  if (r.op != Op::Set) {
+    add_problems(replies, op, problems);
+    reply(id, replies, false);
+    return;
+  }
+  // A JSON integer for a double parameter is that double (JSON cannot tell 2 from 2.0), if exact.
+  const std::vector<msgs::ParameterType> types = controller.types(r.names);
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    msgs::ParameterValue& v = r.values[k].value;
+    if (r.untyped_integer[k] && types[k] == msgs::ParameterType::Double &&
+        v.integer_value >= -(std::int64_t{1} << 53) && v.integer_value <= (std::int64_t{1} << 53)) {
+      v = msgs::ParameterValue::of_double(static_cast<double>(v.integer_value));
+    }
+  }
+  control::Command command;
+  command.kind = control::CommandKind::SetParameters;
+  command.atomic = false;  // each its own result, as set_parameters
+  command.parameters = r.values;
+  command.source = "foxglove";
+  controller.submit(std::move(command),
+                    [link = link, id, answer = r.id, values = r.values, known = std::move(known),
+                     refused = std::move(problems)](const control::CommandResult& result) mutable {
+                      std::vector<Reply> out;
+                      if (result.results.size() != values.size()) {
+                        refused.push_back(result.message);  // never applied (the run ended)
+                      } else {
+                        for (std::size_t k = 0; k < values.size(); ++k) {
+                          if (!result.results[k].successful) refused.push_back(result.results[k].reason);
+                        }
+                      }
+                      if (answer) {
+                        for (msgs::Parameter& p : known) {
+                          for (const msgs::Parameter& c : result.changed) {
+                            if (c.name == p.name) p.value = c.value;
+                          }
+                        }
+                        out.push_back({parameter_values_json(known, answer), false});
+                      }
+                      add_problems(out, "setParameters", refused);
+                      link->deliver(id, out, true);
+                    });
+}
+
+void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
+  const control::ControlService& service = control::control_services()[call.service - 1];
+  Result<control::Command> command = detail::decode_request(service, call.encoding, call.payload);
+  if (!command) {
+    reply(id, {{service_call_failure_json(call.service, call.call, command.error().message), false}}, true);
+    return;
+  }
+  command->source = "foxglove";
+  options.controller->submit(std::move(command.value()), [link = link, id, call = std::move(call)](
+                                                             const control::CommandResult& result) {
+    const control::ControlService& s = control::control_services()[call.service - 1];
+    const std::string payload = detail::encode_response(s, call.encoding, result);
+    Reply r{{}, true};
+    append_service_call_response(r.data, call.service, call.call, call.encoding,
+                                 {reinterpret_cast<const std::byte*>(payload.data()), payload.size()});
+    link->deliver(id, {r}, true);
+  });
+}
+
 Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
                                               std::vector<ChannelSpec> channels) {
   std::unique_ptr<Server> s(new Server());
@@ -198,6 +455,12 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   im.channels = std::move(channels);
   im.advertise = advertise_json(im.channels);
   im.latched.resize(im.channels.size());
+  if (options.controller != nullptr) {
+    im.services = detail::control_service_specs(options.node);
+    im.advertise_services = advertise_services_json(im.services);
+    im.parameter_names = options.controller->list({}, control::kDepthRecursive).names;
+    for (std::size_t i = 0; i < im.parameter_names.size(); ++i) im.parameter_index[im.parameter_names[i]] = i;
+  }
   im.subscribers = std::make_unique<std::atomic<std::uint32_t>[]>(im.channels.size());
   for (std::size_t i = 0; i < im.channels.size(); ++i) im.subscribers[i] = 0;
   im.new_session_locked();
@@ -223,6 +486,13 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   if (!err.empty()) {
     return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
   }
+  if (options.controller != nullptr) {
+    im.link->server = &im;
+    options.controller->on_command(
+        [link = im.link](const control::Command&, const control::CommandResult& r) {
+          link->changed(r.changed);
+        });
+  }
   im.transport->run();
   return s;
 }
@@ -232,7 +502,12 @@ Server::~Server() {
 }
 
 void Server::stop() {
-  if (impl_ && impl_->transport) impl_->transport->stop();
+  if (!impl_) return;
+  {
+    const std::lock_guard lock(impl_->link->mu);  // the controller's callbacks do nothing from here
+    impl_->link->server = nullptr;
+  }
+  if (impl_->transport) impl_->transport->stop();
 }
 
 std::uint16_t Server::port() const {

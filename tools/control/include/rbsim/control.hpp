@@ -20,7 +20,9 @@
 #include <future>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rbsim/core.hpp"
@@ -74,6 +76,10 @@ struct CommandResult {
   std::int64_t step = Command::kNextStep;  // the boundary at which it applied (kNextStep: it never did)
   // SetParameters: one result for an atomic batch, one per parameter otherwise.
   std::vector<SetParametersResult> results;
+  // Every parameter the command changed, with its new value, in table order for a reset (which
+  // returns parameters to their initial values) and request order otherwise; `paused` for a pause
+  // or resume that changed it. What /parameter_events and Foxglove's parameter updates report.
+  std::vector<Parameter> changed;
 };
 
 // For the end line: calls answered (commands applied or refused, and reads) and parameters
@@ -123,10 +129,11 @@ class Controller final : public StepHook {
   void end_when_idle(bool on) { end_when_idle_ = on; }
   // Whether a pass ended that way, and at which step.
   std::optional<std::int64_t> ended_paused() const { return ended_paused_; }
-  // Called on the loop's thread for every command applied or refused at a boundary, with its
-  // step filled in (the record of commands as data).
+  // Adds an observer, called on the loop's thread for every command applied or refused at a
+  // boundary, with its step filled in (the record of commands as data); observers are called in
+  // the order they were added (the node's /parameter_events, the Foxglove server's updates).
   void on_command(std::function<void(const Command&, const CommandResult&)> observer) {
-    observer_ = std::move(observer);
+    observers_.push_back(std::move(observer));
   }
 
   // ---- The run loop's thread (StepHook).
@@ -173,9 +180,27 @@ class Controller final : public StepHook {
   std::int64_t step_budget_ = 0;   // steps left of a `step N` while paused
   std::optional<std::chrono::steady_clock::time_point> resume_at_;  // a timed pause's end
   std::function<void(const RunSettings&)> settings_listener_;
-  std::function<void(const Command&, const CommandResult&)> observer_;
+  std::vector<std::function<void(const Command&, const CommandResult&)>> observers_;
   bool end_when_idle_ = false;
   std::optional<std::int64_t> ended_paused_;
 };
+
+// The control services, one mapping from their requests to Commands and from results to their
+// replies for every front end (the node's DDS services, the Foxglove server): pause, resume and
+// reset (std_srvs/srv/Trigger), step (rbsim_msgs/srv/Step), apply_impulse
+// (rbsim_msgs/srv/ApplyImpulse), in that order. A reply's `step` is the boundary the command
+// applied at (0 if it never did).
+struct ControlService {
+  std::string_view name;  // "pause"
+  std::string_view type;  // "std_srvs/srv/Trigger"
+  CommandKind kind;
+};
+std::span<const ControlService> control_services();
+Command command_for(CommandKind trigger_kind, const msgs::TriggerRequest& request);
+Command command_for(const msgs::StepRequest& request);
+Command command_for(const msgs::ApplyImpulseRequest& request);
+msgs::TriggerResponse trigger_response(const CommandResult& result);
+msgs::StepResponse step_response(const CommandResult& result);
+msgs::ApplyImpulseResponse impulse_response(const CommandResult& result);
 
 }  // namespace rbsim::control

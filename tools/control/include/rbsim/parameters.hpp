@@ -24,6 +24,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -125,6 +127,8 @@ class ParameterTable {
   };
   void add(ParameterDescriptor descriptor, ParameterValue value, ParameterTarget target);
   std::vector<Entry> entries_;
+  // Name -> index: a lookup stays O(log n) however many names a request (or a client) sends.
+  std::map<std::string, std::size_t, std::less<>> index_;
 };
 
 // Applies a value the table accepted to a scene definition (initial values, before the World

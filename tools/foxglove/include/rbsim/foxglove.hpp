@@ -4,9 +4,11 @@
 //
 // Three layers, the first two pure (no I/O, no threads) so that tests and the fuzzer drive them
 // directly:
-//  - the protocol: the JSON a server sends (serverInfo, advertise, status), the binary frames
-//    (messageData, time), the subprotocol choice, and ClientProtocol, which parses one client frame
-//    and keeps that client's subscriptions;
+//  - the protocol: the JSON a server sends (serverInfo, advertise, status, advertiseServices,
+//    parameterValues, serviceCallFailure), the binary frames (messageData, time,
+//    serviceCallResponse), the subprotocol choice, and ClientProtocol, which parses one client
+//    frame, keeps that client's subscriptions and hands over its parameter requests and service
+//    calls as data;
 //  - flow control: ClientQueue, the bounded per-client queue that drops the oldest per-step
 //    message (never a latched one or a control message) when a client falls behind;
 //  - the Server (websocketpp on its own I/O thread) and FoxgloveSink, the Sink that publishes a
@@ -22,7 +24,9 @@
 #include <string_view>
 #include <vector>
 
+#include "rbsim/control.hpp"
 #include "rbsim/core.hpp"
+#include "rbsim/interfaces.hpp"
 #include "rbsim/msgs.hpp"
 #include "rbsim/sink.hpp"
 
@@ -60,11 +64,36 @@ struct ChannelSpec {
 };
 using ChannelId = std::uint32_t;
 using SubscriptionId = std::uint32_t;
+using ServiceId = std::uint32_t;
+using CallId = std::uint32_t;
 
-std::string server_info_json(std::string_view name, std::string_view session_id);
+// With a controller (rbsim node) the server also offers the capabilities parameters,
+// parametersSubscribe and services; a service call's request comes in one of these encodings,
+// the client's choice per call (the spec's "one of the encodings supported by the server"), and
+// its response in the same one. cdr is first: Foxglove Studio calls in the first one it knows.
+inline constexpr std::string_view kServiceEncodings[] = {"cdr", "json"};
+
+// `control`: the capabilities above and supportedEncodings; else only `time`.
+std::string server_info_json(std::string_view name, std::string_view session_id, bool control = false);
 // Every channel of `channels`, channel i (0-based) with id i + 1.
 std::string advertise_json(std::span<const ChannelSpec> channels);
 std::string status_json(StatusLevel level, std::string_view message);
+
+// A service the server offers (ids are 1-based positions in the server's service list).
+struct ServiceSpec {
+  std::string name;             // "/rbsim/pause"
+  std::string type;             // "std_srvs/srv/Trigger"
+  std::string request_schema;   // ros2msg text of <type>_Request
+  std::string response_schema;  // ros2msg text of <type>_Response
+};
+// Each service with `request` and `response` (encoding cdr, schemaEncoding ros2msg) and, for
+// clients of the older form (Foxglove Studio 1.x), `requestSchema` and `responseSchema`.
+std::string advertise_services_json(std::span<const ServiceSpec> services);
+// parameterValues (with `id` when given): a double is sent with "type": "float64", a double array
+// with "float64_array", a byte array base64-encoded with "byte_array", other values as JSON.
+std::string parameter_values_json(std::span<const msgs::Parameter> parameters,
+                                  const std::optional<std::string>& id = std::nullopt);
+std::string service_call_failure_json(ServiceId service, CallId call, std::string_view message);
 
 // The binary frames a server sends (little endian): messageData is opcode 0x01, the subscription
 // id (uint32), the log time (uint64 ns) and the payload; time is opcode 0x02 and the time (ns).
@@ -72,15 +101,47 @@ inline constexpr std::size_t kMessageDataHeader = 1 + 4 + 8;
 void append_message_data(std::string& out, SubscriptionId subscription, std::uint64_t log_time_ns,
                          std::span<const std::byte> payload);
 void append_time(std::string& out, std::uint64_t time_ns);
+// serviceCallResponse: opcode 0x03, service id, call id, encoding length (uint32), encoding, payload.
+void append_service_call_response(std::string& out, ServiceId service, CallId call, std::string_view encoding,
+                                  std::span<const std::byte> payload);
+// A client's service call request (opcode 0x02) is at least this long: opcode, service id, call
+// id, encoding length.
+inline constexpr std::size_t kServiceCallHeader = 1 + 4 + 4 + 4;
+
+// A client's parameter request, parsed (names are not checked: the controller knows them).
+struct ParameterRequest {
+  enum class Op : std::uint8_t { Get, Set, Subscribe, Unsubscribe };
+  Op op = Op::Get;
+  std::vector<std::string> names;  // Get, Subscribe, Unsubscribe; empty: every parameter
+  // Set: the values as typed from JSON: true/false bool, 2 integer, 2.5 double (or any number
+  // with "type": "float64"), "x" string, base64 with "type": "byte_array" bytes, arrays of one
+  // of these. A JSON integer without a type hint may stand for a double (JSON cannot tell 2.0 from
+  // 2): `untyped_integer[k]` says so, and the server types it by the parameter's declared type.
+  std::vector<msgs::Parameter> values;
+  std::vector<bool> untyped_integer;
+  std::optional<std::string> id;  // Get, Set: echoed in the parameterValues answer
+};
+// A client's service call, its header checked (a known service, an offered encoding, within
+// kMaxClientFrame); the payload is the service's to decode.
+struct ServiceCall {
+  ServiceId service = 0;
+  CallId call = 0;
+  std::string encoding;
+  std::string payload;
+};
 
 // One client's side of the protocol: parses its frames and keeps its subscriptions. Channels are
-// 1 .. channel_count. Any input is answered, never thrown on: a malformed frame, an unknown op,
-// an unknown channel or subscription id, a binary frame (we do not offer clientPublish) or a frame
-// over kMaxClientFrame gives one status error per frame (naming at most a few of the problems),
-// and the valid parts of a subscribe or unsubscribe still take effect.
+// 1 .. channel_count; with `parameters` the parameter ops are accepted, and services are
+// 1 .. service_count. Any input is answered, never thrown on: a malformed frame, an unknown op, an
+// op not offered, an unknown channel or subscription id, a binary frame other than a service call
+// (we do not offer clientPublish) or a frame over kMaxClientFrame gives one status error per frame
+// (naming at most a few of the problems), and the valid parts of a subscribe, unsubscribe or
+// setParameters still take effect. A service call with a readable header but an unknown service,
+// an encoding not offered or a payload over the limit gets a serviceCallFailure instead.
 class ClientProtocol {
  public:
-  explicit ClientProtocol(std::uint32_t channel_count);
+  explicit ClientProtocol(std::uint32_t channel_count, bool parameters = false,
+                          std::uint32_t service_count = 0);
 
   struct Subscription {
     SubscriptionId id = 0;
@@ -88,19 +149,23 @@ class ClientProtocol {
     bool operator==(const Subscription&) const = default;
   };
   struct Outcome {
-    std::vector<Subscription> subscribed;    // new, in request order
-    std::vector<Subscription> unsubscribed;  // ended, in request order
-    std::vector<std::string> replies;        // JSON text frames to send back (status)
+    std::vector<Subscription> subscribed;        // new, in request order
+    std::vector<Subscription> unsubscribed;      // ended, in request order
+    std::vector<std::string> replies;            // JSON text frames to send back (status, serviceCallFailure)
+    std::optional<ParameterRequest> parameters;  // a parameter op to carry out
+    std::optional<ServiceCall> call;             // a service call to carry out
     void clear() {
       subscribed.clear();
       unsubscribed.clear();
       replies.clear();
+      parameters.reset();
+      call.reset();
     }
   };
   // Handles one text frame (`out` is cleared first).
   void handle_text(std::string_view frame, Outcome& out);
-  // Handles one binary frame of `size` bytes (`out` is cleared first).
-  void handle_binary(std::size_t size, Outcome& out);
+  // Handles one binary frame (`out` is cleared first).
+  void handle_binary(std::string_view frame, Outcome& out);
 
   // The subscription on `channel`, if any.
   std::optional<SubscriptionId> subscription(ChannelId channel) const;
@@ -110,6 +175,8 @@ class ClientProtocol {
  private:
   std::vector<std::optional<SubscriptionId>> by_channel_;  // index channel - 1
   std::size_t count_ = 0;
+  bool parameters_ = false;
+  std::uint32_t service_count_ = 0;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -139,6 +206,8 @@ class ClientQueue {
   explicit ClientQueue(QueueLimits limits = {});
 
   void push_text(std::string_view json);
+  // A control frame: JSON text, or a binary serviceCallResponse.
+  void push_control(std::string_view data, bool binary);
   void push_message(Kind kind, SubscriptionId subscription, std::uint64_t log_time_ns,
                     std::span<const std::byte> payload);
   void push_time(std::uint64_t time_ns);  // per step: droppable
@@ -152,6 +221,9 @@ class ClientQueue {
   bool empty() const { return count_ == 0; }
   std::size_t size() const { return count_; }
   std::size_t bytes() const { return bytes_; }
+  // The bytes of the frames never dropped (control and latched): what a client that sends
+  // requests and reads no replies piles up (the server refuses its requests past a bound).
+  std::size_t kept_bytes() const { return kept_bytes_; }
   std::uint64_t dropped() const { return dropped_; }    // per-step frames dropped so far
   std::uint64_t warnings() const { return warnings_; }  // overflow bursts (one warning each)
 
@@ -166,7 +238,9 @@ class ClientQueue {
 
   QueueLimits limits_;
   std::vector<Frame> ring_;
-  std::size_t head_ = 0, count_ = 0, bytes_ = 0;
+  void count_in(const Frame& f);   // adds f's bytes to the totals
+  void count_out(const Frame& f);  // takes them away
+  std::size_t head_ = 0, count_ = 0, bytes_ = 0, kept_bytes_ = 0;
   std::vector<std::string> pool_;  // spare buffers
   std::uint64_t dropped_ = 0, warnings_ = 0;
   bool in_burst_ = false;
@@ -185,6 +259,18 @@ struct ServerOptions {
   std::size_t max_in_flight_bytes = 4u << 20;
   // A client that reads nothing of what is in flight for this long is disconnected.
   double stall_timeout_s = 5.0;
+  // Steering (rbsim node): with a controller the server offers parameters, parametersSubscribe and
+  // services (control::control_services() named <node>/<name>); every request goes through the
+  // controller, answered from its callbacks (never waited for on the I/O thread); start() adds
+  // the observer of parameter updates (Controller::on_command), so it comes before the run loop.
+  // The controller must outlive the server. Without one (replay, bridge) only `time` is offered.
+  control::Controller* controller = nullptr;
+  std::string node = "/rbsim";
+  // Per client: parameter sets and service calls submitted and not yet answered (more are refused:
+  // a serviceCallFailure or a status error), and the unread replies and other frames never dropped
+  // beyond which its requests are refused unanswered (one status error per backlog).
+  std::uint32_t max_pending_commands = 32;
+  std::size_t max_reply_backlog_bytes = 4u << 20;
 };
 
 // "127.0.0.1:8765", "8765" (the default address), "0.0.0.0:0", "[::1]:8765" -> options.address
@@ -197,12 +283,14 @@ std::string foxglove_app_link(std::string_view url);
 
 // Counts over the server's life.
 struct ServerStats {
-  std::uint64_t clients = 0;       // connections accepted
-  std::uint64_t refused = 0;       // handshakes refused (no foxglove subprotocol)
-  std::uint64_t dropped = 0;       // per-step frames dropped for slow clients
-  std::uint64_t warnings = 0;      // overflow bursts warned about
-  std::uint64_t disconnected = 0;  // clients disconnected for not reading
-  std::uint64_t published = 0;     // messages handed to the server (publish calls that queued)
+  std::uint64_t clients = 0;           // connections accepted
+  std::uint64_t refused = 0;           // handshakes refused (no foxglove subprotocol)
+  std::uint64_t dropped = 0;           // per-step frames dropped for slow clients
+  std::uint64_t warnings = 0;          // overflow bursts warned about
+  std::uint64_t disconnected = 0;      // clients disconnected for not reading
+  std::uint64_t published = 0;         // messages handed to the server (publish calls that queued)
+  std::uint64_t requests = 0;          // parameter requests and service calls carried out
+  std::uint64_t refused_requests = 0;  // refused for a client's backlog or commands in flight
 };
 
 // Serves a fixed set of channels on its own I/O thread. publish(), time() and new_session() are

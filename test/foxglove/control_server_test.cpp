@@ -1,0 +1,416 @@
+// The Foxglove server steering a run over loopback sockets: a Controller driving a real run loop
+// (the control tests' scene, started paused), clients of ws_client.hpp. Every op answered through
+// the controller (parameters read, set, typed and refused; updates to subscribers only; the five
+// services in cdr and json, their refusals), and the bounds that keep a hostile client from
+// hurting the run (commands in flight, a reply backlog, a server gone before its answers).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "../control/control_test_util.hpp"
+#include "rbsim/foxglove.hpp"
+#include "ws_client.hpp"
+
+namespace rbsim::foxglove {
+namespace {
+
+using Json = nlohmann::json;
+using test::WsClient;
+using namespace std::chrono_literals;
+
+std::string le32(std::uint32_t v) {
+  std::string s(4, '\0');
+  std::memcpy(s.data(), &v, 4);
+  return s;
+}
+std::string call_frame(std::uint32_t service, std::uint32_t call, const std::string& encoding,
+                       const std::string& payload) {
+  return "\x02" + le32(service) + le32(call) + le32(static_cast<std::uint32_t>(encoding.size())) + encoding +
+         payload;
+}
+std::string cdr_text(const Bytes& b) {
+  return {reinterpret_cast<const char*>(b.data()), b.size()};
+}
+template <class T>
+std::string cdr(const T& message) {
+  Bytes b;
+  msgs::encode(message, b);
+  return cdr_text(b);
+}
+
+// A run of the control scene (started paused at step 0, as fast as possible once resumed, long
+// enough to outlast a test) with its controller, on a thread, and a server steering it.
+constexpr std::int64_t kSteps = 100'000'000;
+struct Steered {
+  Scene scene = rbsim::test::control_scene();
+  control::Controller controller{scene, kSteps, control::RunSettings{0.0, 1, true}};
+  std::unique_ptr<Server> server;
+  std::thread loop;
+  explicit Steered(ServerOptions o = {}, bool run = true) {
+    o.address = "127.0.0.1";
+    o.port = 0;
+    o.controller = &controller;
+    o.node = "/sim";
+    auto s = Server::start(o, {});
+    EXPECT_TRUE(s) << (s ? "" : s.error().message);
+    if (s) server = std::move(s.value());
+    if (!run) return;
+    loop = std::thread([this] {
+      Result<Driver> driver = Driver::create(scene);
+      if (!driver) return;
+      DriverOptions options;
+      options.steps = kSteps;
+      options.control = &controller;
+      (void)driver.value().run_pass(options);
+    });
+  }
+  ~Steered() {
+    controller.close("the test ended");
+    if (loop.joinable()) loop.join();
+    server.reset();
+  }
+};
+
+// Reads frames (at most 100, each within the client's 5 s timeout) until one satisfies `want`.
+template <class P>
+std::optional<WsClient::Frame> read_until(WsClient& c, P want) {
+  for (int i = 0; i < 100; ++i) {
+    auto f = c.read();
+    if (!f) return std::nullopt;
+    if (want(*f)) return f;
+  }
+  return std::nullopt;
+}
+// The next text frame with op `op`.
+Json next_op(WsClient& c, const std::string& op) {
+  auto f = read_until(c, [&](const WsClient::Frame& g) {
+    return g.opcode == 1 && Json::parse(g.data, nullptr, false).value("op", "") == op;
+  });
+  return f ? Json::parse(f->data) : Json();
+}
+struct Response {
+  std::uint32_t service = 0, call = 0;
+  std::string encoding, payload;
+};
+std::optional<Response> next_response(WsClient& c) {
+  auto f = read_until(
+      c, [](const WsClient::Frame& g) { return g.opcode == 2 && !g.data.empty() && g.data[0] == 3; });
+  if (!f || f->data.size() < 13) return std::nullopt;
+  Response r;
+  std::uint32_t n = 0;
+  std::memcpy(&r.service, f->data.data() + 1, 4);
+  std::memcpy(&r.call, f->data.data() + 5, 4);
+  std::memcpy(&n, f->data.data() + 9, 4);
+  r.encoding = f->data.substr(13, n);
+  r.payload = f->data.substr(13 + n);
+  return r;
+}
+Json connect(WsClient& c, std::uint16_t port) {
+  EXPECT_EQ(c.connect(port, {"foxglove.websocket.v1"}), 101);
+  const Json info = next_op(c, "serverInfo");
+  EXPECT_FALSE(next_op(c, "advertise").is_null());
+  return info;
+}
+Json value_of(const Json& values, const std::string& name) {
+  for (const Json& p : values["parameters"]) {
+    if (p["name"] == name) return p;
+  }
+  return Json();
+}
+
+TEST(FoxgloveSteering, AdvertisesTheCapabilitiesAndTheFiveServices) {
+  Steered s;
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  const Json info = connect(c, s.server->port());
+  EXPECT_EQ(info["capabilities"], Json::array({"time", "parameters", "parametersSubscribe", "services"}));
+  EXPECT_EQ(info["supportedEncodings"], Json::array({"cdr", "json"}));
+  const Json services = next_op(c, "advertiseServices")["services"];
+  ASSERT_EQ(services.size(), 5u);
+  const char* names[] = {"/sim/pause", "/sim/resume", "/sim/reset", "/sim/step", "/sim/apply_impulse"};
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(services[i]["id"], i + 1);
+    EXPECT_EQ(services[i]["name"], names[i]);
+  }
+  EXPECT_EQ(services[3]["type"], "rbsim_msgs/srv/Step");
+  EXPECT_NE(services[3]["request"]["schema"].get<std::string>().find("uint32 steps"), std::string::npos);
+  EXPECT_EQ(services[3]["request"]["schema"].get<std::string>().find("---"), std::string::npos);
+  EXPECT_NE(services[3]["response"]["schema"].get<std::string>().find("uint64 step"), std::string::npos);
+  EXPECT_EQ(services[0]["requestSchema"].get<std::string>().find("bool"),
+            std::string::npos);  // Trigger: empty
+  EXPECT_NE(services[0]["responseSchema"].get<std::string>().find("string message"), std::string::npos);
+}
+
+TEST(FoxgloveSteering, GetsSetsAndUpdatesParameters) {
+  Steered s;
+  ASSERT_TRUE(s.server);
+  WsClient c, watcher, other;
+  connect(c, s.server->port());
+  connect(watcher, s.server->port());
+  connect(other, s.server->port());
+  ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":[],"id":"all"})"));
+  const Json all = next_op(c, "parameterValues");
+  EXPECT_EQ(all["id"], "all");
+  EXPECT_EQ(all["parameters"].size(), s.controller.list({}, 0).names.size());
+  EXPECT_EQ(value_of(all, "forces.0.fy"),
+            (Json{{"name", "forces.0.fy"}, {"value", -9.81}, {"type", "float64"}}));
+  EXPECT_EQ(value_of(all, "bodies"), (Json{{"name", "bodies"}, {"value", 2}}));
+  EXPECT_EQ(value_of(all, "paused")["value"], true);
+
+  ASSERT_TRUE(watcher.send_text(R"({"op":"subscribeParameterUpdates","parameterNames":["forces.0.fy"]})"));
+  ASSERT_TRUE(watcher.send_text(R"({"op":"getParameters","parameterNames":["forces.0.fy"],"id":"sync"})"));
+  ASSERT_EQ(next_op(watcher, "parameterValues")["id"], "sync");  // the subscription is in place
+  // -3 is a JSON integer: for the double forces.0.fy it is -3.0.
+  ASSERT_TRUE(
+      c.send_text(R"({"op":"setParameters","parameters":[{"name":"forces.0.fy","value":-3}],"id":"set"})"));
+  const Json set = next_op(c, "parameterValues");
+  EXPECT_EQ(set["id"], "set");
+  EXPECT_EQ(set["parameters"],
+            Json::array({{{"name", "forces.0.fy"}, {"value", -3.0}, {"type", "float64"}}}));
+  const Json update = next_op(watcher, "parameterValues");
+  EXPECT_FALSE(update.contains("id"));
+  EXPECT_EQ(update["parameters"], set["parameters"]);
+  EXPECT_EQ(s.controller.get({"forces.0.fy"})[0], msgs::ParameterValue::of_double(-3.0));
+
+  // A client that did not subscribe gets no update: its next parameterValues is its own answer.
+  ASSERT_TRUE(other.send_text(R"({"op":"getParameters","parameterNames":["bodies"],"id":"mine"})"));
+  EXPECT_EQ(next_op(other, "parameterValues")["id"], "mine");
+  // Unsubscribed: no update for the next change.
+  ASSERT_TRUE(watcher.send_text(R"({"op":"unsubscribeParameterUpdates","parameterNames":[]})"));
+  ASSERT_TRUE(
+      c.send_text(R"({"op":"setParameters","parameters":[{"name":"forces.0.fy","value":-2.5}],"id":"2"})"));
+  EXPECT_EQ(next_op(c, "parameterValues")["id"], "2");
+  ASSERT_TRUE(watcher.send_text(R"({"op":"getParameters","parameterNames":["forces.0.fy"],"id":"after"})"));
+  const Json after = next_op(watcher, "parameterValues");
+  EXPECT_EQ(after["id"], "after");
+  EXPECT_EQ(value_of(after, "forces.0.fy")["value"], -2.5);
+}
+
+TEST(FoxgloveSteering, RefusedSetsAreNamedAndTheRestApplies) {
+  Steered s;
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  connect(c, s.server->port());
+  ASSERT_TRUE(c.send_text(R"({"op":"setParameters","id":"mixed","parameters":[
+      {"name":"springs.0.k","value":7.5},{"name":"bodies","value":3},{"name":"rate","value":"fast"},
+      {"name":"nope","value":1.0},{"name":"publish_every","value":2.0},{"name":"forces.1.beta","value":-1.0}]})"));
+  const Json answer = next_op(c, "parameterValues");
+  EXPECT_EQ(answer["id"], "mixed");
+  EXPECT_EQ(value_of(answer, "springs.0.k")["value"], 7.5);
+  EXPECT_EQ(value_of(answer, "bodies")["value"], 2);  // unchanged: its current value
+  EXPECT_TRUE(value_of(answer, "nope").is_null());
+  const Json status = next_op(c, "status");
+  EXPECT_EQ(status["level"], 2);
+  const std::string m = status["message"];
+  for (const char* says : {"bodies", "rate", "nope", "publish_every", "forces.1.beta"}) {
+    EXPECT_NE(m.find(says), std::string::npos) << says << " in " << m;
+  }
+  EXPECT_EQ(m.find("springs.0.k"), std::string::npos) << m;
+  EXPECT_EQ(s.controller.get({"springs.0.k"})[0], msgs::ParameterValue::of_double(7.5));
+  // A request naming more values than the node has parameters is refused whole.
+  std::string many = R"({"op":"setParameters","id":"many","parameters":[)";
+  for (int k = 0; k < 10000; ++k) many += std::string(k ? "," : "") + R"({"name":"rate","value":2.0})";
+  ASSERT_TRUE(c.send_text(many + "]}"));
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("10000 values in one request, more than"),
+            std::string::npos);
+  EXPECT_EQ(s.controller.get({"rate"})[0], msgs::ParameterValue::of_double(0.0));
+  // Unknown names in a read are named too; the known ones still come.
+  ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt","ghost"],"id":"g"})"));
+  EXPECT_EQ(next_op(c, "parameterValues")["parameters"].size(), 1u);
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("no parameter 'ghost'"),
+            std::string::npos);
+}
+
+TEST(FoxgloveSteering, ServicesInCdrAndJsonMoveTheRun) {
+  Steered s;
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  connect(c, s.server->port());
+  ASSERT_TRUE(c.send_text(R"({"op":"subscribeParameterUpdates","parameterNames":["paused"]})"));
+  // step 5 while paused (cdr): applied at step 0, then the run pauses again at 5.
+  ASSERT_TRUE(c.send_binary(call_frame(4, 11, "cdr", cdr(msgs::StepRequest{5}))));
+  auto r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->service, 4u);
+  EXPECT_EQ(r->call, 11u);
+  EXPECT_EQ(r->encoding, "cdr");
+  msgs::StepResponse step;
+  ASSERT_TRUE(
+      msgs::decode({reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, step).ok());
+  EXPECT_TRUE(step.success) << step.message;
+  EXPECT_EQ(step.step, 0u);
+  // An impulse in json: applied at step 5, the boundary the run waits at.
+  ASSERT_TRUE(c.send_binary(call_frame(5, 12, "json", R"({"body":1,"jx":0.5,"jy":2.0})")));
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->encoding, "json");
+  const Json impulse = Json::parse(r->payload);
+  EXPECT_EQ(impulse["success"], true) << impulse;
+  EXPECT_GE(impulse["step"], 1);  // a boundary of the 5 steps, or the one the run waits at after them
+  EXPECT_LE(impulse["step"], 5);
+  // resume (json), then pause (cdr): `paused` updates reach the subscriber, before the reply (the
+  // controller's observers run before a command's own callback).
+  ASSERT_TRUE(c.send_binary(call_frame(2, 13, "json", "{}")));
+  EXPECT_EQ(value_of(next_op(c, "parameterValues"), "paused")["value"], false);
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(Json::parse(r->payload)["success"], true);
+  ASSERT_TRUE(c.send_binary(call_frame(1, 14, "cdr", cdr(msgs::TriggerRequest{}))));
+  EXPECT_EQ(value_of(next_op(c, "parameterValues"), "paused")["value"], true);
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  msgs::TriggerResponse paused;
+  ASSERT_TRUE(
+      msgs::decode({reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, paused).ok());
+  EXPECT_TRUE(paused.success);
+  EXPECT_NE(paused.message.find("paused at step"), std::string::npos) << paused.message;
+  EXPECT_GE(s.server->stats().requests, 4u);
+}
+
+TEST(FoxgloveSteering, BadCallsGetAServiceCallFailureOrAnUnsuccessfulReply) {
+  Steered s;
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  connect(c, s.server->port());
+  struct Bad {
+    std::string frame;
+    const char* says;
+  };
+  for (const Bad& b : std::vector<Bad>{
+           {call_frame(42, 1, "cdr", ""), "unknown service 42"},
+           {call_frame(4, 2, "cdr", "\x00\x01"), "rbsim_msgs/srv/Step"},
+           {call_frame(4, 3, "json", "[1]"), "not a JSON object"},
+           {call_frame(4, 4, "json", R"({"steps":-1})"), "field 'steps' must be an integer"},
+           {call_frame(5, 5, "json", R"({"body":0,"jz":1})"), "no field 'jz'"},
+           {call_frame(5, 6, "json", R"({"body":0,"jx":"1"})"), "field 'jx' must be a number"},
+           {call_frame(1, 7, "ros1", ""), "unsupported encoding"},
+       }) {
+    ASSERT_TRUE(c.send_binary(b.frame));
+    const Json f = next_op(c, "serviceCallFailure");
+    EXPECT_NE(f.value("message", "").find(b.says), std::string::npos) << f << " want " << b.says;
+  }
+  // Decoded but refused by the run: an unsuccessful reply naming why.
+  ASSERT_TRUE(c.send_binary(call_frame(5, 8, "json", R"({"body":9})")));
+  auto r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(Json::parse(r->payload)["success"], false);
+  EXPECT_NE(Json::parse(r->payload)["message"].get<std::string>().find("no body 9"), std::string::npos);
+  ASSERT_TRUE(c.send_binary(call_frame(4, 9, "json", R"({"steps":0})")));
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_NE(Json::parse(r->payload)["message"].get<std::string>().find("steps must be >= 1"),
+            std::string::npos);
+  // The connection still serves.
+  ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt"],"id":"ok"})"));
+  EXPECT_EQ(next_op(c, "parameterValues")["id"], "ok");
+}
+
+TEST(FoxgloveSteering, CommandsInFlightAreBoundedPerClient) {
+  ServerOptions o;
+  o.max_pending_commands = 2;
+  Steered s(o, false);  // no run loop: nothing is applied
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  connect(c, s.server->port());
+  for (std::uint32_t call = 1; call <= 3; ++call)
+    ASSERT_TRUE(c.send_binary(call_frame(1, call, "json", "{}")));
+  const Json refused = next_op(c, "serviceCallFailure");
+  EXPECT_EQ(refused["callId"], 3);
+  EXPECT_NE(refused["message"].get<std::string>().find("too many requests in flight (2 per client)"),
+            std::string::npos);
+  ASSERT_TRUE(c.send_text(R"({"op":"setParameters","parameters":[{"name":"rate","value":1.0}]})"));
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("too many requests in flight"),
+            std::string::npos);
+  // Reads are not commands: still answered.
+  ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt"],"id":"r"})"));
+  EXPECT_EQ(next_op(c, "parameterValues")["id"], "r");
+  // The end of the run answers the two in flight (unsuccessfully), and the bound frees up.
+  s.controller.close("the run ended");
+  for (int k = 0; k < 2; ++k) {
+    auto r = next_response(c);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(Json::parse(r->payload)["success"], false);
+  }
+  EXPECT_EQ(s.server->stats().refused_requests, 2u);
+}
+
+TEST(FoxgloveSteering, AClientThatDoesNotReadItsRepliesIsRefusedNotBuffered) {
+  ServerOptions o;
+  o.max_reply_backlog_bytes = 64 << 10;
+  o.max_in_flight_bytes = 64 << 10;
+  Steered s(o);
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  ASSERT_EQ(c.connect(s.server->port(), {"foxglove.websocket.v1"}, 4096), 101);
+  // 20,000 requests for every parameter, nothing read: the replies stop at the bound.
+  const std::string get = R"({"op":"getParameters","parameterNames":[]})";
+  for (int k = 0; k < 20000; ++k) {
+    if (!c.send_text(get)) break;
+  }
+  EXPECT_TRUE([&] {
+    for (int k = 0; k < 500 && s.server->stats().refused_requests == 0; ++k)
+      std::this_thread::sleep_for(10ms);
+    return s.server->stats().refused_requests > 0;
+  }());
+  const ServerStats st = s.server->stats();
+  EXPECT_LT(st.requests, 20000u);
+  // The run was never held up: a command from another client is answered at once.
+  WsClient d;
+  connect(d, s.server->port());
+  ASSERT_TRUE(d.send_binary(call_frame(4, 1, "json", R"({"steps":3})")));
+  auto r = next_response(d);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(Json::parse(r->payload)["success"], true);
+  // Reading, the flooder finds the one error that said so among its replies.
+  int errors = 0;
+  for (int k = 0; k < 20000; ++k) {
+    auto f = c.read();
+    if (!f) break;
+    const Json j = Json::parse(f->data, nullptr, false);
+    if (j.value("op", "") != "status") continue;
+    ++errors;
+    EXPECT_NE(j["message"].get<std::string>().find("requests refused until this client reads"),
+              std::string::npos);
+  }
+  EXPECT_GE(errors, 1);  // one per backlog: more when reading lets a new one build up
+  EXPECT_LE(static_cast<std::uint64_t>(errors), s.server->stats().refused_requests);
+}
+
+TEST(FoxgloveSteering, AnswersAfterTheServerIsGoneDoNothing) {
+  Scene scene = rbsim::test::control_scene();
+  control::Controller controller(scene, 3, control::RunSettings{0.0, 1, true});
+  {
+    ServerOptions o;
+    o.address = "127.0.0.1";
+    o.port = 0;
+    o.controller = &controller;
+    auto server = Server::start(o, {});
+    ASSERT_TRUE(server);
+    WsClient c;
+    connect(c, server.value()->port());
+    ASSERT_TRUE(c.send_binary(call_frame(1, 1, "cdr", cdr(msgs::TriggerRequest{}))));
+    ASSERT_TRUE(c.send_text(R"({"op":"setParameters","parameters":[{"name":"rate","value":2.0}],"id":"x"})"));
+    ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt"],"id":"sync"})"));
+    EXPECT_EQ(next_op(c, "parameterValues")["id"], "sync");  // both commands are queued by now
+  }
+  // The queued commands apply and are answered into a server that is gone, and the observer of
+  // parameter updates (rate changed) does nothing either.
+  control::Command resume;
+  resume.kind = control::CommandKind::Resume;
+  std::future<control::CommandResult> resumed = controller.submit(resume);
+  Result<Driver> driver = Driver::create(scene);
+  ASSERT_TRUE(driver);
+  DriverOptions options;
+  options.steps = 3;
+  options.control = &controller;
+  EXPECT_TRUE(driver.value().run_pass(options).ok());
+  EXPECT_TRUE(resumed.get().successful);
+  EXPECT_EQ(controller.get({"rate"})[0], msgs::ParameterValue::of_double(2.0));
+}
+
+}  // namespace
+}  // namespace rbsim::foxglove
