@@ -38,8 +38,8 @@
 
 #include "generated_types.inc"  // every idlc-generated header, and kGeneratedTypes
 #include "raw_serdata.hpp"
-#include "rbsim/interfaces.hpp"
 #include "rbsim/builders.hpp"
+#include "rbsim/interfaces.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace {

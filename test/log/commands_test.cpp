@@ -90,11 +90,11 @@ TEST(RunCommands, ARecordingRerunsToTheSameBytes) {
   write_text(dir / "c.yaml",
              "- {step: 20, set: {forces.0.fy: -3.7}}\n- {step: 30, pause: true}\n- {step: 30, steps: 4}\n"
              "- {step: 34, impulse: {body: 2, j: [0.5, 2.0], p: [0.1, 0.0]}}\n- {step: 34, resume: true}\n");
-  const Outcome a = rbsim({"run", scene, "--steps", "100", "--commands", (dir / "c.yaml").string(), "--record",
-                           (dir / "a.mcap").string()});
+  const Outcome a = rbsim({"run", scene, "--steps", "100", "--commands", (dir / "c.yaml").string(),
+                           "--record", (dir / "a.mcap").string()});
   ASSERT_EQ(a.exit_code, 0) << a.err;
-  const Outcome b = rbsim({"run", scene, "--steps", "100", "--commands", (dir / "a.mcap").string(), "--record",
-                           (dir / "b.mcap").string()});
+  const Outcome b = rbsim({"run", scene, "--steps", "100", "--commands", (dir / "a.mcap").string(),
+                           "--record", (dir / "b.mcap").string()});
   ASSERT_EQ(b.exit_code, 0) << b.err;
   EXPECT_EQ(read_bytes(dir / "a.mcap"), read_bytes(dir / "b.mcap"));
   Result<std::vector<msgs::CommandMessage>> got = commands_of(dir / "b.mcap");

@@ -258,7 +258,8 @@ TEST(EncoderMarkers, FilledHullsOutlinesAndAnchorsInTheirFrames) {
 TEST(TopicSet, DefaultIsEverythingButPoses) {
   const rbsim::msgs::TopicSet d = rbsim::msgs::default_topics();
   for (const auto& spec : rbsim::msgs::topics()) {
-    EXPECT_EQ(d.test(static_cast<std::size_t>(spec.id)), spec.id != TopicId::Poses && !spec.event) << spec.suffix;
+    EXPECT_EQ(d.test(static_cast<std::size_t>(spec.id)), spec.id != TopicId::Poses && !spec.event)
+        << spec.suffix;
   }
   EXPECT_TRUE(rbsim::msgs::topic(TopicId::Markers).transient_local);
   EXPECT_FALSE(rbsim::msgs::topic(TopicId::Markers).per_step);

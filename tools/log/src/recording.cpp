@@ -126,7 +126,8 @@ struct Recording::Impl {
       // The scene description when asked for, the per-step topics read, and the commands (an event
       // topic, read whole by read_commands).
       const bool commands = id == msgs::TopicId::Commands;
-      if (id == msgs::TopicId::Scene ? !options.scene : !commands && (i < 0 || !read[static_cast<std::size_t>(i)]))
+      if (id == msgs::TopicId::Scene ? !options.scene
+                                     : !commands && (i < 0 || !read[static_cast<std::size_t>(i)]))
         continue;
       if (!options.ns.empty() && c.channel->topic != msgs::topic_name(*c.spec, options.ns)) continue;
       std::string& topic = topics[static_cast<std::size_t>(id)];
