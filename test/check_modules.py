@@ -25,7 +25,7 @@ MODULES = {
     "core": ("sim_core", set()),
     "scene": ("sim_core/scene", {"core"}),
     "io": ("tools/io", {"core", "scene"}),
-    "control": ("tools/control", {"core", "scene", "io", "msgs"}),
+    "control": ("tools/control", {"core", "scene", "io", "msgs", "log"}),
     "msgs": ("tools/msgs", {"core", "scene"}),
     "mcap": ("tools/mcap", set()),
     "mcap_tools": ("tools/mcap_tools", {"mcap"}),
@@ -34,7 +34,7 @@ MODULES = {
     "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "node": ("node", {"core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
-    "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden"}),
+    "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden", "control"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "control", "msgs"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }

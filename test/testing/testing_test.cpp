@@ -39,6 +39,34 @@ TEST(RecordScene, WritesWhatRbsimRunRecordWrites) {
   EXPECT_TRUE(read_text(api) == read_text(cli)) << "RecordScene and rbsim run --record differ";
 }
 
+// A golden with perturbations: RecordScene takes rbsim run --commands' scripts (and recordings).
+TEST(RecordScene, TakesCommandsAsRbsimRunDoes) {
+  TempDir dir;
+  const std::string script = dir.path() / "kick.yaml";
+  write_text(script,
+             "- {step: 50, set: {forces.0.fy: -3.7}}\n- {t: 0.1, impulse: {body: 2, j: [0.5, 2.0]}}\n");
+  const std::string api = dir.path() / "api.mcap", cli = dir.path() / "cli.mcap",
+                    plain = dir.path() / "plain.mcap";
+  ASSERT_TRUE(RecordScene(kScenes + "chain.xml", api, {.steps = 300, .commands = script}));
+  const auto run = rbsim::test::rbsim(
+      {"run", kScenes + "chain.xml", "--steps", "300", "--record", cli, "--commands", script, "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run;
+  EXPECT_TRUE(read_text(api) == read_text(cli)) << "RecordScene and rbsim run --commands differ";
+  ASSERT_TRUE(RecordScene(kScenes + "chain.xml", plain, {.steps = 300}));
+  EXPECT_FALSE(CheckLogs(api, plain));
+  // Its own recording as the commands: the same file again.
+  const std::string again = dir.path() / "again.mcap";
+  ASSERT_TRUE(RecordScene(kScenes + "chain.xml", again, {.steps = 300, .commands = api}));
+  EXPECT_TRUE(read_text(again) == read_text(api));
+  // A bad script names its line and field; nothing is written.
+  write_text(script, "- {step: 50, impulse: {body: 99, j: [0, 1]}}\n");
+  const std::string bad = dir.path() / "bad.mcap";
+  const auto refused = RecordScene(kScenes + "chain.xml", bad, {.steps = 300, .commands = script});
+  EXPECT_FALSE(refused);
+  EXPECT_NE(message(refused).find("kick.yaml:1: impulse.body"), std::string::npos) << message(refused);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
 TEST(RecordScene, RefusesAnExistingOutputUnlessOverwrite) {
   TempDir dir;
   const std::string out = dir.path() / "run.mcap";

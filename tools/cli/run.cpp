@@ -11,7 +11,6 @@
 #include "rbsim/csv.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
-#include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/sink.hpp"
@@ -41,46 +40,6 @@ struct RunOptions {
   bool overwrite = false;
 };
 
-// A command to apply and the outcome it must have: success for a script's, the recorded one for a
-// re-run of a recording's.
-struct Scripted {
-  control::Command command;
-  bool expect_success = true;
-  std::string origin;  // "steer.yaml:3", "live.mcap: command 4"
-};
-
-bool is_recording(const std::string& path) {
-  return path.ends_with(".mcap");
-}
-
-Result<std::vector<Scripted>> load_commands(const std::string& path, const Scene& scene, std::int64_t steps) {
-  std::vector<Scripted> out;
-  if (!is_recording(path)) {
-    Result<std::vector<control::Command>> script = control::load_command_script(path, scene, steps);
-    if (!script) return script.error();
-    for (control::Command& c : script.value()) {
-      std::string origin = c.source.substr(c.source.find(' ') + 1);  // "script FILE:LINE" -> "FILE:LINE"
-      out.push_back({std::move(c), true, std::move(origin)});
-    }
-    return out;
-  }
-  log::RecordingOptions ro;
-  ro.require_scene = false;
-  Result<std::unique_ptr<log::Recording>> recording = log::Recording::open(path, ro);
-  if (!recording) return recording.error();
-  Result<std::vector<msgs::CommandMessage>> recorded = log::read_commands(*recording.value());
-  if (!recorded) return recorded.error();
-  if (recording.value()->topic(msgs::TopicId::Commands).empty()) {
-    return Error{path + ": no commands topic (rbsim_msgs/msg/Command): not a recording of a steered session"};
-  }
-  for (const msgs::CommandMessage& m : recorded.value()) {
-    Result<control::Command> c = control::from_message(m);
-    if (!c) return Error{path + ": " + c.error().message};
-    out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq)});
-  }
-  return out;
-}
-
 int run(const RunOptions& o) {
   Result<Scene> loaded = load_scene(o.scene);
   if (!loaded) return fail("run", loaded.error().message);
@@ -105,25 +64,13 @@ int run(const RunOptions& o) {
 
   // The commands are read whole before step 0: a bad script entry is a usage error naming its line,
   // a recording that lost commands an error naming the first missing one.
-  std::optional<control::Controller> controller;
-  std::int64_t refused = 0;
+  std::optional<control::ScriptedRun> script;
   if (!o.commands.empty()) {
-    Result<std::vector<Scripted>> script = load_commands(o.commands, scene, steps);
-    if (!script)
-      return fail("run", script.error().message, script.error().code == ErrorCode::InvalidArgument ? 2 : 1);
-    controller.emplace(scene, steps, control::RunSettings{0.0, 1, false});
-    controller->end_when_idle(true);
-    for (Scripted& s : script.value()) {
-      controller->submit(std::move(s.command), [&refused, origin = s.origin,
-                                                expect = s.expect_success](const control::CommandResult& r) {
-        // A re-run matches the session when each command has the outcome it had there.
-        if (r.successful == expect) return;
-        ++refused;
-        std::fprintf(stderr, "rbsim run: %s: %s: %s\n", origin.c_str(),
-                     r.successful ? "applied here but refused in the recording" : "refused",
-                     r.message.c_str());
-      });
-    }
+    Result<std::vector<control::ScriptedCommand>> commands = control::load_commands(o.commands, scene, steps);
+    if (!commands)
+      return fail("run", commands.error().message,
+                  commands.error().code == ErrorCode::InvalidArgument ? 2 : 1);
+    script.emplace(scene, steps, std::move(commands.value()));
   }
 
   Result<Driver> created = Driver::create(scene);
@@ -150,16 +97,8 @@ int run(const RunOptions& o) {
   }
   // A steered run records its commands as the node publishes them (/<ns>/commands), so it can be
   // re-run in turn.
-  Status recorded = Ok{};
-  Bytes command_cdr;
-  if (controller && recorder != nullptr) {
-    controller->on_command(
-        [&, seq = std::uint64_t{0}](const control::Command& c, const control::CommandResult& r) mutable {
-          command_cdr.clear();
-          msgs::encode(control::to_message(c, r, seq++, scene.world.dt), command_cdr);
-          if (Status st = recorder->record_command(command_cdr, r.step); !st && recorded) recorded = st;
-        });
-  }
+  if (script && recorder != nullptr) script->record_to(*recorder);
+
   if (!o.frames.empty()) {
     int width = 0, height = 0;
     if (!render::parse_size(o.size, width, height))
@@ -181,7 +120,7 @@ int run(const RunOptions& o) {
   options.allow_nonfinite = o.allow_nonfinite;
   options.stop = stop_requested;
   options.progress = [&progress](std::int64_t step) { progress.update(step); };
-  if (controller) options.control = &*controller;
+  if (script) options.control = &script->controller();
   const auto start = std::chrono::steady_clock::now();
   const Result<PassEnd> end = driver.run(options);
   if (!end) return fail("run", end.error().message);
@@ -203,21 +142,16 @@ int run(const RunOptions& o) {
         count_of(world.spring_count(), "spring", "springs").c_str(), count_of(done, "step", "steps").c_str(),
         world.time(), format_seconds(wall).c_str(), rate, rate * world.body_count());
   }
-  if (controller) {
-    controller->close("the run ended");
-    if (!recorded) return fail("run", recorded.error().message);
-    if (const std::optional<std::int64_t> k = controller->ended_paused()) {
+  if (script) {
+    const Status applied = script->finish(o.commands);
+    for (const std::string& m : script->mismatches()) std::fprintf(stderr, "rbsim run: %s\n", m.c_str());
+    if (const std::optional<std::int64_t> k = script->ended_paused()) {
       std::fprintf(
           stderr,
           "rbsim run: %s left the run paused at step %lld with nothing to resume it: outputs end there\n",
           o.commands.c_str(), static_cast<long long>(*k));
     }
-    const control::ControlCounters counted = controller->counters();
-    if (refused > 0) {
-      return fail("run", o.commands + ": " + count_of(refused, "command", "commands") + " (of " +
-                             std::to_string(counted.commands) + ") did not apply as " +
-                             (is_recording(o.commands) ? "recorded" : "written") + "; outputs hold the run");
-    }
+    if (!applied) return fail("run", applied.error().message + "; outputs hold the run");
   }
   if (stop_requested()) {
     std::fprintf(stderr, "rbsim run: interrupted at step %lld of %lld; outputs hold steps 0..%lld\n",

@@ -5,9 +5,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/check.hpp"
+#include "rbsim/command_script.hpp"
 #include "rbsim/golden.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
@@ -41,7 +43,9 @@ namespace {
     return failure("RecordScene",
                    "record_every must be >= 1 (got " + std::to_string(options.record_every) + ")");
   }
-  if (Status st = check_outputs({{out_mcap, "out_mcap"}}, {scene_path}, options.overwrite); !st) {
+  std::vector<std::string> inputs{scene_path};
+  if (!options.commands.empty()) inputs.push_back(options.commands);
+  if (Status st = check_outputs({{out_mcap, "out_mcap"}}, inputs, options.overwrite); !st) {
     return failure("RecordScene",
                    st.error().message + (options.overwrite ? "" : " (RecordOptions::overwrite)"));
   }
@@ -56,13 +60,31 @@ namespace {
     ro.topics = topics.value();
   }
 
+  std::optional<control::ScriptedRun> script;
+  if (!options.commands.empty()) {
+    Result<std::vector<control::ScriptedCommand>> commands =
+        control::load_commands(options.commands, scene, steps);
+    if (!commands) return failure("RecordScene", commands.error().message);
+    script.emplace(scene, steps, std::move(commands.value()));
+  }
   Result<Driver> created = Driver::create(scene);
   if (!created) return failure("RecordScene", scene.path + ": " + created.error().message);
-  std::unique_ptr<Sink> sink = log::make_mcap_sink(out_mcap, ro);
+  std::unique_ptr<log::McapSink> sink = log::make_mcap_sink(out_mcap, ro);
   created->add(*sink);
   DriverOptions run;
   run.steps = steps;
+  if (script) {
+    script->record_to(*sink);
+    run.control = &script->controller();
+  }
   if (Status st = created->run_pass(run); !st) return failure("RecordScene", st.error().message);
+  if (script) {
+    if (Status st = script->finish(options.commands); !st) {
+      std::string named;
+      for (const std::string& m : script->mismatches()) named += "\n  " + m;
+      return failure("RecordScene", st.error().message + named);
+    }
+  }
   return ::testing::AssertionSuccess()
          << "recorded " << steps << " steps of " << scene_path << " to " << out_mcap;
 }

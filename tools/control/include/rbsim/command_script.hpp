@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "rbsim/control.hpp"
+#include "rbsim/mcap_sink.hpp"
 #include "rbsim/scene.hpp"
 #include "rbsim/status.hpp"
 
@@ -38,5 +39,44 @@ namespace rbsim::control {
 [[nodiscard]] Result<std::vector<Command>> parse_command_script(std::string_view text,
                                                                 const std::string& path, const Scene& scene,
                                                                 std::int64_t steps);
+
+// A command of an offline run and the outcome it must have: success for a script's, the recorded
+// one for a recording's (a command refused live is refused again in a faithful re-run).
+struct ScriptedCommand {
+  Command command;
+  bool expect_success = true;
+  std::string origin;  // "steer.yaml:3", "live.mcap: command 4"
+};
+// The commands of `path`: a script (above), or a recording (a path ending in .mcap: its
+// /<ns>/commands, rbsim/recording.hpp's read_commands, which refuses one that lost a command).
+[[nodiscard]] Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,
+                                                                 std::int64_t steps);
+bool is_recording_path(const std::string& path);
+
+// An offline run steered by loaded commands (rbsim run --commands, rbsim::testing::RecordScene):
+// the Controller for the Driver (DriverOptions::control), every command submitted, each applied
+// one recorded into the run's MCAP sink when there is one, and those whose outcome differs from
+// the expected one collected. A pause that nothing can end ends the run there.
+class ScriptedRun {
+ public:
+  ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<ScriptedCommand> commands);
+  Controller& controller() { return controller_; }
+  // Every command the controller applies or refuses goes to `sink` as rbsim_msgs/msg/Command.
+  void record_to(log::McapSink& sink);
+  // After the run: closes the controller. The first recording error, or, when commands did not
+  // have their outcome, "PATH: N commands (of M) did not apply as written|recorded", each named
+  // in mismatches().
+  [[nodiscard]] Status finish(const std::string& path);
+  const std::vector<std::string>& mismatches() const { return mismatches_; }  // "ORIGIN: refused: MSG"
+  std::optional<std::int64_t> ended_paused() const { return controller_.ended_paused(); }
+
+ private:
+  const Scene& scene_;
+  Controller controller_;
+  std::vector<std::string> mismatches_;
+  Status recorded_ = Ok{};
+  Bytes cdr_;
+  std::uint64_t seq_ = 0;
+};
 
 }  // namespace rbsim::control

@@ -26,6 +26,10 @@ struct RecordOptions {
   std::vector<std::string> topics{};    // e.g. {"body_states", "energy"}; empty: the default set
   std::string ns = "rbsim";             // ROS namespace of the topics
   bool overwrite = false;               // replace an existing output file
+  // Commands applied at step boundaries, as `rbsim run --commands`: a YAML script
+  // (- {step: 500, set: {forces.0.fy: -3.7}}, impulses, pauses; see the README) or a recording of a
+  // steered session (.mcap, its /<ns>/commands). Empty: none.
+  std::string commands{};
 };
 
 // Runs a scene in process and writes the MCAP `rbsim run SCENE --record OUT` writes with the same

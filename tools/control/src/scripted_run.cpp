@@ -1,0 +1,75 @@
+// Offline runs steered by loaded commands (rbsim/command_script.hpp): scripts or recordings.
+#include <string>
+#include <utility>
+
+#include "rbsim/command_script.hpp"
+#include "rbsim/recording.hpp"
+
+namespace rbsim::control {
+
+bool is_recording_path(const std::string& path) {
+  return path.ends_with(".mcap");
+}
+
+Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,
+                                                   std::int64_t steps) {
+  std::vector<ScriptedCommand> out;
+  if (!is_recording_path(path)) {
+    Result<std::vector<Command>> script = load_command_script(path, scene, steps);
+    if (!script) return script.error();
+    for (Command& c : script.value()) {
+      std::string origin = c.source.substr(c.source.find(' ') + 1);  // "script FILE:LINE" -> "FILE:LINE"
+      out.push_back({std::move(c), true, std::move(origin)});
+    }
+    return out;
+  }
+  log::RecordingOptions ro;
+  ro.require_scene = false;
+  Result<std::unique_ptr<log::Recording>> recording = log::Recording::open(path, ro);
+  if (!recording) return recording.error();
+  if (recording.value()->topic(msgs::TopicId::Commands).empty()) {
+    return Error{path + ": no commands topic (rbsim_msgs/msg/Command): not a recording of a steered session"};
+  }
+  Result<std::vector<msgs::CommandMessage>> recorded = log::read_commands(*recording.value());
+  if (!recorded) return recorded.error();
+  for (const msgs::CommandMessage& m : recorded.value()) {
+    Result<Command> c = from_message(m);
+    if (!c) return Error{path + ": " + c.error().message};
+    out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq)});
+  }
+  return out;
+}
+
+ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<ScriptedCommand> commands)
+    : scene_(scene), controller_(scene, steps, RunSettings{0.0, 1, false}) {
+  controller_.end_when_idle(true);
+  for (ScriptedCommand& s : commands) {
+    controller_.submit(std::move(s.command), [this, origin = s.origin, expect = s.expect_success](
+                                                  const CommandResult& r) {
+      if (r.successful == expect) return;
+      mismatches_.push_back(origin + ": " +
+                            (r.successful ? "applied here but refused in the recording" : "refused") + ": " +
+                            r.message);
+    });
+  }
+}
+
+void ScriptedRun::record_to(log::McapSink& sink) {
+  controller_.on_command([this, &sink](const Command& c, const CommandResult& r) {
+    cdr_.clear();
+    msgs::encode(to_message(c, r, seq_++, scene_.world.dt), cdr_);
+    if (Status st = sink.record_command(cdr_, r.step); !st && recorded_) recorded_ = st;
+  });
+}
+
+Status ScriptedRun::finish(const std::string& path) {
+  const ControlCounters counted = controller_.counters();
+  controller_.close("the run ended");
+  if (!recorded_) return recorded_;
+  if (mismatches_.empty()) return Ok{};
+  return Error{path + ": " + std::to_string(mismatches_.size()) + (mismatches_.size() == 1 ? " command" : " commands") +
+               " (of " + std::to_string(counted.commands) + ") did not apply as " +
+               (is_recording_path(path) ? "recorded" : "written")};
+}
+
+}  // namespace rbsim::control
