@@ -51,6 +51,22 @@ TEST(RbsimRunCommands, EachCommandActsFromTheStepAfterItsBoundary) {
   EXPECT_EQ(read_text(dir / "again.csv"), read_text(dir / "set.csv"));
 }
 
+// t: SECONDS names the first step at or after it: the same run as the step form.
+TEST(RbsimRunCommands, TimeAndStepFormsGiveTheSameRun) {
+  const TempDir dir;
+  write_text(dir / "steps.yaml",
+             "- {step: 50, set: {forces.0.fy: -3.7}}\n- {step: 75, impulse: {body: 1, j: [1, 0]}}\n");
+  write_text(dir / "times.yaml",
+             "- {t: 0.05, set: {forces.0.fy: -3.7}}\n- {t: 0.0745, impulse: {body: 1, j: [1, 0]}}\n");
+  for (const char* form : {"steps", "times"}) {
+    const test::Outcome o =
+        rbsim({"run", kScene, "--steps", "100", "--csv", (dir / (std::string(form) + ".csv")).string(),
+               "--commands", (dir / (std::string(form) + ".yaml")).string()});
+    ASSERT_EQ(o.exit_code, 0) << describe(o);
+  }
+  EXPECT_EQ(read_text(dir / "steps.csv"), read_text(dir / "times.csv"));
+}
+
 TEST(RbsimRunCommands, ABadScriptIsAUsageErrorBeforeAnyOutput) {
   const TempDir dir;
   write_text(dir / "c.yaml",

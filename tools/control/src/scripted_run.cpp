@@ -44,13 +44,13 @@ ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<Scr
     : scene_(scene), controller_(scene, steps, RunSettings{0.0, 1, false}) {
   controller_.end_when_idle(true);
   for (ScriptedCommand& s : commands) {
-    controller_.submit(std::move(s.command), [this, origin = s.origin, expect = s.expect_success](
-                                                  const CommandResult& r) {
-      if (r.successful == expect) return;
-      mismatches_.push_back(origin + ": " +
-                            (r.successful ? "applied here but refused in the recording" : "refused") + ": " +
-                            r.message);
-    });
+    controller_.submit(
+        std::move(s.command), [this, origin = s.origin, expect = s.expect_success](const CommandResult& r) {
+          if (r.successful == expect) return;
+          mismatches_.push_back(origin + ": " +
+                                (r.successful ? "applied here but refused in the recording" : "refused") +
+                                ": " + r.message);
+        });
   }
 }
 
@@ -67,8 +67,9 @@ Status ScriptedRun::finish(const std::string& path) {
   controller_.close("the run ended");
   if (!recorded_) return recorded_;
   if (mismatches_.empty()) return Ok{};
-  return Error{path + ": " + std::to_string(mismatches_.size()) + (mismatches_.size() == 1 ? " command" : " commands") +
-               " (of " + std::to_string(counted.commands) + ") did not apply as " +
+  return Error{path + ": " + std::to_string(mismatches_.size()) +
+               (mismatches_.size() == 1 ? " command" : " commands") + " (of " +
+               std::to_string(counted.commands) + ") did not apply as " +
                (is_recording_path(path) ? "recorded" : "written")};
 }
 
