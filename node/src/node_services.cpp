@@ -284,6 +284,10 @@ void NodeServices::command_applied(const Command& command, const CommandResult& 
   if (impl_->events->publish(impl_->event_cdr)) ++impl_->event_count;
 }
 
+std::span<const std::byte> NodeServices::last_command() const {
+  return impl_->command_cdr;
+}
+
 NodeServiceCounters NodeServices::counters() const {
   NodeServiceCounters c;
   for (const ServiceServer& s : impl_->servers) {

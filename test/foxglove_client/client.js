@@ -86,8 +86,9 @@ async function caseBytes(check) {
   check(c.ws.protocol === "foxglove.websocket.v1", `negotiated subprotocol ${c.ws.protocol}`);
   check(c.serverInfo.capabilities.includes("time"), `serverInfo capabilities ${c.serverInfo.capabilities}`);
   check(typeof c.serverInfo.sessionId === "string" && c.serverInfo.sessionId.length > 0, "serverInfo has no sessionId");
-  check(JSON.stringify(c.topics()) === JSON.stringify([...rec.keys()].sort()),
-    `advertised ${c.topics()}, recorded ${[...rec.keys()].sort()}`);
+  // Every recorded topic, and the node's commands (a run without commands records none).
+  const served = [...rec.keys(), `/${ns}/commands`].sort();
+  check(JSON.stringify(c.topics()) === JSON.stringify(served), `advertised ${c.topics()}, want ${served}`);
   for (const ch of c.channels.values()) {
     const want = rec.get(ch.topic)?.channel;
     if (!want) continue;

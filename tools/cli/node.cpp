@@ -85,6 +85,7 @@ int node_command(const NodeArgs& a) {
   // wake-up) goes first, so viewers do not wait for the DDS writes.
   std::unique_ptr<foxglove::Server> server;
   std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
+  foxglove::ChannelId commands_channel = 0;  // /<ns>/commands to viewers, as on DDS
   if (a.foxglove) {
     foxglove::SinkOptions fo;
     fo.publish_every = settings.publish_every;
@@ -92,12 +93,15 @@ int node_command(const NodeArgs& a) {
     fo.ns = a.node.ns;
     fo.messages = node_options.messages;
     std::vector<foxglove::ChannelId> ids;
-    auto channels = foxglove::ros2_channels(fo.topics, a.node.ns, &ids);
+    msgs::TopicSet served = fo.topics;
+    served.set(static_cast<std::size_t>(msgs::TopicId::Commands));
+    auto channels = foxglove::ros2_channels(served, a.node.ns, &ids);
     if (!channels) return fail("node", channels.error().message);
     auto started = start_foxglove("rbsim node", *a.foxglove, std::move(channels.value()), &controller,
                                   name->fully_qualified());
     if (!started) return fail("node", started.error().message);
     server = std::move(started.value());
+    commands_channel = ids[static_cast<std::size_t>(msgs::TopicId::Commands)];
     foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);
   }
   install_stop_handlers();
@@ -140,10 +144,14 @@ int node_command(const NodeArgs& a) {
   auto services =
       node::NodeServices::create(participant.value(), controller, {name->fully_qualified(), scene.world.dt});
   if (!services) return fail("node", services.error().message);
-  controller.on_command(
-      [&applied = *services.value()](const control::Command& c, const control::CommandResult& r) {
-        applied.command_applied(c, r);
-      });
+  controller.on_command([&applied = *services.value(), &server, commands_channel, dt = scene.world.dt](
+                            const control::Command& c, const control::CommandResult& r) {
+    applied.command_applied(c, r);
+    if (server && commands_channel != 0) {
+      server->publish(commands_channel, msgs::sim_time_ns(r.step >= 0 ? r.step : 0, dt),
+                      applied.last_command());
+    }
+  });
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;
@@ -232,7 +240,8 @@ Subcommand add_node_command(CLI::App& parent) {
       "/clock (rosgraph_msgs/Clock) and, with --topics, poses (geometry_msgs/PoseArray), all reliable, "
       "volatile, keep all: a slow subscriber slows the node down rather than losing samples (--keep-last N "
       "trades that for a node that never waits).\n"
-      "--foxglove serves the same topics to Foxglove beside DDS: encoding cdr, ros2msg schemas as in MCAP, "
+      "--foxglove serves the same topics (and /<namespace>/commands) to Foxglove beside DDS: encoding cdr, "
+      "ros2msg schemas as in MCAP, "
       "log time = simulated time; a client that falls behind loses the oldest per-step messages (never the "
       "latched scene and markers), one that stops reading is disconnected.\n"
       "Parameters, as a ROS 2 node takes them, after the other options: --ros-args -p NAME:=VALUE "

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "rbsim/control.hpp"
@@ -48,6 +49,9 @@ class NodeServices {
   // local, keep all) and /parameter_events for every parameter a command changed. Called on the
   // run loop's thread.
   void command_applied(const control::Command& command, const control::CommandResult& result);
+  // The rbsim_msgs/msg/Command command_applied() published last (the run loop's thread), for the
+  // node's other outputs of /<ns>/commands (its Foxglove server).
+  std::span<const std::byte> last_command() const;
   NodeServiceCounters counters() const;
 
  private:
