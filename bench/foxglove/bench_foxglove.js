@@ -13,7 +13,11 @@
 //       check every frame without decoding it: clients that keep up. A Node client decoding
 //       ~370 MB/s in JavaScript does not on this hardware; the flow control drops its oldest
 //       per-step messages, as the foxglove_client.slow_client test shows;
-//   (c) payload bytes per step of the 1,000-body scene's default topics, before and after.
+//   (c) payload bytes per step of the 1,000-body scene's default topics, before and after;
+//   (d) steering: 1,000 setParameters (forces.0.fy, alternating) on a 1 kHz node, each from the
+//       last body_states step the client had when it sent the request to the first published
+//       step that shows the change (the step after the boundary /NS/commands says it applied
+//       at): median and p99 in steps (target <= 2 steps), and the wall time to that step.
 const fs = require("fs");
 const os = require("os");
 const path = require("path");
@@ -156,13 +160,57 @@ function bytes() {
   return ratio >= 3;
 }
 
+async function steering() {
+  const calls = 1000;
+  const ns = `bench_steer_${process.pid}`;
+  const env = { ...lib.rbsimEnv(), CYCLONEDDS_URI: `file://${path.join(A.root, "node", "config", "cyclonedds-loopback.xml")}` };
+  const [node, url] = await startServer(A.rbsim, ["node", grid(100, 600), "--rate", 1, "--domain", domain, "--namespace", ns],
+    { env });
+  const c = new Client(need, url, { name: "steering", subscribeAll: false });
+  c.messages = { push() {} };
+  let lastStep = -1;
+  const applied = new Map(); // command seq -> boundary step
+  const seen = new Map(); // step -> received ns
+  c.onmessage = (m) => {
+    if (m.topic.endsWith("/body_states")) {
+      lastStep = Number(m.decoded.step);
+      seen.set(lastStep, nowNs());
+    } else if (m.topic.endsWith("/commands")) {
+      applied.set(Number(m.decoded.seq), Number(m.decoded.step));
+    }
+  };
+  await c.ready();
+  for (const ch of c.channels.values()) if (/\/(body_states|commands)$/.test(ch.topic)) c.subscribe(ch);
+  await lib.until("body_states", 20000, () => lastStep > 100);
+  const steps = [], wall = [];
+  for (let k = 0; k < calls; k++) {
+    const from = lastStep, sent = nowNs();
+    c.client.setParameters([{ name: "forces.0.fy", value: k % 2 ? -9.81 : -3.7 }], `s${k}`);
+    await lib.until(`command ${k}`, 5000, () => applied.has(k));
+    const shown = applied.get(k) + 1; // a change at boundary b shows from step b + 1 on
+    await lib.until(`step ${shown}`, 5000, () => seen.has(shown));
+    steps.push(shown - from);
+    wall.push(seen.get(shown) - sent);
+    seen.clear();
+  }
+  c.close();
+  node.kill("SIGINT");
+  await node.wait(30000);
+  const med = quantile(steps, 0.5), p99 = quantile(steps, 0.99);
+  console.log(`(d) steering, ${calls} setParameters on a 1 kHz node (100 bodies): request to the first published step showing it`);
+  console.log(`    steps: median ${med}, p99 ${p99} (target <= 2): ${p99 <= 2 ? "met" : med <= 2 ? "median met, p99 MISSED" : "MISSED"}`);
+  console.log(`    wall: median ${us(quantile(wall, 0.5))} us, p99 ${us(quantile(wall, 0.99))} us`);
+  return med <= 2 && p99 <= 2;
+}
+
 (async () => {
-  const only = A.only ? A.only.split(",") : ["a", "b", "c"];
+  const only = A.only ? A.only.split(",") : ["a", "b", "c", "d"];
   const results = [];
   try {
     if (only.includes("a")) results.push(await latency());
     if (only.includes("b")) results.push(await fanOut());
     if (only.includes("c")) results.push(bytes());
+    if (only.includes("d")) results.push(await steering());
   } catch (e) {
     console.log(`bench-foxglove: ${e instanceof Failure ? e.message : e.stack}`);
     results.push(false);
