@@ -210,7 +210,9 @@ Subcommand add_run_command(CLI::App& parent) {
       "--commands", o->commands,
       "Apply a script of commands at step boundaries (YAML: - {step: 500, set: {forces.1.fx: 2.0}}, "
       "- {t: 1.5, impulse: {body: 3, j: [0, 4], p: [0, 0]}}, pause, steps, resume, reset; see the "
-      "README), exactly as a live node applies them; checked whole before step 0");
+      "README), exactly as a live node applies them; or a recording (FILE.mcap) of a steered session, "
+      "re-simulated: its /<ns>/commands at their steps, each with its recorded outcome. Read whole before "
+      "step 0; with --record the commands are recorded too");
   auto* frames =
       app->add_option("--frames", o->frames,
                       "Draw PNG frames into this folder during the run, as rbsim render draws them: "
