@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <future>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -128,6 +129,27 @@ TEST(ControllerSetParameters, AtStepKActsFromThatBoundaryOn) {
   for (std::size_t i = 0; i <= 40; ++i)
     EXPECT_TRUE(test::same_bits(changed[i].state, unchanged[i].state)) << i;
   EXPECT_FALSE(test::same_bits(changed[41].state, unchanged[41].state));
+}
+
+// A command's answer (and its observers) come after the values are published: a read made on
+// hearing the answer sees the change (a Foxglove getParameters right after a setParameters).
+TEST(ControllerSetParameters, AReadOnHearingTheAnswerSeesTheChange) {
+  const Scene scene = test::control_scene();
+  Controller controller(scene, kSteps, RunSettings{0.0, 1, false});
+  std::vector<std::optional<V>> seen_by_observer, seen_by_caller;
+  controller.on_command([&](const Command&, const CommandResult&) {
+    seen_by_observer.push_back(controller.get({"forces.0.fy"})[0]);
+  });
+  controller.submit(set(10, {{"forces.0.fy", V::of_double(-2.0)}}), [&](const CommandResult&) {
+    seen_by_caller.push_back(controller.get({"forces.0.fy"})[0]);
+  });
+  controller.submit(set(10, {{"forces.0.fy", V::of_double(-3.0)}}), [&](const CommandResult&) {
+    seen_by_caller.push_back(controller.get({"forces.0.fy"})[0]);
+  });
+  (void)test::run(scene, kSteps, &controller);
+  // Both applied at the boundary of step 10, then answered: each read sees the boundary's result.
+  EXPECT_EQ(seen_by_caller, (std::vector<std::optional<V>>{V::of_double(-3.0), V::of_double(-3.0)}));
+  EXPECT_EQ(seen_by_observer, seen_by_caller);
 }
 
 TEST(ControllerSetParameters, AnAtomicBatchWithOneBadParameterChangesNothing) {

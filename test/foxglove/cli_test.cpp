@@ -289,8 +289,8 @@ TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
   EXPECT_NE(node.err().find("rbsim node: stopped after"), std::string::npos) << node.err();
   EXPECT_NE(node.err().find("foxglove: 1 client,"), std::string::npos) << node.err();
   // Steered through its controller: parameters and the node's five services.
-  EXPECT_EQ(seen.capabilities,
-            nlohmann::json::array({"time", "parameters", "parametersSubscribe", "services"}));
+  EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time", "parameters", "parametersSubscribe", "services",
+                                                      "clientPublish"}));
   EXPECT_EQ(seen.services, (std::vector<std::string>{"/fox_e2e/pause", "/fox_e2e/resume", "/fox_e2e/reset",
                                                      "/fox_e2e/step", "/fox_e2e/apply_impulse"}));
 }

@@ -39,7 +39,8 @@ Json only_reply(const ClientProtocol::Outcome& o) {
 
 TEST(FoxgloveControlProtocol, ServerInfoOffersSteeringOnlyWithAController) {
   const Json with = Json::parse(server_info_json("rbsim", "1-1", true));
-  EXPECT_EQ(with["capabilities"], Json::array({"time", "parameters", "parametersSubscribe", "services"}));
+  EXPECT_EQ(with["capabilities"],
+            Json::array({"time", "parameters", "parametersSubscribe", "services", "clientPublish"}));
   EXPECT_EQ(with["supportedEncodings"], Json::array({"cdr", "json"}));
   const Json without = Json::parse(server_info_json("rbsim", "1-1"));
   EXPECT_EQ(without["capabilities"], Json::array({"time"}));

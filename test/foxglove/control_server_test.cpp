@@ -127,7 +127,8 @@ TEST(FoxgloveSteering, AdvertisesTheCapabilitiesAndTheFiveServices) {
   ASSERT_TRUE(s.server);
   WsClient c;
   const Json info = connect(c, s.server->port());
-  EXPECT_EQ(info["capabilities"], Json::array({"time", "parameters", "parametersSubscribe", "services"}));
+  EXPECT_EQ(info["capabilities"],
+            Json::array({"time", "parameters", "parametersSubscribe", "services", "clientPublish"}));
   EXPECT_EQ(info["supportedEncodings"], Json::array({"cdr", "json"}));
   const Json services = next_op(c, "advertiseServices")["services"];
   ASSERT_EQ(services.size(), 5u);
@@ -410,6 +411,90 @@ TEST(FoxgloveSteering, AnswersAfterTheServerIsGoneDoNothing) {
   EXPECT_TRUE(driver.value().run_pass(options).ok());
   EXPECT_TRUE(resumed.get().successful);
   EXPECT_EQ(controller.get({"rate"})[0], msgs::ParameterValue::of_double(2.0));
+}
+
+// clientPublish: a command published on /sim/command_in applies at the next boundary.
+std::string advertise_command_in(std::uint32_t id, const std::string& encoding) {
+  return Json{{"op", "advertise"},
+              {"channels", Json::array({{{"id", id},
+                                         {"topic", "/sim/command_in"},
+                                         {"encoding", encoding},
+                                         {"schemaName", "rbsim_msgs/msg/Command"}}})}}
+      .dump();
+}
+std::string published(std::uint32_t channel, const std::string& payload) {
+  return "\x01" + le32(channel) + payload;
+}
+// Polls (bounded: 5 s) until `name` has `value` in the controller.
+bool becomes(control::Controller& c, const std::string& name, const msgs::ParameterValue& value) {
+  for (int k = 0; k < 500; ++k) {
+    if (c.get({name})[0] == value) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+TEST(FoxgloveSteering, CommandsPublishedOnCommandInApplyInCdrAndJson) {
+  Steered s;
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  connect(c, s.server->port());
+  ASSERT_TRUE(c.send_text(advertise_command_in(1, "json")));
+  ASSERT_TRUE(c.send_text(advertise_command_in(2, "cdr")));
+  ASSERT_TRUE(c.send_binary(published(
+      1, R"({"kind":0,"parameters":[{"name":"forces.0.fy","value":{"type":3,"double_value":-4.0}}]})")));
+  EXPECT_TRUE(becomes(s.controller, "forces.0.fy", msgs::ParameterValue::of_double(-4.0)));
+  msgs::CommandMessage m;
+  m.kind = msgs::CommandMessage::SetParameters;
+  m.parameters = {{"forces.0.fy", msgs::ParameterValue::of_double(-1.5)}};
+  ASSERT_TRUE(c.send_binary(published(2, cdr(m))));
+  EXPECT_TRUE(becomes(s.controller, "forces.0.fy", msgs::ParameterValue::of_double(-1.5)));
+  // The run is paused; a published resume un-pauses it.
+  ASSERT_TRUE(c.send_binary(published(1, R"({"kind":2})")));
+  EXPECT_TRUE(becomes(s.controller, "paused", msgs::ParameterValue::of_bool(false)));
+  // Success says nothing: the next status is the refusal of an impulse on a body that is not there.
+  ASSERT_TRUE(c.send_binary(published(1, R"({"kind":5,"body":99,"jx":1})")));
+  const std::string refused = next_op(c, "status")["message"];
+  EXPECT_NE(refused.find("clientPublish /sim/command_in: apply_impulse: "), std::string::npos) << refused;
+  EXPECT_NE(refused.find("99"), std::string::npos) << refused;
+  // Malformed: a status error, and the connection still serves.
+  ASSERT_TRUE(c.send_binary(published(2, "\x07")));
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("clientPublish /sim/command_in: "),
+            std::string::npos);
+  ASSERT_TRUE(c.send_binary(published(1, R"({"parameters":[{"name":"nope"}]})")));
+  EXPECT_NE(next_op(c, "status")["message"].get<std::string>().find("no parameter 'nope'"),
+            std::string::npos);
+  ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["forces.0.fy"],"id":"ok"})"));
+  EXPECT_EQ(value_of(next_op(c, "parameterValues"), "forces.0.fy")["value"], -1.5);
+}
+
+TEST(FoxgloveSteering, AFloodOfPublishedCommandsIsBoundedPerClient) {
+  ServerOptions o;
+  o.max_pending_commands = 4;
+  Steered s(o, false);  // no run loop: nothing is applied, so every command stays in flight
+  ASSERT_TRUE(s.server);
+  WsClient c;
+  connect(c, s.server->port());
+  ASSERT_TRUE(c.send_text(advertise_command_in(1, "json")));
+  for (int k = 0; k < 1000; ++k) ASSERT_TRUE(c.send_binary(published(1, R"({"kind":1})")));
+  const std::string refused = next_op(c, "status")["message"];
+  EXPECT_NE(refused.find("clientPublish: too many requests in flight (4 per client)"), std::string::npos)
+      << refused;
+  // Answered after the 996 refusals queued before it (each a status error).
+  ASSERT_TRUE(c.send_text(R"({"op":"getParameters","parameterNames":["dt"],"id":"r"})"));
+  int statuses = 0;
+  bool answered = false;
+  for (int k = 0; k < 2000 && !answered; ++k) {
+    auto f = c.read();
+    if (!f) break;
+    const Json j = Json::parse(f->data, nullptr, false);
+    statuses += j.value("op", "") == "status";
+    answered = j.value("op", "") == "parameterValues" && j.value("id", "") == "r";
+  }
+  EXPECT_TRUE(answered);
+  EXPECT_EQ(statuses, 995);  // and the one read above
+  const ServerStats st = s.server->stats();
+  EXPECT_EQ(st.refused_requests, 996u) << st.requests;
 }
 
 }  // namespace

@@ -119,6 +119,15 @@ runMain("foxglove_client.viewer", async (check) => {
     }
     log(`topics listed ${((performance.now() - t0) / 1000).toFixed(1)} s after opening the page`);
     check(missing.length === 0, `topics not listed in Foxglove: ${missing.join(" ")}`);
+    // The layout's Parameters panel lists the node's parameters (got over the protocol's parameters
+    // capability); the Service Call buttons are newer than Studio 1.48 (it shows them as unknown).
+    let params = [];
+    for (const deadline = Date.now() + 20000; Date.now() < deadline && params.length < 2; ) {
+      const t = await text();
+      params = ["publish_every", "forces.0.fy"].filter((p) => t.includes(p));
+      if (params.length < 2) await page.waitForTimeout(250);
+    }
+    check(params.length === 2, `the Parameters panel does not list publish_every and forces.0.fy (found: ${params})`);
     // Let it draw, then dismiss the 3D panel's first-use hint (it covers the plot's legend).
     await page.waitForTimeout(3000);
     const hint = page.getByText("Open settings to configure topics and layers.");

@@ -1,10 +1,13 @@
 // libFuzzer target: the Foxglove server's client-message handler (ClientProtocol, with the
-// parameter ops and 5 services offered) and the queue its replies go into. The input is a sequence
+// parameter ops, 5 services and clientPublish on /f/command_in offered) and the queue its replies
+// go into. The input is a sequence
 // of client frames separated by a 0x00 byte; a frame whose first byte is 0x01 is handed over as a
-// binary frame without that byte (a service call when it then starts with 0x02), any other as a
+// binary frame without that byte (a service call when it then starts with 0x02, a client message
+// when 0x01), any other as a
 // text frame, all to one ClientProtocol, so subscribe/unsubscribe sequences build up state. After
 // every frame the bookkeeping must agree with itself, every reply must be a JSON status or
-// serviceCallFailure, and a service call handed over must name an offered service and encoding;
+// serviceCallFailure, a service call handed over must name an offered service and encoding, a
+// client message an advertised channel's encoding, and the client channels stay within bounds;
 // the replies and a message per subscription go through a small ClientQueue, whose limits must
 // hold.
 #include <nlohmann/json.hpp>
@@ -21,6 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   constexpr std::uint32_t kChannels = 7;
   constexpr std::uint32_t kServices = 5;
   fox::ClientProtocol protocol(kChannels, true, kServices);
+  protocol.accept_publish("/f/command_in");
   fox::ClientQueue queue(fox::QueueLimits{8, 4096});
   fox::ClientProtocol::Outcome out;
   fox::ClientQueue::Frame frame;
@@ -64,6 +68,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (out.call->service == 0 || out.call->service > kServices) __builtin_trap();
       if (out.call->encoding != "cdr" && out.call->encoding != "json") __builtin_trap();
       if (!out.replies.empty()) __builtin_trap();  // a call is carried out or refused, not both
+    }
+    if (protocol.client_channel_count() > fox::kMaxClientChannels) __builtin_trap();
+    if (out.published) {
+      if (out.published->encoding != "cdr" && out.published->encoding != "json") __builtin_trap();
+      if (!out.replies.empty() || out.call) __builtin_trap();
     }
     if (out.parameters && out.parameters->values.size() != out.parameters->untyped_integer.size())
       __builtin_trap();

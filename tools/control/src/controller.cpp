@@ -206,7 +206,10 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       apply_now(p, world, b);
       applied = true;
     }
-    if (applied) publish_values(world);
+    if (applied) {
+      publish_values(world);
+      answer();
+    }
     bool closed = false;
     {
       const std::lock_guard lock(mutex_);
@@ -254,8 +257,15 @@ void Controller::apply_now(Pending& p, World& world, Boundary& b) {
     const std::lock_guard lock(mutex_);
     ++counters_.commands;
   }
-  for (const auto& observer : observers_) observer(p.command, r);
-  if (p.done) p.done(r);
+  answered_.emplace_back(std::move(p), std::move(r));
+}
+
+void Controller::answer() {
+  for (auto& [p, r] : answered_) {
+    for (const auto& observer : observers_) observer(p.command, r);
+    if (p.done) p.done(r);
+  }
+  answered_.clear();
 }
 
 void Controller::settings_changed(Boundary& boundary) {

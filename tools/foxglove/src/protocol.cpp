@@ -26,7 +26,8 @@ std::string server_info_json(std::string_view name, std::string_view session_id,
                       {"metadata", nlohmann::json::object()},
                       {"sessionId", std::string(session_id)}};
   if (control) {
-    for (const char* c : {"parameters", "parametersSubscribe", "services"}) j["capabilities"].push_back(c);
+    for (const char* c : {"parameters", "parametersSubscribe", "services", "clientPublish"})
+      j["capabilities"].push_back(c);
     j["supportedEncodings"] = nlohmann::json::array();
     for (std::string_view e : kServiceEncodings) j["supportedEncodings"].push_back(std::string(e));
   }
@@ -116,38 +117,14 @@ void append_service_call_response(std::string& out, ServiceId service, CallId ca
 // ---------------------------------------------------------------------------------------------
 // ClientProtocol
 
+using detail::kMaxDepth;
 using detail::parameter_op;
 using detail::Problems;
+using detail::PublishOps;
 using detail::shown;
+using detail::too_deep;
 
 namespace {
-// nlohmann's parser keeps its own stack, but a deeply nested value is still walked recursively
-// elsewhere (dump, compare): no client message of this protocol nests deeper than 3.
-constexpr int kMaxDepth = 16;
-bool too_deep(std::string_view text) {
-  int depth = 0;
-  bool in_string = false, escaped = false;
-  for (char c : text) {
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-      }
-      continue;
-    }
-    if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > kMaxDepth) return true;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return false;
-}
 
 // A protocol id: a JSON integer in [0, 2^32). (An out parameter: GCC 12 misreports an
 // std::optional<uint32_t> here as maybe uninitialized under -O2.)
@@ -197,10 +174,17 @@ void ClientProtocol::handle_binary(std::string_view frame, Outcome& out) {
   out.clear();
   const auto error = [&](const std::string& m) { out.replies.push_back(status_json(StatusLevel::Error, m)); };
   const std::string size = std::to_string(frame.size()) + " bytes";
+  if (!publish_topic_.empty() && !frame.empty() && frame[0] == '\x01') {
+    PublishOps::message(*this, frame, out);
+    return;
+  }
   if (service_count_ == 0 || frame.empty() || frame[0] != '\x02') {
     error("binary message of " + size + " refused: this server accepts " +
           (service_count_ == 0 ? std::string("no client publishing or service calls")
-                               : "service call requests (opcode 0x02) only, no client publishing"));
+           : publish_topic_.empty()
+               ? std::string("service call requests (opcode 0x02) only, no client publishing")
+               : std::string("client messages (opcode 0x01) and service call requests "
+                             "(opcode 0x02) only")));
     return;
   }
   if (frame.size() < kServiceCallHeader) {
@@ -317,6 +301,12 @@ void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
       --count_;
       out.unsubscribed.push_back({id, static_cast<ChannelId>(it - by_channel_.begin() + 1)});
     }
+  } else if ((op == "advertise" || op == "unadvertise") && !publish_topic_.empty()) {
+    if (op == "advertise") {
+      PublishOps::advertise(*this, j, problems);
+    } else {
+      PublishOps::unadvertise(*this, j, problems);
+    }
   } else if (std::find(std::begin(kParameterOps), std::end(kParameterOps), op) != std::end(kParameterOps) &&
              parameters_) {
     parameter_op(op, j, out, problems);
@@ -324,7 +314,7 @@ void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
              std::find(std::begin(kParameterOps), std::end(kParameterOps), op) != std::end(kParameterOps)) {
     error("op " + shown(*op_it) + " is not supported by this server (capabilities: time" +
           (parameters_ ? ", parameters, parametersSubscribe" : "") +
-          (service_count_ > 0 ? ", services" : "") + ")");
+          (service_count_ > 0 ? ", services" : "") + (publish_topic_.empty() ? "" : ", clientPublish") + ")");
     return;
   } else {
     error("unknown op " + shown(*op_it));

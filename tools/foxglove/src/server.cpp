@@ -96,6 +96,7 @@ struct Server::Impl {
   // Steering (options.controller set): fixed for the server's life.
   std::vector<ServiceSpec> services;
   std::string advertise_services;
+  std::string command_in;                    // <node>/command_in, the clientPublish topic
   std::vector<std::string> parameter_names;  // the controller's table, in order
   std::unordered_map<std::string, std::size_t> parameter_index;
   std::shared_ptr<ReplyLink> link = std::make_shared<ReplyLink>();
@@ -123,6 +124,7 @@ struct Server::Impl {
       auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()),
                                         options.controller != nullptr,
                                         static_cast<std::uint32_t>(services.size()), options.queue);
+      if (options.controller != nullptr) c->protocol.accept_publish(command_in);
       c->queue.push_text(server_info);
       c->queue.push_text(advertise);
       if (!services.empty()) c->queue.push_text(advertise_services);
@@ -153,20 +155,23 @@ struct Server::Impl {
   void message(detail::ConnectionId id, const std::string& payload, bool binary) {
     std::optional<ParameterRequest> parameters;
     std::optional<ServiceCall> call;
+    std::optional<ClientMessage> published;
     {
       std::lock_guard lock(mu);
       if (!handle(id, payload, binary)) return;
       parameters = std::move(outcome.parameters);
       call = std::move(outcome.call);
+      published = std::move(outcome.published);
     }
     // Without `mu`: the controller may answer inside submit(), through the link.
     if (parameters) serve_parameters(id, std::move(*parameters));
     if (call) serve_call(id, std::move(*call));
+    if (published) serve_publish(id, std::move(*published));
     pump_all();
   }
 
   // Under `mu`: whether `c` may make a request now (false: refused, and told so once per backlog).
-  bool admit(Client& c, bool command, const ServiceCall* call) {
+  bool admit(Client& c, bool command, const ServiceCall* call, const char* op = "setParameters") {
     const std::size_t backlog = c.queue.kept_bytes();
     if (backlog < options.max_reply_backlog_bytes / 2) c.backlog_told = false;
     if (backlog >= options.max_reply_backlog_bytes) {
@@ -184,7 +189,7 @@ struct Server::Impl {
       const std::string m = "too many requests in flight (" + std::to_string(options.max_pending_commands) +
                             " per client): wait for their answers";
       c.queue.push_text(call ? service_call_failure_json(call->service, call->call, m)
-                             : status_json(StatusLevel::Error, "setParameters: " + m));
+                             : status_json(StatusLevel::Error, op + (": " + m)));
       return false;
     }
     ++totals.requests;
@@ -214,6 +219,7 @@ struct Server::Impl {
       outcome.parameters.reset();
     }
     if (outcome.call && !admit(*c, true, &*outcome.call)) outcome.call.reset();
+    if (outcome.published && !admit(*c, true, nullptr, "clientPublish")) outcome.published.reset();
     return true;
   }
 
@@ -224,6 +230,7 @@ struct Server::Impl {
   // I/O thread, without `mu`.
   void serve_parameters(detail::ConnectionId id, ParameterRequest r);
   void serve_call(detail::ConnectionId id, ServiceCall call);
+  void serve_publish(detail::ConnectionId id, ClientMessage message);
 
   // Under `mu`: takes the frames websocketpp may have now (while less than max_in_flight_bytes is
   // buffered there) and notes whether the client read anything since the last pump.
@@ -446,6 +453,33 @@ void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
   });
 }
 
+// A command on <node>/command_in: applied at the next boundary, source "foxglove"; its refusal
+// (undecodable, or what the run loop said) comes back as a status error, success says nothing.
+// Parameter names are checked on this thread, as for setParameters (decode_command).
+void Server::Impl::serve_publish(detail::ConnectionId id, ClientMessage message) {
+  const std::string where = "clientPublish " + command_in + ": ";
+  Result<control::Command> command =
+      detail::decode_command(message.encoding, message.payload, parameter_index);
+  if (!command) {
+    reply(id, {{status_json(StatusLevel::Error, where + command.error().message), false}}, true);
+    return;
+  }
+  command->step = control::Command::kNextStep;
+  command->source = "foxglove";
+  const std::string kind = control::to_string(command->kind);
+  options.controller->submit(std::move(command.value()), [link = link, id, what = where + kind + ": "](
+                                                             const control::CommandResult& result) {
+    std::vector<std::string> refused;
+    if (!result.successful) refused.push_back(result.message);
+    for (const auto& r : result.results) {
+      if (!r.successful && refused.empty()) refused.push_back(r.reason);
+    }
+    std::vector<Reply> out;
+    if (!refused.empty()) out.push_back({status_json(StatusLevel::Error, what + refused.front()), false});
+    link->deliver(id, out, true);
+  });
+}
+
 Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
                                               std::vector<ChannelSpec> channels) {
   std::unique_ptr<Server> s(new Server());
@@ -458,6 +492,7 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   if (options.controller != nullptr) {
     im.services = detail::control_service_specs(options.node);
     im.advertise_services = advertise_services_json(im.services);
+    im.command_in = options.node + "/" + std::string(kCommandInSuffix);
     im.parameter_names = options.controller->list({}, control::kDepthRecursive).names;
     for (std::size_t i = 0; i < im.parameter_names.size(); ++i) im.parameter_index[im.parameter_names[i]] = i;
   }

@@ -6,6 +6,7 @@
 
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "rbsim/control.hpp"
@@ -21,5 +22,12 @@ Result<control::Command> decode_request(const control::ControlService& service, 
 // The result as the service's response payload in `encoding`.
 std::string encode_response(const control::ControlService& service, std::string_view encoding,
                             const control::CommandResult& result);
+
+// A client's message on <node>/command_in (`encoding` cdr or json) as its Command
+// (src/command_in.cpp); its step and source are the caller's to set. A set_parameters naming a
+// parameter not in `known` (the node's, by name) or more values than it has is refused here, so the
+// run loop's work stays bounded. The error names what is wrong.
+Result<control::Command> decode_command(std::string_view encoding, std::string_view payload,
+                                        const std::unordered_map<std::string, std::size_t>& known);
 
 }  // namespace rbsim::foxglove::detail

@@ -23,6 +23,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rbsim/core.hpp"
@@ -156,7 +157,11 @@ class Controller final : public StepHook {
   void settings_changed(Boundary& boundary);
   // Applies one command now (from the schedule, or a timed pause's own resume): result, counters,
   // observer and callback.
+  // Applies `pending` and keeps it with its result in `answered_`; answer() then tells its
+  // observers and its caller, after publish_values(), so a read after an answer sees the change.
   void apply_now(Pending& pending, World& world, Boundary& boundary);
+  void answer();
+  std::vector<std::pair<Pending, CommandResult>> answered_;  // run loop thread only
   void publish_values(const World& world);
 
   const Scene& scene_;

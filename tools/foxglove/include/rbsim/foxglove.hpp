@@ -32,6 +32,10 @@
 
 namespace rbsim::foxglove {
 
+namespace detail {
+struct PublishOps;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Protocol
 
@@ -68,7 +72,7 @@ using ServiceId = std::uint32_t;
 using CallId = std::uint32_t;
 
 // With a controller (rbsim node) the server also offers the capabilities parameters,
-// parametersSubscribe and services; a service call's request comes in one of these encodings,
+// parametersSubscribe, services and clientPublish; a service call's request comes in one of these encodings,
 // the client's choice per call (the spec's "one of the encodings supported by the server"), and
 // its response in the same one. cdr is first: Foxglove Studio calls in the first one it knows.
 inline constexpr std::string_view kServiceEncodings[] = {"cdr", "json"};
@@ -121,6 +125,22 @@ struct ParameterRequest {
   std::vector<bool> untyped_integer;
   std::optional<std::string> id;  // Get, Set: echoed in the parameterValues answer
 };
+// clientPublish (rbsim node only): a client may advertise channels on one topic, <node>/command_in,
+// schema rbsim_msgs/msg/Command, in one of these encodings (cdr: the CDR of Command.msg; json: its
+// fields by name), at most kMaxClientChannels at a time; each message it sends on one is a command
+// (src/command_in.cpp decodes it) applied at the next step boundary.
+inline constexpr std::string_view kCommandInSuffix = "command_in";
+inline constexpr std::string_view kCommandInSchema = "rbsim_msgs/msg/Command";
+inline constexpr std::string_view kClientPublishEncodings[] = {"cdr", "json"};
+inline constexpr std::size_t kMaxClientChannels = 16;
+// A client's messageData (opcode 0x01): opcode, channel id (uint32), payload.
+inline constexpr std::size_t kClientMessageHeader = 1 + 4;
+struct ClientMessage {
+  ChannelId channel = 0;  // the client's id
+  std::string encoding;   // its channel's
+  std::string payload;
+};
+
 // A client's service call, its header checked (a known service, an offered encoding, within
 // kMaxClientFrame); the payload is the service's to decode.
 struct ServiceCall {
@@ -134,9 +154,10 @@ struct ServiceCall {
 // 1 .. channel_count; with `parameters` the parameter ops are accepted, and services are
 // 1 .. service_count. Any input is answered, never thrown on: a malformed frame, an unknown op, an
 // op not offered, an unknown channel or subscription id, a binary frame other than a service call
-// (we do not offer clientPublish) or a frame over kMaxClientFrame gives one status error per frame
-// (naming at most a few of the problems), and the valid parts of a subscribe, unsubscribe or
-// setParameters still take effect. A service call with a readable header but an unknown service,
+// or (with accept_publish) a message on an advertised client channel, or a frame over
+// kMaxClientFrame gives one status error per frame (naming at most a few of the problems), and the
+// valid parts of a subscribe, unsubscribe, advertise, unadvertise or setParameters still take
+// effect. A service call with a readable header but an unknown service,
 // an encoding not offered or a payload over the limit gets a serviceCallFailure instead.
 class ClientProtocol {
  public:
@@ -154,12 +175,14 @@ class ClientProtocol {
     std::vector<std::string> replies;            // JSON text frames to send back (status, serviceCallFailure)
     std::optional<ParameterRequest> parameters;  // a parameter op to carry out
     std::optional<ServiceCall> call;             // a service call to carry out
+    std::optional<ClientMessage> published;      // a message on one of the client's channels
     void clear() {
       subscribed.clear();
       unsubscribed.clear();
       replies.clear();
       parameters.reset();
       call.reset();
+      published.reset();
     }
   };
   // Handles one text frame (`out` is cleared first).
@@ -169,6 +192,10 @@ class ClientProtocol {
 
   // The subscription on `channel`, if any.
   std::optional<SubscriptionId> subscription(ChannelId channel) const;
+  // Offers clientPublish: channels advertised on `topic` with kCommandInSchema and an encoding of
+  // kClientPublishEncodings are accepted (every other advertisement is refused).
+  void accept_publish(std::string topic) { publish_topic_ = std::move(topic); }
+  std::size_t client_channel_count() const { return client_channels_.size(); }
   std::size_t subscription_count() const { return count_; }
   std::uint32_t channel_count() const { return static_cast<std::uint32_t>(by_channel_.size()); }
 
@@ -177,6 +204,15 @@ class ClientProtocol {
   std::size_t count_ = 0;
   bool parameters_ = false;
   std::uint32_t service_count_ = 0;
+  // clientPublish (src/client_publish.cpp): the accepted topic ("" when not offered) and the
+  // client's channels.
+  friend struct detail::PublishOps;
+  std::string publish_topic_;
+  struct ClientChannel {
+    ChannelId id = 0;
+    std::string encoding;
+  };
+  std::vector<ClientChannel> client_channels_;
 };
 
 // ---------------------------------------------------------------------------------------------
