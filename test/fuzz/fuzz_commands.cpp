@@ -53,6 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   options.control = &run.controller();
   (void)driver.value().run_pass(options);
   (void)run.finish("fuzz.yaml");
-  if (run.controller().counters().commands > 2 * n + 1) __builtin_trap();  // each answered once (and timed resumes)
+  if (run.controller().counters().commands > 2 * n + 1)
+    __builtin_trap();  // each answered once (and timed resumes)
   return 0;
 }
