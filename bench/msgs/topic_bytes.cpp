@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   std::size_t per_step = 0, once = 0;
   std::printf("%d bodies, %d springs: CDR bytes per message\n", n, world->spring_count());
   for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
+    if (spec.event) continue;  // the controller's, not encoded from a World
     encoder.encode(spec.id, world.value(), out);
     const bool in_default = defaults.test(static_cast<std::size_t>(spec.id));
     std::printf("  %-28s %10zu  %s%s\n", rbsim::msgs::topic_name(spec, "rbsim").c_str(), out.size(),

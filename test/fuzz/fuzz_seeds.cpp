@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     rbsim::msgs::Bytes bytes;
     for (int step = 0; step <= 3; ++step) {
       for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
-        if (spec.id == rbsim::msgs::TopicId::Scene && step > 0) continue;
+        if ((spec.id == rbsim::msgs::TopicId::Scene && step > 0) || spec.event) continue;  // events: no World
         encoder.encode(spec.id, world.value(), bytes);
         std::ofstream f(out / "cdr" / (stem + "-" + std::string(spec.suffix) + "-" + std::to_string(step)),
                         std::ios::binary);
