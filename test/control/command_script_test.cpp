@@ -104,6 +104,12 @@ TEST(ParseCommandScript, ErrorsNameTheFileLineAndField) {
       {ok + "- {step: 1, steps: 0}", "c.yaml:2: steps: must be an integer >= 1"},
       {ok + "- {step: 3, steps: 2}", "c.yaml:2: steps: only while paused"},
       {ok + "- {step: 9, pause: true}\n- {step: 8, resume: true}", "c.yaml:2: pause: no resume follows"},
+      // The fuzzer's hang: steps 20..23 while paused, a reset at 30 never reached.
+      {ok + "- {step: 20, pause: true}\n- {step: 20, steps: 3}\n- {step: 30, reset: true}",
+       "c.yaml:2: pause: no resume follows at or before step 23"},
+      {ok + "- {step: 20, pause: true}\n- {step: 20, steps: 3}\n- {step: 23, resume: true}\n- {step: 24, "
+            "steps: 1}",
+       "c.yaml:5: steps: only while paused"},
       {ok + "- {step: 1, set: {forces.0.fy: [1.0, }", "c.yaml:2: not valid YAML"},
   };
   for (const auto& [text, want] : cases) {

@@ -120,6 +120,14 @@ TEST(RunCommands, ARecordingThatEndsPausedEndsTheRerunThere) {
   EXPECT_EQ(o.exit_code, 0) << o.err;
   EXPECT_NE(o.err.find("left the run paused at step 5"), std::string::npos) << o.err;
   EXPECT_EQ(lines_of(read_text(dir / "out.csv")).size(), 1 + 6u * 5);  // the header, steps 0..5 of 5 bodies
+  // A command for a later step is never reached while paused: the re-run still ends there, and
+  // says that command did not apply.
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "later.mcap", {0, 1}));  // pauses at 5 and 6
+  const Outcome later = rbsim({"run", source_path("scenes/cantilever.xml"), "--commands",
+                               (dir / "later.mcap").string(), "--csv", (dir / "later.csv").string()});
+  EXPECT_EQ(later.exit_code, 1) << later.err;
+  EXPECT_NE(later.err.find("left the run paused at step 5"), std::string::npos) << later.err;
+  EXPECT_NE(later.err.find("1 of its commands never applied"), std::string::npos) << later.err;
 }
 
 }  // namespace

@@ -180,8 +180,9 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
   return Ok{};
 }
 
-// An offline run has no one to resume it: a `pause: true` needs a later resume, and `steps` is
-// only meaningful while such a pause holds. Walks the commands in the order they apply.
+// An offline run has no one to resume it: walks the commands in the order they apply, as the
+// Controller does, with the last step a pause can reach (its step plus the `steps` given while it
+// holds). A command past that step, or a pause no resume ends, would leave the run paused for ever.
 Status check_pauses(const std::vector<Command>& commands, const std::vector<YAML::Node>& nodes,
                     const std::string& path) {
   std::vector<std::size_t> order(commands.size());
@@ -189,21 +190,32 @@ Status check_pauses(const std::vector<Command>& commands, const std::vector<YAML
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return commands[a].step < commands[b].step; });
   std::optional<std::size_t> open;  // the pause: true in effect
+  std::int64_t reach = 0;           // the last step the run reaches while it holds
+  const auto stuck = [&]() {
+    return Entry{path, nodes[*open]}.error(
+        nodes[*open], "pause",
+        "no resume follows at or before step " + std::to_string(reach) +
+            ", where the run would stay paused for ever (add a resume entry, "
+            "or pause for SECONDS of wall time)");
+  };
   for (std::size_t i : order) {
     const Command& c = commands[i];
-    const Entry e{path, nodes[i]};
-    if (c.kind == CommandKind::Pause && c.pause_seconds == 0.0 && !open) open = i;
-    if (c.kind == CommandKind::Resume || c.kind == CommandKind::Reset) open.reset();
-    if (c.kind == CommandKind::Step && !open) {
-      return e.error(nodes[i], "steps",
-                     "only while paused (a pause: true at or before this step, not resumed)");
+    if (open && c.step > reach) return stuck();
+    if (c.kind == CommandKind::Pause && c.pause_seconds == 0.0 && !open) {
+      open = i;
+      reach = c.step;
     }
+    if (c.kind == CommandKind::Resume) open.reset();
+    if (c.kind == CommandKind::Step) {
+      if (!open) {
+        return Entry{path, nodes[i]}.error(
+            nodes[i], "steps", "only while paused (a pause: true at or before this step, not resumed)");
+      }
+      reach += c.steps;
+    }
+    if (c.kind == CommandKind::Reset && open) reach = 0;  // a reset keeps the run paused, at step 0
   }
-  if (open) {
-    return Entry{path, nodes[*open]}.error(nodes[*open], "pause",
-                                           "no resume follows: the run would stay paused for ever (add a "
-                                           "resume entry, or pause for SECONDS of wall time)");
-  }
+  if (open) return stuck();
   return Ok{};
 }
 

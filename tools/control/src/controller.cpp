@@ -220,7 +220,9 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       return b;
     }
     if (!settings_.paused || step_budget_ > 0) break;
-    if (end_when_idle_ && schedule_.empty() && !resume_at_ &&
+    // Offline, nothing can end this pause: no resume timer, nothing due now, and a command queued
+    // for a later step is never reached while paused without a step budget.
+    if (end_when_idle_ && !due(world.step_index()) && !resume_at_ &&
         !has_incoming_.load(std::memory_order_acquire)) {
       ended_paused_ = world.step_index();
       b.stop = true;

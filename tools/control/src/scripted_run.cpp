@@ -43,9 +43,11 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
 ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<ScriptedCommand> commands)
     : scene_(scene), controller_(scene, steps, RunSettings{0.0, 1, false}) {
   controller_.end_when_idle(true);
+  submitted_ = commands.size();
   for (ScriptedCommand& s : commands) {
     controller_.submit(
         std::move(s.command), [this, origin = s.origin, expect = s.expect_success](const CommandResult& r) {
+          ++answered_;
           if (r.successful == expect) return;
           mismatches_.push_back(origin + ": " +
                                 (r.successful ? "applied here but refused in the recording" : "refused") +
@@ -66,6 +68,11 @@ Status ScriptedRun::finish(const std::string& path) {
   const ControlCounters counted = controller_.counters();
   controller_.close("the run ended");
   if (!recorded_) return recorded_;
+  // Commands for steps the run never reached (it ended, or stayed paused before them).
+  if (answered_ < submitted_) {
+    mismatches_.push_back(std::to_string(submitted_ - answered_) +
+                          " of its commands never applied: the run ended before their steps");
+  }
   if (mismatches_.empty()) return Ok{};
   return Error{path + ": " + std::to_string(mismatches_.size()) +
                (mismatches_.size() == 1 ? " command" : " commands") + " (of " +

@@ -72,11 +72,14 @@ class ScriptedRun {
 
  private:
   const Scene& scene_;
-  Controller controller_;
   std::vector<std::string> mismatches_;
   Status recorded_ = Ok{};
   Bytes cdr_;
   std::uint64_t seq_ = 0;
+  std::size_t submitted_ = 0, answered_ = 0;
+  // Last: destroyed first, so the callbacks it still runs (commands never reached) find the
+  // members above alive.
+  Controller controller_;
 };
 
 }  // namespace rbsim::control
