@@ -3,16 +3,24 @@
 // The real viewer: Foxglove Studio's last open-source web build (npm @foxglove/studio-base 1.48.0)
 // in Debian's headless Chromium with software WebGL, connected to a live `rbsim node --foxglove`
 // with docs/foxglove-layout.json, driven over the DevTools protocol (playwright-core, Chromium
-// started from /usr/bin/chromium). Passes when the sidebar lists every advertised topic and the 3D
-// panel shows the body colours of the scene's XML.
+// started from /usr/bin/chromium). Both cases first wait for the sidebar to list every advertised
+// topic. Cases:
+//   colours     the 3D panel shows the body colours of the scene's XML, and the Parameters panel
+//               lists parameters (foxglove_client.viewer, wind-garden);
+//   parameters  the Parameters panel lists exactly the parameters the server sends an independent
+//               client; the wind (forces.0.fx) set by typing in that panel and clicking its submit
+//               button makes the square of viewer/drift.xml drift right, not before, in the 3D
+//               panel's pixels, and the node publishes the set on /rbsim/commands, from "foxglove"
+//               (foxglove_client.viewer_parameters).
 //
-//   viewer.js --rbsim BUILD/rbsim --source-dir SRC --workdir DIR --npm BUILD/npm --index N
-//             [--scene FILE] [--screenshot PNG]   (--screenshot: also write the whole page there)
+//   viewer.js --case colours|parameters --rbsim BUILD/rbsim --source-dir SRC --workdir DIR
+//             --npm BUILD/npm --index N [--scene FILE] [--screenshot PNG]
+//   (--screenshot: also write the page of case colours there)
 const fs = require("fs");
 const http = require("http");
 const path = require("path");
 const lib = require("./lib");
-const { Failure, startServer, Client, runMain } = lib;
+const { Failure, until, startServer, Client, runMain } = lib;
 
 const A = {};
 for (let i = 2; i < process.argv.length; i += 2) A[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
@@ -21,6 +29,8 @@ const src = path.resolve(A["source-dir"]);
 const workdir = path.resolve(A.workdir);
 fs.rmSync(workdir, { recursive: true, force: true });
 fs.mkdirSync(workdir, { recursive: true });
+const CASES = { colours: ["foxglove_client.viewer", caseColours], parameters: ["foxglove_client.viewer_parameters", caseParameters] };
+if (!CASES[A.case]) throw new Error(`unknown --case ${A.case}`);
 const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
 
 const CHROMIUM = "/usr/bin/chromium";
@@ -77,19 +87,27 @@ function countColours(png, rect, colours, tol) {
   return counts;
 }
 
-runMain("foxglove_client.viewer", async (check) => {
+// Centre (x, y) and count of the PNG's pixels within `tol` of `colour` (per channel).
+function centroid(png, colour, tol) {
+  let n = 0, sx = 0, sy = 0;
+  for (let y = 0; y < png.height; y++) {
+    for (let x = 0; x < png.width; x++) {
+      const i = (y * png.width + x) * 4;
+      if ([0, 1, 2].every((k) => Math.abs(png.data[i + k] - colour[k]) <= tol)) [n, sx, sy] = [n + 1, sx + x, sy + y];
+    }
+  }
+  return { n, x: sx / n, y: sy / n };
+}
+
+// Starts the node on `sceneFile` (namespace rbsim, the layout's) and Studio on it, waits for every
+// advertised topic in the sidebar, runs body({ page, url, PNG, canvas }) and closes everything.
+async function withStudio(check, sceneFile, nodeArgs, body) {
   if (!fs.existsSync(CHROMIUM)) throw new Failure(`${CHROMIUM} not found: run scripts/setup`);
   const { chromium } = need("playwright-core");
   const { PNG } = need("pngjs");
   need("@foxglove/studio-base/package.json");
   need("react-dom/package.json");
-
-  const sceneFile = path.resolve(A.scene ?? path.join(src, "scenes", "creative", "wind-garden.xml"));
-  const colours = expectedColours(sceneFile);
-  if (!colours.length) throw new Failure(`${sceneFile} has no <rigidbodycolor>`);
-  // 50 Hz for the scene's 2 ms steps, a viewer's pace: Chromium's single main thread, with software
-  // WebGL, on a busy 2-core machine, falls behind every step's messages and then never paints.
-  const [node, url] = await startServer(A.rbsim, ["node", sceneFile, "--rate", 1, "--loop", "--publish-every", 10,
+  const [node, url] = await startServer(A.rbsim, ["node", sceneFile, ...nodeArgs,
     "--domain", lib.domainFor(Number(A.index)), "--namespace", "rbsim"], { logDir: workdir });
   // The topics the server advertises, seen by an independent client.
   const probe = await new Client(need, url, { name: "probe", subscribeAll: false }).ready();
@@ -110,48 +128,28 @@ runMain("foxglove_client.viewer", async (check) => {
     await page.goto(`${page0}?ds=foxglove-websocket&ds.url=${encodeURIComponent(url)}&layoutId=rbsim`,
       { timeout: 60000 });
     // The data source sidebar lists every topic once the player has connected.
-    const text = () => page.evaluate(() => document.body.innerText);
     let missing = topics;
     for (const deadline = Date.now() + 60000; Date.now() < deadline && missing.length; ) {
-      const t = await text();
+      const t = await page.evaluate(() => document.body.innerText);
       missing = topics.filter((topic) => !t.includes(topic));
       if (missing.length) await page.waitForTimeout(250);
     }
     log(`topics listed ${((performance.now() - t0) / 1000).toFixed(1)} s after opening the page`);
-    check(missing.length === 0, `topics not listed in Foxglove: ${missing.join(" ")}`);
-    // The layout's Parameters panel lists the node's parameters (got over the protocol's parameters
-    // capability); the Service Call buttons are newer than Studio 1.48 (it shows them as unknown).
-    let params = [];
-    for (const deadline = Date.now() + 20000; Date.now() < deadline && params.length < 2; ) {
-      const t = await text();
-      params = ["publish_every", "forces.0.fy"].filter((p) => t.includes(p));
-      if (params.length < 2) await page.waitForTimeout(250);
-    }
-    check(params.length === 2, `the Parameters panel does not list publish_every and forces.0.fy (found: ${params})`);
+    if (!check(missing.length === 0, `topics not listed in Foxglove: ${missing.join(" ")}`)) return;
     // Let it draw, then dismiss the 3D panel's first-use hint (it covers the plot's legend).
     await page.waitForTimeout(3000);
     const hint = page.getByText("Open settings to configure topics and layers.");
     await hint.locator("xpath=ancestor::div[.//button][1]//button").first().click({ timeout: 3000 }).catch(() => {});
     await hint.waitFor({ state: "hidden", timeout: 2000 }).catch(() => {});
     // The 3D panel's canvas: the largest one (the plot's is smaller).
-    const rect = await page.evaluate(() => {
+    const canvas = await page.evaluate(() => {
       const cs = [...document.querySelectorAll("canvas")].map((c) => c.getBoundingClientRect())
         .sort((a, b) => b.width * b.height - a.width * a.height);
       return cs.length ? { x: Math.round(cs[0].x), y: Math.round(cs[0].y), width: Math.round(cs[0].width),
         height: Math.round(cs[0].height) } : undefined;
     });
-    const shot = path.join(workdir, "viewer.png");
-    await page.screenshot({ path: shot });
-    if (A.screenshot) fs.copyFileSync(shot, path.resolve(A.screenshot));
-    log(`screenshot ${shot}; 3D canvas ${JSON.stringify(rect)}`);
-    if (!check(rect && rect.width > 200 && rect.height > 200, `no 3D canvas (${JSON.stringify(rect)})`)) return;
-    const png = PNG.sync.read(fs.readFileSync(shot));
-    const counts = countColours(png, rect, colours, 10);
-    const shown = colours.filter((_, k) => counts[k] >= 20);
-    log(`scene colours in the 3D panel (pixels): ${colours.map((c, k) => `rgb(${c}) ${counts[k]}`).join(", ")}`);
-    check(shown.length === colours.length,
-      `${colours.length - shown.length} of the scene's ${colours.length} body colours not drawn in the 3D panel: ` +
-        colours.filter((_, k) => counts[k] < 20).map((c) => `rgb(${c})`).join(" "));
+    if (!check(canvas && canvas.width > 200 && canvas.height > 200, `no 3D canvas (${JSON.stringify(canvas)})`)) return;
+    await body({ page, url, PNG, canvas });
     check(errors.length === 0, `page errors: ${errors.join("; ")}`);
   } finally {
     await browser.close();
@@ -159,4 +157,105 @@ runMain("foxglove_client.viewer", async (check) => {
     node.kill("SIGINT");
     check((await node.wait(15000)) === 0, `node exited with ${node.code}\n${node.output()}`);
   }
-});
+}
+
+async function caseColours(check) {
+  const sceneFile = path.resolve(A.scene ?? path.join(src, "scenes", "creative", "wind-garden.xml"));
+  const colours = expectedColours(sceneFile);
+  if (!colours.length) throw new Failure(`${sceneFile} has no <rigidbodycolor>`);
+  // 50 Hz for the scene's 2 ms steps, a viewer's pace: Chromium's single main thread, with software
+  // WebGL, on a busy 2-core machine, falls behind every step's messages and then never paints.
+  await withStudio(check, sceneFile, ["--rate", 1, "--loop", "--publish-every", 10], async ({ page, PNG, canvas }) => {
+    // The layout's Parameters panel lists the node's parameters (got over the protocol's parameters
+    // capability); the Service Call buttons are newer than Studio 1.48 (it shows them as unknown).
+    let params = [];
+    for (const deadline = Date.now() + 20000; Date.now() < deadline && params.length < 2; ) {
+      const t = await page.evaluate(() => document.body.innerText);
+      params = ["publish_every", "forces.0.fy"].filter((p) => t.includes(p));
+      if (params.length < 2) await page.waitForTimeout(250);
+    }
+    check(params.length === 2, `the Parameters panel does not list publish_every and forces.0.fy (found: ${params})`);
+    const shot = path.join(workdir, "viewer.png");
+    await page.screenshot({ path: shot });
+    if (A.screenshot) fs.copyFileSync(shot, path.resolve(A.screenshot));
+    log(`screenshot ${shot}; 3D canvas ${JSON.stringify(canvas)}`);
+    const png = PNG.sync.read(fs.readFileSync(shot));
+    const counts = countColours(png, canvas, colours, 10);
+    const shown = colours.filter((_, k) => counts[k] >= 20);
+    log(`scene colours in the 3D panel (pixels): ${colours.map((c, k) => `rgb(${c}) ${counts[k]}`).join(", ")}`);
+    check(shown.length === colours.length,
+      `${colours.length - shown.length} of the scene's ${colours.length} body colours not drawn in the 3D panel: ` +
+        colours.filter((_, k) => counts[k] < 20).map((c) => `rgb(${c})`).join(" "));
+  });
+}
+
+async function caseParameters(check) {
+  const sceneFile = path.join(__dirname, "viewer", "drift.xml");
+  const [colour] = expectedColours(sceneFile);
+  await withStudio(check, sceneFile, ["--rate", 1, "--publish-every", 10], async ({ page, url, PNG, canvas }) => {
+    // An independent client: the parameter names the server sends, and /rbsim/commands.
+    const c = new Client(need, url, { name: "params", subscribeAll: false });
+    const values = [];
+    c.client.on("parameterValues", (m) => values.push(m));
+    await c.ready();
+    const commands = [...c.channels.values()].find((ch) => ch.topic === "/rbsim/commands");
+    if (!commands) throw new Failure(`no /rbsim/commands channel: ${c.topics()}`);
+    c.subscribe(commands);
+    c.client.getParameters([], "all");
+    const names = (await until("parameterValues", 5000, () => values.find((v) => v.id === "all")))
+      .parameters.map((p) => p.name).sort();
+    // The Parameters panel: a table headed Parameter | Value, a name per row.
+    const listed = () => page.evaluate(() => {
+      const t = [...document.querySelectorAll("table")].find((e) => /^Parameter\s+Value/.test(e.tHead?.innerText ?? ""));
+      return t ? [...t.tBodies[0].rows].map((r) => r.cells[0].innerText.trim()).sort() : [];
+    });
+    let shown = [];
+    for (const deadline = Date.now() + 20000; Date.now() < deadline && shown.join() !== names.join(); ) {
+      shown = await listed();
+      if (shown.join() !== names.join()) await page.waitForTimeout(250);
+    }
+    log(`the Parameters panel lists the ${shown.length} parameters the server sends`);
+    check(names.includes("forces.0.fx") && shown.join() === names.join(),
+      `the Parameters panel lists ${shown.join(" ")}; the server sends ${names.join(" ")}`);
+
+    // The square, in the 3D panel's pixels: drawn, and still while the wind is still.
+    const square = async () => centroid(PNG.sync.read(await page.screenshot({ clip: canvas })), colour, 10);
+    await page.waitForTimeout(1000);
+    const before = await square();
+    await page.waitForTimeout(1000);
+    const still = await square();
+    log(`square before: ${JSON.stringify(before)}, 1 s later ${JSON.stringify(still)}`);
+    if (!check(before.n >= 200 && Math.hypot(still.x - before.x, still.y - before.y) < 3,
+      `the square is not drawn, or moves in a still wind: ${JSON.stringify([before, still])}`)) return;
+
+    // The wind set through the panel: its value typed in the row's editor, then its submit button.
+    const row = page.locator("tbody tr", { has: page.locator('[title="forces.0.fx"]') });
+    await row.locator("textarea").click({ timeout: 5000 });
+    await page.keyboard.press("Control+A");
+    await page.keyboard.type("2.5");
+    await row.getByRole("button", { name: "Submit change" }).click({ timeout: 5000 });
+    const set = await until("the set on /rbsim/commands", 10000, () => c.messages.find((m) => m.topic === "/rbsim/commands"));
+    const cmd = set.decoded;
+    const p = cmd.parameters;
+    const text = JSON.stringify(cmd, (k, v) => (typeof v === "bigint" ? Number(v) : v));
+    log(`/rbsim/commands: ${text}`);
+    check(cmd.kind === 0 && cmd.source === "foxglove" && cmd.success && p.length === 1 && p[0].name === "forces.0.fx" &&
+      p[0].value.type === 3 && p[0].value.double_value === 2.5,
+    `the command on /rbsim/commands is not forces.0.fx = 2.5 from foxglove, applied: ${text}`);
+
+    // The square drifts: wait until it moved 60 px, then it must have moved right, not up or down.
+    let after = still;
+    for (const deadline = Date.now() + 15000; Date.now() < deadline && Math.hypot(after.x - still.x, after.y - still.y) < 60; ) {
+      after = await square();
+    }
+    log(`square after the set: ${JSON.stringify(after)}`);
+    const [dx, dy] = [after.x - still.x, after.y - still.y];
+    check(after.n >= 200 && dx >= 60 && Math.abs(dy) < dx / 4,
+      `the square did not drift right after forces.0.fx = 2.5: moved (${dx.toFixed(1)}, ${dy.toFixed(1)}) px`);
+    check(c.messages.filter((m) => m.topic === "/rbsim/commands").length === 1, "more than one command published");
+    await page.screenshot({ path: path.join(workdir, "viewer.png") });
+    c.close();
+  });
+}
+
+runMain(CASES[A.case][0], CASES[A.case][1]);
