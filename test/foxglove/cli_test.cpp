@@ -339,9 +339,14 @@ TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {
     EXPECT_LE(seen.max_time.at("/fox_br/body_states"), 20'000'000'000ull) << "log time is simulated time";
   }
   EXPECT_NE(bridge.err().find("rbsim bridge: stopped after"), std::string::npos) << bridge.err();
-  // Relaying steering to the node over DDS is not done yet: the bridge offers none.
-  EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time"}));
-  EXPECT_TRUE(seen.services.empty());
+  // Steering relayed to the node's services (foxglove_client.bridge_steered uses it).
+  for (const char* capability : {"parameters", "parametersSubscribe", "services", "clientPublish"}) {
+    EXPECT_TRUE(std::find(seen.capabilities.begin(), seen.capabilities.end(), capability) !=
+                seen.capabilities.end())
+        << capability << " in " << seen.capabilities.dump();
+  }
+  EXPECT_EQ(seen.services, (std::vector<std::string>{"/fox_br/pause", "/fox_br/resume", "/fox_br/reset",
+                                                     "/fox_br/step", "/fox_br/apply_impulse"}));
 }
 
 }  // namespace

@@ -53,7 +53,7 @@ struct Steered {
   explicit Steered(ServerOptions o = {}, bool run = true) {
     o.address = "127.0.0.1";
     o.port = 0;
-    o.controller = &controller;
+    o.steering = &controller;
     o.node = "/sim";
     auto s = Server::start(o, {});
     EXPECT_TRUE(s) << (s ? "" : s.error().message);
@@ -388,7 +388,7 @@ TEST(FoxgloveSteering, AnswersAfterTheServerIsGoneDoNothing) {
     ServerOptions o;
     o.address = "127.0.0.1";
     o.port = 0;
-    o.controller = &controller;
+    o.steering = &controller;
     auto server = Server::start(o, {});
     ASSERT_TRUE(server);
     WsClient c;

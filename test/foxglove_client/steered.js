@@ -3,8 +3,11 @@
 // A session steered from Foxglove's own client (npm @foxglove/ws-protocol), recorded over DDS by
 // `rbsim record` and re-simulated from that recording:
 //
-//   steered.js --rbsim BUILD/rbsim --source-dir SRC --workdir DIR --npm BUILD/npm --index N
+//   steered.js --rbsim BUILD/rbsim --source-dir SRC --workdir DIR --npm BUILD/npm --index N [--via bridge]
 //
+// With --via bridge the client talks to `rbsim bridge`, which relays everything to the node's ROS 2
+// services over DDS (the node records the commands with source "ros2 service"); the session and
+// its re-simulation are the same.
 // `rbsim node --foxglove` waits for the recorder; the client sets forces.0.fy (setParameters),
 // pauses and steps 5 (services, cdr), applies an impulse (a command published on /NS/command_in,
 // json: clientPublish), steps 1 and resumes (published, cdr). The recording's /NS/commands holds the six
@@ -30,6 +33,10 @@ const ns = `fg_steered_${process.pid}`;
 const domain = lib.domainFor(Number(A.index));
 const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
 const bigint = (k, v) => (typeof v === "bigint" ? Number(v) : v);
+const viaBridge = A.via === "bridge";
+if (A.via !== undefined && !viaBridge) throw new Error(`--via ${A.via}: only "bridge"`);
+// What the node records as the commands' source: the bridge calls the node's ROS 2 services.
+const source = viaBridge ? "ros2 service" : "foxglove";
 
 // rbsim's own commands, each bounded; `ok`: exit 0 required.
 async function rbsim(name, argv, ok = true) {
@@ -48,8 +55,16 @@ async function main(check) {
   const expected = 2 + 6 * (steps + 1) + 6;
   const rec = new Proc("record", [A.rbsim, "record", live, "--domain", domain, "--namespace", ns, "--max-messages",
     expected, "--wall-duration", 120, "--compression", "none"].map(String), { logDir: workdir });
-  const [node, url] = await startServer(A.rbsim, ["node", scene, "--domain", domain, "--namespace", ns,
-    "--duration", duration, "--wait-for-subscribers", 1], { name: "node", logDir: workdir });
+  const nodeArgs = ["node", scene, "--domain", domain, "--namespace", ns, "--duration", duration];
+  let node, url, bridge;
+  if (viaBridge) {
+    // The recorder and the bridge both subscribe to the body states: the node waits for both.
+    node = new Proc("node", [A.rbsim, ...nodeArgs, "--wait-for-subscribers", 2].map(String), { logDir: workdir });
+    [bridge, url] = await startServer(A.rbsim, ["bridge", "--domain", domain, "--namespace", ns],
+      { name: "bridge", logDir: workdir });
+  } else {
+    [node, url] = await startServer(A.rbsim, [...nodeArgs, "--wait-for-subscribers", 1], { name: "node", logDir: workdir });
+  }
   const c = new Client(need, url, { name: "steered", subscribeAll: false });
   const values = [];
   const responses = new Map();
@@ -88,6 +103,13 @@ async function main(check) {
   const cdrChannel = c.client.advertise({ topic: `/${ns}/command_in`, encoding: "cdr", schemaName: "rbsim_msgs/msg/Command" });
   const statuses = () => c.statuses.filter((s) => s.level === 2).map((s) => s.message);
 
+  if (viaBridge) {
+    // The bridge's table is the node's, read over DDS.
+    c.client.getParameters([], "all");
+    const all = await until("the parameter list", 5000, () => values.find((v) => v.id === "all"));
+    check(all.parameters.some((p) => p.name === "forces.0.fy") && all.parameters.length > 5,
+      `the bridge's parameters: ${all.parameters.map((p) => p.name)}`);
+  }
   c.client.setParameters([{ name: "forces.0.fy", value: -4.5 }], "set");
   await until("the set's answer", 5000, () => values.find((v) => v.id === "set"));
   const paused = await call("pause", {});
@@ -108,6 +130,11 @@ async function main(check) {
   check((await node.wait(60000)) === 0, `node exited with ${node.code}\n${node.output()}`);
   check((await rec.wait(60000)) === 0, `rbsim record exited with ${rec.code}\n${rec.output()}`);
   c.close();
+  if (bridge) {
+    bridge.kill("SIGINT");
+    check((await bridge.wait(20000)) === 0, `bridge exited with ${bridge.code}\n${bridge.output()}`);
+    check(/6 commands relayed to \//.test(bridge.err), `the bridge's end line: ${bridge.err}`);
+  }
 
   // The recording's commands: the six, from Foxglove, each applied.
   const recorded = readMcap(need, live);
@@ -120,10 +147,13 @@ async function main(check) {
   check(JSON.stringify(commands.map((m) => m.kind)) === JSON.stringify([0, 1, 3, 5, 3, 2]) ||
     JSON.stringify(commands.map((m) => m.kind)) === JSON.stringify([0, 1, 3, 3, 5, 2]),
   `/NS/commands kinds ${summary}`);
-  check(commands.every((m) => m.source === "foxglove" && m.success), `/NS/commands: ${summary}`);
+  check(commands.every((m) => m.source === source && m.success), `/NS/commands: ${summary}`);
   const impulse = commands.find((m) => m.kind === 5);
-  check(impulse && impulse.body === 2 && impulse.jy === 2.0 && Number(impulse.step) === at + 5,
-    `impulse ${JSON.stringify(impulse, bigint)}, want body 2 at step ${at + 5}`);
+  // Through the bridge the impulse and the step are two services' calls, which the node may take in
+  // either order: the impulse then applies at the step's boundary or at the one after it.
+  const impulseSteps = viaBridge ? [at + 5, at + 6] : [at + 5];
+  check(impulse && impulse.body === 2 && impulse.jy === 2.0 && impulseSteps.includes(Number(impulse.step)),
+    `impulse ${JSON.stringify(impulse, bigint)}, want body 2 at step ${impulseSteps.join(" or ")}`);
 
   // Re-simulated from the recording: the same session; without the commands: not.
   const rerun = path.join(workdir, "rerun.mcap");
@@ -139,4 +169,4 @@ async function main(check) {
   check(states2.code === 1, `body_states of the plain run equal the steered session's (exit ${states2.code})`);
 }
 
-runMain("foxglove_client.steered", main);
+runMain(viaBridge ? "foxglove_client.bridge_steered" : "foxglove_client.steered", main);

@@ -1,5 +1,6 @@
-// rbsim bridge: the DDS topics of any rbsim node relayed to Foxglove over its WebSocket protocol
-// (what foxglove_bridge does for ROS 2, with no ROS install).
+// rbsim bridge: the DDS topics of any rbsim node relayed to Foxglove over its WebSocket protocol,
+// and Foxglove's parameter requests and service calls relayed to the node's services (what
+// foxglove_bridge does for ROS 2, with no ROS install).
 #include <cstdio>
 #include <memory>
 
@@ -46,7 +47,15 @@ int bridge_command(const BridgeArgs& a) {
   if (!channels) return fail("bridge", channels.error().message);
   auto relay = node::Relay::create(participant.value(), a.ns);
   if (!relay) return fail("bridge", relay.error().message);
-  auto started = start_foxglove("rbsim bridge", *a.foxglove, std::move(channels.value()));
+  // The steered node is the one whose topics are relayed: /<namespace> (as rbsim node names itself).
+  const Result<node::NodeName> target = node::parse_node_name(a.ns);
+  if (!target) return fail("bridge", target.error().message, 2);
+  node::RemoteSteeringOptions steer;
+  steer.node = target->fully_qualified();
+  auto steering = node::RemoteSteering::create(participant.value(), steer);
+  if (!steering) return fail("bridge", steering.error().message);
+  auto started = start_foxglove("rbsim bridge", *a.foxglove, std::move(channels.value()),
+                                steering.value().get(), steer.node);
   if (!started) return fail("bridge", started.error().message);
   foxglove::Server& server = *started.value();
   install_stop_handlers();
@@ -58,7 +67,13 @@ int bridge_command(const BridgeArgs& a) {
   const node::Relay::OnSample on_sample = [&](const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
     const std::optional<std::uint64_t> t = sim_time(spec, cdr);
     if (spec.id == msgs::TopicId::Scene) {
-      // A scene (re)started: a new session, so viewers drop what they showed of the last one.
+      // A scene (re)started: its node's parameters (read before the new session, which hands them
+      // to the viewers), and a new session, so viewers drop what they showed of the last one. A
+      // source without services (rbsim replay) costs a bounded wait and a line.
+      if (Status st = steering.value()->refresh(); !st && !a.quiet) {
+        RBSIM_LOG(Warn, "rbsim bridge: warning: no parameters or controls to relay: %s\n",
+                  st.error().message.c_str());
+      }
       server.new_session();
       last_time = 0;
       ++scenes;
@@ -74,9 +89,13 @@ int bridge_command(const BridgeArgs& a) {
   }
   if (!a.quiet) {
     RBSIM_LOG(
-        Info, "rbsim bridge: stopped after %llu samples (%llu scene descriptions, %llu lost in DDS); %s\n",
+        Info,
+        "rbsim bridge: stopped after %llu samples (%llu scene descriptions, %llu lost in DDS), %llu commands "
+        "relayed to %s; %s\n",
         static_cast<unsigned long long>(relay.value()->received()), static_cast<unsigned long long>(scenes),
-        static_cast<unsigned long long>(relay.value()->lost()), foxglove_summary(server).c_str());
+        static_cast<unsigned long long>(relay.value()->lost()),
+        static_cast<unsigned long long>(steering.value()->calls()), steer.node.c_str(),
+        foxglove_summary(server).c_str());
   }
   return 0;
 }
@@ -101,7 +120,15 @@ Subcommand add_bridge_command(CLI::App& parent) {
       "slows the "
       "node) and serves them as Foxglove channels (encoding cdr, ros2msg schemas, log time = simulated "
       "time). "
-      "Every scene description that arrives (a node started, or a --loop pass) starts a new session. Ctrl-C "
+      "Every scene description that arrives (a node started, or a --loop pass) starts a new session.\n"
+      "Steering: Foxglove's Parameters panel, its service calls (pause, resume, reset, step, apply_impulse) "
+      "and "
+      "commands published on /<namespace>/command_in reach the node /<namespace> through its ROS 2 services "
+      "(rcl_interfaces' set_parameters, rbsim's controls), as any ROS 2 client's would: the node applies "
+      "them "
+      "at its next step and records them on /<namespace>/commands (source \"ros2 service\"). The parameter "
+      "table is read from the node when its scene description arrives and follows /parameter_events. A "
+      "command for a given step or a timed pause cannot be relayed (the services have neither). Ctrl-C "
       "stops.\n"
       "Exit status: 0 stopped by Ctrl-C/SIGTERM, 1 error (DDS failure, --foxglove port in use), 2 usage "
       "error.");

@@ -43,11 +43,11 @@ CLI::Option* add_foxglove_option(CLI::App* app, std::optional<std::string>& addr
 // Starts the Foxglove server on `address` and prints, prefixed with `command`, the line
 // "foxglove: listening on ws://ADDR:PORT" (the actual port), the app.foxglove.dev link and where the
 // layout file is. Errors: a port in use, an address not on this host.
-// With a controller (rbsim node, whose fully qualified name `node` prefixes the services) the
-// server offers parameters and services; replay and bridge have none.
+// With a steering (rbsim node's controller, rbsim bridge's relay; `node`, the steered node's fully
+// qualified name, prefixes the services) the server offers parameters and services; replay has none.
 Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const std::string& address,
                                                          std::vector<foxglove::ChannelSpec> channels,
-                                                         control::Controller* controller = nullptr,
+                                                         control::Steering* steering = nullptr,
                                                          const std::string& node = "/rbsim");
 // "foxglove: 2 clients, 1200 messages queued, 0 dropped for slow clients" for a command's end line.
 std::string foxglove_summary(const foxglove::Server& server);

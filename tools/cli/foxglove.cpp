@@ -49,11 +49,11 @@ CLI::Option* add_foxglove_option(CLI::App* app, std::optional<std::string>& addr
 
 Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const std::string& address,
                                                          std::vector<foxglove::ChannelSpec> channels,
-                                                         control::Controller* controller,
+                                                         control::Steering* steering,
                                                          const std::string& node) {
   foxglove::ServerOptions options;
   if (Status st = foxglove::parse_listen_address(address, options); !st) return st.error();
-  options.controller = controller;
+  options.steering = steering;
   options.node = node;
   auto server = foxglove::Server::start(options, std::move(channels));
   if (!server) return server.error();

@@ -6,10 +6,11 @@
 // socket, nor on websocketpp: the I/O thread holds `mu` only to take frames out of the queues
 // (moves, no copies) and hands them to websocketpp after releasing it.
 //
-// Steering: the I/O thread reads the controller and submits commands without holding `mu` (a
-// closed controller answers inside submit()); the answers and the parameter updates come from the
-// controller's callbacks on the run loop's thread, through a ReplyLink that the server empties when
-// it stops, so a callback after the server is gone does nothing.
+// Steering: the I/O thread reads the steering (the node's controller, or a bridge's relay to a
+// node) and submits commands without holding `mu` (a closed controller answers inside submit());
+// the answers and the parameter updates come from its callbacks on its own thread, through a
+// ReplyLink that the server empties when it stops, so a callback after the server is gone does
+// nothing.
 #include <arpa/inet.h>
 
 #include <atomic>
@@ -19,6 +20,7 @@
 #include <thread>
 
 #include <unordered_map>
+#include <unordered_set>
 
 #include "rbsim/foxglove.hpp"
 #include "services.hpp"
@@ -47,9 +49,10 @@ struct Client {
   std::vector<ClientQueue::Frame> outgoing;
   std::size_t taken = 0;
   // Steering.
-  std::vector<bool> parameter_updates;  // by parameter index: subscribed to its updates
-  std::uint32_t pending = 0;            // commands submitted, not answered
-  bool backlog_told = false;            // told its requests are refused for its backlog
+  // The parameters whose updates it subscribed to (names of the table: bounded by its size).
+  std::unordered_set<std::string> parameter_updates;
+  std::uint32_t pending = 0;  // commands submitted, not answered
+  bool backlog_told = false;  // told its requests are refused for its backlog
   Client(detail::ConnectionId id, std::uint32_t channels, bool parameters, std::uint32_t services,
          const QueueLimits& limits)
       : connection(id), protocol(channels, parameters, services), queue(limits) {}
@@ -60,13 +63,23 @@ struct Reply {
   bool binary = false;
 };
 
-// How the controller's callbacks reach the server: empty once the server stops.
+// The steering's parameter names, read at start and at every new session (a bridge's node may
+// come, go or change its scene); requests check names against the table of their time.
+struct ParameterTable {
+  std::vector<std::string> names;  // in the steering's order
+  std::unordered_map<std::string, std::size_t> index;
+  explicit ParameterTable(std::vector<std::string> n) : names(std::move(n)) {
+    for (std::size_t i = 0; i < names.size(); ++i) index.emplace(names[i], i);
+  }
+};
+
+// How the steering's callbacks reach the server: empty once the server stops.
 struct ReplyLink {
   std::mutex mu;
   Server::Impl* server = nullptr;
   // Queues `replies` for connection `id` (gone: dropped); `answered`: one of its commands is done.
   void deliver(detail::ConnectionId id, const std::vector<Reply>& replies, bool answered);
-  // The controller's observer: parameterValues to each client subscribed to a changed parameter.
+  // The steering's observer: parameterValues to each client subscribed to a changed parameter.
   void changed(const std::vector<msgs::Parameter>& parameters);
 };
 
@@ -93,13 +106,24 @@ struct Server::Impl {
   // I/O thread scratch, reused.
   ClientProtocol::Outcome outcome;
 
-  // Steering (options.controller set): fixed for the server's life.
+  // Steering (options.steering set): fixed for the server's life but the table (under `mu`).
   std::vector<ServiceSpec> services;
   std::string advertise_services;
-  std::string command_in;                    // <node>/command_in, the clientPublish topic
-  std::vector<std::string> parameter_names;  // the controller's table, in order
-  std::unordered_map<std::string, std::size_t> parameter_index;
+  std::string command_in;  // <node>/command_in, the clientPublish topic
+  std::shared_ptr<const ParameterTable> table = std::make_shared<ParameterTable>(std::vector<std::string>{});
   std::shared_ptr<ReplyLink> link = std::make_shared<ReplyLink>();
+
+  std::shared_ptr<const ParameterTable> parameters() const {
+    const std::lock_guard lock(mu);
+    return table;
+  }
+  // Reads the steering's table (without `mu`: the steering has locks of its own).
+  void refresh_parameters() {
+    if (options.steering == nullptr) return;
+    auto fresh = std::make_shared<const ParameterTable>(options.steering->names());
+    const std::lock_guard lock(mu);
+    table = std::move(fresh);
+  }
 
   Client* find(detail::ConnectionId id) {
     for (auto& c : clients) {
@@ -114,7 +138,7 @@ struct Server::Impl {
                         std::chrono::system_clock::now().time_since_epoch())
                         .count();
     server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions),
-                                   options.controller != nullptr);
+                                   options.steering != nullptr);
     for (Latched& l : latched) l.has = false;
   }
 
@@ -122,9 +146,9 @@ struct Server::Impl {
     {
       std::lock_guard lock(mu);
       auto c = std::make_unique<Client>(id, static_cast<std::uint32_t>(channels.size()),
-                                        options.controller != nullptr,
+                                        options.steering != nullptr,
                                         static_cast<std::uint32_t>(services.size()), options.queue);
-      if (options.controller != nullptr) c->protocol.accept_publish(command_in);
+      if (options.steering != nullptr) c->protocol.accept_publish(command_in);
       c->queue.push_text(server_info);
       c->queue.push_text(advertise);
       if (!services.empty()) c->queue.push_text(advertise_services);
@@ -163,7 +187,7 @@ struct Server::Impl {
       call = std::move(outcome.call);
       published = std::move(outcome.published);
     }
-    // Without `mu`: the controller may answer inside submit(), through the link.
+    // Without `mu`: the steering may answer inside submit(), through the link.
     if (parameters) serve_parameters(id, std::move(*parameters));
     if (call) serve_call(id, std::move(*call));
     if (published) serve_publish(id, std::move(*published));
@@ -309,8 +333,7 @@ void ReplyLink::changed(const std::vector<msgs::Parameter>& parameters) {
       if (c->parameter_updates.empty()) continue;
       subset.clear();
       for (const msgs::Parameter& p : parameters) {
-        const auto it = server->parameter_index.find(p.name);
-        if (it != server->parameter_index.end() && c->parameter_updates[it->second]) subset.push_back(p);
+        if (c->parameter_updates.count(p.name) != 0) subset.push_back(p);
       }
       if (subset.empty()) continue;
       c->queue.push_text(parameter_values_json(subset));
@@ -334,7 +357,10 @@ void add_problems(std::vector<Reply>& replies, const std::string& op,
 
 void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r) {
   using Op = ParameterRequest::Op;
-  control::Controller& controller = *options.controller;
+  control::Steering& steering = *options.steering;
+  const std::shared_ptr<const ParameterTable> table_now = parameters();
+  const std::vector<std::string>& parameter_names = table_now->names;
+  const std::unordered_map<std::string, std::size_t>& parameter_index = table_now->index;
   const char* op = r.op == Op::Get         ? "getParameters"
                    : r.op == Op::Set       ? "setParameters"
                    : r.op == Op::Subscribe ? "subscribeParameterUpdates"
@@ -372,7 +398,7 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
     r.names = parameter_names;  // every parameter
   }
   // The values now: a get's answer, and a set's answer for what it does not change.
-  std::vector<std::optional<msgs::ParameterValue>> now = controller.get(r.names);
+  std::vector<std::optional<msgs::ParameterValue>> now = steering.get(r.names);
   std::vector<msgs::Parameter> known;
   for (std::size_t k = 0; k < r.names.size(); ++k) {
     if (now[k]) {
@@ -386,9 +412,13 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
   } else if (r.op == Op::Subscribe || r.op == Op::Unsubscribe) {
     const std::lock_guard lock(mu);
     if (Client* c = find(id)) {
-      c->parameter_updates.resize(parameter_names.size());
-      for (const msgs::Parameter& p : known)
-        c->parameter_updates[parameter_index.at(p.name)] = r.op == Op::Subscribe;
+      for (const msgs::Parameter& p : known) {
+        if (r.op == Op::Subscribe) {
+          c->parameter_updates.insert(p.name);
+        } else {
+          c->parameter_updates.erase(p.name);
+        }
+      }
     }
   }
   if (r.op != Op::Set) {
@@ -397,7 +427,7 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
     return;
   }
   // A JSON integer for a double parameter is that double (JSON cannot tell 2 from 2.0), if exact.
-  const std::vector<msgs::ParameterType> types = controller.types(r.names);
+  const std::vector<msgs::ParameterType> types = steering.types(r.names);
   for (std::size_t k = 0; k < r.values.size(); ++k) {
     msgs::ParameterValue& v = r.values[k].value;
     if (r.untyped_integer[k] && types[k] == msgs::ParameterType::Double &&
@@ -410,28 +440,28 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
   command.atomic = false;  // each its own result, as set_parameters
   command.parameters = r.values;
   command.source = "foxglove";
-  controller.submit(std::move(command),
-                    [link = link, id, answer = r.id, values = r.values, known = std::move(known),
-                     refused = std::move(problems)](const control::CommandResult& result) mutable {
-                      std::vector<Reply> out;
-                      if (result.results.size() != values.size()) {
-                        refused.push_back(result.message);  // never applied (the run ended)
-                      } else {
-                        for (std::size_t k = 0; k < values.size(); ++k) {
-                          if (!result.results[k].successful) refused.push_back(result.results[k].reason);
+  steering.submit(std::move(command),
+                  [link = link, id, answer = r.id, values = r.values, known = std::move(known),
+                   refused = std::move(problems)](const control::CommandResult& result) mutable {
+                    std::vector<Reply> out;
+                    if (result.results.size() != values.size()) {
+                      refused.push_back(result.message);  // never applied (the run ended)
+                    } else {
+                      for (std::size_t k = 0; k < values.size(); ++k) {
+                        if (!result.results[k].successful) refused.push_back(result.results[k].reason);
+                      }
+                    }
+                    if (answer) {
+                      for (msgs::Parameter& p : known) {
+                        for (const msgs::Parameter& c : result.changed) {
+                          if (c.name == p.name) p.value = c.value;
                         }
                       }
-                      if (answer) {
-                        for (msgs::Parameter& p : known) {
-                          for (const msgs::Parameter& c : result.changed) {
-                            if (c.name == p.name) p.value = c.value;
-                          }
-                        }
-                        out.push_back({parameter_values_json(known, answer), false});
-                      }
-                      add_problems(out, "setParameters", refused);
-                      link->deliver(id, out, true);
-                    });
+                      out.push_back({parameter_values_json(known, answer), false});
+                    }
+                    add_problems(out, "setParameters", refused);
+                    link->deliver(id, out, true);
+                  });
 }
 
 void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
@@ -442,8 +472,8 @@ void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
     return;
   }
   command->source = "foxglove";
-  options.controller->submit(std::move(command.value()), [link = link, id, call = std::move(call)](
-                                                             const control::CommandResult& result) {
+  options.steering->submit(std::move(command.value()), [link = link, id, call = std::move(call)](
+                                                           const control::CommandResult& result) {
     const control::ControlService& s = control::control_services()[call.service - 1];
     const std::string payload = detail::encode_response(s, call.encoding, result);
     Reply r{{}, true};
@@ -459,7 +489,7 @@ void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
 void Server::Impl::serve_publish(detail::ConnectionId id, ClientMessage message) {
   const std::string where = "clientPublish " + command_in + ": ";
   Result<control::Command> command =
-      detail::decode_command(message.encoding, message.payload, parameter_index);
+      detail::decode_command(message.encoding, message.payload, parameters()->index);
   if (!command) {
     reply(id, {{status_json(StatusLevel::Error, where + command.error().message), false}}, true);
     return;
@@ -467,8 +497,8 @@ void Server::Impl::serve_publish(detail::ConnectionId id, ClientMessage message)
   command->step = control::Command::kNextStep;
   command->source = "foxglove";
   const std::string kind = control::to_string(command->kind);
-  options.controller->submit(std::move(command.value()), [link = link, id, what = where + kind + ": "](
-                                                             const control::CommandResult& result) {
+  options.steering->submit(std::move(command.value()), [link = link, id, what = where + kind + ": "](
+                                                           const control::CommandResult& result) {
     std::vector<std::string> refused;
     if (!result.successful) refused.push_back(result.message);
     for (const auto& r : result.results) {
@@ -489,12 +519,11 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   im.channels = std::move(channels);
   im.advertise = advertise_json(im.channels);
   im.latched.resize(im.channels.size());
-  if (options.controller != nullptr) {
+  if (options.steering != nullptr) {
     im.services = detail::control_service_specs(options.node);
     im.advertise_services = advertise_services_json(im.services);
     im.command_in = options.node + "/" + std::string(kCommandInSuffix);
-    im.parameter_names = options.controller->list({}, control::kDepthRecursive).names;
-    for (std::size_t i = 0; i < im.parameter_names.size(); ++i) im.parameter_index[im.parameter_names[i]] = i;
+    im.refresh_parameters();
   }
   im.subscribers = std::make_unique<std::atomic<std::uint32_t>[]>(im.channels.size());
   for (std::size_t i = 0; i < im.channels.size(); ++i) im.subscribers[i] = 0;
@@ -521,12 +550,11 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   if (!err.empty()) {
     return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
   }
-  if (options.controller != nullptr) {
+  if (options.steering != nullptr) {
     im.link->server = &im;
-    options.controller->on_command(
-        [link = im.link](const control::Command&, const control::CommandResult& r) {
-          link->changed(r.changed);
-        });
+    options.steering->on_command([link = im.link](const control::Command&, const control::CommandResult& r) {
+      link->changed(r.changed);
+    });
   }
   im.transport->run();
   return s;
@@ -539,7 +567,7 @@ Server::~Server() {
 void Server::stop() {
   if (!impl_) return;
   {
-    const std::lock_guard lock(impl_->link->mu);  // the controller's callbacks do nothing from here
+    const std::lock_guard lock(impl_->link->mu);  // the steering's callbacks do nothing from here
     impl_->link->server = nullptr;
   }
   if (impl_->transport) impl_->transport->stop();
@@ -555,6 +583,7 @@ const std::vector<ChannelSpec>& Server::channels() const {
 
 void Server::new_session() {
   Impl& im = *impl_;
+  im.refresh_parameters();
   {
     std::lock_guard lock(im.mu);
     im.new_session_locked();

@@ -91,7 +91,25 @@ struct ControlCounters {
   std::uint64_t parameter_changes = 0;
 };
 
-class Controller final : public StepHook {
+// What steers a run from outside its loop (the Foxglove server): the run's own Controller, or a
+// relay of the same requests to a node over DDS (rbsim bridge, node::RemoteSteering). An I/O
+// boundary, so an interface. All of it may be called from any thread; submit()'s `done` and the
+// observers run on the steering's own thread and must not block.
+class Steering {
+ public:
+  virtual ~Steering() = default;
+  // Applies `command` (at its step boundary, or the next one) and reports the outcome.
+  virtual void submit(Command command, std::function<void(const CommandResult&)> done) = 0;
+  // The parameters as last known: an unknown name gives nullopt or NotSet.
+  virtual std::vector<std::optional<ParameterValue>> get(const std::vector<std::string>& names) const = 0;
+  virtual std::vector<ParameterType> types(const std::vector<std::string>& names) const = 0;
+  // Every parameter's name, in table order.
+  virtual std::vector<std::string> names() const = 0;
+  // Adds an observer of every command applied or refused (its `changed` parameters above all).
+  virtual void on_command(std::function<void(const Command&, const CommandResult&)> observer) = 0;
+};
+
+class Controller final : public StepHook, public Steering {
  public:
   // `scene` holds the run's initial parameters (apply_overrides) and outlives the controller:
   // reset goes back to its step 0. `steps` is the pass length (the `steps` parameter).
@@ -105,14 +123,15 @@ class Controller final : public StepHook {
   // the controller closes.
   std::future<CommandResult> submit(Command command);
   // Same; `done` runs on the run loop's thread (or the closing one) and must not block.
-  void submit(Command command, std::function<void(const CommandResult&)> done);
+  void submit(Command command, std::function<void(const CommandResult&)> done) override;
   // Reads as of the last boundary (rcl_interfaces' get, describe, get_types, list). An unknown
   // name gives nullopt or NotSet; rclcpp's services answer an empty list when any name is
   // undeclared. list() keeps the table's order (rclcpp's is alphabetical, from its std::map).
-  std::vector<std::optional<ParameterValue>> get(const std::vector<std::string>& names) const;
+  std::vector<std::optional<ParameterValue>> get(const std::vector<std::string>& names) const override;
   std::vector<std::optional<ParameterDescriptor>> describe(const std::vector<std::string>& names) const;
-  std::vector<ParameterType> types(const std::vector<std::string>& names) const;
+  std::vector<ParameterType> types(const std::vector<std::string>& names) const override;
   ListParametersResult list(const std::vector<std::string>& prefixes, std::uint64_t depth) const;
+  std::vector<std::string> names() const override { return list({}, kDepthRecursive).names; }
   RunSettings settings() const;
   ControlCounters counters() const;
   // Answers every queued command with failure (`reason`) and refuses later ones at once. Also
@@ -133,7 +152,7 @@ class Controller final : public StepHook {
   // Adds an observer, called on the loop's thread for every command applied or refused at a
   // boundary, with its step filled in (the record of commands as data); observers are called in
   // the order they were added (the node's /parameter_events, the Foxglove server's updates).
-  void on_command(std::function<void(const Command&, const CommandResult&)> observer) {
+  void on_command(std::function<void(const Command&, const CommandResult&)> observer) override {
     observers_.push_back(std::move(observer));
   }
 

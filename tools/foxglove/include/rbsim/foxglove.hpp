@@ -295,12 +295,14 @@ struct ServerOptions {
   std::size_t max_in_flight_bytes = 4u << 20;
   // A client that reads nothing of what is in flight for this long is disconnected.
   double stall_timeout_s = 5.0;
-  // Steering (rbsim node): with a controller the server offers parameters, parametersSubscribe and
-  // services (control::control_services() named <node>/<name>); every request goes through the
-  // controller, answered from its callbacks (never waited for on the I/O thread); start() adds
-  // the observer of parameter updates (Controller::on_command), so it comes before the run loop.
-  // The controller must outlive the server. Without one (replay, bridge) only `time` is offered.
-  control::Controller* controller = nullptr;
+  // Steering: with a steering (rbsim node's Controller, rbsim bridge's relay to a node) the server
+  // offers parameters, parametersSubscribe and services (control::control_services() named
+  // <node>/<name>); every request goes through the steering, answered from its callbacks (never
+  // waited for on the I/O thread); start() adds the observer of parameter updates
+  // (Steering::on_command), so it comes before the run loop, and start() and new_session() read
+  // its parameter names. The steering must outlive the server. Without one (replay) only `time` is
+  // offered.
+  control::Steering* steering = nullptr;
   std::string node = "/rbsim";
   // Per client: parameter sets and service calls submitted and not yet answered (more are refused:
   // a serviceCallFailure or a status error), and the unread replies and other frames never dropped
