@@ -4,7 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <optional>
+#include <regex>
 
+#include "rbsim/bag.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/recorder.hpp"
 
@@ -44,15 +48,12 @@ std::uint64_t Recorder::Gaps::lost(double dt) const {
   return expected > static_cast<std::int64_t>(count) ? static_cast<std::uint64_t>(expected) - count : 0;
 }
 
-Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participant,
-                                                   const RecorderOptions& options) {
-  std::unique_ptr<Recorder> r(new Recorder());
-  r->options_ = options;
-  std::vector<const msgs::TopicSpec*> wanted;
-  if (options.topics.empty()) {
-    for (const msgs::TopicSpec& spec : msgs::topics()) wanted.push_back(&spec);
-  } else {
-    for (const std::string& name : options.topics) {
+namespace {
+// The topics `options` choose, in msgs::topics() order (rosbag2's rule, RecorderOptions).
+Result<std::vector<const msgs::TopicSpec*>> choose_topics(const RecorderOptions& options) {
+  auto named = [&](const std::vector<std::string>& names) -> Result<std::vector<const msgs::TopicSpec*>> {
+    std::vector<const msgs::TopicSpec*> out;
+    for (const std::string& name : names) {
       const msgs::TopicSpec* spec = find_topic(name, options.ns);
       if (spec == nullptr) {
         std::string known;
@@ -60,29 +61,107 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
           known += (known.empty() ? "" : ", ") + msgs::topic_name(s, options.ns);
         return Error{"unknown topic \"" + name + "\" (rbsim topics: " + known + ")"};
       }
-      wanted.push_back(spec);
+      out.push_back(spec);
     }
+    return out;
+  };
+  auto regex = [](const std::string& text, const char* option) -> Result<std::optional<std::regex>> {
+    if (text.empty()) return std::optional<std::regex>();
+    try {
+      return std::optional<std::regex>(std::regex(text, std::regex::ECMAScript));
+    } catch (const std::regex_error& e) {
+      return Error{std::string(option) + " \"" + text + "\": not a regular expression (" + e.what() + ")",
+                   ErrorCode::InvalidArgument};
+    }
+  };
+  auto include = named(options.topics);
+  auto exclude = named(options.exclude_topics);
+  auto match = regex(options.regex, "--regex");
+  auto unmatch = regex(options.exclude_regex, "--exclude-regex");
+  if (!include) return include.error();
+  if (!exclude) return exclude.error();
+  if (!match) return match.error();
+  if (!unmatch) return unmatch.error();
+  const bool all = options.topics.empty() && options.regex.empty();
+  std::vector<const msgs::TopicSpec*> out;
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    const std::string name = msgs::topic_name(spec, options.ns);
+    const auto in = [&spec](const std::vector<const msgs::TopicSpec*>& v) {
+      return std::find(v.begin(), v.end(), &spec) != v.end();
+    };
+    const bool chosen = all || in(include.value()) || (*match && std::regex_match(name, **match));
+    const bool dropped = in(exclude.value()) || (*unmatch && std::regex_match(name, **unmatch));
+    if (chosen && !dropped) out.push_back(&spec);
   }
+  if (out.empty()) return Error{"the topic options choose no topic to record", ErrorCode::InvalidArgument};
+  return out;
+}
+}  // namespace
+
+Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participant,
+                                                   const RecorderOptions& options) {
+  std::unique_ptr<Recorder> r(new Recorder());
+  r->options_ = options;
+  Result<std::vector<const msgs::TopicSpec*>> chosen = choose_topics(options);
+  if (!chosen) return chosen.error();
+  std::vector<const msgs::TopicSpec*> wanted = std::move(chosen.value());
   // The node's --wait-for-subscribers watches the body-state topic: subscribe to it last, so
   // every other reader exists by the time the node starts publishing.
   std::stable_partition(wanted.begin(), wanted.end(),
                         [](const msgs::TopicSpec* s) { return s->id != msgs::TopicId::BodyStates; });
-  if (auto st = r->writer_.open(options.path, log::writer_options(options.compression, options.chunk_size,
-                                                                  options.compression_level));
-      !st.ok()) {
-    return Error{options.path + ": " + st.error().message};
-  }
+  if (Status st = r->open_file(); !st) return st.error();
   r->waitset_ = dds_create_waitset(participant.handle());
   for (const msgs::TopicSpec* spec : wanted) {
     const std::string ros = msgs::topic_name(*spec, options.ns);
     auto sub = Subscription::create(participant, *spec, ros, qos_for(*spec));
     if (!sub) return sub.error();
     dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
-    r->topics_.push_back(Topic{std::move(sub.value()), 0, 0, Gaps{}});
+    Topic topic{std::move(sub.value()), 0, 0, {}, {}, 0, Gaps{}};
+    r->topics_.push_back(std::move(topic));
     r->latched_pending_.push_back(spec->latched());
     if (spec->latched()) r->holding_ = true;
   }
   return r;
+}
+
+// The next file: options.path, or the bag's file files_.size().
+Status Recorder::open_file() {
+  const std::string path = options_.bag.empty() ? options_.path : log::bag_file(options_.bag, files_.size());
+  if (auto st = writer_.open(
+          path, log::writer_options(options_.compression, options_.chunk_size, options_.compression_level));
+      !st.ok()) {
+    return Error{path + ": " + st.error().message};
+  }
+  options_.path = path;  // what errors name
+  files_.push_back(path);
+  file_start_ = 0;
+  file_bytes_ = 0;
+  return Ok{};
+}
+
+// Closes the open file, lists it in the bag's metadata and opens the next, which defines every
+// channel under its old id and starts with the latched topics' latest messages at `log_time`.
+Status Recorder::split(std::uint64_t log_time) {
+  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
+  if (Status st = log::write_bag_metadata(options_.bag, files_); !st) return st;
+  if (Status st = open_file(); !st) return st;
+  for (const std::size_t i : channel_order_) {
+    Topic& t = topics_[i];
+    auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, t.offered);
+    if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
+    if (channel.value() != t.channel) {
+      return Error{options_.path + ": channel of " + t.subscription.ros_topic() + " got id " +
+                   std::to_string(channel.value()) + ", not " + std::to_string(t.channel)};
+    }
+  }
+  file_start_ = log_time;
+  for (const std::size_t i : channel_order_) {
+    Topic& t = topics_[i];
+    if (!t.subscription.spec().latched() || t.last.empty()) continue;
+    if (auto st = writer_.write_message(t.channel, t.received - 1, log_time, t.last_source, t.last); !st.ok())
+      return Error{options_.path + ": " + st.error().message};
+  }
+  return Ok{};
 }
 
 Recorder::~Recorder() {
@@ -147,13 +226,31 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
 }
 
 Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time) {
+  const bool latched = t.subscription.spec().latched();
+  if (options_.max_file_bytes > 0 && ++written_ % 16 == 0) {  // the size as chunks reached the file
+    std::error_code ec;
+    file_bytes_ = std::filesystem::file_size(options_.path, ec);
+    if (ec) file_bytes_ = 0;
+  }
+  if (!latched && file_start_ != 0 && !options_.bag.empty() &&
+      ((options_.max_file_bytes > 0 && file_bytes_ >= options_.max_file_bytes) ||
+       (options_.max_file_duration_ns > 0 && log_time >= file_start_ + options_.max_file_duration_ns))) {
+    if (Status st = split(log_time); !st) return st;
+  }
+  if (file_start_ == 0) file_start_ = log_time;
   if (t.channel == 0) {  // like rosbag2: the channel says what the (first) publisher offers
     auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
     if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
     t.channel = channel.value();
+    t.offered = sample.offered;
+    channel_order_.push_back(static_cast<std::size_t>(&t - topics_.data()));
   }
   const std::uint64_t source =
       sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : log_time;
+  if (latched && !options_.bag.empty()) {
+    t.last.assign(sample.cdr.begin(), sample.cdr.end());
+    t.last_source = source;
+  }
   if (auto st = writer_.write_message(t.channel, t.received, log_time, source, sample.cdr); !st.ok()) {
     return Error{options_.path + ": " + st.error().message};
   }
@@ -219,6 +316,7 @@ std::vector<Recorder::TopicCount> Recorder::counts() const {
 Status Recorder::close() {
   if (Status st = release_held(); !st) return st;
   if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
+  if (!options_.bag.empty() && received_ > 0) return log::write_bag_metadata(options_.bag, files_);
   return Ok{};
 }
 

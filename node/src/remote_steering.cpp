@@ -18,8 +18,8 @@ using control::CommandResult;
 
 // clients_: the parameter services first, then control::control_services() in order.
 enum ClientIndex : std::size_t { kList, kGet, kSet, kSetAtomically, kControls };
-constexpr std::string_view kParameterServices[] = {
-    "list_parameters", "get_parameters", "set_parameters", "set_parameters_atomically"};
+constexpr std::string_view kParameterServices[] = {"list_parameters", "get_parameters", "set_parameters",
+                                                   "set_parameters_atomically"};
 constexpr std::string_view kParameterTypes[] = {
     msgs::ListParametersRequest::kService, msgs::GetParametersRequest::kService,
     msgs::SetParametersRequest::kService, msgs::SetParametersAtomicallyRequest::kService};
@@ -66,7 +66,6 @@ Result<Res> call(ServiceClient& client, const Req& request, const RemoteSteering
   }
   return res;
 }
-
 
 struct Request {
   std::size_t client = 0;  // index in clients_
@@ -123,8 +122,8 @@ template <class Res>
 Result<Res> decode_reply(std::span<const std::byte> reply, const RemoteSteeringOptions& o) {
   Res res;
   if (Status st = msgs::decode(reply, res); !st) {
-    return Error{"node " + o.node + " replied with a malformed " + std::string(Res::kService) + " response: " +
-                 st.error().message};
+    return Error{"node " + o.node + " replied with a malformed " + std::string(Res::kService) +
+                 " response: " + st.error().message};
   }
   return res;
 }
@@ -145,7 +144,8 @@ CommandResult control_result(const Result<Res>& reply) {
 }
 
 // The node's reply to the call that carried `command`, as its result.
-CommandResult result_of(const Command& command, std::span<const std::byte> reply, const RemoteSteeringOptions& o) {
+CommandResult result_of(const Command& command, std::span<const std::byte> reply,
+                        const RemoteSteeringOptions& o) {
   switch (command.kind) {
     case CommandKind::SetParameters: {
       CommandResult r;
@@ -161,8 +161,8 @@ CommandResult result_of(const Command& command, std::span<const std::byte> reply
       auto res = decode_reply<msgs::SetParametersResponse>(reply, o);
       if (!res) return failed(res.error().message);
       if (res->results.size() != command.parameters.size()) {
-        return failed("node " + o.node + " answered " + std::to_string(res->results.size()) + " results for " +
-                      std::to_string(command.parameters.size()) + " parameters");
+        return failed("node " + o.node + " answered " + std::to_string(res->results.size()) +
+                      " results for " + std::to_string(command.parameters.size()) + " parameters");
       }
       r.results = res->results;
       r.successful = true;
@@ -202,7 +202,8 @@ Result<std::unique_ptr<RemoteSteering>> RemoteSteering::create(const Participant
       co.request_user_data = msgs::typehash_user_data(h->request);
       co.reply_user_data = msgs::typehash_user_data(h->reply);
     }
-    Result<ServiceClient> c = ServiceClient::create(participant, options.node + "/" + std::string(name), type, co);
+    Result<ServiceClient> c =
+        ServiceClient::create(participant, options.node + "/" + std::string(name), type, co);
     if (!c) return c.error();
     if (Graph* graph = participant.graph()) {  // ros2 node info lists the bridge's clients
       if (Status st = graph->add(Graph::Kind::Writer, c->request_writer().guid); !st) return st;
@@ -241,7 +242,8 @@ RemoteSteering::~RemoteSteering() {
 
 Status RemoteSteering::refresh() {
   msgs::ListParametersRequest list;  // every name, any depth
-  Result<msgs::ListParametersResponse> listed = call<msgs::ListParametersResponse>(client(kList), list, options_);
+  Result<msgs::ListParametersResponse> listed =
+      call<msgs::ListParametersResponse>(client(kList), list, options_);
   if (!listed) return listed.error();
   msgs::GetParametersRequest get{listed->result.names};
   Result<msgs::GetParametersResponse> got = call<msgs::GetParametersResponse>(client(kGet), get, options_);
@@ -269,7 +271,8 @@ void RemoteSteering::submit(Command command, std::function<void(const CommandRes
   done(failed("the bridge stopped"));
 }
 
-std::vector<std::optional<msgs::ParameterValue>> RemoteSteering::get(const std::vector<std::string>& names) const {
+std::vector<std::optional<msgs::ParameterValue>> RemoteSteering::get(
+    const std::vector<std::string>& names) const {
   const std::lock_guard lock(mutex_);
   std::vector<std::optional<msgs::ParameterValue>> out;
   for (const std::string& n : names) {
@@ -348,10 +351,11 @@ void RemoteSteering::send(Pending pending, std::vector<InFlight>& out) {
     pending.done(failed("node " + options_.node + ": " + seq.error().message));
     return;
   }
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(options_.call_timeout_s));
-  out.push_back({std::move(pending.command), std::move(pending.done), request->client, seq.value(), deadline});
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(options_.call_timeout_s));
+  out.push_back(
+      {std::move(pending.command), std::move(pending.done), request->client, seq.value(), deadline});
 }
 
 // Answers the calls whose replies came, and those past their deadline.
@@ -373,8 +377,8 @@ void RemoteSteering::collect(std::vector<InFlight>& out, Bytes& reply) {
       ++it;
       continue;
     }
-    it->done(failed("node " + options_.node + " did not reply within " + std::to_string(options_.call_timeout_s) +
-                    " s"));
+    it->done(failed("node " + options_.node + " did not reply within " +
+                    std::to_string(options_.call_timeout_s) + " s"));
     it = out.erase(it);
   }
 }

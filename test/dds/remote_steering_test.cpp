@@ -54,9 +54,8 @@ TEST(RemoteSteering, RelaysParametersAndControlsToTheNodesServices) {
   Participant node_participant = participant(node);
   auto services = NodeServices::create(node_participant, controller, {"/" + node, scene.world.dt});
   ASSERT_TRUE(services.ok()) << services.error().message;
-  controller.on_command([&s = *services.value()](const Command& c, const CommandResult& r) {
-    s.command_applied(c, r);
-  });
+  controller.on_command(
+      [&s = *services.value()](const Command& c, const CommandResult& r) { s.command_applied(c, r); });
   auto run = std::async(std::launch::async, [&] { return test::run(scene, 120, &controller); });
 
   Participant bridge = participant("remote_steering_bridge");
@@ -89,7 +88,8 @@ TEST(RemoteSteering, RelaysParametersAndControlsToTheNodesServices) {
   for (int i = 0; i < 500 && !seen; ++i) {
     {
       const std::lock_guard lock(mu);
-      for (const msgs::Parameter& p : updates) seen = seen || (p.name == "forces.1.fx" && p.value == V::of_double(-2.0));
+      for (const msgs::Parameter& p : updates)
+        seen = seen || (p.name == "forces.1.fx" && p.value == V::of_double(-2.0));
     }
     if (!seen) std::this_thread::sleep_for(10ms);
   }

@@ -1343,6 +1343,120 @@ def case_record_sigkill(ctx):
     exited_ok(ctx, node, 30, "node stopped with SIGINT")
 
 
+def bag_metadata(path):
+    """metadata.yaml of a bag directory, as a dict (rosbag2_bagfile_information)."""
+    from ruamel.yaml import YAML  # rosbags' YAML library
+
+    with open(os.path.join(path, "metadata.yaml")) as f:
+        return YAML(typ="safe").load(f)["rosbag2_bagfile_information"]
+
+
+def check_bag_with_rosbags(ctx, bag, what):
+    """The `rosbags` library opens the bag, reads every message and agrees with metadata.yaml's
+    counts; the official MCAP reader reads every file (CRCs checked). Returns the per-topic counts."""
+    from pathlib import Path
+    from rosbags.rosbag2 import Reader
+
+    meta = bag_metadata(bag)
+    files = [os.path.join(bag, f) for f in meta["relative_file_paths"]]
+    with Reader(Path(bag)) as reader:
+        counted = {}
+        for connection, _, _ in reader.messages():
+            counted[connection.topic] = counted.get(connection.topic, 0) + 1
+        declared = {c.topic: c.msgcount for c in reader.connections}
+        ctx.check(reader.message_count == sum(counted.values()),
+                  f"{what}: rosbags read {sum(counted.values())} messages, metadata says {reader.message_count}")
+    listed = {t["topic_metadata"]["name"]: t["message_count"] for t in meta["topics_with_message_count"]}
+    ctx.check(counted == declared == listed, f"{what}: counts read {counted}, metadata {listed}")
+    per_file = [len(Log(f).messages) for f in files]
+    ctx.check(per_file == [f["message_count"] for f in meta["files"]],
+              f"{what}: the files hold {per_file} messages, metadata says {[f['message_count'] for f in meta['files']]}")
+    ctx.check(meta["version"] == 9 and meta["storage_identifier"] == "mcap" and meta["ros_distro"] == "jazzy",
+              f"{what}: metadata version/storage/distro {meta['version']}/{meta['storage_identifier']}/{meta['ros_distro']}")
+    return counted
+
+
+def case_record_bag(ctx):
+    """rbsim record DIR --max-file-size: a rosbag2 bag split into several files, each starting with
+    the scene description and markers (each file checks and renders on its own); rosbags and the
+    official MCAP reader agree with metadata.yaml; the bag read as one equals `rbsim run --record`."""
+    scene = ctx.scene("cantilever.xml")
+    duration = 3.0  # in real time: the topics interleave in each file as a node publishes them
+    golden = ctx.path("golden.mcap")
+    ctx.rbrun("golden", "run", scene, "--duration", duration, "--record", golden, "--namespace", ctx.ns)
+    bag = ctx.path("bag")
+    expected = len(Log(golden).messages)
+    rec = ctx.rb("record", *record_args(ctx, bag, "--max-messages", expected, "--wall-duration", 90,
+                                        "--chunk-size", 65536, "--max-file-size", 1048576))
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", duration, "--wait-for-subscribers", 1))
+    exited_ok(ctx, node, 90)
+    exited_ok(ctx, rec, 90)
+    meta = bag_metadata(bag)
+    files = [os.path.join(bag, f) for f in meta["relative_file_paths"]]
+    ctx.log(f"{len(files)} files: {meta['relative_file_paths']}")
+    ctx.require(len(files) >= 3, f"--max-file-size 1048576 made {len(files)} files, want at least 3")
+    ctx.check(files == [os.path.join(bag, f"bag_{i}.mcap") for i in range(len(files))],
+              f"file names {meta['relative_file_paths']}")
+    counted = check_bag_with_rosbags(ctx, bag, "split bag")
+    # Each file starts with the latched topics, so the bag holds them once per file.
+    for suffix in LATCHED:
+        n = sum(v for k, v in counted.items() if k.endswith("/" + suffix))
+        ctx.check(n == len(files), f"{suffix}: {n} messages in the bag, want one per file ({len(files)})")
+    # Read as one recording: every message once, equal to the offline run.
+    rbsim_check(ctx, bag, golden, "the bag against rbsim run --record", live=True)
+    for i, f in enumerate(files):
+        first = read_stream_messages(f)[0][0]
+        ctx.check(first.endswith("/scene"), f"{f}: first message on {first}, want the scene description")
+        ctx.rbrun(f"doctor-{i}", "log", "doctor", f, timeout=60)
+    for i, f in ((0, files[0]), (len(files) - 1, files[-1])):  # the first and the last, each alone
+        frames = ctx.path(f"frames-{i}")
+        ctx.rbrun(f"render-{i}", "render", f, "--out", frames, "--fps", 2, timeout=120)
+        ctx.check(len(os.listdir(frames)) > 0, f"{f} rendered no frame")
+    rc, out, _ = ctx.rbrun("info", "log", "info", bag)
+    ctx.check(f"rosbag2, {len(files)} files" in out, f"rbsim log info on the bag:\n{out}")
+
+
+def case_record_bag_sigkill(ctx):
+    """A split recorder SIGKILLed: metadata.yaml lists the closed files, each intact (the official
+    reader, rosbags), the open one is saved by `rbsim log recover`, and the steps they hold follow
+    on from each other with nothing lost between files."""
+    scene = ctx.scene("cantilever.xml")
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 2, "--publish-every", 2, "--loop"))
+    node.wait_for_text("rbsim node:", 20, stream="stderr")
+    bag = ctx.path("killed")
+    rec = ctx.rb("record", *record_args(ctx, bag, "--chunk-size", 16384, "--max-file-duration", 0.7,
+                                        "--wall-duration", 60))
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and not os.path.exists(os.path.join(bag, "killed_3.mcap")):
+        time.sleep(0.05)
+    time.sleep(0.3)
+    rec.signal(signal.SIGKILL)
+    rec.wait(10)
+    ctx.check(rec.rc == -signal.SIGKILL, f"recorder exited with {rec.rc}, not killed")
+    meta = bag_metadata(bag)
+    closed = [os.path.join(bag, f) for f in meta["relative_file_paths"]]
+    present = sorted(os.path.join(bag, f) for f in os.listdir(bag) if f.endswith(".mcap"))
+    ctx.require(len(closed) >= 3, f"metadata lists {len(closed)} closed files, want at least 3")
+    open_files = [f for f in present if f not in closed]
+    ctx.check(len(open_files) == 1, f"files not in metadata.yaml: {open_files}, want the one open file")
+    check_bag_with_rosbags(ctx, bag, "killed bag (closed files)")
+    recovered = check_recover(ctx, open_files[0], "the open file")
+    # Steps per file: each file carries on from the last step of the one before (publish-every 2).
+    logs = [Log(f) for f in closed] + ([recovered] if recovered else [])
+    last = None
+    for f, log in zip(closed + open_files, logs):
+        steps = [step_of(m[5]) for m in log.messages if m[0].endswith("/body_states")]
+        ctx.check(steps == sorted(steps) and all(b - a == 2 for a, b in zip(steps, steps[1:])),
+                  f"{f}: body_states steps not every 2nd step: {steps[:5]}...")
+        if last is not None and steps:
+            ctx.check(steps[0] == last + 2 or steps[0] == 0, f"{f}: starts at step {steps[0]} after {last}: lost between files")
+        if steps:
+            last = steps[-1]
+    ctx.check(node.alive(), "the node stopped when its recorder was killed")
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 30, "node stopped with SIGINT")
+
+
 def rss_kib(pid):
     try:
         with open(f"/proc/{pid}/status") as f:
@@ -1426,6 +1540,8 @@ CASES = {
     "ros_env": case_ros_env,
     "ros_graph": case_ros_graph,
     "record_disk_full": case_record_disk_full,
+    "record_bag": case_record_bag,
+    "record_bag_sigkill": case_record_bag_sigkill,
     "record_sigkill": case_record_sigkill,
     "soak": case_soak,
 }

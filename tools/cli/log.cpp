@@ -6,6 +6,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/cat.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
@@ -28,10 +29,22 @@ struct LogOptions {
   std::optional<double> start, end;
 };
 
+// A bag directory: its files, then each file's summary.
 int info_command(const LogOptions& o) {
-  auto info = mcap_tools::info(o.file);
-  if (!info) return fail("log info", o.file + ": " + info.error().message);
-  std::fputs(mcap_tools::format_info(info.value()).c_str(), stdout);
+  const Result<std::vector<std::string>> files = log::recording_files(o.file);
+  if (!files) return fail("log info", files.error().message);
+  const bool bag = files->size() != 1 || files->front() != o.file;
+  if (bag) {
+    std::printf("bag:         %s (rosbag2, %zu file%s)\n", o.file.c_str(), files->size(),
+                files->size() == 1 ? "" : "s");
+    for (const std::string& f : files.value()) std::printf("  %s\n", f.c_str());
+  }
+  for (const std::string& f : files.value()) {
+    auto info = mcap_tools::info(f);
+    if (!info) return fail("log info", f + ": " + info.error().message);
+    if (bag) std::printf("\n%s:\n", f.c_str());
+    std::fputs(mcap_tools::format_info(info.value()).c_str(), stdout);
+  }
   return 0;
 }
 
@@ -128,7 +141,7 @@ Subcommand add_log_command(CLI::App& parent) {
       app->add_subcommand("info",
                           "Summarise a recording: duration, topics with types and counts, chunks, "
                           "compression");
-  info->add_option("file", o->file, "MCAP file")->required();
+  info->add_option("file", o->file, "MCAP file or rosbag2 bag directory")->required();
   info->footer(
       "Reads the summary section (or scans a file that has none, and says so) and checks the data section "
       "CRC.\nExit status: 0 success, 1 error (unreadable, truncated or corrupted file), 2 usage error.");

@@ -2,10 +2,12 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
@@ -22,6 +24,7 @@ struct RecordArgs {
   node::RecorderOptions rec;
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   std::optional<double> duration;
+  std::optional<double> max_file_duration;  // seconds
   std::string compression = "zstd";
   std::optional<int> compression_level;
   bool quiet = false;
@@ -47,14 +50,38 @@ int record_command(RecordArgs a) {
   // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
   // error, leaving a recoverable file, instead of SIGXFSZ killing it.
   std::signal(SIGXFSZ, SIG_IGN);
-  if (Status st = check_outputs({{a.rec.path, "OUT"}}, {}, a.overwrite); !st)
-    return fail("record", st.error().message);
+  // OUT ending in .mcap is one file; any other path a rosbag2 bag directory, holding file 0.
+  std::string bag;
+  std::vector<OutputPath> outputs{{a.rec.path, "OUT"}};
+  if (a.max_file_duration)
+    a.rec.max_file_duration_ns = static_cast<std::uint64_t>(*a.max_file_duration * 1e9);
+  if (log::is_bag_output(a.rec.path)) {
+    bag = a.rec.path;
+    outputs = log::bag_outputs(bag, "OUT");
+    a.rec.bag = bag;
+  } else if (a.rec.max_file_bytes > 0 || a.rec.max_file_duration_ns > 0) {
+    return fail("record",
+                "--max-file-size and --max-file-duration split a bag directory: OUT " + a.rec.path +
+                    " ends in .mcap (one file); name a directory instead",
+                2);
+  }
+
+  if (Status st = check_outputs(outputs, {}, a.overwrite); !st) return fail("record", st.error().message);
+  std::error_code ec;
+  const bool made_bag = !bag.empty() && !std::filesystem::exists(bag, ec);
+  if (!bag.empty()) {
+    if (Status st = log::make_bag_directory(bag); !st) return fail("record", st.error().message);
+  }
   auto participant = node::Participant::create(a.domain, a.node);
   if (!participant) return fail("record", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
   if (!rosout) return fail("record", rosout.error().message);
   auto recorder = node::Recorder::create(participant.value(), a.rec);
-  if (!recorder) return fail("record", recorder.error().message);
+  if (!recorder) {
+    if (made_bag) std::filesystem::remove_all(bag, ec);  // it holds at most the file just opened
+    return fail("record", recorder.error().message,
+                recorder.error().code == ErrorCode::InvalidArgument ? 2 : 1);
+  }
   install_stop_handlers();
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",
@@ -98,7 +125,8 @@ int record_command(RecordArgs a) {
   }
   if (failure) return fail("record", *failure + " (the file was finished up to that point)");
   if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
-    std::remove(a.rec.path.c_str());
+    for (const std::string& f : recorder.value()->files()) std::remove(f.c_str());
+    if (made_bag) std::filesystem::remove(bag, ec);
     return fail("record", "nothing received on " + participant.value().description() + " under /" + a.rec.ns +
                               "; nothing written (is a node running with the same domain and namespace?)");
   }
@@ -110,12 +138,24 @@ Subcommand add_record_command(CLI::App& parent) {
   auto a = std::make_shared<RecordArgs>();
   CLI::App* app =
       parent.add_subcommand("record", "Record rbsim topics from DDS into an MCAP file (rosbag2 layout)");
-  app->add_option("out", a->rec.path, "MCAP file to write")->required();
+  app->add_option("out", a->rec.path,
+                  "Where to record: an MCAP file (a path ending in .mcap), or else a rosbag2 bag directory "
+                  "(OUT/metadata.yaml and OUT/OUT_0.mcap, as ROS 2 Jazzy's recorder writes them)")
+      ->required();
   app->add_option(
          "--topics", a->rec.topics,
          "Topics to record, comma-separated or repeated (body_states or /rbsim/body_states); default all")
       ->delimiter(',')
       ->allow_extra_args(false);
+  app->add_option("--regex", a->rec.regex,
+                  "Also record the topics whose full name matches this regular expression (ECMAScript, "
+                  "the whole name: '.*states')");
+  app->add_option("--exclude-topics", a->rec.exclude_topics,
+                  "Topics not to record, comma-separated or repeated (wins over --topics and --regex)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  app->add_option("--exclude-regex", a->rec.exclude_regex,
+                  "Do not record the topics whose full name matches this regular expression");
   add_domain_option(app, a->domain);
   add_node_name_option(app, a->node);
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")
@@ -144,6 +184,14 @@ Subcommand add_record_command(CLI::App& parent) {
          "the one being compressed")
       ->check(CLI::Range(std::uint64_t{1024}, std::uint64_t{1} << 30))
       ->default_str("1048576");
+  app->add_option("--max-file-size", a->rec.max_file_bytes,
+                  "Bag only: start a new file once the open one holds this many bytes (as chunks reach it; "
+                  "rosbag2's --max-bag-size)")
+      ->check(CLI::Range(std::uint64_t{1} << 16, std::uint64_t{1} << 50));
+  app->add_option("--max-file-duration", a->max_file_duration,
+                  "Bag only: start a new file once the open one spans this many seconds of log (wall) time "
+                  "(rosbag2's --max-bag-duration)")
+      ->check(positive());
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
   app->add_flag("--overwrite", a->overwrite,
                 "Replace OUT if it exists (by default an existing OUT is refused)");

@@ -6,6 +6,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/command_script.hpp"
 #include "rbsim/control.hpp"
 #include "rbsim/csv.hpp"
@@ -53,14 +54,16 @@ int run(const RunOptions& o) {
   std::vector<std::string> inputs{o.scene};
   if (!o.commands.empty()) inputs.push_back(o.commands);
   // Every output path is checked before step 0: a run never ends by throwing its result away.
-  if (Status st = check_outputs({{o.csv, "--csv"},
-                                 {o.energy_csv, "--energy-csv"},
-                                 {o.fosssim_out, "--fosssim-out"},
-                                 {o.record, "--record"},
-                                 {o.frames, "--frames", true}},
-                                inputs, o.overwrite);
-      !st)
-    return fail("run", st.error().message);
+  std::vector<OutputPath> outputs = {{o.csv, "--csv"},
+                                     {o.energy_csv, "--energy-csv"},
+                                     {o.fosssim_out, "--fosssim-out"},
+                                     {o.frames, "--frames", true}};
+  if (!o.record.empty() && log::is_bag_output(o.record)) {  // a bag directory (rbsim/bag.hpp)
+    for (OutputPath& p : log::bag_outputs(o.record, "--record")) outputs.push_back(std::move(p));
+  } else {
+    outputs.push_back({o.record, "--record"});
+  }
+  if (Status st = check_outputs(outputs, inputs, o.overwrite); !st) return fail("run", st.error().message);
 
   // The commands are read whole before step 0: a bad script entry is a usage error naming its line,
   // a recording that lost commands an error naming the first missing one.
@@ -187,7 +190,10 @@ Subcommand add_run_command(CLI::App& parent) {
   auto* record = app->add_option(
       "--record", o->record,
       "Record the topics (scene description and markers once, then body states, spring states, energy "
-      "terms, /tf, springs and /clock per step; --topics chooses) to an MCAP file in the rosbag2 layout");
+      "terms, /tf, springs and /clock per step; --topics chooses) to an MCAP file in the rosbag2 layout (a "
+      "path "
+      "ending in .mcap), or to a rosbag2 bag directory DIR/ (DIR/metadata.yaml and DIR/DIR_0.mcap, as ROS 2 "
+      "Jazzy's recorder writes them) for any other path");
   // Options of one output need that output: given alone they would be silently ignored.
   app->add_option("--record-every", o->record_every, "Record every k-th step (step 0 always)")
       ->check(positive())

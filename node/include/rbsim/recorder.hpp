@@ -27,9 +27,25 @@ namespace rbsim::node {
 // dropped (messages that DDS itself never reports). k is the smallest step difference seen.
 
 struct RecorderOptions {
-  std::string path;
+  std::string path;  // the file; with `bag`, ignored: the files are the bag's
+  // A rosbag2 bag directory (rbsim/bag.hpp), made already: files bag_0.mcap, bag_1.mcap, ... and
+  // metadata.yaml, rewritten (atomically) at every split listing the closed files, and at close().
+  std::string bag;
+  // Splits (bag only; 0: none): a new file once the open one holds this many bytes (checked as
+  // chunks reach it) or spans this much log time. Every file starts with the latest scene
+  // description and markers (each file is readable and drawable alone) and defines the channels
+  // under the same ids as the files before it.
+  std::uint64_t max_file_bytes = 0;
+  std::uint64_t max_file_duration_ns = 0;
   std::string ns = "rbsim";
-  std::vector<std::string> topics;  // names ("body_states" or "/rbsim/body_states"); empty: all
+  // Which topics, as rosbag2's recorder chooses: those named in `topics` ("body_states" or
+  // "/rbsim/body_states") and those whose full name matches `regex` (ECMAScript, the whole name),
+  // every topic when both are empty; minus those named in `exclude_topics` or matching
+  // `exclude_regex`.
+  std::vector<std::string> topics;
+  std::string regex;
+  std::vector<std::string> exclude_topics;
+  std::string exclude_regex;
   mcap::Compression compression = mcap::Compression::Zstd;
   int compression_level = 0;  // 0: the codec's default
   std::uint64_t chunk_size = 1 << 20;
@@ -43,8 +59,10 @@ class Recorder {
   ~Recorder();
   // Waits up to `timeout_ns` for data and records everything available; true if anything came.
   Result<bool> poll(std::int64_t timeout_ns);
-  [[nodiscard]] Status close();  // finishes a valid, indexed file
+  [[nodiscard]] Status close();  // finishes a valid, indexed file (and a bag's metadata)
   std::uint64_t received() const { return received_; }
+  // The files written so far (the last one open until close()); one unless a bag was split.
+  const std::vector<std::string>& files() const { return files_; }
   struct TopicCount {
     std::string topic;
     std::uint64_t received = 0, lost = 0;  // lost: reported by DDS plus gaps in the steps
@@ -67,6 +85,11 @@ class Recorder {
     Subscription subscription;
     std::uint16_t channel;  // 0 until the first sample: its writer's QoS goes into the channel
     std::uint32_t received;
+    msgs::OfferedQos offered{};  // what its channel says (the first publisher's offer)
+    // A latched topic's latest sample (payload and times), written again at the start of every
+    // later file of a split bag.
+    msgs::Bytes last{};
+    std::uint64_t last_source = 0;
     Gaps gaps;
     // Per writer, the newest source timestamp recorded. A sample not newer than that is one
     // delivered again: after a reconnection DDS can resend what a reader already had (seen when
@@ -76,6 +99,13 @@ class Recorder {
   };
   RecorderOptions options_;
   mcap::Writer writer_;
+  std::vector<std::string> files_;
+  std::vector<std::size_t> channel_order_;  // topics_ indices in the order their channels were added
+  std::uint64_t file_start_ = 0;            // log time of the open file's first message (0: none yet)
+  std::uint64_t file_bytes_ = 0;            // the open file's size as last seen (every 16 messages)
+  std::uint64_t written_ = 0;
+  [[nodiscard]] Status open_file();
+  [[nodiscard]] Status split(std::uint64_t log_time);
   std::int32_t waitset_ = 0;
   std::vector<Topic> topics_;
   std::uint64_t received_ = 0;

@@ -1,4 +1,5 @@
 // Offline runs steered by loaded commands (rbsim/command_script.hpp): scripts or recordings.
+#include <filesystem>
 #include <string>
 #include <utility>
 
@@ -8,7 +9,8 @@
 namespace rbsim::control {
 
 bool is_recording_path(const std::string& path) {
-  return path.ends_with(".mcap");
+  std::error_code ec;
+  return path.ends_with(".mcap") || std::filesystem::is_directory(path, ec);  // a file or a bag directory
 }
 
 Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,

@@ -4,6 +4,8 @@
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap_sink.hpp"
+
+#include "rbsim/bag.hpp"
 #include "rbsim/type_hash.hpp"
 
 namespace rbsim::log {
@@ -16,8 +18,15 @@ Error fail(const std::string& path, const Error& error) {
 
 class McapFileSink final : public McapSink {
  public:
+  // A path not ending in ".mcap" is a bag directory: the recording is its file 0 and finish()
+  // writes its metadata.yaml.
   McapFileSink(std::string path, RecordOptions options)
-      : path_(std::move(path)), options_(std::move(options)), ids_(msgs::topic_ids(options_.topics)) {}
+      : path_(std::move(path)), options_(std::move(options)), ids_(msgs::topic_ids(options_.topics)) {
+    if (is_bag_output(path_)) {
+      bag_ = path_;
+      path_ = bag_file(bag_, 0);
+    }
+  }
 
   Status begin(const Scene& scene, const World& world) override {
     if (options_.every < 1) {
@@ -27,6 +36,9 @@ class McapFileSink final : public McapSink {
     dt_ = scene.world.dt;
     // Written under a temporary name and renamed into place by finish(): a killed run leaves the
     // temporary (`<path>.tmp.<pid>`), which `rbsim log recover` turns into a recording.
+    if (!bag_.empty()) {
+      if (Status st = make_bag_directory(bag_); !st) return st;
+    }
     file_.open_external(path_);
     if (auto st = writer_.open(file_.temp_path(), writer_options(options_.compression, options_.chunk_size,
                                                                  options_.compression_level));
@@ -62,7 +74,8 @@ class McapFileSink final : public McapSink {
 
   Status finish() override {
     if (auto st = writer_.close(); !st.ok()) return fail(path_, st.error());
-    return file_.commit();
+    if (Status st = file_.commit(); !st) return st;
+    return bag_.empty() ? Status(Ok{}) : write_bag_metadata(bag_, {path_});
   }
 
  private:
@@ -81,6 +94,7 @@ class McapFileSink final : public McapSink {
   }
 
   std::string path_;
+  std::string bag_;  // the bag directory, if the output is one
   RecordOptions options_;
   std::vector<msgs::TopicId> ids_;  // the selected topics
   AtomicFile file_;  // declared before writer_: the writer closes before the temporary is removed

@@ -1,21 +1,53 @@
 // The reader thread of a streamed recording (rbsim/record_stream.hpp).
 #include "rbsim/record_stream.hpp"
 
+#include "rbsim/bag.hpp"
 #include "rbsim/mcap_tools.hpp"
 
 namespace rbsim::log {
 
-Status RecordStream::open(const std::string& path) {
-  path_ = path;
-  if (const Status st = reader_.open(path); !st.ok())
-    return Error{path + ": " + mcap_tools::read_error(st.error())};
+Status RecordStream::open(const std::string& given) {
+  Result<std::vector<std::string>> files = recording_files(given);  // a bag directory: its files
+  if (!files) return files.error();
+  files_ = std::move(files.value());
+  path_ = files_.front();
+  if (const Status st = reader_.open(path_); !st.ok())
+    return Error{path_ + ": " + mcap_tools::read_error(st.error())};
   thread_ = std::thread([this] { run(); });
   return Ok{};
 }
 
 Status RecordStream::status() const {
   if (status_.ok()) return Ok{};
+  if (joined_) return status_;  // the bag's files disagree: the message names the file
   return Error{path_ + ": " + mcap_tools::read_error(status_.error())};
+}
+
+// A record of file `file_` to pass on: the files of a bag read as one (BagJoin), so a later file's
+// repeats of schemas, channels and latched messages are skipped.
+bool RecordStream::keep(const mcap::Record& record) {
+  if (const auto* m = std::get_if<mcap::Message>(&record)) return !join_.repeated(file_, *m);
+  if (const auto* s = std::get_if<mcap::Schema>(&record)) return schemas_.insert(s->id).second;
+  if (const auto* c = std::get_if<mcap::Channel>(&record)) {
+    bool repeat = false;
+    if (Status st = join_.channel(file_, *c, repeat); !st) {
+      joined_ = true;
+      failure_ = Error{files_[file_] + ": " + st.error().message, ErrorCode::Malformed};
+      return false;
+    }
+    return !repeat;
+  }
+  return false;
+}
+
+// At the end of a file: the next file of the bag, if the file was read whole and there is one.
+bool RecordStream::next_file() {
+  if (!reader_.status().ok() || !failure_.ok() || file_ + 1 >= files_.size()) return false;
+  ++file_;
+  std::lock_guard<std::mutex> lock(mu_);
+  path_ = files_[file_];
+  if (Status st = reader_.open(path_); !st.ok()) failure_ = st;
+  return failure_.ok();
 }
 
 void RecordStream::run() {
@@ -35,17 +67,14 @@ void RecordStream::run() {
         spare.pop_back();
       }
     }
-    const bool more = reader_.next(entry);
-    if (more) {
-      if (const auto* m = std::get_if<mcap::Message>(&entry.record)) {
-        bytes += m->data.size() + 64;
-        batch.push_back(std::move(entry.record));
-      } else if (std::holds_alternative<mcap::Schema>(entry.record) ||
-                 std::holds_alternative<mcap::Channel>(entry.record)) {
-        bytes += 64;
-        batch.push_back(std::move(entry.record));
-      }
+    bool more = reader_.next(entry);
+    if (!more) more = next_file() && reader_.next(entry);
+    if (more && keep(entry.record)) {
+      if (const auto* m = std::get_if<mcap::Message>(&entry.record)) bytes += m->data.size();
+      bytes += 64;
+      batch.push_back(std::move(entry.record));
     }
+    if (!failure_.ok()) more = false;
     if (!more || batch.size() >= kBatchRecords || bytes >= kBatchBytes) {
       std::unique_lock<std::mutex> lock(mu_);
       cv_.wait(lock, [&] { return stop_ || queued_ < kPumpBytes; });
@@ -55,7 +84,7 @@ void RecordStream::run() {
       batch = {};
       bytes = 0;
       if (!more) {
-        status_ = reader_.status();
+        status_ = failure_.ok() ? reader_.status() : failure_;
         finished_ = true;
       }
       lock.unlock();

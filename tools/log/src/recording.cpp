@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "rbsim/assert.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/mcap_tools.hpp"
 
 namespace rbsim::log {
@@ -36,17 +37,24 @@ std::string_view RecordedChannel::schema_text() const {
 
 namespace {
 
+// The schema of `channel` in `reader`, and how many messages the reader's summary counts on it.
+const mcap::Schema* schema_of(const mcap::IndexedReader& reader, const mcap::Channel& channel) {
+  const auto schema = reader.schemas().find(channel.schema_id);
+  return schema == reader.schemas().end() ? nullptr : &schema->second;
+}
+std::optional<std::uint64_t> count_of(const mcap::IndexedReader& reader, std::uint16_t channel) {
+  if (const auto& stats = reader.statistics()) {
+    if (const auto n = stats->channel_message_counts.find(channel); n != stats->channel_message_counts.end())
+      return n->second;
+  }
+  return std::nullopt;
+}
+
 // What this build makes of a channel: its rbsim topic (by schema name), whether it can decode it.
-RecordedChannel describe_channel(const mcap::IndexedReader& reader, const mcap::Channel& channel) {
+RecordedChannel describe_channel(const mcap::Channel& channel, const mcap::Schema* schema) {
   RecordedChannel c;
   c.channel = &channel;
-  if (const auto schema = reader.schemas().find(channel.schema_id); schema != reader.schemas().end())
-    c.schema = &schema->second;
-  if (const auto& stats = reader.statistics()) {
-    if (const auto n = stats->channel_message_counts.find(channel.id);
-        n != stats->channel_message_counts.end())
-      c.message_count = n->second;
-  }
+  c.schema = schema;
   if (c.schema == nullptr) return c;
   c.spec = msgs::topic_for_type(c.schema->name);
   if (c.spec == nullptr) return c;
@@ -81,7 +89,10 @@ struct Recording::Impl {
 
   std::string path;
   RecordingOptions options;
-  mcap::IndexedReader reader;
+  // One reader per file: one, or a bag's files in order, read as one recording through `join`
+  // (rbsim/bag.hpp), whose repeat tracking each pass copies.
+  std::vector<std::unique_ptr<mcap::IndexedReader>> readers;
+  BagJoin join;
   // Every channel, in the order they became known (the summary's by id, then any a read found);
   // a deque, so the pointers handed out in RecordedMessage stay valid as channels are added.
   std::deque<RecordedChannel> channels;
@@ -102,20 +113,47 @@ struct Recording::Impl {
 
   Error fail(const std::string& what) const { return Error{path + ": " + what}; }
 
-  // The description of `channel`, made the first time it is asked for.
-  const RecordedChannel& described(const mcap::Channel& channel) {
+  // The description of `channel`, made the first time it is asked for (a bag's later files
+  // define it again under the same id).
+  RecordedChannel& described(const mcap::Channel& channel, const mcap::Schema* schema) {
     const auto [it, fresh] = channel_at.try_emplace(channel.id, channels.size());
-    if (fresh) channels.push_back(describe_channel(reader, channel));
+    if (fresh) channels.push_back(describe_channel(channel, schema));
     return channels[it->second];
   }
 
   // The channel a message arrived on (one the summary did not list is described now).
   const RecordedChannel* channel_of(const mcap::MessageEntry& e) {
-    return e.channel == nullptr ? nullptr : &described(*e.channel);
+    return e.channel == nullptr ? nullptr : &described(*e.channel, e.schema);
   }
 
-  void learn_channels() {
-    for (const auto& [id, channel] : reader.channels()) described(channel);
+  Status learn_channels() {
+    for (std::size_t k = 0; k < readers.size(); ++k) {
+      for (const auto& [id, channel] : readers[k]->channels()) {
+        bool repeat = false;
+        if (Status st = join.channel(k, channel, repeat); !st) return fail(st.error().message);
+        RecordedChannel& c = described(channel, schema_of(*readers[k], channel));
+        if (const std::optional<std::uint64_t> n = count_of(*readers[k], id))
+          c.message_count = c.message_count.value_or(0) + *n;
+      }
+    }
+    return Ok{};
+  }
+
+  // Every file's messages `ro` picks, file after file (each in log-time order), a split's
+  // repeats of latched messages skipped, until `on` returns false.
+  Status each_message(const mcap::ReadMessagesOptions& ro,
+                      const std::function<bool(const mcap::MessageEntry&)>& on) {
+    BagJoin pass = join;
+    bool stopped = false;
+    for (std::size_t k = 0; k < readers.size() && !stopped; ++k) {
+      const Status st = readers[k]->read_messages(ro, [&](const mcap::MessageEntry& e) {
+        if (readers.size() > 1 && pass.repeated(k, e.message)) return true;
+        stopped = !on(e);
+        return !stopped;
+      });
+      if (!st.ok()) return st;
+    }
+    return Ok{};
   }
 
   Status classify() {
@@ -164,7 +202,7 @@ struct Recording::Impl {
     mcap::ReadMessagesOptions ro;
     ro.topics.push_back(topic);
     Status failure = Ok{};
-    const Status st = reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+    const Status st = each_message(ro, [&](const mcap::MessageEntry& e) {
       const auto r = route.find(e.message.channel_id);
       if (r == route.end() || r->second != msgs::TopicId::Scene) return true;
       Result<msgs::SceneMessage> decoded = msgs::decode_scene(e.message.data);
@@ -313,10 +351,14 @@ struct Recording::Impl {
 Recording::Recording() : impl_(std::make_unique<Impl>()) {}
 Recording::~Recording() = default;
 
-Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, const RecordingOptions& options) {
+Result<std::unique_ptr<Recording>> Recording::open(const std::string& given,
+                                                   const RecordingOptions& options) {
+  // A bag directory is read through its files (rbsim/bag.hpp).
+  const Result<std::vector<std::string>> files = recording_files(given);
+  if (!files) return files.error();
   std::unique_ptr<Recording> r(new Recording());
   Impl& im = *r->impl_;
-  im.path = path;
+  im.path = given;
   im.options = options;
   for (msgs::TopicId id : options.read) {
     const int i = per_step_index(id);
@@ -330,19 +372,24 @@ Result<std::unique_ptr<Recording>> Recording::open(const std::string& path, cons
       return im.fail("cannot require " + std::string(msgs::topic(id).type) + " without reading it");
     }
   }
-  if (std::string e = mcap_tools::unreadable(path); !e.empty()) return im.fail(e);
-  if (Status s = im.reader.open(path); !s.ok()) return im.fail(mcap_tools::read_error(s.error()));
-  if (options.verify_crc) {
-    if (Status s = im.reader.verify_data_section_crc(); !s.ok())
-      return im.fail(mcap_tools::read_error(s.error()));
+  for (const std::string& file : files.value()) {
+    im.path = file;  // what errors name
+    if (std::string e = mcap_tools::unreadable(file); !e.empty()) return im.fail(e);
+    auto& reader = *im.readers.emplace_back(std::make_unique<mcap::IndexedReader>());
+    if (Status s = reader.open(file); !s.ok()) return im.fail(mcap_tools::read_error(s.error()));
+    if (options.verify_crc) {
+      if (Status s = reader.verify_data_section_crc(); !s.ok())
+        return im.fail(mcap_tools::read_error(s.error()));
+    }
+    // A file whose summary lists no channels defines them in its data section: read it once to
+    // learn them.
+    if (reader.channels().empty()) {
+      const Status s = reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
+      if (!s.ok()) return im.fail(mcap_tools::read_error(s.error()));
+    }
   }
-  // A file whose summary lists no channels defines them in its data section: read it once to
-  // learn them.
-  if (im.reader.channels().empty()) {
-    const Status s = im.reader.read_messages({}, [](const mcap::MessageEntry&) { return true; });
-    if (!s.ok()) return im.fail(mcap_tools::read_error(s.error()));
-  }
-  im.learn_channels();
+  im.path = files->size() == 1 ? files->front() : given;
+  if (Status st = im.learn_channels(); !st) return st.error();
   if (Status st = im.classify(); !st) return st.error();
   if (options.scene && options.require_scene &&
       im.topics[static_cast<std::size_t>(msgs::TopicId::Scene)].empty()) {
@@ -372,34 +419,36 @@ const std::deque<RecordedChannel>& Recording::channels() const {
 }
 
 const mcap::Header& Recording::header() const {
-  return impl_->reader.header();
+  return impl_->readers.front()->header();
 }
 
 bool Recording::lists_every_channel() const {
-  const mcap::IndexedReader& reader = impl_->reader;
-  if (!reader.indexed()) return false;
-  for (const mcap::ChunkIndex& ci : reader.chunk_indexes()) {
-    if (ci.message_index_offsets.empty()) return false;
-    for (const auto& [channel_id, offset] : ci.message_index_offsets) {
-      if (reader.channels().count(channel_id) == 0) return false;
+  for (const auto& reader : impl_->readers) {
+    if (!reader->indexed()) return false;
+    for (const mcap::ChunkIndex& ci : reader->chunk_indexes()) {
+      if (ci.message_index_offsets.empty()) return false;
+      for (const auto& [channel_id, offset] : ci.message_index_offsets) {
+        if (reader->channels().count(channel_id) == 0) return false;
+      }
     }
   }
   return true;
 }
 
 std::optional<mcap::Timestamp> Recording::last_log_time() const {
-  const mcap::IndexedReader& reader = impl_->reader;
   std::optional<mcap::Timestamp> last;
-  for (const mcap::ChunkIndex& ci : reader.chunk_indexes())
-    last = std::max(last.value_or(0), ci.message_end_time);
-  if (const auto& stats = reader.statistics()) last = std::max(last.value_or(0), stats->message_end_time);
+  for (const auto& reader : impl_->readers) {
+    for (const mcap::ChunkIndex& ci : reader->chunk_indexes())
+      last = std::max(last.value_or(0), ci.message_end_time);
+    if (const auto& stats = reader->statistics()) last = std::max(last.value_or(0), stats->message_end_time);
+  }
   return last;
 }
 
 Status Recording::read_messages(const MessageFilter& filter, const MessageCallback& on_message) {
   Impl& im = *impl_;
   const mcap::ReadMessagesOptions ro{filter.topics, filter.start, filter.end};
-  const Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+  const Status st = im.each_message(ro, [&](const mcap::MessageEntry& e) {
     const RecordedChannel* channel = im.channel_of(e);
     if (channel == nullptr) return true;  // a message on a channel the file never defines
     return on_message(RecordedMessage{channel, &e.message});
@@ -429,7 +478,7 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   };
   Status failure = Ok{};
   bool stopped = false;
-  const Status st = im.reader.read_messages(ro, [&](const mcap::MessageEntry& e) {
+  const Status st = im.each_message(ro, [&](const mcap::MessageEntry& e) {
     const auto r = im.route.find(e.message.channel_id);
     const int i = r == im.route.end() ? -1 : per_step_index(r->second);
     if (i < 0) {

@@ -8,18 +8,21 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "rbsim/bag.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/status.hpp"
 
 namespace rbsim::log {
 
-// Reads one file on its own thread (decompression and CRCs are most of the work), every CRC
+// Reads one file, or a bag directory's files in order as one recording (rbsim/bag.hpp's BagJoin),
+// on its own thread (decompression and CRCs are most of the work), every CRC
 // verified, handing its Schema, Channel and Message records over in batches; at most kPumpBytes
 // ahead of the consumer.
 // Message buffers the consumer is done with come back through recycle() and are filled again:
@@ -76,8 +79,16 @@ class RecordStream {
 
  private:
   void run();
+  bool keep(const mcap::Record& record);
+  bool next_file();
 
-  std::string path_;
+  std::string path_;                // the file being read (guarded by mu_ once the thread runs)
+  std::vector<std::string> files_;  // one, or a bag's
+  std::size_t file_ = 0;            // reader thread: the file being read, its BagJoin, schemas seen
+  BagJoin join_;
+  std::set<std::uint16_t> schemas_;
+  Status failure_ = Ok{};
+  bool joined_ = false;
   mcap::StreamReader reader_;
   std::thread thread_;
   std::mutex mu_;

@@ -1,0 +1,66 @@
+// rosbag2's bag directory, as ROS 2 Jazzy's recorder writes it with the mcap storage: DIR/metadata.yaml
+// (what `ros2 bag info DIR` and the `rosbags` library open) beside the recording files DIR/DIR_0.mcap,
+// DIR_1.mcap, ... An output path ending in ".mcap" is one file; any other is a bag directory.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rbsim/mcap.hpp"
+#include "rbsim/outputs.hpp"
+#include "rbsim/status.hpp"
+
+namespace rbsim::log {
+
+inline constexpr std::string_view kBagMetadataFile = "metadata.yaml";
+// The rosbag2 metadata version Jazzy writes (QoS policies by name).
+inline constexpr int kBagMetadataVersion = 9;
+
+// True when an output path names a bag directory (it does not end in ".mcap").
+bool is_bag_output(std::string_view path);
+// The path of file `index` of bag `dir`: "runs/bag" -> "runs/bag/bag_0.mcap".
+std::string bag_file(const std::string& dir, std::size_t index);
+
+// What check_outputs() checks for bag `dir` given as `option`: the directory (its parent must
+// exist) and, when it exists already, the files a recording writes into it (refused unless
+// overwrite). Before writing, make_bag_directory() creates it.
+std::vector<OutputPath> bag_outputs(const std::string& dir, const std::string& option);
+[[nodiscard]] Status make_bag_directory(const std::string& dir);
+
+// Writes `dir`/metadata.yaml (atomically: a reader sees the old or the new one) describing `files`
+// (paths inside `dir`, in recording order) from their MCAP summaries: each topic's type, offered
+// QoS and type hash (the channel metadata rosbag2's mcap storage writes) and message count, each
+// file's start, duration and count, and the bag's. Fails naming a file that cannot be read.
+[[nodiscard]] Status write_bag_metadata(const std::string& dir, const std::vector<std::string>& files);
+
+// The recording files `path` names: itself for a file; for a directory, the files its
+// metadata.yaml lists, in order (errors name the directory and what is wrong: no metadata.yaml, a
+// storage other than mcap, a listed file missing).
+[[nodiscard]] Result<std::vector<std::string>> recording_files(const std::string& path);
+
+// The one rule by which a bag of several files reads as one recording (rbsim's readers use it):
+// a file after the first defines its channels under the ids the earlier files used, as rbsim record
+// writes them (a bag whose files disagree is refused, naming the channel), and the latched messages
+// a split repeats at the start of a file (on a transient-local channel, equal to the last message
+// read on it, the first on it in its file) are read once.
+class BagJoin {
+ public:
+  // A channel record of file `file` (0-based): `repeat` is set when an earlier file defined it.
+  [[nodiscard]] Status channel(std::size_t file, const mcap::Channel& channel, bool& repeat);
+  // True for a split's repeat of a latched message (to skip); call for every message, in order.
+  bool repeated(std::size_t file, const mcap::Message& message);
+
+ private:
+  struct Known {
+    std::string topic;
+    bool latched = false;
+    std::vector<std::byte> last;      // the last message on a latched channel
+    std::size_t file = 0;             // the file it was read from
+  };
+  std::map<std::uint16_t, Known> channels_;
+};
+
+}  // namespace rbsim::log
