@@ -62,5 +62,33 @@ TEST(ReplayCli, EmptyFileIsNamedWithoutSuggestingRecover) {
   EXPECT_EQ(o.err.find("recover"), std::string::npos) << o;
 }
 
+TEST(RecordCli, BagOptionsAreCheckedBeforeAnythingIsMade) {
+  test::TempDir dir;
+  // A bad --regex is a usage error, and the bag directory it would have made is not left behind.
+  const fs::path bag = dir / "bag";
+  test::Outcome o =
+      rbsim({"record", bag.string(), "--regex", "(", "--domain", kQuietDomain, "--wall-duration", "5"});
+  EXPECT_EQ(o.exit_code, 2) << o;
+  EXPECT_NE(o.err.find("--regex \"(\": not a regular expression"), std::string::npos) << o;
+  EXPECT_FALSE(fs::exists(bag));
+  // Splits need a bag directory, not one .mcap file.
+  o = rbsim({"record", (dir / "one.mcap").string(), "--max-file-size", "100000", "--domain", kQuietDomain});
+  EXPECT_EQ(o.exit_code, 2) << o;
+  EXPECT_NE(o.err.find("split a bag directory"), std::string::npos) << o;
+  // An existing bag is refused unless --overwrite (its metadata.yaml would be replaced).
+  fs::create_directory(bag);
+  test::write_text(bag / "metadata.yaml", "a bag the user wants to keep");
+  o = rbsim({"record", bag.string(), "--domain", kQuietDomain, "--wall-duration", "0.2"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_NE(o.err.find("metadata.yaml: exists (use --overwrite to replace it)"), std::string::npos) << o;
+  EXPECT_EQ(test::read_text(bag / "metadata.yaml"), "a bag the user wants to keep");
+  // Topics that choose nothing are a usage error.
+  o = rbsim({"record", (dir / "none").string(), "--topics", "clock", "--exclude-regex", ".*", "--domain",
+             kQuietDomain});
+  EXPECT_EQ(o.exit_code, 2) << o;
+  EXPECT_NE(o.err.find("choose no topic"), std::string::npos) << o;
+  EXPECT_FALSE(fs::exists(dir / "none"));
+}
+
 }  // namespace
 }  // namespace rbsim

@@ -583,5 +583,57 @@ TEST(LogCli, EveryToolOnBadInputFailsCleanly) {
   }
 }
 
+// A rosbag2 bag directory (rbsim run --record DIR): metadata.yaml beside DIR_0.mcap, which holds
+// the bytes the .mcap output holds; every reader takes the directory as it takes the file.
+TEST(LogCli, BagDirectoryIsReadWhereverAFileIs) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/chain.xml");
+  const std::string file = (dir / "run.mcap").string(), bag = (dir / "run").string();
+  for (const std::string& out : {file, bag}) {
+    const Outcome o = rbsim({"run", scene, "-q", "--steps", "60", "--record", out});
+    ASSERT_EQ(o.exit_code, 0) << describe(o);
+  }
+  EXPECT_EQ(read_text(dir / "run" / "run_0.mcap"), read_text(file))
+      << "a bag's file is the .mcap run --record writes";
+  const std::string meta = read_text(dir / "run" / "metadata.yaml");
+  for (const char* want :
+       {"version: 9", "storage_identifier: mcap", "relative_file_paths:\n    - run_0.mcap",
+        "message_count: 368", "name: /rbsim/body_states", "type: rbsim_msgs/msg/BodyStates",
+        "type_description_hash: RIHS01_", "durability: transient_local", "ros_distro: jazzy"}) {
+    EXPECT_NE(meta.find(want), std::string::npos) << want << " in\n" << meta;
+  }
+  // The same output from the directory as from the file.
+  const std::vector<std::vector<std::string>> readers = {{"log", "cat", "@", "--topics", "energy"},
+                                                         {"check", "@", file}};
+  for (const auto& args : readers) {
+    std::vector<std::string> from_file = args, from_bag = args;
+    std::replace(from_file.begin(), from_file.end(), std::string("@"), file);
+    std::replace(from_bag.begin(), from_bag.end(), std::string("@"), bag);
+    const Outcome a = rbsim(from_file), b = rbsim(from_bag);
+    EXPECT_EQ(a.exit_code, 0) << describe(a);
+    EXPECT_EQ(b.exit_code, 0) << describe(b);
+    if (args[0] != "check") {
+      EXPECT_EQ(a.out, b.out) << args[0] << " " << args[1];
+    }
+  }
+  for (const std::string& in : {file, bag}) {
+    const Outcome o = rbsim({"log", "export", in, "--csv", in + ".csv"});
+    EXPECT_EQ(o.exit_code, 0) << describe(o);
+  }
+  EXPECT_EQ(read_text(bag + ".csv"), read_text(file + ".csv"));
+  const Outcome info = rbsim({"log", "info", bag});
+  EXPECT_EQ(info.exit_code, 0) << describe(info);
+  EXPECT_NE(info.out.find("(rosbag2, 1 file)"), std::string::npos) << info.out;
+  // A directory that is not a bag, and a bag whose file is gone: errors naming them.
+  fs::create_directory(dir / "empty");
+  Outcome bad = rbsim({"log", "cat", (dir / "empty").string()});
+  EXPECT_EQ(bad.exit_code, 1) << describe(bad);
+  EXPECT_NE(bad.err.find("without metadata.yaml: not a rosbag2 bag"), std::string::npos) << bad.err;
+  fs::remove(dir / "run" / "run_0.mcap");
+  bad = rbsim({"check", bag, file});
+  EXPECT_NE(bad.exit_code, 0) << describe(bad);
+  EXPECT_NE(bad.err.find("run_0.mcap, which is missing"), std::string::npos) << bad.err;
+}
+
 }  // namespace
 }  // namespace rbsim::test

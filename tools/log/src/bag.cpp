@@ -122,8 +122,8 @@ Status write_bag_metadata(const std::string& dir, const std::vector<std::string>
     y << YAML::Key << "message_count" << YAML::Value << t.count << YAML::EndMap;
   }
   y << YAML::EndSeq;
-  y << YAML::Key << "compression_format" << YAML::Value << "" << YAML::Key << "compression_mode" << YAML::Value
-    << "";
+  y << YAML::Key << "compression_format" << YAML::Value << "" << YAML::Key << "compression_mode"
+    << YAML::Value << "";
   y << YAML::Key << "relative_file_paths" << YAML::Value << YAML::BeginSeq;
   for (const FileInfo& f : infos) y << f.name;
   y << YAML::EndSeq << YAML::Key << "files" << YAML::Value << YAML::BeginSeq;
@@ -153,14 +153,17 @@ Result<std::vector<std::string>> recording_files(const std::string& path) {
     const YAML::Node root = YAML::LoadFile(metadata.string());
     const YAML::Node info = root["rosbag2_bagfile_information"];
     if (!info) return Error{metadata.string() + ": no rosbag2_bagfile_information"};
-    const std::string storage = info["storage_identifier"] ? info["storage_identifier"].as<std::string>() : "";
+    const std::string storage =
+        info["storage_identifier"] ? info["storage_identifier"].as<std::string>() : "";
     if (storage != "mcap") {
-      return Error{metadata.string() + ": storage_identifier \"" + storage + "\": rbsim reads mcap bags only"};
+      return Error{metadata.string() + ": storage_identifier \"" + storage +
+                   "\": rbsim reads mcap bags only"};
     }
     std::vector<std::string> files;
     for (const YAML::Node& f : info["relative_file_paths"]) {
       const fs::path file = fs::path(path) / fs::path(f.as<std::string>()).filename();
-      if (!fs::exists(file, ec)) return Error{metadata.string() + ": lists " + file.string() + ", which is missing"};
+      if (!fs::exists(file, ec))
+        return Error{metadata.string() + ": lists " + file.string() + ", which is missing"};
       files.push_back(file.string());
     }
     if (files.empty()) return Error{metadata.string() + ": relative_file_paths lists no file"};
@@ -175,13 +178,15 @@ Status BagJoin::channel(std::size_t file, const mcap::Channel& channel, bool& re
   repeat = !fresh;
   if (fresh) {
     it->second.topic = channel.topic;
-    it->second.latched = value_of(channel.metadata, "offered_qos_profiles").find("durability: transient_local") !=
-                         std::string::npos;
+    it->second.latched =
+        value_of(channel.metadata, "offered_qos_profiles").find("durability: transient_local") !=
+        std::string::npos;
     return Ok{};
   }
   if (it->second.topic != channel.topic) {
-    return Error{"file " + std::to_string(file) + " of the bag defines channel " + std::to_string(channel.id) +
-                 " as " + channel.topic + ", an earlier one as " + it->second.topic +
+    return Error{"file " + std::to_string(file) + " of the bag defines channel " +
+                 std::to_string(channel.id) + " as " + channel.topic + ", an earlier one as " +
+                 it->second.topic +
                  ": rbsim reads bags whose files share their channel ids (as rbsim record writes them)"};
   }
   return Ok{};

@@ -57,8 +57,8 @@ class BagJoin {
   struct Known {
     std::string topic;
     bool latched = false;
-    std::vector<std::byte> last;      // the last message on a latched channel
-    std::size_t file = 0;             // the file it was read from
+    std::vector<std::byte> last;  // the last message on a latched channel
+    std::size_t file = 0;         // the file it was read from
   };
   std::map<std::uint16_t, Known> channels_;
 };
