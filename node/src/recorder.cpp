@@ -109,7 +109,9 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   // every other reader exists by the time the node starts publishing.
   std::stable_partition(wanted.begin(), wanted.end(),
                         [](const msgs::TopicSpec* s) { return s->id != msgs::TopicId::BodyStates; });
-  if (Status st = r->open_file(); !st) return st.error();
+  if (options.snapshot_duration_ns == 0) {
+    if (Status st = r->open_file(); !st) return st.error();
+  }
   r->waitset_ = dds_create_waitset(participant.handle());
   for (const msgs::TopicSpec* spec : wanted) {
     const std::string ros = msgs::topic_name(*spec, options.ns);
@@ -145,6 +147,19 @@ Status Recorder::split(std::uint64_t log_time) {
   if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
   if (Status st = log::write_bag_metadata(options_.bag, files_); !st) return st;
   if (Status st = open_file(); !st) return st;
+  if (Status st = add_channels(); !st) return st;
+  file_start_ = log_time;
+  for (const std::size_t i : channel_order_) {
+    Topic& t = topics_[i];
+    if (!t.subscription.spec().latched() || t.last.empty()) continue;
+    if (auto st = writer_.write_message(t.channel, t.received - 1, log_time, t.last_source, t.last); !st.ok())
+      return Error{options_.path + ": " + st.error().message};
+  }
+  return Ok{};
+}
+
+// Every channel of the files before, in the order they were added: the same ids in every file.
+Status Recorder::add_channels() {
   for (const std::size_t i : channel_order_) {
     Topic& t = topics_[i];
     auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, t.offered);
@@ -154,14 +169,59 @@ Status Recorder::split(std::uint64_t log_time) {
                    std::to_string(channel.value()) + ", not " + std::to_string(t.channel)};
     }
   }
-  file_start_ = log_time;
-  for (const std::size_t i : channel_order_) {
+  return Ok{};
+}
+
+Status Recorder::split_now() {
+  if (options_.bag.empty() || options_.snapshot_duration_ns > 0) {
+    return Error{"splitting needs a bag directory being recorded (not one .mcap file, not snapshot mode)"};
+  }
+  if (file_start_ == 0) return Ok{};  // nothing in the open file yet: it stays the new one
+  return split(file_start_ > 0 ? std::max(file_start_, wall_ns()) : wall_ns());
+}
+
+// Snapshot mode: the sample is kept (copied) instead of written; the oldest go once they are
+// older than the duration or the payload is over its bound. Latched topics keep only their
+// latest (Topic::last), written at the start of every snapshot.
+void Recorder::keep(Topic& t, const Received& sample, std::uint64_t log_time, std::uint64_t source) {
+  kept_.push_back({static_cast<std::size_t>(&t - topics_.data()),
+                   msgs::Bytes(sample.cdr.begin(), sample.cdr.end()), log_time, source, t.received});
+  kept_bytes_ += sample.cdr.size();
+  while (!kept_.empty() && (kept_.front().log_time + options_.snapshot_duration_ns < log_time ||
+                            kept_bytes_ > options_.snapshot_max_bytes)) {
+    if (kept_.front().log_time + options_.snapshot_duration_ns >= log_time) ++snapshot_dropped_;
+    kept_bytes_ -= kept_.front().cdr.size();
+    kept_.pop_front();
+  }
+}
+
+Result<std::uint64_t> Recorder::snapshot() {
+  if (options_.snapshot_duration_ns == 0)
+    return Error{"not recording in snapshot mode (--snapshot-duration)"};
+  if (Status st = release_held(); !st) return st.error();
+  if (kept_.empty()) return std::uint64_t{0};
+  if (Status st = open_file(); !st) return st.error();
+  if (Status st = add_channels(); !st) return st.error();
+  std::uint64_t n = 0;
+  const std::uint64_t first = kept_.front().log_time;
+  for (const std::size_t i : channel_order_) {  // the latched topics' latest, at the first kept time
     Topic& t = topics_[i];
     if (!t.subscription.spec().latched() || t.last.empty()) continue;
-    if (auto st = writer_.write_message(t.channel, t.received - 1, log_time, t.last_source, t.last); !st.ok())
+    if (auto st = writer_.write_message(t.channel, t.received - 1, first, t.last_source, t.last); !st.ok())
       return Error{options_.path + ": " + st.error().message};
+    ++n;
   }
-  return Ok{};
+  for (const Kept& k : kept_) {
+    if (auto st = writer_.write_message(topics_[k.topic].channel, k.sequence, k.log_time, k.source, k.cdr);
+        !st.ok())
+      return Error{options_.path + ": " + st.error().message};
+    ++n;
+  }
+  kept_.clear();
+  kept_bytes_ = 0;
+  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
+  if (Status st = log::write_bag_metadata(options_.bag, files_); !st) return st.error();
+  return n;
 }
 
 Recorder::~Recorder() {
@@ -174,7 +234,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
   bool any = false;
   // A chunk compressed while no message came in reaches the file now, not at the next message.
-  if (auto st = writer_.write_compressed_chunk(); !st.ok())
+  if (auto st = writer_.is_open() ? writer_.write_compressed_chunk() : Status(Ok{}); !st.ok())
     return Error{options_.path + ": " + st.error().message};
   Received sample;
   for (Topic& t : topics_) {
@@ -227,23 +287,28 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
 
 Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time) {
   const bool latched = t.subscription.spec().latched();
+  const bool snapshots = options_.snapshot_duration_ns > 0;
   if (options_.max_file_bytes > 0 && ++written_ % 16 == 0) {  // the size as chunks reached the file
     std::error_code ec;
     file_bytes_ = std::filesystem::file_size(options_.path, ec);
     if (ec) file_bytes_ = 0;
   }
-  if (!latched && file_start_ != 0 && !options_.bag.empty() &&
+  if (!latched && !snapshots && file_start_ != 0 && !options_.bag.empty() &&
       ((options_.max_file_bytes > 0 && file_bytes_ >= options_.max_file_bytes) ||
        (options_.max_file_duration_ns > 0 && log_time >= file_start_ + options_.max_file_duration_ns))) {
     if (Status st = split(log_time); !st) return st;
   }
   if (file_start_ == 0) file_start_ = log_time;
   if (t.channel == 0) {  // like rosbag2: the channel says what the (first) publisher offers
-    auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
-    if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
-    t.channel = channel.value();
     t.offered = sample.offered;
     channel_order_.push_back(static_cast<std::size_t>(&t - topics_.data()));
+    if (snapshots) {  // no file open: the id add_channels() gives it (one schema and channel each, in order)
+      t.channel = static_cast<std::uint16_t>(channel_order_.size());
+    } else {
+      auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
+      if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
+      t.channel = channel.value();
+    }
   }
   const std::uint64_t source =
       sample.source_time_ns > 0 ? static_cast<std::uint64_t>(sample.source_time_ns) : log_time;
@@ -251,7 +316,9 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
     t.last.assign(sample.cdr.begin(), sample.cdr.end());
     t.last_source = source;
   }
-  if (auto st = writer_.write_message(t.channel, t.received, log_time, source, sample.cdr); !st.ok()) {
+  if (snapshots) {
+    if (!latched) keep(t, sample, log_time, source);
+  } else if (auto st = writer_.write_message(t.channel, t.received, log_time, source, sample.cdr); !st.ok()) {
     return Error{options_.path + ": " + st.error().message};
   }
   ++t.received;
@@ -315,6 +382,8 @@ std::vector<Recorder::TopicCount> Recorder::counts() const {
 
 Status Recorder::close() {
   if (Status st = release_held(); !st) return st;
+  if (options_.snapshot_duration_ns > 0)
+    return Ok{};  // what a snapshot did not take is dropped, as rosbag2's
   if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
   if (!options_.bag.empty() && received_ > 0) return log::write_bag_metadata(options_.bag, files_);
   return Ok{};

@@ -1457,6 +1457,39 @@ def case_record_bag_sigkill(ctx):
     exited_ok(ctx, node, 30, "node stopped with SIGINT")
 
 
+def case_record_snapshot(ctx):
+    """rbsim record DIR --snapshot-duration 1: nothing written until asked; each snapshot (SIGUSR1) is
+    a file of the bag holding exactly the last second of log time, contiguous steps, with the scene
+    description and markers first, that renders on its own."""
+    scene = ctx.scene("chain.xml")
+    bag = ctx.path("snap")
+    rec = ctx.rb("record", *record_args(ctx, bag, "--snapshot-duration", 1, "--wall-duration", 60))
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", 5, "--wait-for-subscribers", 1))
+    time.sleep(2.5)
+    ctx.check(not any(f.endswith(".mcap") for f in os.listdir(bag)), "snapshot mode wrote a file before a snapshot")
+    for i in range(2):
+        rec.signal(signal.SIGUSR1)
+        rec.wait_for_text(f"written to {bag}/snap_{i}.mcap", 10, stream="stderr")
+        time.sleep(1.2)
+    exited_ok(ctx, node, 60)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 30)
+    meta = bag_metadata(bag)
+    ctx.check(meta["relative_file_paths"] == ["snap_0.mcap", "snap_1.mcap"], f"files {meta['relative_file_paths']}")
+    check_bag_with_rosbags(ctx, bag, "snapshot bag")
+    for i, f in enumerate(meta["relative_file_paths"]):
+        log = Log(os.path.join(bag, f))
+        ctx.check([m[0].rsplit("/", 1)[-1] for m in log.messages[:2]] == ["scene", "markers"] or
+                  log.messages[0][0].endswith("/scene"), f"{f}: starts with {[m[0] for m in log.messages[:2]]}")
+        per_step = [m for m in log.messages if m[0].endswith("/body_states")]
+        steps = [step_of(m[5]) for m in per_step]
+        span = (per_step[-1][2] - per_step[0][2]) / 1e9
+        ctx.log(f"{f}: steps {steps[0]}..{steps[-1]} ({len(steps)}), log-time span {span:.3f} s")
+        ctx.check(steps == list(range(steps[0], steps[0] + len(steps))), f"{f}: steps not contiguous")
+        ctx.check(0.9 <= span <= 1.0, f"{f}: keeps {span:.3f} s of log time, want the last 1 s")
+        ctx.rbrun(f"render-{i}", "render", os.path.join(bag, f), "--out", ctx.path(f"frames-{i}"), "--fps", 2)
+
+
 def rss_kib(pid):
     try:
         with open(f"/proc/{pid}/status") as f:
@@ -1542,6 +1575,7 @@ CASES = {
     "record_disk_full": case_record_disk_full,
     "record_bag": case_record_bag,
     "record_bag_sigkill": case_record_bag_sigkill,
+    "record_snapshot": case_record_snapshot,
     "record_sigkill": case_record_sigkill,
     "soak": case_soak,
 }

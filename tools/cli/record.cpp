@@ -1,4 +1,5 @@
 // rbsim record: DDS topics to MCAP until Ctrl-C, --wall-duration or --max-messages.
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -25,6 +26,7 @@ struct RecordArgs {
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   std::optional<double> duration;
   std::optional<double> max_file_duration;  // seconds
+  std::optional<double> snapshot_duration;  // seconds
   std::string compression = "zstd";
   std::optional<int> compression_level;
   bool quiet = false;
@@ -32,6 +34,21 @@ struct RecordArgs {
   std::optional<double> wrong_duration;
   node::NodeName node{"/", "rbsim_recorder"};  // as rosbag2's recorder names its node
 };
+
+// SIGUSR1 asks a recorder in snapshot mode for a snapshot.
+std::atomic<int> g_snapshot{0};
+void on_snapshot_signal(int) {
+  g_snapshot.store(1, std::memory_order_relaxed);
+}
+void install_snapshot_handler() {
+  struct sigaction sa {};
+  sa.sa_handler = on_snapshot_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGUSR1, &sa, nullptr);
+}
+bool snapshot_requested() {
+  return g_snapshot.exchange(0, std::memory_order_relaxed) != 0;
+}
 
 int record_command(RecordArgs a) {
   if (a.wrong_duration) {
@@ -55,14 +72,20 @@ int record_command(RecordArgs a) {
   std::vector<OutputPath> outputs{{a.rec.path, "OUT"}};
   if (a.max_file_duration)
     a.rec.max_file_duration_ns = static_cast<std::uint64_t>(*a.max_file_duration * 1e9);
+  if (a.snapshot_duration)
+    a.rec.snapshot_duration_ns = static_cast<std::uint64_t>(*a.snapshot_duration * 1e9);
   if (log::is_bag_output(a.rec.path)) {
     bag = a.rec.path;
     outputs = log::bag_outputs(bag, "OUT");
     a.rec.bag = bag;
-  } else if (a.rec.max_file_bytes > 0 || a.rec.max_file_duration_ns > 0) {
+  } else if (a.rec.max_file_bytes > 0 || a.rec.max_file_duration_ns > 0 || a.rec.snapshot_duration_ns > 0) {
     return fail("record",
-                "--max-file-size and --max-file-duration split a bag directory: OUT " + a.rec.path +
-                    " ends in .mcap (one file); name a directory instead",
+                "--max-file-size, --max-file-duration and --snapshot-duration write a bag directory: OUT " +
+                    a.rec.path + " ends in .mcap (one file); name a directory instead",
+                2);
+  }
+  if (a.rec.snapshot_duration_ns > 0 && (a.rec.max_file_bytes > 0 || a.rec.max_file_duration_ns > 0)) {
+    return fail("record", "--snapshot-duration writes one file per snapshot: it takes no --max-file-* option",
                 2);
   }
 
@@ -83,6 +106,7 @@ int record_command(RecordArgs a) {
                 recorder.error().code == ErrorCode::InvalidArgument ? 2 : 1);
   }
   install_stop_handlers();
+  install_snapshot_handler();
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",
               a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(),
@@ -101,6 +125,18 @@ int record_command(RecordArgs a) {
       break;
     }
     if (a.rec.max_messages > 0 && recorder.value()->received() >= a.rec.max_messages) break;
+    if (a.rec.snapshot_duration_ns > 0 && snapshot_requested()) {
+      Result<std::uint64_t> n = recorder.value()->snapshot();
+      if (!n) {
+        failure = n.error().message;
+        break;
+      }
+      if (!a.quiet) {
+        RBSIM_LOG(Info, "rbsim record: snapshot: %llu messages written to %s\n",
+                  static_cast<unsigned long long>(n.value()),
+                  n.value() > 0 ? recorder.value()->files().back().c_str() : "nothing (none kept yet)");
+      }
+    }
   }
   // Whatever stopped us, finish a valid indexed file.
   if (Status st = recorder.value()->close(); !st)
@@ -126,7 +162,7 @@ int record_command(RecordArgs a) {
   if (failure) return fail("record", *failure + " (the file was finished up to that point)");
   if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
     for (const std::string& f : recorder.value()->files()) std::remove(f.c_str());
-    if (made_bag) std::filesystem::remove(bag, ec);
+    if (made_bag) std::filesystem::remove_all(bag, ec);
     return fail("record", "nothing received on " + participant.value().description() + " under /" + a.rec.ns +
                               "; nothing written (is a node running with the same domain and namespace?)");
   }
@@ -191,6 +227,11 @@ Subcommand add_record_command(CLI::App& parent) {
   app->add_option("--max-file-duration", a->max_file_duration,
                   "Bag only: start a new file once the open one spans this many seconds of log (wall) time "
                   "(rosbag2's --max-bag-duration)")
+      ->check(positive());
+  app->add_option("--snapshot-duration", a->snapshot_duration,
+                  "Snapshot mode (bag only): keep the last SECONDS of log time in memory (at most 1 GiB of "
+                  "payload; the latched topics' latest always) and write them to the bag's next file on each "
+                  "snapshot request (kill -USR1), as rosbag2's --snapshot-mode")
       ->check(positive());
   app->add_flag("-q,--quiet", a->quiet, "Only errors");
   app->add_flag("--overwrite", a->overwrite,

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <utility>
@@ -37,6 +38,11 @@ struct RecorderOptions {
   // under the same ids as the files before it.
   std::uint64_t max_file_bytes = 0;
   std::uint64_t max_file_duration_ns = 0;
+  // Snapshot mode (bag only; 0: off): nothing is written as it arrives; the last this-many ns of
+  // log time are kept in memory (at most snapshot_max_bytes of payload, oldest dropped first; the
+  // latched topics' latest messages always), and each snapshot() writes them to the bag's next file.
+  std::uint64_t snapshot_duration_ns = 0;
+  std::uint64_t snapshot_max_bytes = std::uint64_t{1} << 30;
   std::string ns = "rbsim";
   // Which topics, as rosbag2's recorder chooses: those named in `topics` ("body_states" or
   // "/rbsim/body_states") and those whose full name matches `regex` (ECMAScript, the whole name),
@@ -60,6 +66,11 @@ class Recorder {
   // Waits up to `timeout_ns` for data and records everything available; true if anything came.
   Result<bool> poll(std::int64_t timeout_ns);
   [[nodiscard]] Status close();  // finishes a valid, indexed file (and a bag's metadata)
+  // Snapshot mode: writes what is kept (latched topics first) to the bag's next file, lists it in
+  // metadata.yaml and empties the buffer; returns the messages written (0: nothing was kept, no file).
+  Result<std::uint64_t> snapshot();
+  // A new file now (bag only, not in snapshot mode), as a split does.
+  [[nodiscard]] Status split_now();
   std::uint64_t received() const { return received_; }
   // The files written so far (the last one open until close()); one unless a bag was split.
   const std::vector<std::string>& files() const { return files_; }
@@ -106,6 +117,23 @@ class Recorder {
   std::uint64_t written_ = 0;
   [[nodiscard]] Status open_file();
   [[nodiscard]] Status split(std::uint64_t log_time);
+  [[nodiscard]] Status add_channels();
+  // Snapshot mode's buffer: per-step and event messages in arrival order.
+  struct Kept {
+    std::size_t topic;
+    msgs::Bytes cdr;
+    std::uint64_t log_time, source;
+    std::uint32_t sequence;
+  };
+  std::deque<Kept> kept_;
+  std::uint64_t kept_bytes_ = 0;
+  std::uint64_t snapshot_dropped_ = 0;  // for the end line: dropped to keep within the bounds
+  void keep(Topic& t, const Received& sample, std::uint64_t log_time, std::uint64_t source);
+
+ public:
+  std::uint64_t snapshot_dropped() const { return snapshot_dropped_; }
+
+ private:
   std::int32_t waitset_ = 0;
   std::vector<Topic> topics_;
   std::uint64_t received_ = 0;
