@@ -621,6 +621,12 @@ TEST(LogCli, BagDirectoryIsReadWhereverAFileIs) {
     EXPECT_EQ(o.exit_code, 0) << describe(o);
   }
   EXPECT_EQ(read_text(bag + ".csv"), read_text(file + ".csv"));
+  for (const std::string& in : {file, bag}) {
+    const Outcome o = rbsim({"render", in, "--out", in + ".frames", "--fps", "4", "--size", "64x48"});
+    EXPECT_EQ(o.exit_code, 0) << describe(o);
+  }
+  EXPECT_EQ(read_text(fs::path(bag + ".frames") / "frame00001.png"),
+            read_text(fs::path(file + ".frames") / "frame00001.png"));
   const Outcome info = rbsim({"log", "info", bag});
   EXPECT_EQ(info.exit_code, 0) << describe(info);
   EXPECT_NE(info.out.find("(rosbag2, 1 file)"), std::string::npos) << info.out;

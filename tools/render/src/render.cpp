@@ -15,6 +15,7 @@
 #include "process.hpp"
 
 #include "rbsim/atomic_file.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/mcap.hpp"
 #include "rbsim/mcap_records.hpp"
 #include "rbsim/recording.hpp"
@@ -153,6 +154,8 @@ class FrameSink final : public Sink {
 }  // namespace
 
 bool is_recording(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return log::recording_files(path).ok();  // a rosbag2 bag
   Result<std::unique_ptr<mcap::ByteSource>> source = mcap::open_file_source(path);
   return source.ok() && mcap::check_magic(*source.value(), 0).ok();
 }

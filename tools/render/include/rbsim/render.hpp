@@ -144,7 +144,7 @@ struct PlotOptions {
 };
 [[nodiscard]] Status plot(const std::string& input, const PlotOptions& options);
 
-// Whether `path` is an MCAP recording (starts with the MCAP magic) rather than a scene.
+// Whether `path` is a recording (an MCAP file, by its magic, or a rosbag2 bag directory) rather than a scene.
 bool is_recording(const std::string& path);
 
 // Parses "1280x720".
