@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "graph.hpp"
+#include "parameter_events.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
 #include "rbsim/type_hash.hpp"
@@ -24,15 +25,6 @@ using control::CommandKind;
 using control::CommandResult;
 
 constexpr std::size_t kBudgetPerServer = 8;  // requests one server handles before the next one's turn
-
-// rclcpp's parameter events QoS: reliable, volatile, keep last 1000.
-QosSpec parameter_events_qos() {
-  QosSpec q;
-  q.transient_local = false;
-  q.keep_all = false;
-  q.depth = 1000;
-  return q;
-}
 
 // /<ns>/commands: every command reaches a late joiner (a recorder started after the first
 // command), reliable, transient local, keep all.
@@ -248,11 +240,7 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->add(participant, name, type, std::move(handler)); !st) return st.error();
   }
-  auto events = Publisher::create(
-      participant,
-      RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType),
-               std::string(msgs::ParameterEvent::kType)},
-      parameter_events_qos());
+  auto events = Publisher::create(participant, parameter_events_topic(), parameter_events_qos());
   if (!events) return events.error();
   impl->events.emplace(std::move(events.value()));
   const std::string commands_topic = options.node + "/" + std::string(msgs::CommandMessage::kSuffix);

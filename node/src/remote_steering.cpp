@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "graph.hpp"
+#include "parameter_events.hpp"
 #include "rbsim/assert.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/relay.hpp"
@@ -23,15 +24,6 @@ constexpr std::string_view kParameterServices[] = {"list_parameters", "get_param
 constexpr std::string_view kParameterTypes[] = {
     msgs::ListParametersRequest::kService, msgs::GetParametersRequest::kService,
     msgs::SetParametersRequest::kService, msgs::SetParametersAtomicallyRequest::kService};
-
-// rclcpp's parameter events QoS: reliable, volatile, keep last 1000.
-QosSpec parameter_events_qos() {
-  QosSpec q;
-  q.transient_local = false;
-  q.keep_all = false;
-  q.depth = 1000;
-  return q;
-}
 
 // The client of the control service for `kind` (every kind but SetParameters has one).
 std::size_t control_client(CommandKind kind) {
@@ -218,11 +210,7 @@ Result<std::unique_ptr<RemoteSteering>> RemoteSteering::create(const Participant
   for (const control::ControlService& c : control::control_services()) {
     if (Status st = add(c.name, c.type); !st) return st.error();
   }
-  auto events = Subscription::create(
-      participant,
-      RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType),
-               std::string(msgs::ParameterEvent::kType)},
-      parameter_events_qos());
+  auto events = Subscription::create(participant, parameter_events_topic(), parameter_events_qos());
   if (!events) return events.error();
   s->events_.emplace(std::move(events.value()));
   RemoteSteering* raw = s.get();

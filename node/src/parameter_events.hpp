@@ -1,0 +1,25 @@
+// /parameter_events as rclcpp makes it, for its publisher (the node's services) and its readers
+// (the bridge's RemoteSteering): rcl_interfaces/msg/ParameterEvent, reliable, volatile, keep last 1000.
+#pragma once
+
+#include <string>
+
+#include "rbsim/dds.hpp"
+#include "rbsim/interfaces.hpp"
+
+namespace rbsim::node {
+
+inline RawTopic parameter_events_topic() {
+  return RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType),
+                  std::string(msgs::ParameterEvent::kType)};
+}
+
+inline QosSpec parameter_events_qos() {
+  QosSpec q;
+  q.transient_local = false;
+  q.keep_all = false;
+  q.depth = 1000;
+  return q;
+}
+
+}  // namespace rbsim::node
