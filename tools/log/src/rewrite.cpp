@@ -123,7 +123,8 @@ Result<std::vector<std::pair<const RecordedChannel*, mcap::Message>>> latched_be
   std::map<const RecordedChannel*, mcap::Message> last;
   MessageFilter filter;
   for (const RecordedChannel& c : recording.channels()) {
-    if (c.spec != nullptr && c.spec->latched() && keep(c.channel->topic)) filter.topics.push_back(c.channel->topic);
+    if (c.spec != nullptr && c.spec->latched() && keep(c.channel->topic))
+      filter.topics.push_back(c.channel->topic);
   }
   std::vector<std::pair<const RecordedChannel*, mcap::Message>> out;
   if (filter.topics.empty() || start == 0) return out;
@@ -176,7 +177,8 @@ Result<RewriteReport> filter(const std::string& in, const std::string& out, cons
     if (!keep(c.channel->topic)) return std::uint16_t{0};
     return output.channel(c, c.channel->topic);
   };
-  for (const RecordedChannel& c : recording.channels()) {  // every kept channel listed, with or without messages
+  for (const RecordedChannel& c :
+       recording.channels()) {  // every kept channel listed, with or without messages
     if (auto r = routes.route(c, decide); !r) return r.error();
   }
   auto latched = latched_before(recording, start, keep);
@@ -294,7 +296,8 @@ class Pump {
       item.message.publish_time = m.message->publish_time;
       batch.data.insert(batch.data.end(), m.cdr().begin(), m.cdr().end());
       batch.items.push_back(std::move(item));
-      if (batch.items.size() >= kBatchMessages || batch.data.size() >= kBatchBytes) stopped = !hand_over(batch);
+      if (batch.items.size() >= kBatchMessages || batch.data.size() >= kBatchBytes)
+        stopped = !hand_over(batch);
       return !stopped;
     });
     if (!stopped && !batch.items.empty()) hand_over(batch);
@@ -346,7 +349,8 @@ Status check_scenes(const std::vector<std::unique_ptr<Recording>>& inputs,
       const auto [it, fresh] = seen.try_emplace(topic, i, *scene);
       if (!fresh && it->second.second != *scene) {
         return Error{inputs[it->second.first]->path() + " and " + r.path() + " record different scenes on " +
-                     topic + ": one file may hold one scene per topic (put each input under a namespace of "
+                     topic +
+                     ": one file may hold one scene per topic (put each input under a namespace of "
                      "its own to merge them)"};
       }
     }
@@ -380,9 +384,9 @@ Result<RewriteReport> merge(const std::vector<std::string>& inputs, const std::s
   std::vector<std::unique_ptr<Pump>> pumps;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     for (const RecordedChannel& c : recordings[i]->channels()) {
-      if (auto r = routes[i].route(c, [&](const RecordedChannel& rc) {
-            return output.channel(rc, prefixes[i] + rc.channel->topic);
-          });
+      if (auto r = routes[i].route(
+              c,
+              [&](const RecordedChannel& rc) { return output.channel(rc, prefixes[i] + rc.channel->topic); });
           !r)
         return r.error();
     }
