@@ -92,7 +92,8 @@ TEST(LogFilter, WindowStartingMidRunRendersAndChecksOnItsOwn) {
   EXPECT_EQ(all.exit_code, 1) << describe(all);
   EXPECT_NE(all.out.find("identical"), std::string::npos) << all.out;
   EXPECT_EQ(all.out.find("max error:"), std::string::npos) << all.out;
-  EXPECT_NE(all.out.find("/rbsim/body_states: run lacks steps 0..299, 600..1000"), std::string::npos) << all.out;
+  EXPECT_NE(all.out.find("/rbsim/body_states: run lacks steps 0..299, 600..1000"), std::string::npos)
+      << all.out;
 }
 
 TEST(LogFilter, TopicsKeepsAndExcludeTopicsLeavesOut) {
@@ -175,7 +176,8 @@ TEST(LogMerge, TwoNodesInLogTimeOrderEqualTimesInInputOrder) {
   ASSERT_EQ(cat.exit_code, 0) << describe(cat);
   std::string order;  // which node each body_states message at log time 0.003 s came from
   for (const std::string& line : lines_of(cat.out)) {
-    if (line.find("\"log_time\":3000000,") != std::string::npos) order += line.find("/a/") != std::string::npos ? 'a' : 'b';
+    if (line.find("\"log_time\":3000000,") != std::string::npos)
+      order += line.find("/a/") != std::string::npos ? 'a' : 'b';
   }
   EXPECT_EQ(order, "ab");
   Outcome swapped = rbsim({"log", "merge", b, a, (dir / "ba.mcap").string()});
@@ -211,6 +213,9 @@ TEST(LogMerge, DifferentScenesRefusedUnlessNamespacesMoveThemApart) {
       << refused.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(rbsim({"log", "merge", a, b, out, "--namespaces", "/one"}).exit_code, 2);
+  Outcome bad = rbsim({"log", "merge", a, b, out, "--namespaces", "/one,2two"});
+  EXPECT_EQ(bad.exit_code, 2) << describe(bad);
+  EXPECT_NE(bad.err.find("\"2two\" is not a ROS 2 namespace"), std::string::npos) << bad.err;
 
   Outcome apart = rbsim({"log", "merge", a, b, out, "--namespaces", "/one,/two"});
   ASSERT_EQ(apart.exit_code, 0) << describe(apart);
@@ -218,7 +223,8 @@ TEST(LogMerge, DifferentScenesRefusedUnlessNamespacesMoveThemApart) {
   Outcome info = rbsim({"log", "info", out});
   EXPECT_EQ(info_count(info.out, "/one/rbsim/body_states"), 101) << info.out;
   EXPECT_EQ(info_count(info.out, "/two/rbsim/body_states"), 101) << info.out;
-  Outcome exp = rbsim({"log", "export", out, "-q", "--namespace", "/two/rbsim", "--csv", (dir / "two.csv").string()});
+  Outcome exp =
+      rbsim({"log", "export", out, "-q", "--namespace", "/two/rbsim", "--csv", (dir / "two.csv").string()});
   ASSERT_EQ(exp.exit_code, 0) << describe(exp);
   ASSERT_EQ(rbsim({"log", "export", b, "-q", "--csv", (dir / "b.csv").string()}).exit_code, 0);
   EXPECT_EQ(read_text(dir / "two.csv"), read_text(dir / "b.csv"));

@@ -84,6 +84,10 @@ int merge_command(const LogOptions& o) {
                     " inputs: give one per input, in order (\"/\" for an input that keeps its topics)",
                 2);
   }
+  for (const std::string& ns : o.namespaces) {
+    if (const std::string problem = ns == "/" ? "" : ros_namespace_problem(ns); !problem.empty())
+      return fail("log merge", "--namespaces: \"" + ns + "\" is not a ROS 2 namespace: it " + problem, 2);
+  }
   return rewrite_command("log merge", m, inputs, [&](const log::OutputOptions& output) {
     log::MergeOptions options;
     options.namespaces = o.namespaces;

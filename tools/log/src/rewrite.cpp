@@ -350,8 +350,8 @@ Status check_scenes(const std::vector<std::unique_ptr<Recording>>& inputs,
       if (!fresh && it->second.second != *scene) {
         return Error{inputs[it->second.first]->path() + " and " + r.path() + " record different scenes on " +
                      topic +
-                     ": one file may hold one scene per topic (put each input under a namespace of "
-                     "its own to merge them)"};
+                     ": one file holds one scene per topic (give each input a namespace of its own: "
+                     "--namespaces)"};
       }
     }
   }
