@@ -96,6 +96,41 @@ TEST(LogFilter, WindowStartingMidRunRendersAndChecksOnItsOwn) {
       << all.out;
 }
 
+// Chunks inside the window are copied as stored: the same messages as a filter that writes every
+// chunk anew (another codec), and a copied chunk that is damaged fails the filter, writing nothing.
+TEST(LogFilter, CopiesWholeChunksAndChecksThem) {
+  TempDir dir;
+  const std::string run = record(dir, "run.mcap", "cantilever.xml", {"--steps", "1000"});
+  const std::string in = (dir / "in.mcap").string();  // ~80 chunks
+  ASSERT_EQ(rbsim({"log", "compress", run, in, "--chunk-size", "50000"}).exit_code, 0);
+  const std::string copied = (dir / "copied.mcap").string(), anew = (dir / "anew.mcap").string();
+  Outcome filter = rbsim({"log", "filter", in, copied, "--start", "0.2", "--end", "0.8"});
+  ASSERT_EQ(filter.exit_code, 0) << describe(filter);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(filter.out, m, std::regex("; ([0-9]+) chunks copied whole"))) << filter.out;
+  EXPECT_GT(std::stoi(m[1]), 20) << filter.out;
+  expect_doctor_clean(copied);
+  ASSERT_EQ(
+      rbsim({"log", "filter", in, anew, "--start", "0.2", "--end", "0.8", "--compression", "lz4"}).exit_code,
+      0);
+  EXPECT_EQ(rbsim({"log", "cat", copied}).out, rbsim({"log", "cat", anew}).out);
+  EXPECT_EQ(rbsim({"check", copied, anew, "--strict-metadata"}).exit_code, 0);
+
+  mcap::Bytes bytes = read_bytes(in);  // a byte of the middle chunk's compressed records flipped
+  const auto records = top_level_records(bytes);
+  std::size_t chunks = 0;
+  for (const RawRecord& r : records) chunks += r.opcode == static_cast<std::uint8_t>(mcap::Opcode::Chunk);
+  const RawRecord middle = find_record(records, mcap::Opcode::Chunk, chunks / 2);
+  bytes[middle.offset + middle.length - 100] ^= std::byte{0x55};
+  const std::string damaged = (dir / "damaged.mcap").string(), out = (dir / "out.mcap").string();
+  write_bytes(damaged, bytes);
+  Outcome bad = rbsim({"log", "filter", damaged, out, "--start", "0.2", "--end", "0.8"});
+  EXPECT_EQ(bad.exit_code, 1) << describe(bad);
+  EXPECT_NE(bad.err.find(damaged + ": chunk at offset " + std::to_string(middle.offset)), std::string::npos)
+      << bad.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(LogFilter, TopicsKeepsAndExcludeTopicsLeavesOut) {
   TempDir dir;
   const std::string in = record(dir, "in.mcap", "chain.xml", {"--steps", "200"});

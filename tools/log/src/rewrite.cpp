@@ -5,14 +5,17 @@
 #include <algorithm>
 #include <condition_variable>
 #include <deque>
+#include <future>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 #include <tuple>
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap_sink.hpp"
+#include "rbsim/mcap_tools.hpp"
 #include "rbsim/recording.hpp"
 #include "select.hpp"
 
@@ -68,6 +71,30 @@ class Output {
     return it->second;
   }
 
+  // `c` with its own id and its schema's (a filter of one file keeps them, so whole chunks can be
+  // copied).
+  Result<std::uint16_t> same_channel(const RecordedChannel& c) {
+    mcap::Channel channel = *c.channel;
+    if (c.schema != nullptr) {
+      if (Status st = writer_.add_schema(*c.schema); !st.ok()) return fail(st.error());
+      if (schema_ids_.insert(c.schema->id).second) ++report_.schemas;
+    } else {
+      channel.schema_id = 0;
+    }
+    if (Status st = writer_.add_channel(channel); !st.ok()) return fail(st.error());
+    ++report_.channels;
+    if (topics_.insert(channel.topic).second) report_.topics.push_back(channel.topic);
+    return channel.id;
+  }
+
+  // A whole chunk of the input, as stored.
+  Status copy(const Recording::RawChunk& raw) {
+    if (Status st = writer_.copy_chunk(raw.chunk, raw.indexes); !st.ok()) return fail(st.error());
+    for (const mcap::MessageIndex& mi : raw.indexes) report_.messages += mi.records.size();
+    ++report_.copied_chunks;
+    return Ok{};
+  }
+
   Status write(std::uint16_t channel, const mcap::Message& m, ByteView data) {
     if (Status st = writer_.write_message(channel, m.sequence, m.log_time, m.publish_time, data); !st.ok())
       return fail(st.error());
@@ -91,6 +118,7 @@ class Output {
   std::map<std::tuple<std::string, std::string, Bytes>, std::uint16_t> schemas_;
   std::map<std::tuple<std::string, std::string, std::uint16_t, mcap::KeyValueMap>, std::uint16_t> channels_;
   std::set<std::string> topics_;
+  std::set<std::uint16_t> schema_ids_;
   RewriteReport report_;
 };
 
@@ -140,6 +168,38 @@ Result<std::vector<std::pair<const RecordedChannel*, mcap::Message>>> latched_be
   return out;
 }
 
+// The chunks a filter copies whole: inside the window, every channel kept, compressed as the
+// output is, spanning more than one log time, and no other chunk holding a time strictly inside
+// theirs (a neighbour may share their first or last time: a chunk boundary within one step), so
+// log-time order holds around them; by start time. None when the file's chunks may hold channels
+// its summary lacks.
+std::vector<const mcap::ChunkIndex*> whole_chunks(const Recording& recording, mcap::Timestamp start,
+                                                  mcap::Timestamp end, const std::set<std::uint16_t>& kept,
+                                                  mcap::Compression compression) {
+  std::vector<const mcap::ChunkIndex*> all, out;
+  if (!recording.lists_every_channel()) return out;
+  for (const mcap::ChunkIndex& ci : recording.chunk_indexes()) all.push_back(&ci);
+  std::stable_sort(all.begin(), all.end(), [](const mcap::ChunkIndex* a, const mcap::ChunkIndex* b) {
+    return a->message_start_time < b->message_start_time;
+  });
+  std::optional<mcap::Timestamp> end_before;  // the latest end of the chunks before
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const mcap::ChunkIndex& ci = *all[i];
+    const bool overlaps = (end_before && *end_before > ci.message_start_time) ||
+                          (i + 1 < all.size() && all[i + 1]->message_start_time < ci.message_end_time);
+    end_before = std::max(end_before.value_or(0), ci.message_end_time);
+    if (overlaps || ci.message_start_time >= ci.message_end_time ||
+        ci.compression != mcap::compression_name(compression) || ci.message_start_time < start ||
+        ci.message_end_time >= end || ci.message_index_offsets.empty())
+      continue;
+    bool all_kept = true;
+    for (const auto& [channel_id, offset] : ci.message_index_offsets)
+      all_kept = all_kept && kept.count(channel_id) > 0;
+    if (all_kept) out.push_back(&ci);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string RewriteReport::summary(const std::string& out) const {
@@ -147,11 +207,18 @@ std::string RewriteReport::summary(const std::string& out) const {
   if (latched > 0) s += " (" + count_text(latched) + " latched from before the window)";
   s += " on " + count_text(topics.size()) + (topics.size() == 1 ? " topic, " : " topics, ");
   s += count_text(channels) + (channels == 1 ? " channel, " : " channels, ");
-  s += count_text(schemas) + (schemas == 1 ? " schema\n" : " schemas\n");
+  s += count_text(schemas) + (schemas == 1 ? " schema" : " schemas");
+  if (copied_chunks > 0)
+    s += "; " + count_text(copied_chunks) + (copied_chunks == 1 ? " chunk" : " chunks") + " copied whole";
+  s += '\n';
   return s;
 }
 
-Result<RewriteReport> filter(const std::string& in, const std::string& out, const FilterOptions& options) {
+namespace {
+
+// filter() and compress(): with copy_chunks, whole chunks inside the window are copied as stored.
+Result<RewriteReport> filter_file(const std::string& in, const std::string& out, const FilterOptions& options,
+                                  bool copy_chunks) {
   if (!options.topics.empty() && !options.exclude_topics.empty())
     return Error{in + ": topics to keep and topics to leave out: give one or the other"};
   const mcap::Timestamp start = detail::to_ns(options.start).value_or(0);
@@ -173,9 +240,11 @@ Result<RewriteReport> filter(const std::string& in, const std::string& out, cons
   Output output;
   if (Status st = output.open(out, recording.header().profile, options.output); !st) return st.error();
   Routes routes;
+  std::set<std::uint16_t> kept_ids;
   const auto decide = [&](const RecordedChannel& c) -> Result<std::uint16_t> {
     if (!keep(c.channel->topic)) return std::uint16_t{0};
-    return output.channel(c, c.channel->topic);
+    kept_ids.insert(c.channel->id);
+    return output.same_channel(c);
   };
   for (const RecordedChannel& c :
        recording.channels()) {  // every kept channel listed, with or without messages
@@ -191,30 +260,71 @@ Result<RewriteReport> filter(const std::string& in, const std::string& out, cons
   }
 
   MessageFilter selection;
-  selection.start = start;
-  selection.end = end;
   if (!kept.empty() || !left.empty()) {
     for (const RecordedChannel& c : recording.channels()) {
       if (keep(c.channel->topic)) selection.topics.push_back(c.channel->topic);
     }
     if (selection.topics.empty()) return output.close();  // nothing kept: channels only
   }
-  Status failure = Ok{};
-  const Status read = recording.read_messages(selection, [&](const RecordedMessage& m) {
-    auto id = routes.route(*m.channel, decide);
-    if (!id) failure = id.error();
-    if (id && id.value() != 0) failure = output.write(id.value(), *m.message, m.cdr());
-    return static_cast<bool>(failure);
-  });
-  if (!read) return read.error();
-  if (!failure) return failure.error();
+  const auto copy_messages = [&](mcap::Timestamp from, mcap::Timestamp to) -> Status {
+    selection.start = from;
+    selection.end = to;
+    Status failure = Ok{};
+    const Status read = recording.read_messages(selection, [&](const RecordedMessage& m) {
+      auto id = routes.route(*m.channel, decide);
+      if (!id) failure = id.error();
+      if (id && id.value() != 0) failure = output.write(id.value(), *m.message, m.cdr());
+      return static_cast<bool>(failure);
+    });
+    return read ? failure : read;
+  };
+  // Whole chunks are copied as stored, and the messages between them read and written: those
+  // sharing a copied chunk's first time before it, its last time after it (file order at ties).
+  mcap::Timestamp cursor = start;
+  if (copy_chunks) {
+    const auto whole = whole_chunks(recording, start, end, kept_ids, options.output.compression);
+    for (const mcap::ChunkIndex* ci : whole) selection.skip_chunks.push_back(ci->chunk_start_offset);
+    // Each copied chunk's CRC is checked on a second thread while the next is copied; the output
+    // is committed only once every check passed.
+    std::future<Status> checked;
+    for (const mcap::ChunkIndex* ci : whole) {
+      if (Status st = copy_messages(cursor, ci->message_start_time + 1); !st) return st.error();
+      auto raw = recording.read_chunk(*ci, false);
+      if (!raw) return raw.error();
+      if (Status st = output.copy(raw.value()); !st) return st.error();
+      if (checked.valid()) {
+        if (Status st = checked.get(); !st) return st.error();
+      }
+      checked = std::async(
+          std::launch::async,
+          [&in, offset = ci->chunk_start_offset, chunk = std::move(raw.value().chunk)]() -> Status {
+            Bytes records;
+            if (Status st = mcap::decompress_chunk(chunk, records, true); !st.ok()) {
+              return Error{in + ": chunk at offset " + std::to_string(offset) + ": " +
+                           mcap_tools::read_error(st.error())};
+            }
+            return Ok{};
+          });
+      cursor = ci->message_end_time;
+    }
+    if (checked.valid()) {
+      if (Status st = checked.get(); !st) return st.error();
+    }
+  }
+  if (Status st = copy_messages(cursor, end); !st) return st.error();
   return output.close();
+}
+
+}  // namespace
+
+Result<RewriteReport> filter(const std::string& in, const std::string& out, const FilterOptions& options) {
+  return filter_file(in, out, options, true);
 }
 
 Result<RewriteReport> compress(const std::string& in, const std::string& out, const OutputOptions& output) {
   FilterOptions options;
   options.output = output;
-  return filter(in, out, options);
+  return filter_file(in, out, options, false);  // re-chunked: every chunk written anew
 }
 
 namespace {

@@ -23,8 +23,10 @@ struct RewriteReport {
   std::uint64_t messages = 0;  // messages written (latched ones included)
   std::uint64_t latched = 0;   // of those: latched messages from before a window's start
   std::uint64_t channels = 0, schemas = 0;
+  std::uint64_t copied_chunks = 0;  // chunks copied whole, as stored (filter)
   std::vector<std::string> topics;  // the output's topics, in channel order (a topic once)
-  // "wrote OUT: 1,234 messages on 7 topics (2 latched from before the window), 7 channels, 7 schemas"
+  // "wrote OUT: 1,234 messages (2 latched from before the window) on 7 topics, 7 channels, 7
+  // schemas; 12 chunks copied whole"
   std::string summary(const std::string& out) const;
 };
 
@@ -42,8 +44,11 @@ struct FilterOptions {
 
 // Writes the messages of `in` that `options` selects to `out` (under a temporary name, renamed into
 // place), in log-time order (equal times in file order). Every kept channel is listed, also one
-// with no message in the window; each with its schema, metadata and sequence numbers as recorded,
-// and the input's profile. Errors name the file and the rule: unreadable or corrupt input, an
+// with no message in the window; each with its id, schema, metadata and sequence numbers as
+// recorded, and the input's profile. A chunk inside the window whose channels are all kept, whose
+// compression is the output's and whose time range no other chunk's crosses is copied as stored
+// (its CRC checked on a second thread), not decompressed and compressed again; chunk_size applies
+// to the chunks written anew. Errors name the file and the rule: unreadable or corrupt input, an
 // unknown topic, both `topics` and `exclude_topics`, an end before the start.
 [[nodiscard]] Result<RewriteReport> filter(const std::string& in, const std::string& out,
                                            const FilterOptions& options);
