@@ -74,7 +74,7 @@ TEST(RecordCli, BagOptionsAreCheckedBeforeAnythingIsMade) {
   // Splits need a bag directory, not one .mcap file.
   o = rbsim({"record", (dir / "one.mcap").string(), "--max-file-size", "100000", "--domain", kQuietDomain});
   EXPECT_EQ(o.exit_code, 2) << o;
-  EXPECT_NE(o.err.find("split a bag directory"), std::string::npos) << o;
+  EXPECT_NE(o.err.find("write a bag directory"), std::string::npos) << o;
   // An existing bag is refused unless --overwrite (its metadata.yaml would be replaced).
   fs::create_directory(bag);
   test::write_text(bag / "metadata.yaml", "a bag the user wants to keep");

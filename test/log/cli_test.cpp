@@ -207,7 +207,10 @@ TEST(LogCli, HelpForEveryCommand) {
                                         {"log", "doctor", "--help"},
                                         {"log", "recover", "--help"},
                                         {"log", "export", "--help"},
-                                        {"log", "cat", "--help"}}) {
+                                        {"log", "cat", "--help"},
+                                        {"log", "filter", "--help"},
+                                        {"log", "merge", "--help"},
+                                        {"log", "compress", "--help"}}) {
     Outcome o = rbsim(args, seconds(20));
     EXPECT_EQ(o.exit_code, 0) << describe(o);
     EXPECT_NE(o.out.find("Usage"), std::string::npos) << describe(o);

@@ -1,5 +1,7 @@
-// rbsim log: info, doctor, recover, export and cat on MCAP recordings.
+// rbsim log: info, doctor, recover, export, cat, filter, merge and compress on MCAP recordings.
+#include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -12,6 +14,7 @@
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_tools.hpp"
 #include "rbsim/outputs.hpp"
+#include "rbsim/rewrite.hpp"
 #include "validators.hpp"
 
 namespace rbsim::cli {
@@ -25,9 +28,80 @@ struct LogOptions {
   std::string csv, energy_csv, ns;
   bool quiet = false;
   bool overwrite = false;
-  std::vector<std::string> topics;
+  std::vector<std::string> topics, exclude_topics, files, namespaces;
   std::optional<double> start, end;
+  std::string format = "json";
+  std::uint64_t chunk_size = 1u << 20;
 };
+
+// The output options of filter, merge and compress: codec and chunk size.
+Result<log::OutputOptions> output_options(const LogOptions& o) {
+  const Result<mcap::Compression> codec = compression_option(o.compression);
+  if (!codec) return codec.error();
+  log::OutputOptions out;
+  out.compression = codec.value();
+  out.chunk_size = o.chunk_size;
+  return out;
+}
+
+// Writes one rewrite's OUT (filter, merge, compress): outputs checked first, the report on stdout.
+int rewrite_command(const char* command, const LogOptions& o, const std::vector<std::string>& inputs,
+                    const std::function<Result<log::RewriteReport>(const log::OutputOptions&)>& write) {
+  if (Status st = check_outputs({{o.out, "OUT"}}, inputs, o.overwrite); !st)
+    return fail(command, st.error().message);
+  auto options = output_options(o);
+  if (!options) return fail(command, options.error().message, 2);
+  auto report = write(options.value());
+  if (!report) return fail(command, report.error().message);
+  if (!o.quiet) std::fputs(report.value().summary(o.out).c_str(), stdout);
+  std::fflush(stdout);
+  return 0;
+}
+
+int filter_command(const LogOptions& o) {
+  if (o.start && o.end && *o.end < *o.start)
+    return fail("log filter",
+                "--end " + std::to_string(*o.end) + " is before --start " + std::to_string(*o.start), 2);
+  return rewrite_command("log filter", o, {o.file}, [&](const log::OutputOptions& output) {
+    log::FilterOptions options;
+    options.topics = o.topics;
+    options.exclude_topics = o.exclude_topics;
+    options.start = o.start;
+    options.end = o.end;
+    options.output = output;
+    return log::filter(o.file, o.out, options);
+  });
+}
+
+int merge_command(const LogOptions& o) {
+  // The last positional argument is OUT.
+  LogOptions m = o;
+  m.out = o.files.back();
+  const std::vector<std::string> inputs(o.files.begin(), o.files.end() - 1);
+  if (!o.namespaces.empty() && o.namespaces.size() != inputs.size()) {
+    return fail("log merge",
+                "--namespaces: " + std::to_string(o.namespaces.size()) + " given for " +
+                    std::to_string(inputs.size()) +
+                    " inputs: give one per input, in order (\"/\" for an input that keeps its topics)",
+                2);
+  }
+  for (const std::string& ns : o.namespaces) {
+    if (const std::string problem = ns == "/" ? "" : ros_namespace_problem(ns); !problem.empty())
+      return fail("log merge", "--namespaces: \"" + ns + "\" is not a ROS 2 namespace: it " + problem, 2);
+  }
+  return rewrite_command("log merge", m, inputs, [&](const log::OutputOptions& output) {
+    log::MergeOptions options;
+    options.namespaces = o.namespaces;
+    options.output = output;
+    return log::merge(inputs, m.out, options);
+  });
+}
+
+int compress_command(const LogOptions& o) {
+  return rewrite_command("log compress", o, {o.file}, [&](const log::OutputOptions& output) {
+    return log::compress(o.file, o.out, output);
+  });
+}
 
 // A bag directory: its files, then each file's summary.
 int info_command(const LogOptions& o) {
@@ -119,6 +193,7 @@ int cat_command(const LogOptions& o) {
   }
   options.start = o.start;
   options.end = o.end;
+  options.format = o.format == "csv" ? log::CatFormat::Csv : log::CatFormat::Json;
   Status st = log::cat(o.file, options, [](std::string_view line) {
     std::fwrite(line.data(), 1, line.size(), stdout);
     std::fputc('\n', stdout);
@@ -128,12 +203,90 @@ int cat_command(const LogOptions& o) {
   return 0;
 }
 
+struct RewriteApps {
+  CLI::App *filter = nullptr, *merge = nullptr, *compress = nullptr;
+};
+
+// rbsim log filter | merge | compress.
+RewriteApps add_rewrite_commands(CLI::App* app, const std::shared_ptr<LogOptions>& o) {
+  const auto add_output_options = [o](CLI::App* sub) {
+    sub->add_option("--compression", o->compression, "Chunk compression of OUT")
+        ->check(CLI::IsMember({"zstd", "lz4", "none"}))
+        ->default_str("zstd");
+    sub->add_option("--chunk-size", o->chunk_size, "Uncompressed bytes per chunk of OUT")
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 32))
+        ->default_str("1048576");
+    sub->add_flag("-q,--quiet", o->quiet, "No report on stdout");
+    sub->add_flag("--overwrite", o->overwrite, "Replace OUT if it exists (by default it is refused)");
+  };
+  const char* rewrite_footer =
+      "OUT is written under a temporary name, then renamed into place; it passes 'rbsim log doctor', and "
+      "'rbsim check OUT IN' (with --topics for a selection) matches what it kept. Prints 'wrote OUT: N "
+      "messages on T topics, C channels, S schemas'.\n"
+      "Exit status: 0 OUT written, 1 error (unreadable or corrupt input, an unknown topic, OUT unwritable or "
+      "existing without --overwrite; no OUT written), 2 usage error.";
+
+  CLI::App* filter = app->add_subcommand(
+      "filter", "Copy a time window and/or some topics of a recording to a new one that reads on its own");
+  filter->add_option("in", o->file, "MCAP file")->required();
+  filter->add_option("out", o->out, "Output MCAP file")->required();
+  filter->add_option("--start", o->start, "Keep messages logged at or after this many seconds")
+      ->check(non_negative());
+  filter->add_option("--end", o->end, "Keep messages logged before this many seconds")->check(non_negative());
+  auto* keep =
+      filter
+          ->add_option("--topics", o->topics,
+                       "Keep only these topics, comma-separated; each as recorded (/rbsim/body_states) "
+                       "or by its last name (body_states)")
+          ->delimiter(',');
+  filter->add_option("--exclude-topics", o->exclude_topics, "Leave these topics out, comma-separated")
+      ->delimiter(',')
+      ->excludes(keep);
+  add_output_options(filter);
+  filter->footer(
+      std::string("With --start, the last message before the window of each kept latched topic (the "
+                  "scene description, the markers: found by type) is kept too, with its own log "
+                  "time, so the slice renders and checks on its own. Every kept topic is listed, "
+                  "also one without messages in the window. Messages are written in log-time "
+                  "order with their sequence numbers, schemas and channel metadata as recorded.\n") +
+      rewrite_footer);
+
+  CLI::App* merge =
+      app->add_subcommand("merge", "Merge recordings into one, in log-time order (as 'mcap merge')");
+  merge->add_option("files", o->files, "IN... OUT: two or more MCAP files, then the output")
+      ->required()
+      ->expected(3, -1);
+  merge
+      ->add_option("--namespaces", o->namespaces,
+                   "One ROS namespace per input, comma-separated (\"/\": none), put before its topics: "
+                   "/a,/b makes /a/rbsim/body_states and /b/rbsim/body_states")
+      ->delimiter(',');
+  add_output_options(merge);
+  merge->footer(
+      std::string("Equal log times keep the order of the inputs, then of each file. Identical "
+                  "schemas and channels are written once. Two recordings of different scenes (their "
+                  "scene descriptions differ on one topic) are refused unless --namespaces moves "
+                  "them apart.\n") +
+      rewrite_footer);
+
+  CLI::App* compress = app->add_subcommand(
+      "compress", "Re-chunk and re-compress a recording: the same messages, channels and schemas");
+  compress->add_option("in", o->file, "MCAP file")->required();
+  compress->add_option("out", o->out, "Output MCAP file")->required();
+  add_output_options(compress);
+  compress->footer(std::string("Messages in log-time order, as 'rbsim log filter' without a selection.\n") +
+                   rewrite_footer);
+
+  return {filter, merge, compress};
+}
+
 }  // namespace
 
 Subcommand add_log_command(CLI::App& parent) {
   auto o = std::make_shared<LogOptions>();
-  CLI::App* app = parent.add_subcommand(
-      "log", "Inspect, check, repair, export and print MCAP recordings (rbsim run --record)");
+  CLI::App* app = parent.add_subcommand("log",
+                                        "Inspect, check, repair, export, print, filter, merge and "
+                                        "re-compress MCAP recordings (rbsim run --record)");
   app->require_subcommand(1);
   app->footer("Run 'rbsim log <command> --help' for a command's options.");
 
@@ -193,7 +346,9 @@ Subcommand add_log_command(CLI::App& parent) {
       "--record-every k).\nExit status: 0 success, 1 error, 2 usage error.");
 
   CLI::App* cat = app->add_subcommand(
-      "cat", "Print every message as one line of JSON, decoded by its schema (as 'mcap cat --json')");
+      "cat",
+      "Print every message as one line of JSON, decoded by its schema (as 'mcap cat --json'), or one topic "
+      "as CSV");
   cat->add_option("file", o->file, "MCAP file")->required();
   cat->add_option("--topics", o->topics,
                   "Only these topics, comma-separated; each as recorded (/rbsim/body_states) or by its "
@@ -202,22 +357,34 @@ Subcommand add_log_command(CLI::App& parent) {
   cat->add_option("--start", o->start, "Only messages logged at or after this many seconds")
       ->check(non_negative());
   cat->add_option("--end", o->end, "Only messages logged before this many seconds")->check(non_negative());
+  cat->add_option("--format", o->format, "json: a JSON object per message; csv: one topic as a table")
+      ->check(CLI::IsMember({"json", "csv"}))
+      ->default_str("json");
   cat->footer(
-      "One JSON object per line and message, in log-time order (equal times in file order):\n"
+      "json (the default): one JSON object per line and message, in log-time order (equal times in file "
+      "order):\n"
       "  {\"topic\":\"/rbsim/body_states\",\"sequence\":0,\"log_time\":0,\"publish_time\":0,\"data\":{...}}\n"
       "log_time and publish_time are integer nanoseconds as recorded. data is the message decoded from its "
       "channel's ros2msg schema as nested JSON: an object per message type, an array per array or "
       "sequence, field names as in the .msg definitions; floats shortest round-trip, NaN and infinities as "
       "null (JSON has neither); data is null for a channel without a ros2msg/CDR schema.\n"
+      "csv: one topic (--topics, or the file's only one): a header log_time,publish_time,sequence,<fields> "
+      "whose fields are the first message's flattened schema fields (bodies[0].x, ..., bodies.length), then "
+      "one row per message; a message of another shape (other sequence lengths) is an error.\n"
       "Exit status: 0 success, 1 error (unreadable or corrupt file, a message its schema cannot decode, an "
-      "unknown topic), 2 usage error.");
+      "unknown topic; for csv several topics or another shape), 2 usage error.");
 
-  return {app, [o, info, doctor, recover, exp, cat]() -> int {
+  const RewriteApps rewrite = add_rewrite_commands(app, o);
+
+  return {app, [o, info, doctor, recover, exp, cat, rewrite]() -> int {
             if (info->parsed()) return info_command(*o);
             if (doctor->parsed()) return doctor_command(*o);
             if (recover->parsed()) return recover_command(*o);
             if (exp->parsed()) return export_command(*o);
             if (cat->parsed()) return cat_command(*o);
+            if (rewrite.filter->parsed()) return filter_command(*o);
+            if (rewrite.merge->parsed()) return merge_command(*o);
+            if (rewrite.compress->parsed()) return compress_command(*o);
             return 1;
           }};
 }

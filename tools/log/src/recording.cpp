@@ -445,9 +445,27 @@ std::optional<mcap::Timestamp> Recording::last_log_time() const {
   return last;
 }
 
+const std::vector<mcap::ChunkIndex>& Recording::chunk_indexes() const {
+  // Chunks are served whole from one file only: a bag's files each have offsets of their own.
+  static const std::vector<mcap::ChunkIndex> none;
+  return impl_->readers.size() == 1 ? impl_->readers.front()->chunk_indexes() : none;
+}
+
+Result<Recording::RawChunk> Recording::read_chunk(const mcap::ChunkIndex& index, bool verify) {
+  Impl& im = *impl_;
+  RawChunk raw;
+  auto chunk = im.readers.front()->read_chunk(index, verify);
+  if (!chunk) return im.fail(mcap_tools::read_error(chunk.error()));
+  raw.chunk = std::move(chunk.value());
+  auto indexes = im.readers.front()->read_message_indexes(index);
+  if (!indexes) return im.fail(mcap_tools::read_error(indexes.error()));
+  raw.indexes = std::move(indexes.value());
+  return raw;
+}
+
 Status Recording::read_messages(const MessageFilter& filter, const MessageCallback& on_message) {
   Impl& im = *impl_;
-  const mcap::ReadMessagesOptions ro{filter.topics, filter.start, filter.end};
+  const mcap::ReadMessagesOptions ro{filter.topics, filter.start, filter.end, filter.skip_chunks};
   const Status st = im.each_message(ro, [&](const mcap::MessageEntry& e) {
     const RecordedChannel* channel = im.channel_of(e);
     if (channel == nullptr) return true;  // a message on a channel the file never defines

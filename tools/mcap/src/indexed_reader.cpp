@@ -262,6 +262,9 @@ Status IndexedReader::read_messages(const ReadMessagesOptions& options,
   for (const ChunkIndex& ci : r.chunk_indexes) {
     if (ci.message_end_time < options.start_time) continue;
     if (options.end_time != kMaxTime && ci.message_start_time >= options.end_time) continue;
+    if (std::find(options.skip_chunks.begin(), options.skip_chunks.end(), ci.chunk_start_offset) !=
+        options.skip_chunks.end())
+      continue;
     bool relevant = topics.empty() || ci.message_index_offsets.empty();
     for (const auto& [channel_id, offset] : ci.message_index_offsets) {
       auto it = r.channels.find(channel_id);
@@ -302,6 +305,42 @@ Result<std::vector<Message>> IndexedReader::read_all_messages(const ReadMessages
     return true;
   });
   if (!s.ok()) return s.error();
+  return out;
+}
+
+Result<Chunk> IndexedReader::read_chunk(const ChunkIndex& index, bool verify) {
+  if (Status s = impl_->check_open(); !s.ok()) return s.error();
+  const std::string where = "chunk at offset " + std::to_string(index.chunk_start_offset);
+  RecordView rec;
+  if (Status s = read_record(*impl_->source, index.chunk_start_offset, rec); !s.ok())
+    return with_context(s.error(), where);
+  auto record = parse_record(rec.opcode, rec.content);
+  if (!record.ok() || rec.opcode != static_cast<std::uint8_t>(Opcode::Chunk)) {
+    return Error{"chunk index points at no Chunk (" + where + ")", ErrorCode::Malformed};
+  }
+  Chunk chunk = std::get<Chunk>(std::move(record).value());
+  if (verify) {
+    Bytes data;
+    if (Status s = decompress_chunk(chunk, data, true); !s.ok()) return with_context(s.error(), where);
+  }
+  return chunk;
+}
+
+Result<std::vector<MessageIndex>> IndexedReader::read_message_indexes(const ChunkIndex& index) {
+  if (Status s = impl_->check_open(); !s.ok()) return s.error();
+  std::vector<MessageIndex> out;
+  for (const auto& [channel_id, offset] : index.message_index_offsets) {
+    RecordView rec;
+    if (Status s = read_record(*impl_->source, offset, rec); !s.ok()) return s.error();
+    auto record = parse_record(rec.opcode, rec.content);
+    if (!record.ok() || rec.opcode != static_cast<std::uint8_t>(Opcode::MessageIndex) ||
+        std::get<MessageIndex>(record.value()).channel_id != channel_id) {
+      return Error{"chunk index points at no Message Index of channel " + std::to_string(channel_id) +
+                       " (offset " + std::to_string(offset) + ")",
+                   ErrorCode::Malformed};
+    }
+    out.push_back(std::get<MessageIndex>(std::move(record).value()));
+  }
   return out;
 }
 

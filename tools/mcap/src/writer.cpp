@@ -8,6 +8,7 @@
 // chunk's (crc32_combine). Attachments and metadata, which never go inside a chunk, close it first.
 // Compressed chunks are built in memory, compressed whole and then written.
 #include <algorithm>
+#include <optional>
 
 #include "byte_sink.hpp"
 #include "codec.hpp"
@@ -213,17 +214,21 @@ struct Writer::Impl {
     return s;
   }
 
-  Status write_chunk(ByteView records, ByteView payload, std::uint32_t crc, ChunkMeta& meta) {
+  // `records` are the uncompressed records (their size is the chunk's uncompressed size unless
+  // `uncompressed_size` says otherwise: a copied chunk, whose records stay compressed).
+  Status write_chunk(ByteView records, ByteView payload, std::uint32_t crc, ChunkMeta& meta,
+                     std::optional<std::uint64_t> uncompressed_size = std::nullopt) {
     Status s;
+    const std::uint64_t records_size = uncompressed_size.value_or(records.size());
     // Chunk header written by hand so the (possibly large) records are not copied again.
     scratch.clear();
-    chunk_header(scratch, records.size(), payload.size(), crc, meta);
+    chunk_header(scratch, records_size, payload.size(), crc, meta);
     ChunkIndex index;
     index.message_start_time = meta.has_messages ? meta.start_time : 0;
     index.message_end_time = meta.has_messages ? meta.end_time : 0;
     index.chunk_start_offset = offset;
     index.compressed_size = payload.size();
-    index.uncompressed_size = records.size();
+    index.uncompressed_size = records_size;
     if (!(s = write(scratch)).ok() || !(s = write(payload)).ok()) return s;
     index.chunk_length = offset - index.chunk_start_offset;
     return finish_chunk(index, meta);
@@ -471,6 +476,45 @@ Status Writer::add_metadata(std::string_view name, const KeyValueMap& metadata) 
   }
   ++w.stats.metadata_count;
   return Ok{};
+}
+
+Status Writer::copy_chunk(const Chunk& chunk, const std::vector<MessageIndex>& indexes) {
+  Impl& w = *impl_;
+  if (Status s = w.check_open(); !s.ok()) return s;
+  if (!w.options.use_chunks)
+    return Error{"copy_chunk: the writer writes no chunks", ErrorCode::InvalidArgument};
+  if (chunk.compression != compression_name(w.options.compression)) {
+    return Error{"copy_chunk: a chunk compressed with \"" + chunk.compression + "\" into a file of \"" +
+                     std::string(compression_name(w.options.compression)) + "\" chunks",
+                 ErrorCode::InvalidArgument};
+  }
+  Impl::ChunkMeta meta;
+  std::uint64_t count = 0;
+  for (const MessageIndex& mi : indexes) {
+    if (w.channels.count(mi.channel_id) == 0) {
+      return Error{"copy_chunk: unknown channel id " + std::to_string(mi.channel_id),
+                   ErrorCode::InvalidArgument};
+    }
+    count += mi.records.size();
+    auto& entries = meta.message_index[mi.channel_id];
+    entries.insert(entries.end(), mi.records.begin(), mi.records.end());
+  }
+  // The open chunk (and the one being compressed) go first: file order is kept.
+  if (Status s = w.flush_chunk(); !s.ok()) return s;
+  if (Status s = w.finish_pending(); !s.ok()) return s;
+  meta.start_time = chunk.message_start_time;
+  meta.end_time = chunk.message_end_time;
+  meta.has_messages = count > 0;
+  Statistics& st = w.stats;
+  if (count > 0) {
+    st.message_start_time =
+        st.message_count == 0 ? meta.start_time : std::min(st.message_start_time, meta.start_time);
+    st.message_end_time =
+        st.message_count == 0 ? meta.end_time : std::max(st.message_end_time, meta.end_time);
+    st.message_count += count;
+    for (const MessageIndex& mi : indexes) st.channel_message_counts[mi.channel_id] += mi.records.size();
+  }
+  return w.write_chunk(chunk.records, chunk.records, chunk.uncompressed_crc, meta, chunk.uncompressed_size);
 }
 
 Status Writer::flush_chunk() {

@@ -60,8 +60,9 @@ struct RecordedMessage {
 // Which messages read_messages() passes on: by topic name (empty: every topic) and log time.
 struct MessageFilter {
   std::vector<std::string> topics;
-  mcap::Timestamp start = 0;             // log time >= start
-  mcap::Timestamp end = mcap::kMaxTime;  // log time < end
+  mcap::Timestamp start = 0;                    // log time >= start
+  mcap::Timestamp end = mcap::kMaxTime;         // log time < end
+  std::vector<std::uint64_t> skip_chunks = {};  // chunks (chunk_indexes()' start offsets) not to read
 };
 
 // Called for each message in log-time order; returns false to stop reading (not an error).
@@ -150,6 +151,17 @@ class Recording {
   bool lists_every_channel() const;
   // The log time of the last message, from the summary (statistics, chunk indexes), if it says.
   std::optional<mcap::Timestamp> last_log_time() const;
+
+  // The summary's chunk indexes (none in a file without them or in a bag of several files), and one chunk as
+  // stored, still compressed, with its message indexes; with verify its CRC is checked (a decompression; a
+  // caller may instead check it with mcap::decompress_chunk elsewhere, as log filter does on a
+  // second thread). For a tool that copies whole chunks (through mcap::Writer::copy_chunk).
+  const std::vector<mcap::ChunkIndex>& chunk_indexes() const;
+  struct RawChunk {
+    mcap::Chunk chunk;
+    std::vector<mcap::MessageIndex> indexes;
+  };
+  [[nodiscard]] Result<RawChunk> read_chunk(const mcap::ChunkIndex& index, bool verify = true);
 
   // The raw messages `filter` picks, in log-time order, until `on_message` returns false. Fails
   // on an unreadable or corrupt file (naming it and what is wrong).

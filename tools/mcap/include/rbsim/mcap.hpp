@@ -263,6 +263,11 @@ class Writer {
   Status add_attachment(Timestamp log_time, Timestamp create_time, std::string_view name,
                         std::string_view media_type, ByteView data);
   Status add_metadata(std::string_view name, const KeyValueMap& metadata);
+  // Copies a complete chunk of another file as it is stored (no decompression), after the pending
+  // chunk, with its message indexes (offsets into its records, as read): a tool that keeps whole
+  // chunks of a file. Its compression must be this writer's, and every channel its indexes name
+  // must have been added with the same id (its records are not rewritten).
+  Status copy_chunk(const Chunk& chunk, const std::vector<MessageIndex>& indexes);
   // Writes the pending chunk now (a recorder may call this periodically to bound loss).
   Status flush_chunk();
   // With background_compression: writes a chunk whose compression has finished, without waiting
@@ -331,9 +336,10 @@ struct IndexedOptions {
 };
 
 struct ReadMessagesOptions {
-  std::vector<std::string> topics;  // empty: all topics
-  Timestamp start_time = 0;         // inclusive
-  Timestamp end_time = kMaxTime;    // exclusive (kMaxTime: no upper bound)
+  std::vector<std::string> topics;              // empty: all topics
+  Timestamp start_time = 0;                     // inclusive
+  Timestamp end_time = kMaxTime;                // exclusive (kMaxTime: no upper bound)
+  std::vector<std::uint64_t> skip_chunks = {};  // chunks (by file offset) not to read (indexed files)
 };
 
 struct MessageEntry {
@@ -363,6 +369,11 @@ class IndexedReader {
                        const std::function<bool(const MessageEntry&)>& on_message);
   Result<std::vector<Message>> read_all_messages(const ReadMessagesOptions& options = {});
 
+  // The Chunk record `index` points at, as stored (compressed); with verify it is decompressed
+  // once to check its size and CRC (then dropped). For Writer::copy_chunk.
+  Result<Chunk> read_chunk(const ChunkIndex& index, bool verify = true);
+  // The message indexes of that chunk (spec: Message Index), one per channel it lists.
+  Result<std::vector<MessageIndex>> read_message_indexes(const ChunkIndex& index);
   Result<Attachment> read_attachment(const AttachmentIndex& index);
   Result<Metadata> read_metadata(const MetadataIndex& index);
   // Checks DataEnd.data_section_crc against the bytes before it (reads the whole data section).
