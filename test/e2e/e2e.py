@@ -677,6 +677,110 @@ def case_replay_options(ctx):
     exited_ok(ctx, rep, 10, "replay stopped with SIGINT while replaying")
 
 
+def case_player(ctx):
+    """rosbag2's player services on /rbsim_player/..., called by an independent Python client
+    (test/e2e/player_client.py) while a recorder records what the replay publishes: --start-paused
+    sends only the latched topics; set_rate/get_rate round trip, rates <= 0 refused; play_next
+    publishes exactly one message and burst N exactly N, only while paused; a pause holds; a seek
+    re-sends the scene description and the markers and the next messages are at that simulated
+    time; /clock jumps there. The recording's publish times (the replay's source timestamps) say
+    which call each message followed."""
+    from player_client import Player
+
+    scene = ctx.scene("cantilever.xml")
+    every = 20
+    x = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--duration", 2, "--record", x, "--record-every", every,
+              "--namespace", ctx.ns)
+    want = Log(x)
+    per_step_topics = {m[0] for m in want.messages if m[0].rsplit("/", 1)[-1] not in LATCHED}
+    per_step_count = len([m for m in want.messages if m[0] in per_step_topics])
+    out = ctx.path("player.mcap")
+    rec = ctx.rb("record", *record_args(ctx, out, "--wall-duration", 90))
+    rep = ctx.rb("replay", "replay", x, "--domain", ctx.domain, "--start-paused", "--clock",
+                 "--wait-for-subscribers", 1)
+    player = Player(ctx.domain, "/rbsim_player", "file://" + ctx.loopback_xml)
+    ctx.require(player.wait_matched(20), "the Python client did not match the player's nine services in 20 s")
+    marks = {}
+
+    def mark(name):
+        time.sleep(0.4)  # what the last call published has arrived (loopback) before the next mark
+        marks[name] = time.time_ns()
+
+    def call(name, **fields):
+        r = player.call(name, **fields)
+        ctx.require(r is not None, f"no reply from /rbsim_player/{name} within 15 s\n{rep.output()}")
+        return r
+
+    time.sleep(1.0)  # the recorder matched, the replay started (paused)
+    ctx.check(call("is_paused").paused, "is_paused: false after --start-paused")
+    ctx.check(call("get_rate").rate == 1.0, "get_rate: not 1 (the default --rate)")
+    for bad in (0.0, -2.0):
+        ctx.check(not call("set_rate", rate=bad).success, f"set_rate({bad}) accepted (want refused: rate <= 0)")
+    ctx.check(call("set_rate", rate=3.5).success, "set_rate(3.5) refused")
+    ctx.check(call("get_rate").rate == 3.5, "get_rate after set_rate(3.5)")
+    mark("start_play_next")
+    ctx.check(call("play_next").success, "play_next while paused: success false")
+    mark("end_play_next")
+    r = call("burst", num_messages=5)
+    ctx.check(r.actually_burst == 5, f"burst 5 while paused: actually_burst {r.actually_burst}")
+    mark("end_burst")
+    time.sleep(0.8)  # paused: nothing more may go out
+    mark("end_hold")
+    # Seek to simulated t = 1 s while paused: scene and markers again, /clock at 1 s.
+    ctx.check(call("seek", time=player.Time(sec=1, nanosec=0)).success, "seek to 1 s: success false")
+    ctx.check(not call("seek", time=player.Time(sec=100, nanosec=0)).success, "seek past the end accepted")
+    mark("end_seek")
+    ctx.check(call("play_next").success, "play_next after the seek: success false")
+    mark("end_play_next2")
+    ctx.check(call("is_paused").paused, "is_paused: false before resume")
+    call("toggle_paused")  # resume at 3.5x: the second half of the log in ~0.3 s
+    ctx.check(not call("is_paused").paused, "is_paused: true after toggle_paused")
+    ctx.check(not call("play_next").success, "play_next while playing: success true (rosbag2: paused only)")
+    exited_ok(ctx, rep, 30, "replay after resume")
+    time.sleep(0.5)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 15, "recorder of the player")
+
+    got = Log(out)
+    # (suffix, publish time, payload) in publish order (the replay's source timestamps)
+    msgs = sorted(((m[0].rsplit("/", 1)[-1], m[3], m[5]) for m in got.messages), key=lambda m: m[1])
+
+    def between(a, b):
+        lo = marks.get(a, 0)
+        hi = marks.get(b, 1 << 63)
+        return [m for m in msgs if lo <= m[1] < hi]
+
+    first = between(None, "start_play_next")
+    ctx.check(sorted({m[0] for m in first}) == sorted(LATCHED),
+              f"--start-paused: published {sorted({m[0] for m in first})} before play_next, want only {LATCHED}")
+    one = [m for m in between("start_play_next", "end_play_next") if m[0] != "clock"]
+    ctx.check(len(one) == 1 and one[0][0] not in LATCHED,
+              f"play_next while paused published {[m[0] for m in one]}, want exactly one per-step message")
+    five = [m for m in between("end_play_next", "end_burst") if m[0] != "clock"]
+    ctx.check(len(five) == 5, f"burst 5 published {len(five)} messages ({[m[0] for m in five]})")
+    held = between("end_burst", "end_hold")
+    ctx.check(not held, f"paused: {len(held)} messages published while paused ({[m[0] for m in held]})")
+    seek = between("end_hold", "end_seek")
+    ctx.check(sorted(m[0] for m in seek if m[0] != "clock") == sorted(LATCHED),
+              f"seek: published {[m[0] for m in seek]}, want the scene description and the markers again")
+    clocks = [stamp_of(m[2]) for m in seek if m[0] == "clock"]
+    ctx.check(clocks == [(1, 0)], f"seek to 1 s: /clock published {clocks}, want one jump to (1, 0)")
+    nxt = [m for m in between("end_seek", "end_play_next2") if m[0] != "clock"]
+    ctx.check(len(nxt) == 1 and sim_stamp(nxt[0][0], nxt[0][2]) == (1, 0),
+              f"play_next after seek to 1 s: {[(m[0], sim_stamp(m[0], m[2])) for m in nxt]}, want one at (1, 0)")
+    rest = between("end_play_next2", None)
+    steps = [step_of(m[2]) for m in rest if m[0] == "body_states"]
+    ctx.check(bool(steps) and steps[0] in (1000, 1000 + every) and steps[-1] == 2000
+              and steps == sorted(steps),
+              f"after resume: body-state steps {steps[:3]}..{steps[-3:]}, want from step 1000 on to 2000")
+    # Everything published was one of the recording's messages (the latched ones more than once).
+    recorded = {m[5] for m in want.messages}
+    ctx.check(all(m[2] in recorded for m in msgs if m[0] != "clock"), "a published payload is not in the recording")
+    ctx.log(f"player: {len(msgs)} messages recorded ({per_step_count} per-step in the log); marks at "
+            + ", ".join(f"{k} {(v - marks['start_play_next']) * 1e-9:+.2f} s" for k, v in marks.items()))
+
+
 def case_subscribers_come_and_go(ctx):
     """The node keeps running while recorders and a Python subscriber come and go (clean exits,
     SIGKILL); a SIGKILLed recorder's file is repaired by `rbsim log recover`. After a clean
@@ -1418,6 +1522,7 @@ CASES = {
     "late_recorder": case_late_recorder,
     "replay_roundtrip": case_replay_roundtrip,
     "replay_options": case_replay_options,
+    "player": case_player,
     "subscribers_come_and_go": case_subscribers_come_and_go,
     "python_subscriber": case_python_subscriber,
     "netns": case_netns,
