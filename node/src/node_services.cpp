@@ -172,7 +172,6 @@ struct NodeServices::Impl {
                          },
                          [](const Error&) { return std::optional<SetParametersAtomicallyResponse>(); }));
   }
-
 };
 
 NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

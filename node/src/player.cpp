@@ -25,7 +25,8 @@ std::uint64_t PlayerControl::now_log_locked() const {
 
 std::int64_t PlayerControl::due_wall_locked(std::uint64_t log_time) const {
   if (log_time <= anchor_log_) return anchor_wall_;
-  return anchor_wall_ + static_cast<std::int64_t>(std::llround(static_cast<double>(log_time - anchor_log_) / rate_));
+  return anchor_wall_ +
+         static_cast<std::int64_t>(std::llround(static_cast<double>(log_time - anchor_log_) / rate_));
 }
 
 void PlayerControl::pause() {
@@ -78,7 +79,8 @@ bool PlayerControl::seek(std::uint64_t sim_ns, double timeout_s) {
   seek_request_ = sim_ns;
   const std::uint64_t serial = ++seek_serial_;
   loop_wake_.notify_all();
-  if (!answer_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return seek_answered_ >= serial; })) {
+  if (!answer_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                        [&] { return seek_answered_ >= serial; })) {
     if (seek_request_ && seek_serial_ == serial) seek_request_.reset();  // withdrawn: never taken
     return false;
   }
@@ -236,32 +238,35 @@ Status add_player_services(ServiceSet& set, const Participant& participant, cons
                           [](const Error&) { return std::optional<GetRateResponse>(); }));
       !st)
     return st;
-  if (Status st = add("set_rate", SetRateRequest::kService,
-                      typed_handler<SetRateRequest, SetRateResponse>(
-                          [&control](const RequestHeader&, const SetRateRequest& req) {
-                            return SetRateResponse{control.set_rate(req.rate)};
-                          },
-                          [](const Error&) { return std::optional<SetRateResponse>(SetRateResponse{false}); }));
+  if (Status st =
+          add("set_rate", SetRateRequest::kService,
+              typed_handler<SetRateRequest, SetRateResponse>(
+                  [&control](const RequestHeader&, const SetRateRequest& req) {
+                    return SetRateResponse{control.set_rate(req.rate)};
+                  },
+                  [](const Error&) { return std::optional<SetRateResponse>(SetRateResponse{false}); }));
       !st)
     return st;
   if (Status st = add("seek", SeekRequest::kService,
                       typed_handler<SeekRequest, SeekResponse>(
                           [&control, wait_s](const RequestHeader&, const SeekRequest& req) {
                             const std::uint64_t sim_ns =
-                                req.time.sec < 0 ? 0
-                                                 : static_cast<std::uint64_t>(req.time.sec) * 1'000'000'000ull +
-                                                       req.time.nanosec;
+                                req.time.sec < 0
+                                    ? 0
+                                    : static_cast<std::uint64_t>(req.time.sec) * 1'000'000'000ull +
+                                          req.time.nanosec;
                             return SeekResponse{control.seek(sim_ns, wait_s)};
                           },
                           [](const Error&) { return std::optional<SeekResponse>(SeekResponse{false}); }));
       !st)
     return st;
-  if (Status st = add("play_next", PlayNextRequest::kService,
-                      typed_handler<PlayNextRequest, PlayNextResponse>(
-                          [&control, wait_s](const RequestHeader&, const PlayNextRequest&) {
-                            return PlayNextResponse{control.burst(1, wait_s) == 1};
-                          },
-                          [](const Error&) { return std::optional<PlayNextResponse>(PlayNextResponse{false}); }));
+  if (Status st =
+          add("play_next", PlayNextRequest::kService,
+              typed_handler<PlayNextRequest, PlayNextResponse>(
+                  [&control, wait_s](const RequestHeader&, const PlayNextRequest&) {
+                    return PlayNextResponse{control.burst(1, wait_s) == 1};
+                  },
+                  [](const Error&) { return std::optional<PlayNextResponse>(PlayNextResponse{false}); }));
       !st)
     return st;
   return add("burst", BurstRequest::kService,

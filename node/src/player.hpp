@@ -23,7 +23,7 @@ class PlayerControl {
   void resume();
   bool toggle_paused();  // returns whether it is paused now
   bool paused() const;
-  double rate() const;   // 0: as fast as possible
+  double rate() const;         // 0: as fast as possible
   bool set_rate(double rate);  // only > 0 (as rosbag2's)
   // Asks the loop to seek to simulated time `sim_ns`; waits (up to `timeout_s`) for its answer.
   bool seek(std::uint64_t sim_ns, double timeout_s);
@@ -74,7 +74,7 @@ class ServiceSet;
 // The player's services on `set` (rosbag2_interfaces, as rosbag2's player offers them):
 // <node>/pause, resume, toggle_paused, is_paused, get_rate, set_rate, seek, play_next, burst.
 // Seek, play_next and burst wait up to `wait_s` for the loop.
-[[nodiscard]] Status add_player_services(ServiceSet& set, const Participant& participant, const std::string& node,
-                                         PlayerControl& control, double wait_s);
+[[nodiscard]] Status add_player_services(ServiceSet& set, const Participant& participant,
+                                         const std::string& node, PlayerControl& control, double wait_s);
 
 }  // namespace rbsim::node

@@ -51,7 +51,7 @@ struct Replay::Impl {
   std::optional<std::size_t> clock_publisher;
   std::size_t wait_publisher = 0;
   std::unique_ptr<PlayerControl> control;
-  ServiceSet services;  // after `control`: stopped (destroyed) before what its handlers use
+  ServiceSet services;   // after `control`: stopped (destroyed) before what its handlers use
   bool delayed = false;  // --delay waited (the first pass only)
 
   // The simulated time of a message: its own stamp (the scene description's too), else nullopt.
@@ -59,11 +59,20 @@ struct Replay::Impl {
   // Publishes, per latched channel, the last message before `start`, or else the first one at or
   // after it (then in `sent_early`, not sent twice).
   Status send_latched(std::uint64_t start, std::set<std::uint16_t>& sent_early,
-                      std::map<std::uint16_t, mcap::Message>& latched, const std::function<void(
-                          std::uint16_t, const mcap::Message&)>& sent, bool (*stop)());
+                      std::map<std::uint16_t, mcap::Message>& latched,
+                      const std::function<void(std::uint16_t, const mcap::Message&)>& sent, bool (*stop)());
   // The log time a seek to simulated time `sim_ns` lands at: the first message of a per-step
   // channel stamped at or after it (nullopt: past the end).
   Result<std::optional<std::uint64_t>> seek_position(std::uint64_t sim_ns);
+  // Where a pass starts: --start-offset seconds of log time after the first message.
+  std::uint64_t start_of(std::uint64_t first_log_time) const;
+  // Where a pass ends: --playback-duration (log time from `start`) and --playback-until (simulated
+  // time); past both given, as rosbag2's player plays until the later of the two.
+  struct End {
+    std::optional<std::uint64_t> log, sim;
+    bool past(std::uint64_t log_time, std::optional<std::uint64_t> sim_ns) const;
+  };
+  End end_of(std::uint64_t start) const;
 };
 
 Replay::~Replay() = default;
@@ -183,7 +192,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   im.control->jump(r->first_log_time_);
   if (options.services) {
     if (Status added = add_player_services(im.services, participant, participant.node().fully_qualified(),
-                                        *im.control, options.service_wait_s);
+                                           *im.control, options.service_wait_s);
         !added)
       return added.error();
     im.services.start();
@@ -210,7 +219,8 @@ Status Replay::finish(double timeout_s) {
   return Ok{};
 }
 
-std::optional<std::uint64_t> Replay::Impl::sim_time(std::uint16_t channel, std::span<const std::byte> cdr) const {
+std::optional<std::uint64_t> Replay::Impl::sim_time(std::uint16_t channel,
+                                                    std::span<const std::byte> cdr) const {
   const msgs::TopicId id = topic_of.at(channel);
   std::optional<msgs::Time> stamp;
   if (id == msgs::TopicId::Scene) {
@@ -220,7 +230,8 @@ std::optional<std::uint64_t> Replay::Impl::sim_time(std::uint16_t channel, std::
     stamp = msgs::decode_stamp(id, cdr);
   }
   if (!stamp) return std::nullopt;
-  return static_cast<std::uint64_t>(std::max<std::int32_t>(0, stamp->sec)) * 1'000'000'000ull + stamp->nanosec;
+  return static_cast<std::uint64_t>(std::max<std::int32_t>(0, stamp->sec)) * 1'000'000'000ull +
+         stamp->nanosec;
 }
 
 Status Replay::Impl::send_latched(std::uint64_t start, std::set<std::uint16_t>& sent_early,
@@ -267,13 +278,41 @@ Result<std::optional<std::uint64_t>> Replay::Impl::seek_position(std::uint64_t s
   return found;
 }
 
+namespace {
+std::uint64_t seconds_ns(double s) {
+  return static_cast<std::uint64_t>(std::llround(std::max(0.0, s) * 1e9));
+}
+}  // namespace
+
+std::uint64_t Replay::Impl::start_of(std::uint64_t first_log_time) const {
+  const double offset_ns = std::max(0.0, options.start_offset) * 1e9;
+  return offset_ns >= static_cast<double>(mcap::kMaxTime - first_log_time)
+             ? mcap::kMaxTime
+             : first_log_time + static_cast<std::uint64_t>(std::llround(offset_ns));
+}
+
+Replay::Impl::End Replay::Impl::end_of(std::uint64_t start) const {
+  End e;
+  if (options.playback_duration) e.log = start + seconds_ns(*options.playback_duration);
+  if (options.playback_until) e.sim = seconds_ns(*options.playback_until);
+  return e;
+}
+
+bool Replay::Impl::End::past(std::uint64_t log_time, std::optional<std::uint64_t> sim_ns) const {
+  if (!log && !sim) return false;
+  const bool log_past = !log || log_time > *log;
+  const bool sim_past = !sim || (sim_ns && *sim_ns > *sim);
+  return log_past && sim_past;
+}
+
 Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
   Impl& im = *impl_;
   PlayerControl& control = *im.control;
   if (tap != nullptr && tap->pass) tap->pass();
   if (!im.delayed && im.options.delay > 0.0) {
     im.delayed = true;
-    if (!sleep_until_or_stop(monotonic_ns() + static_cast<std::int64_t>(std::llround(im.options.delay * 1e9)), stop))
+    if (!sleep_until_or_stop(monotonic_ns() + static_cast<std::int64_t>(std::llround(im.options.delay * 1e9)),
+                             stop))
       return false;
   }
   // The simulated time of a message for the tap: its own stamp, else the last one seen (the scene
@@ -291,29 +330,8 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     ++published_;
     return Ok{};
   };
-  const double offset_ns = std::max(0.0, im.options.start_offset) * 1e9;
-  const std::uint64_t start = offset_ns >= static_cast<double>(mcap::kMaxTime - first_log_time_)
-                                  ? mcap::kMaxTime
-                                  : first_log_time_ + static_cast<std::uint64_t>(std::llround(offset_ns));
-  // --playback-duration (log time from the start) and --playback-until (simulated time): the pass
-  // ends past both given (as rosbag2's player, which plays until the later of the two).
-  const std::optional<std::uint64_t> until_log =
-      im.options.playback_duration
-          ? std::optional<std::uint64_t>(start + static_cast<std::uint64_t>(
-                                                     std::llround(std::max(0.0, *im.options.playback_duration) * 1e9)))
-          : std::nullopt;
-  const std::optional<std::uint64_t> until_sim =
-      im.options.playback_until
-          ? std::optional<std::uint64_t>(
-                static_cast<std::uint64_t>(std::llround(std::max(0.0, *im.options.playback_until) * 1e9)))
-          : std::nullopt;
-  auto past_end = [&](std::uint64_t log_time, std::optional<std::uint64_t> sim) {
-    if (!until_log && !until_sim) return false;
-    const bool log_past = !until_log || log_time > *until_log;
-    const bool sim_past = !until_sim || (sim && *sim > *until_sim);
-    return log_past && sim_past;
-  };
-
+  const std::uint64_t start = im.start_of(first_log_time_);
+  const Impl::End end = im.end_of(start);
   std::map<std::uint16_t, mcap::Message> latched;
   std::set<std::uint16_t> sent_early;
   auto latched_sent = [&](std::uint16_t ch, const mcap::Message& m) {
@@ -362,7 +380,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
         return true;
       }
       const std::optional<std::uint64_t> sim = im.sim_time(m.channel_id, m.data);
-      if (past_end(m.log_time, sim.has_value() ? sim : last_sim)) return false;
+      if (end.past(m.log_time, sim.has_value() ? sim : last_sim)) return false;
       if (!started) {
         started = true;
         control.jump(m.log_time);

@@ -65,8 +65,8 @@ class ProgressLine {
     if (s.sim_time) std::snprintf(sim, sizeof sim, "%.3f s", static_cast<double>(*s.sim_time) * 1e-9);
     char rate[32] = "as fast as possible";
     if (s.rate > 0) std::snprintf(rate, sizeof rate, "%gx", s.rate);
-    std::fprintf(stderr, "\r\033[K[%s] log %.3f / %.3f s, simulated %s, rate %s", s.paused ? "paused" : "playing",
-                 at, span, sim, rate);
+    std::fprintf(stderr, "\r\033[K[%s] log %.3f / %.3f s, simulated %s, rate %s",
+                 s.paused ? "paused" : "playing", at, span, sim, rate);
     std::fflush(stderr);
   }
   std::mutex mutex_;
@@ -206,12 +206,14 @@ Subcommand add_replay_command(CLI::App& parent) {
   app->add_flag("--start-paused", a->replay.start_paused,
                 "Start paused: only the latched topics (scene description, markers) go out until "
                 "/rbsim_player/resume (or toggle_paused, play_next, burst)");
-  app->add_option("--playback-duration", a->replay.playback_duration,
-                  "Play this many seconds of log time from the start (after --start-offset), then end the pass")
+  app->add_option(
+         "--playback-duration", a->replay.playback_duration,
+         "Play this many seconds of log time from the start (after --start-offset), then end the pass")
       ->check(non_negative());
-  app->add_option("--playback-until", a->replay.playback_until,
-                  "End each pass past this simulated time (s; the time the messages carry, as seek takes it); "
-                  "with --playback-duration, past both")
+  app->add_option(
+         "--playback-until", a->replay.playback_until,
+         "End each pass past this simulated time (s; the time the messages carry, as seek takes it); "
+         "with --playback-duration, past both")
       ->check(non_negative());
   app->add_option("--delay", a->replay.delay,
                   "Wait this many seconds before publishing (after --wait-for-subscribers)")

@@ -44,7 +44,7 @@ struct ReplayOptions {
 
 // Where the player stands (Replay::status(), from any thread).
 struct PlayerStatus {
-  std::uint64_t log_time = 0;            // the player's clock, log time (ns)
+  std::uint64_t log_time = 0;             // the player's clock, log time (ns)
   std::optional<std::uint64_t> sim_time;  // the simulated time of the last message published (ns)
   double rate = 1.0;                      // 0: as fast as possible
   bool paused = false;

@@ -381,13 +381,11 @@ void get(Reader& r, ApplyImpulseResponse& m) {
 
 // rosbag2_interfaces: empty halves are the placeholder byte, as TriggerRequest.
 template <class T>
-  requires(std::is_empty_v<T>)
-void put(CdrWriter& w, const T&) {
+requires(std::is_empty_v<T>) void put(CdrWriter& w, const T&) {
   w.u8(0);
 }
 template <class T>
-  requires(std::is_empty_v<T>)
-void get(Reader& r, T&) {
+requires(std::is_empty_v<T>) void get(Reader& r, T&) {
   (void)r.get<std::uint8_t>();
 }
 void put(CdrWriter& w, const IsPausedResponse& m) {

@@ -1,9 +1,9 @@
 // ROS 2 service and parameter interfaces as plain structs with CDR codecs: rcl_interfaces' parameter
 // messages and its six parameter services, std_srvs/srv/Trigger, rbsim_msgs' Step and
-// ApplyImpulse services, and rosbag2_interfaces' player services. Field order and types follow the .msg/.srv definitions (ros2/rcl_interfaces,
-// ros2/common_interfaces, tools/msgs/definitions); the bytes are those of msgs.hpp's CDR (XCDR1,
-// little endian, 4-byte encapsulation header), the body of a service sample without the request
-// header rmw_cyclonedds_cpp puts before it (node/include/rbsim/service.hpp adds and strips that).
+// ApplyImpulse services, and rosbag2_interfaces' player services. Field order and types follow the .msg/.srv
+// definitions (ros2/rcl_interfaces, ros2/common_interfaces, tools/msgs/definitions); the bytes are those of
+// msgs.hpp's CDR (XCDR1, little endian, 4-byte encapsulation header), the body of a service sample without
+// the request header rmw_cyclonedds_cpp puts before it (node/include/rbsim/service.hpp adds and strips that).
 //
 // decode() reads untrusted bytes: a truncated message, a length that runs past the data or a wrong
 // encapsulation header is an error naming the type and the byte offset, never a crash; every
@@ -250,10 +250,10 @@ struct ApplyImpulseResponse {
 
 // rosbag2_interfaces (Jazzy): the player's services (rbsim replay's /rbsim_player/...). A half with
 // no fields is rosidl's one placeholder member on the wire, as TriggerRequest.
-#define RBSIM_EMPTY_HALF(Name, service)                                \
-  struct Name {                                                        \
-    static constexpr std::string_view kService = service;             \
-    bool operator==(const Name&) const = default;                      \
+#define RBSIM_EMPTY_HALF(Name, service)                   \
+  struct Name {                                           \
+    static constexpr std::string_view kService = service; \
+    bool operator==(const Name&) const = default;         \
   };
 RBSIM_EMPTY_HALF(PauseRequest, "rosbag2_interfaces/srv/Pause")
 RBSIM_EMPTY_HALF(PauseResponse, "rosbag2_interfaces/srv/Pause")
@@ -288,7 +288,9 @@ struct SetRateResponse {
 struct SeekRequest {
   static constexpr std::string_view kService = "rosbag2_interfaces/srv/Seek";
   Time time;  // builtin_interfaces/Time
-  bool operator==(const SeekRequest& o) const { return time.sec == o.time.sec && time.nanosec == o.time.nanosec; }
+  bool operator==(const SeekRequest& o) const {
+    return time.sec == o.time.sec && time.nanosec == o.time.nanosec;
+  }
 };
 struct SeekResponse {
   static constexpr std::string_view kService = SeekRequest::kService;
