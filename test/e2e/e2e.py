@@ -734,13 +734,52 @@ def case_player(ctx):
     ctx.check(call("play_next").success, "play_next after the seek: success false")
     mark("end_play_next2")
     ctx.check(call("is_paused").paused, "is_paused: false before resume")
-    call("toggle_paused")  # resume at 3.5x: the second half of the log in ~0.3 s
+    ctx.check(call("set_rate", rate=0.5).success, "set_rate(0.5) refused")
+    call("toggle_paused")  # playing at half speed
     ctx.check(not call("is_paused").paused, "is_paused: true after toggle_paused")
     ctx.check(not call("play_next").success, "play_next while playing: success true (rosbag2: paused only)")
+    time.sleep(0.6)
+    call("pause")
+    mark("paused_again")
+    time.sleep(0.8)  # a pause while playing holds too
+    mark("end_hold2")
+    ctx.check(call("is_paused").paused, "is_paused: false after pause")
+    ctx.check(call("set_rate", rate=4.0).success, "set_rate(4) refused")
+    call("resume")  # the rest of the log at 4x
     exited_ok(ctx, rep, 30, "replay after resume")
     time.sleep(0.5)
     rec.signal(signal.SIGINT)
     exited_ok(ctx, rec, 15, "recorder of the player")
+
+    ctx.check("\r" not in rep.stderr() and "[paused]" not in rep.stderr(),
+              f"replay piped: a progress line on stderr\n{rep.stderr()}")
+    # On a terminal: the progress line (clock, rate, paused), cleared at the end.
+    import pty
+    master, slave = pty.openpty()
+    tty = subprocess.Popen([ctx.rbsim, "replay", x, "--domain", str(ctx.domain), "--namespace", ctx.ns + "_tty",
+                            "--start-paused", "--rate", "2"], env=ctx.env(), stdin=subprocess.DEVNULL,
+                           stdout=subprocess.DEVNULL, stderr=slave, preexec_fn=_child_setup())
+    os.close(slave)
+    text = b""
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and b"[paused]" not in text:
+        import select
+        if select.select([master], [], [], 0.2)[0]:
+            try:
+                text += os.read(master, 4096)
+            except OSError:
+                break
+    tty.send_signal(signal.SIGINT)
+    try:
+        tty_rc = tty.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        tty.kill()
+        tty_rc = None
+    os.close(master)
+    line = text.decode(errors="replace")
+    ctx.check("[paused] log 0.000 / 2.000 s" in line and "rate 2x" in line,
+              f"replay on a terminal: no progress line with the clock, rate and paused state in {line!r}")
+    ctx.check(tty_rc == 0, f"replay on a terminal stopped with SIGINT exited with {tty_rc}")
 
     got = Log(out)
     # (suffix, publish time, payload) in publish order (the replay's source timestamps)
@@ -769,11 +808,20 @@ def case_player(ctx):
     nxt = [m for m in between("end_seek", "end_play_next2") if m[0] != "clock"]
     ctx.check(len(nxt) == 1 and sim_stamp(nxt[0][0], nxt[0][2]) == (1, 0),
               f"play_next after seek to 1 s: {[(m[0], sim_stamp(m[0], m[2])) for m in nxt]}, want one at (1, 0)")
+    half = [m for m in between("end_play_next2", "paused_again") if m[0] == "body_states"]
+    if ctx.check(len(half) >= 5, f"{len(half)} body states in 0.6 s at rate 0.5 (want about 15)"):
+        sim = (sim_stamp("body_states", half[-1][2])[0] - sim_stamp("body_states", half[0][2])[0]) * 1e9 + \
+            sim_stamp("body_states", half[-1][2])[1] - sim_stamp("body_states", half[0][2])[1]
+        wall = half[-1][1] - half[0][1]
+        ctx.check(1.5 <= wall / sim <= 3.0, f"rate 0.5: {wall * 1e-9:.3f} s of wall time for {sim * 1e-9:.3f} s "
+                                            f"of log, want about twice as long")
+    held = between("paused_again", "end_hold2")
+    ctx.check(not held, f"pause while playing: {len(held)} messages published while paused")
     rest = between("end_play_next2", None)
     steps = [step_of(m[2]) for m in rest if m[0] == "body_states"]
-    ctx.check(bool(steps) and steps[0] in (1000, 1000 + every) and steps[-1] == 2000
-              and steps == sorted(steps),
-              f"after resume: body-state steps {steps[:3]}..{steps[-3:]}, want from step 1000 on to 2000")
+    ctx.check(bool(steps) and steps[0] in (1000, 1000 + every) and steps == list(range(steps[0], 2001, every)),
+              f"after the seek: body-state steps {steps[:3]}..{steps[-3:]}, want every one from step 1000 on to "
+              f"2000 across pause and resume")
     # Everything published was one of the recording's messages (the latched ones more than once).
     recorded = {m[5] for m in want.messages}
     ctx.check(all(m[2] in recorded for m in msgs if m[0] != "clock"), "a published payload is not in the recording")
