@@ -683,8 +683,9 @@ def case_player(ctx):
     sends only the latched topics; set_rate/get_rate round trip, rates <= 0 refused; play_next
     publishes exactly one message and burst N exactly N, only while paused; a pause holds; a seek
     re-sends the scene description and the markers and the next messages are at that simulated
-    time; /clock jumps there. The recording's publish times (the replay's source timestamps) say
-    which call each message followed."""
+    time; /clock jumps there; a pause while playing holds and set_rate paces; a progress line on a
+    terminal, none when piped; --playback-until, --playback-duration and --delay. The recording's
+    publish times (the replay's source timestamps) say which call each message followed."""
     from player_client import Player
 
     scene = ctx.scene("cantilever.xml")
@@ -825,6 +826,30 @@ def case_player(ctx):
     # Everything published was one of the recording's messages (the latched ones more than once).
     recorded = {m[5] for m in want.messages}
     ctx.check(all(m[2] in recorded for m in msgs if m[0] != "clock"), "a published payload is not in the recording")
+    # --playback-until (simulated time), --playback-duration (log time after --start-offset), --delay.
+    def bounded(tag, *extra):
+        path = ctx.path(f"{tag}.mcap")
+        r = ctx.rb(f"record-{tag}", *record_args(ctx, path, "--wall-duration", 60))
+        t0 = time.time_ns()
+        p = ctx.rb(f"replay-{tag}", "replay", x, "--domain", ctx.domain, "--rate", 0, "--wait-for-subscribers", 1,
+                   "--node-name", f"player_{tag}", *extra)
+        exited_ok(ctx, p, 60)
+        time.sleep(0.5)
+        r.signal(signal.SIGINT)
+        exited_ok(ctx, r, 15)
+        log = Log(path)
+        return [step_of(m[5]) for m in log.messages if m[0].endswith("/body_states")], log, t0
+
+    steps, _, _ = bounded("until", "--playback-until", 0.5)
+    ctx.check(steps == list(range(0, 501, every)), f"--playback-until 0.5: steps {steps[:2]}..{steps[-2:]}")
+    steps, _, _ = bounded("duration", "--start-offset", 1, "--playback-duration", 0.3)
+    ctx.check(steps == list(range(1000, 1301, every)),
+              f"--start-offset 1 --playback-duration 0.3: steps {steps[:2]}..{steps[-2:]}")
+    steps, log, t0 = bounded("delay", "--delay", 1.5)
+    first = min(m[3] for m in log.messages) if log.messages else 0
+    ctx.check(len(steps) == 101 and first - t0 >= 1.5e9,
+              f"--delay 1.5: {len(steps)} body states, the first message {(first - t0) * 1e-9:.2f} s after the start")
+
     ctx.log(f"player: {len(msgs)} messages recorded ({per_step_count} per-step in the log); marks at "
             + ", ".join(f"{k} {(v - marks['start_play_next']) * 1e-9:+.2f} s" for k, v in marks.items()))
 
