@@ -89,12 +89,13 @@ bool PlayerControl::seek(std::uint64_t sim_ns, double timeout_s) {
 
 std::uint64_t PlayerControl::burst(std::uint64_t count, double timeout_s) {
   std::unique_lock lock(mutex_);
-  if (!paused_) return 0;
+  if (!paused_ || closed_) return 0;
   burst_left_ = count == 0 ? std::numeric_limits<std::uint64_t>::max() : count;
   burst_done_ = 0;
   burst_active_ = true;
   loop_wake_.notify_all();
-  if (!answer_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return !burst_active_; })) {
+  if (!answer_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                        [&] { return !burst_active_ || closed_; })) {
     burst_active_ = false;  // what was not published by now is not wanted any more
     burst_left_ = 0;
   }
@@ -183,9 +184,13 @@ void PlayerControl::pass_end() {
   answer_.notify_all();
 }
 
-void PlayerControl::set_sim_time(std::uint64_t sim_ns) {
+void PlayerControl::close() {
   const std::lock_guard lock(mutex_);
-  sim_ns_ = sim_ns;
+  closed_ = true;
+  burst_active_ = false;
+  burst_left_ = 0;
+  seek_request_.reset();
+  answer_.notify_all();
 }
 
 Status add_player_services(ServiceSet& set, const Participant& participant, const std::string& node,

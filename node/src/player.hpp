@@ -49,7 +49,9 @@ class PlayerControl {
   void jump(std::uint64_t log_time);
   // The pass ended (or the replay stopped): a burst waiting gets what was published, a seek false.
   void pass_end();
-  void set_sim_time(std::uint64_t sim_ns);
+  // No loop will play any more (the replay is going): waiting requests are answered at once, new
+  // ones refused.
+  void close();
 
  private:
   std::int64_t due_wall_locked(std::uint64_t log_time) const;
@@ -68,6 +70,7 @@ class PlayerControl {
   // burst: messages still wanted, published so far, and whether it is over
   std::uint64_t burst_left_ = 0, burst_done_ = 0;
   bool burst_active_ = false;
+  bool closed_ = false;
 };
 
 class ServiceSet;

@@ -75,7 +75,10 @@ struct Replay::Impl {
   End end_of(std::uint64_t start) const;
 };
 
-Replay::~Replay() = default;
+Replay::~Replay() {
+  // A service handler waiting for the loop is answered now; then the services stop (Impl).
+  if (impl_ && impl_->control) impl_->control->close();
+}
 
 Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, const ReplayOptions& options) {
   std::unique_ptr<Replay> r(new Replay());
@@ -440,6 +443,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     from = *position.value();
     skip_at_from = 0;
     fresh = true;
+    if (tap != nullptr && tap->pass) tap->pass();  // a second output starts afresh there too
     if (im.clock_publisher) {
       if (Status s = publish_clock(from); !s) return s.error();
       last_clock = from;
