@@ -76,11 +76,13 @@ bool PlayerControl::set_rate(double rate) {
 
 bool PlayerControl::seek(std::uint64_t sim_ns, double timeout_s) {
   std::unique_lock lock(mutex_);
+  if (closed_) return false;
   seek_request_ = sim_ns;
   const std::uint64_t serial = ++seek_serial_;
   loop_wake_.notify_all();
-  if (!answer_.wait_for(lock, std::chrono::duration<double>(timeout_s),
-                        [&] { return seek_answered_ >= serial; })) {
+  answer_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                   [&] { return seek_answered_ >= serial || closed_; });
+  if (seek_answered_ < serial) {
     if (seek_request_ && seek_serial_ == serial) seek_request_.reset();  // withdrawn: never taken
     return false;
   }
