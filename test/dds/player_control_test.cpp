@@ -64,7 +64,8 @@ TEST(PlayerControl, BurstOnlyWhilePausedCountsWhatTheLoopPublishes) {
   c.jump(0);
   std::thread loop([&] {
     for (std::uint64_t t = 1; t <= 3; ++t) {
-      ASSERT_EQ(c.wait_due(t * 1000 * kMs, never), PlayerControl::Next::Publish);  // far in the future: only a burst
+      ASSERT_EQ(c.wait_due(t * 1000 * kMs, never),
+                PlayerControl::Next::Publish);  // far in the future: only a burst
       c.published(t * 1000 * kMs, t);
     }
   });
