@@ -4,17 +4,13 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <future>
-#include <mutex>
-#include <thread>
 #include <vector>
 
-#include "graph.hpp"
 #include "parameter_events.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
-#include "rbsim/type_hash.hpp"
+#include "service_set.hpp"
 
 namespace rbsim::node {
 
@@ -40,21 +36,14 @@ QosSpec commands_qos() {
 struct NodeServices::Impl {
   control::Controller& controller;
   NodeServicesOptions options;
-  std::shared_ptr<Graph> graph;
-  std::vector<ServiceServer> servers;
-  std::vector<ServiceServer::Handler> handlers;
   std::optional<Publisher> events;
   std::optional<Publisher> commands;  // /<ns>/commands
   Bytes command_cdr;                  // the run loop's thread only
   std::uint64_t next_sequence = 0;    // the run loop's thread only
   Bytes event_cdr;
-
-  std::mutex mutex;  // guards `arrived` and `stopping`
-  std::condition_variable wake;
-  bool arrived = false, stopping = false;
   std::atomic<std::uint64_t> event_count{0};
   std::atomic<std::uint64_t> command_count{0};
-  std::thread thread;
+  ServiceSet services;  // last: stopped first, before the members its handlers use go
 
   Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
 
@@ -68,34 +57,6 @@ struct NodeServices::Impl {
       return r;
     }
     return done.get();
-  }
-
-  Status add(const Participant& participant, std::string_view name, std::string_view srv_type,
-             ServiceServer::Handler handler) {
-    ServiceOptions so;
-    if (has_type_hashes(participant.distro())) {
-      Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
-      if (!h) return h.error();
-      so.request_user_data = msgs::typehash_user_data(h->request);
-      so.reply_user_data = msgs::typehash_user_data(h->reply);
-    }
-    so.on_arrival = [this] {
-      {
-        const std::lock_guard lock(mutex);
-        arrived = true;
-      }
-      wake.notify_one();
-    };
-    Result<ServiceServer> s =
-        ServiceServer::create(participant, options.node + "/" + std::string(name), srv_type, so);
-    if (!s) return s.error();
-    if (graph) {
-      if (Status st = graph->add(Graph::Kind::Reader, s->request_reader().guid); !st) return st;
-      if (Status st = graph->add(Graph::Kind::Writer, s->reply_writer().guid); !st) return st;
-    }
-    servers.push_back(std::move(s.value()));
-    handlers.push_back(std::move(handler));
-    return Ok{};
   }
 
   // The control services through the control module's one mapping (control::control_services()).
@@ -203,42 +164,24 @@ struct NodeServices::Impl {
                          },
                          [](const Error&) { return std::optional<SetParametersAtomicallyResponse>(); }));
   }
-
-  void serve_loop() {
-    while (true) {
-      {
-        std::unique_lock lock(mutex);
-        // Bounded wait: replies waiting for their client's reader are retried at each serve().
-        wake.wait_for(lock, std::chrono::milliseconds(20), [this] { return arrived || stopping; });
-        if (stopping) return;
-        arrived = false;
-      }
-      for (std::size_t k = 0; k < servers.size(); ++k) servers[k].serve(handlers[k], kBudgetPerServer);
-    }
-  }
 };
 
 NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 NodeServices::~NodeServices() {
-  {
-    const std::lock_guard lock(impl_->mutex);
-    impl_->stopping = true;
-  }
-  impl_->wake.notify_one();
-  if (impl_->thread.joinable()) impl_->thread.join();
+  impl_->services.stop();
 }
 
 Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& participant,
                                                            control::Controller& controller,
                                                            const NodeServicesOptions& options) {
   auto impl = std::make_unique<Impl>(controller, options);
-  impl->graph = participant.shared_graph();
   std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services;
   impl->add_controls(services);
   impl->add_parameters(services);
   for (auto& [name, type, handler] : services) {
-    if (Status st = impl->add(participant, name, type, std::move(handler)); !st) return st.error();
+    if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
+      return st.error();
   }
   auto events = Publisher::create(participant, parameter_events_topic(), parameter_events_qos());
   if (!events) return events.error();
@@ -251,8 +194,7 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
       commands_qos());
   if (!commands) return commands.error();
   impl->commands.emplace(std::move(commands.value()));
-  Impl* raw = impl.get();
-  impl->thread = std::thread([raw] { raw->serve_loop(); });
+  impl->services.start(kBudgetPerServer);
   return std::unique_ptr<NodeServices>(new NodeServices(std::move(impl)));
 }
 
@@ -278,8 +220,7 @@ std::span<const std::byte> NodeServices::last_command() const {
 
 NodeServiceCounters NodeServices::counters() const {
   NodeServiceCounters c;
-  for (const ServiceServer& s : impl_->servers) {
-    const ServiceStats st = s.stats();
+  for (const ServiceStats& st : impl_->services.stats()) {
     c.received += st.received;
     c.calls += st.answered;
     c.dropped += st.dropped_full + st.dropped_large + st.malformed + st.client_gone + st.client_unmatched +

@@ -162,5 +162,26 @@ TEST(Help, EveryCommandStatesItsExitStatus) {
   }
 }
 
+// rbsim replay's player: every flag and the services in its --help; a bad value is a usage error.
+TEST(Help, ReplayDescribesThePlayer) {
+  const test::Outcome o = rbsim({"replay", "--help"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  for (const char* text : {"--start-paused", "--playback-duration", "--playback-until", "--delay",
+                           "pause, resume", "toggle_paused", "is_paused", "get_rate", "set_rate", "seek",
+                           "play_next", "burst", "rosbag2_interfaces/srv", "progress line"}) {
+    EXPECT_NE(o.out.find(text), std::string::npos) << text << o;
+  }
+  for (const std::vector<std::string>& bad :
+       std::vector<std::vector<std::string>>{{"--playback-duration", "-1"},
+                                             {"--playback-until", "x"},
+                                             {"--delay", "-0.5"},
+                                             {"--playback-duration"}}) {
+    std::vector<std::string> args = {"replay", "in.mcap"};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const test::Outcome r = rbsim(args);
+    EXPECT_EQ(r.exit_code, 2) << testing::PrintToString(bad) << r;
+  }
+}
+
 }  // namespace
 }  // namespace rbsim

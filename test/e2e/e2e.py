@@ -677,6 +677,183 @@ def case_replay_options(ctx):
     exited_ok(ctx, rep, 10, "replay stopped with SIGINT while replaying")
 
 
+def case_player(ctx):
+    """rosbag2's player services on /rbsim_player/..., called by an independent Python client
+    (test/e2e/player_client.py) while a recorder records what the replay publishes: --start-paused
+    sends only the latched topics; set_rate/get_rate round trip, rates <= 0 refused; play_next
+    publishes exactly one message and burst N exactly N, only while paused; a pause holds; a seek
+    re-sends the scene description and the markers and the next messages are at that simulated
+    time; /clock jumps there; a pause while playing holds and set_rate paces; a progress line on a
+    terminal, none when piped; --playback-until, --playback-duration and --delay. The recording's
+    publish times (the replay's source timestamps) say which call each message followed."""
+    from player_client import Player
+
+    scene = ctx.scene("cantilever.xml")
+    every = 20
+    x = ctx.path("run.mcap")
+    ctx.rbrun("run-record", "run", scene, "--duration", 2, "--record", x, "--record-every", every,
+              "--namespace", ctx.ns)
+    want = Log(x)
+    per_step_topics = {m[0] for m in want.messages if m[0].rsplit("/", 1)[-1] not in LATCHED}
+    per_step_count = len([m for m in want.messages if m[0] in per_step_topics])
+    out = ctx.path("player.mcap")
+    rec = ctx.rb("record", *record_args(ctx, out, "--wall-duration", 90))
+    rep = ctx.rb("replay", "replay", x, "--domain", ctx.domain, "--start-paused", "--clock",
+                 "--wait-for-subscribers", 1)
+    player = Player(ctx.domain, "/rbsim_player", "file://" + ctx.loopback_xml)
+    ctx.require(player.wait_matched(20), "the Python client did not match the player's nine services in 20 s")
+    marks = {}
+
+    def mark(name):
+        time.sleep(0.4)  # what the last call published has arrived (loopback) before the next mark
+        marks[name] = time.time_ns()
+
+    def call(name, **fields):
+        r = player.call(name, **fields)
+        ctx.require(r is not None, f"no reply from /rbsim_player/{name} within 15 s\n{rep.output()}")
+        return r
+
+    time.sleep(1.0)  # the recorder matched, the replay started (paused)
+    ctx.check(call("is_paused").paused, "is_paused: false after --start-paused")
+    ctx.check(call("get_rate").rate == 1.0, "get_rate: not 1 (the default --rate)")
+    for bad in (0.0, -2.0):
+        ctx.check(not call("set_rate", rate=bad).success, f"set_rate({bad}) accepted (want refused: rate <= 0)")
+    ctx.check(call("set_rate", rate=3.5).success, "set_rate(3.5) refused")
+    ctx.check(call("get_rate").rate == 3.5, "get_rate after set_rate(3.5)")
+    mark("start_play_next")
+    ctx.check(call("play_next").success, "play_next while paused: success false")
+    mark("end_play_next")
+    r = call("burst", num_messages=5)
+    ctx.check(r.actually_burst == 5, f"burst 5 while paused: actually_burst {r.actually_burst}")
+    mark("end_burst")
+    time.sleep(0.8)  # paused: nothing more may go out
+    mark("end_hold")
+    # Seek to simulated t = 1 s while paused: scene and markers again, /clock at 1 s.
+    ctx.check(call("seek", time=player.Time(sec=1, nanosec=0)).success, "seek to 1 s: success false")
+    ctx.check(not call("seek", time=player.Time(sec=100, nanosec=0)).success, "seek past the end accepted")
+    mark("end_seek")
+    ctx.check(call("play_next").success, "play_next after the seek: success false")
+    mark("end_play_next2")
+    ctx.check(call("is_paused").paused, "is_paused: false before resume")
+    ctx.check(call("set_rate", rate=0.5).success, "set_rate(0.5) refused")
+    call("toggle_paused")  # playing at half speed
+    ctx.check(not call("is_paused").paused, "is_paused: true after toggle_paused")
+    ctx.check(not call("play_next").success, "play_next while playing: success true (rosbag2: paused only)")
+    time.sleep(0.6)
+    call("pause")
+    mark("paused_again")
+    time.sleep(0.8)  # a pause while playing holds too
+    mark("end_hold2")
+    ctx.check(call("is_paused").paused, "is_paused: false after pause")
+    ctx.check(call("set_rate", rate=4.0).success, "set_rate(4) refused")
+    call("resume")  # the rest of the log at 4x
+    exited_ok(ctx, rep, 30, "replay after resume")
+    time.sleep(0.5)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 15, "recorder of the player")
+
+    ctx.check("\r" not in rep.stderr() and "[paused]" not in rep.stderr(),
+              f"replay piped: a progress line on stderr\n{rep.stderr()}")
+    # On a terminal: the progress line (clock, rate, paused), cleared at the end.
+    import pty
+    master, slave = pty.openpty()
+    tty = subprocess.Popen([ctx.rbsim, "replay", x, "--domain", str(ctx.domain), "--namespace", ctx.ns + "_tty",
+                            "--start-paused", "--rate", "2"], env=ctx.env(), stdin=subprocess.DEVNULL,
+                           stdout=subprocess.DEVNULL, stderr=slave, preexec_fn=_child_setup())
+    os.close(slave)
+    text = b""
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and b"[paused]" not in text:
+        import select
+        if select.select([master], [], [], 0.2)[0]:
+            try:
+                text += os.read(master, 4096)
+            except OSError:
+                break
+    tty.send_signal(signal.SIGINT)
+    try:
+        tty_rc = tty.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        tty.kill()
+        tty_rc = None
+    os.close(master)
+    line = text.decode(errors="replace")
+    ctx.check("[paused] log 0.000 / 2.000 s" in line and "rate 2x" in line,
+              f"replay on a terminal: no progress line with the clock, rate and paused state in {line!r}")
+    ctx.check(tty_rc == 0, f"replay on a terminal stopped with SIGINT exited with {tty_rc}")
+
+    got = Log(out)
+    # (suffix, publish time, payload) in publish order (the replay's source timestamps)
+    msgs = sorted(((m[0].rsplit("/", 1)[-1], m[3], m[5]) for m in got.messages), key=lambda m: m[1])
+
+    def between(a, b):
+        lo = marks.get(a, 0)
+        hi = marks.get(b, 1 << 63)
+        return [m for m in msgs if lo <= m[1] < hi]
+
+    first = between(None, "start_play_next")
+    ctx.check(sorted({m[0] for m in first}) == sorted(LATCHED),
+              f"--start-paused: published {sorted({m[0] for m in first})} before play_next, want only {LATCHED}")
+    one = [m for m in between("start_play_next", "end_play_next") if m[0] != "clock"]
+    ctx.check(len(one) == 1 and one[0][0] not in LATCHED,
+              f"play_next while paused published {[m[0] for m in one]}, want exactly one per-step message")
+    five = [m for m in between("end_play_next", "end_burst") if m[0] != "clock"]
+    ctx.check(len(five) == 5, f"burst 5 published {len(five)} messages ({[m[0] for m in five]})")
+    held = between("end_burst", "end_hold")
+    ctx.check(not held, f"paused: {len(held)} messages published while paused ({[m[0] for m in held]})")
+    seek = between("end_hold", "end_seek")
+    ctx.check(sorted(m[0] for m in seek if m[0] != "clock") == sorted(LATCHED),
+              f"seek: published {[m[0] for m in seek]}, want the scene description and the markers again")
+    clocks = [stamp_of(m[2]) for m in seek if m[0] == "clock"]
+    ctx.check(clocks == [(1, 0)], f"seek to 1 s: /clock published {clocks}, want one jump to (1, 0)")
+    nxt = [m for m in between("end_seek", "end_play_next2") if m[0] != "clock"]
+    ctx.check(len(nxt) == 1 and sim_stamp(nxt[0][0], nxt[0][2]) == (1, 0),
+              f"play_next after seek to 1 s: {[(m[0], sim_stamp(m[0], m[2])) for m in nxt]}, want one at (1, 0)")
+    half = [m for m in between("end_play_next2", "paused_again") if m[0] == "body_states"]
+    if ctx.check(len(half) >= 5, f"{len(half)} body states in 0.6 s at rate 0.5 (want about 15)"):
+        sim = (sim_stamp("body_states", half[-1][2])[0] - sim_stamp("body_states", half[0][2])[0]) * 1e9 + \
+            sim_stamp("body_states", half[-1][2])[1] - sim_stamp("body_states", half[0][2])[1]
+        wall = half[-1][1] - half[0][1]
+        ctx.check(1.5 <= wall / sim <= 3.0, f"rate 0.5: {wall * 1e-9:.3f} s of wall time for {sim * 1e-9:.3f} s "
+                                            f"of log, want about twice as long")
+    held = between("paused_again", "end_hold2")
+    ctx.check(not held, f"pause while playing: {len(held)} messages published while paused")
+    rest = between("end_play_next2", None)
+    steps = [step_of(m[2]) for m in rest if m[0] == "body_states"]
+    ctx.check(bool(steps) and steps[0] in (1000, 1000 + every) and steps == list(range(steps[0], 2001, every)),
+              f"after the seek: body-state steps {steps[:3]}..{steps[-3:]}, want every one from step 1000 on to "
+              f"2000 across pause and resume")
+    # Everything published was one of the recording's messages (the latched ones more than once).
+    recorded = {m[5] for m in want.messages}
+    ctx.check(all(m[2] in recorded for m in msgs if m[0] != "clock"), "a published payload is not in the recording")
+    # --playback-until (simulated time), --playback-duration (log time after --start-offset), --delay.
+    def bounded(tag, *extra):
+        path = ctx.path(f"{tag}.mcap")
+        r = ctx.rb(f"record-{tag}", *record_args(ctx, path, "--wall-duration", 60))
+        t0 = time.time_ns()
+        p = ctx.rb(f"replay-{tag}", "replay", x, "--domain", ctx.domain, "--rate", 0, "--wait-for-subscribers", 1,
+                   "--node-name", f"player_{tag}", *extra)
+        exited_ok(ctx, p, 60)
+        time.sleep(0.5)
+        r.signal(signal.SIGINT)
+        exited_ok(ctx, r, 15)
+        log = Log(path)
+        return [step_of(m[5]) for m in log.messages if m[0].endswith("/body_states")], log, t0
+
+    steps, _, _ = bounded("until", "--playback-until", 0.5)
+    ctx.check(steps == list(range(0, 501, every)), f"--playback-until 0.5: steps {steps[:2]}..{steps[-2:]}")
+    steps, _, _ = bounded("duration", "--start-offset", 1, "--playback-duration", 0.3)
+    ctx.check(steps == list(range(1000, 1301, every)),
+              f"--start-offset 1 --playback-duration 0.3: steps {steps[:2]}..{steps[-2:]}")
+    steps, log, t0 = bounded("delay", "--delay", 1.5)
+    first = min(m[3] for m in log.messages) if log.messages else 0
+    ctx.check(len(steps) == 101 and first - t0 >= 1.5e9,
+              f"--delay 1.5: {len(steps)} body states, the first message {(first - t0) * 1e-9:.2f} s after the start")
+
+    ctx.log(f"player: {len(msgs)} messages recorded ({per_step_count} per-step in the log); marks at "
+            + ", ".join(f"{k} {(v - marks['start_play_next']) * 1e-9:+.2f} s" for k, v in marks.items()))
+
+
 def case_subscribers_come_and_go(ctx):
     """The node keeps running while recorders and a Python subscriber come and go (clean exits,
     SIGKILL); a SIGKILLed recorder's file is repaired by `rbsim log recover`. After a clean
@@ -1565,6 +1742,7 @@ CASES = {
     "late_recorder": case_late_recorder,
     "replay_roundtrip": case_replay_roundtrip,
     "replay_options": case_replay_options,
+    "player": case_player,
     "subscribers_come_and_go": case_subscribers_come_and_go,
     "python_subscriber": case_python_subscriber,
     "netns": case_netns,

@@ -11,15 +11,17 @@
 namespace rbsim::fuzz {
 
 namespace m = rbsim::msgs;
-using InterfaceTypes =
-    std::tuple<m::ParameterValue, m::Parameter, m::ParameterDescriptor, m::SetParametersResult,
-               m::ListParametersResult, m::ParameterEvent, m::ListParametersRequest,
-               m::ListParametersResponse, m::GetParametersRequest, m::GetParametersResponse,
-               m::SetParametersRequest, m::SetParametersResponse, m::SetParametersAtomicallyRequest,
-               m::SetParametersAtomicallyResponse, m::DescribeParametersRequest,
-               m::DescribeParametersResponse, m::GetParameterTypesRequest, m::GetParameterTypesResponse,
-               m::TriggerRequest, m::TriggerResponse, m::StepRequest, m::StepResponse, m::ApplyImpulseRequest,
-               m::ApplyImpulseResponse>;
+using InterfaceTypes = std::tuple<
+    m::ParameterValue, m::Parameter, m::ParameterDescriptor, m::SetParametersResult, m::ListParametersResult,
+    m::ParameterEvent, m::ListParametersRequest, m::ListParametersResponse, m::GetParametersRequest,
+    m::GetParametersResponse, m::SetParametersRequest, m::SetParametersResponse,
+    m::SetParametersAtomicallyRequest, m::SetParametersAtomicallyResponse, m::DescribeParametersRequest,
+    m::DescribeParametersResponse, m::GetParameterTypesRequest, m::GetParameterTypesResponse,
+    m::TriggerRequest, m::TriggerResponse, m::StepRequest, m::StepResponse, m::ApplyImpulseRequest,
+    m::ApplyImpulseResponse, m::PauseRequest, m::PauseResponse, m::ResumeRequest, m::ResumeResponse,
+    m::TogglePausedRequest, m::TogglePausedResponse, m::IsPausedRequest, m::IsPausedResponse,
+    m::GetRateRequest, m::GetRateResponse, m::SetRateRequest, m::SetRateResponse, m::SeekRequest,
+    m::SeekResponse, m::PlayNextRequest, m::PlayNextResponse, m::BurstRequest, m::BurstResponse>;
 inline constexpr std::size_t kInterfaceCount = std::tuple_size_v<InterfaceTypes>;
 
 // Calls f.template operator()<T>() with T the type of index i (< kInterfaceCount).

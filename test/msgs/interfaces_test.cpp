@@ -132,6 +132,42 @@ TEST(InterfacesCodec, EveryTypeRoundTrips) {
   expect_round_trip(StepResponse{true, "stepped", 1ull << 40});
   expect_round_trip(ApplyImpulseRequest{7, 1.0, -2.0, 0.25, -0.125});
   expect_round_trip(ApplyImpulseResponse{false, "unknown body 7", 3});
+  expect_round_trip(PauseRequest{});
+  expect_round_trip(PauseResponse{});
+  expect_round_trip(ResumeRequest{});
+  expect_round_trip(ResumeResponse{});
+  expect_round_trip(TogglePausedRequest{});
+  expect_round_trip(TogglePausedResponse{});
+  expect_round_trip(IsPausedRequest{});
+  expect_round_trip(IsPausedResponse{true});
+  expect_round_trip(GetRateRequest{});
+  expect_round_trip(GetRateResponse{0.25});
+  expect_round_trip(SetRateRequest{-3.5});
+  expect_round_trip(SetRateResponse{true});
+  expect_round_trip(SeekRequest{{-2, 999999999u}});
+  expect_round_trip(SeekResponse{true});
+  expect_round_trip(PlayNextRequest{});
+  expect_round_trip(PlayNextResponse{true});
+  expect_round_trip(BurstRequest{1ull << 40});
+  expect_round_trip(BurstResponse{7});
+}
+
+// rosbag2_interfaces (Jazzy): empty halves are the placeholder byte; Seek's builtin_interfaces/Time
+// is int32 sec, uint32 nanosec; Burst's uint64 and SetRate's float64 start at offset 0.
+TEST(InterfacesCodec, PlayerServicesLayout) {
+  Bytes cdr;
+  encode(PauseRequest{}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 3, 0, 0, 0, 0}));
+  encode(ResumeResponse{}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 3, 0, 0, 0, 0}));
+  encode(SeekRequest{{1, 2}}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0}));
+  encode(BurstRequest{5}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 0, 5, 0, 0, 0, 0, 0, 0, 0}));
+  encode(SetRateRequest{1.0}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0xf0, 0x3f}));
+  encode(IsPausedResponse{true}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 3, 1, 0, 0, 0}));
 }
 
 // CDR offsets count from the end of the 4-byte encapsulation header; the message is padded to a
@@ -251,6 +287,11 @@ TEST(InterfacesCodec, EveryTruncationOfAValidMessageFails) {
   expect_every_truncation_fails(ApplyImpulseRequest{1, 2, 3, 4, 5}, "rbsim_msgs/srv/ApplyImpulse request");
   expect_every_truncation_fails(TriggerRequest{}, "std_srvs/srv/Trigger request");
   expect_every_truncation_fails(TriggerResponse{true, "x"}, "std_srvs/srv/Trigger response");
+  expect_every_truncation_fails(PauseRequest{}, "rosbag2_interfaces/srv/Pause request");
+  expect_every_truncation_fails(SeekRequest{{3, 4}}, "rosbag2_interfaces/srv/Seek request");
+  expect_every_truncation_fails(SetRateRequest{2.0}, "rosbag2_interfaces/srv/SetRate request");
+  expect_every_truncation_fails(BurstRequest{9}, "rosbag2_interfaces/srv/Burst request");
+  expect_every_truncation_fails(GetRateResponse{2.0}, "rosbag2_interfaces/srv/GetRate response");
   ParameterEvent e;
   e.node = "/rbsim";
   e.changed_parameters = {parameter("rate", full_value())};

@@ -1,6 +1,13 @@
 // rbsim replay: republish a recording over DDS with its recorded timing.
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "cli_util.hpp"
 #include "commands.hpp"
@@ -21,6 +28,51 @@ struct ReplayArgs {
   std::int32_t wait_for = 0;
   bool quiet = false;
   std::optional<std::string> foxglove;  // [ADDR:]PORT
+};
+
+// The progress line on a terminal (stderr): the player's clock, the simulated time, the rate and
+// whether it is paused, redrawn every 200 ms on a thread of its own; nothing when stderr is not a
+// terminal or with --quiet. Cleared when it stops.
+class ProgressLine {
+ public:
+  ProgressLine(const node::Replay& replay, bool on) {
+    if (!on || ::isatty(STDERR_FILENO) == 0) return;
+    thread_ = std::thread([this, &replay] {
+      std::unique_lock lock(mutex_);
+      while (!done_) {
+        draw(replay);
+        wake_.wait_for(lock, std::chrono::milliseconds(200));
+      }
+      std::fprintf(stderr, "\r\033[K");
+      std::fflush(stderr);
+    });
+  }
+  ~ProgressLine() {
+    {
+      const std::lock_guard lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  static void draw(const node::Replay& replay) {
+    const node::PlayerStatus s = replay.status();
+    const double at = static_cast<double>(s.log_time - std::min(s.log_time, replay.first_log_time())) * 1e-9;
+    const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
+    char sim[48] = "-";
+    if (s.sim_time) std::snprintf(sim, sizeof sim, "%.3f s", static_cast<double>(*s.sim_time) * 1e-9);
+    char rate[32] = "as fast as possible";
+    if (s.rate > 0) std::snprintf(rate, sizeof rate, "%gx", s.rate);
+    std::fprintf(stderr, "\r\033[K[%s] log %.3f / %.3f s, simulated %s, rate %s",
+                 s.paused ? "paused" : "playing", at, span, sim, rate);
+    std::fflush(stderr);
+  }
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool done_ = false;
+  std::thread thread_;
 };
 
 int replay_command(ReplayArgs a) {
@@ -93,12 +145,15 @@ int replay_command(ReplayArgs a) {
   }
   std::uint64_t passes = 0;
   bool complete = true;
+  std::optional<ProgressLine> progress;
+  progress.emplace(replay, !a.quiet);
   do {
     auto played = replay.play(stop_requested, server ? &tap : nullptr);
     if (!played) return fail("replay", played.error().message);
     complete = played.value();
     if (complete) ++passes;
   } while (a.loop && complete && !stop_requested());
+  progress.reset();
   if (complete) {
     if (Status st = replay.finish(); !st) return fail("replay", st.error().message);
   }
@@ -148,6 +203,21 @@ Subcommand add_replay_command(CLI::App& parent) {
          "Per-step writers keep the last N samples instead of all (the replay never waits for a slow "
          "subscriber, which may then lose samples)")
       ->check(positive());
+  app->add_flag("--start-paused", a->replay.start_paused,
+                "Start paused: only the latched topics (scene description, markers) go out until "
+                "/rbsim_player/resume (or toggle_paused, play_next, burst)");
+  app->add_option(
+         "--playback-duration", a->replay.playback_duration,
+         "Play this many seconds of log time from the start (after --start-offset), then end the pass")
+      ->check(non_negative());
+  app->add_option(
+         "--playback-until", a->replay.playback_until,
+         "End each pass past this simulated time (s; the time the messages carry, as seek takes it); "
+         "with --playback-duration, past both")
+      ->check(non_negative());
+  app->add_option("--delay", a->replay.delay,
+                  "Wait this many seconds before publishing (after --wait-for-subscribers)")
+      ->check(non_negative());
   add_foxglove_option(app, a->foxglove);
   app->add_flag("-q,--quiet", a->quiet, "Only errors (and --foxglove's listening line)");
   app->footer(
@@ -158,6 +228,11 @@ Subcommand add_replay_command(CLI::App& parent) {
       "Ctrl-C stops cleanly. --foxglove also serves them to Foxglove with the recording's schemas (log time "
       "= "
       "the messages' simulated time; a new session on every --loop pass).\n"
+      "Player services (rosbag2_interfaces/srv, as ros2 bag play offers them) under the node name "
+      "(--node-name, default /rbsim_player): pause, resume, toggle_paused, is_paused, get_rate, set_rate "
+      "(> 0 only), seek (simulated time; the latched topics are sent again and /clock jumps), play_next and "
+      "burst (while paused). On a terminal a progress line shows the clock, rate and whether it is "
+      "paused.\n"
       "Exit status: 0 done or stopped by Ctrl-C/SIGTERM, 1 error (unreadable recording, no rbsim topics, DDS "
       "failure), 2 usage error.");
   return {app, [a] { return replay_command(*a); }};

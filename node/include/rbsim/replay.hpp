@@ -17,7 +17,8 @@ namespace rbsim::node {
 // The replay: an MCAP recording (rbsim run --record or rbsim record) republished over DDS with
 // its recorded timing. Every channel whose schema names one of our types (msgs::topics()) and
 // whose messages are CDR gets a publisher with that topic's QoS; messages go out in log-time
-// order, paced by their log-time differences divided by `rate`.
+// order, paced by their log-time differences divided by `rate`, steered by rosbag2's player
+// services (ReplayOptions::services).
 
 struct ReplayOptions {
   std::string path;
@@ -30,6 +31,23 @@ struct ReplayOptions {
                        // (recorded /clock messages are then not replayed)
   std::optional<std::string> ns;  // republish under /<ns>/<name> instead of the recorded names
   std::int32_t keep_last = 0;     // per-step writers keep last N instead of keep all (0)
+  // The player (rosbag2's controls): services on <node>/pause, resume, toggle_paused, is_paused,
+  // get_rate, set_rate, seek, play_next, burst (rosbag2_interfaces/srv/...), for the participant's
+  // node name (rbsim replay: /rbsim_player).
+  bool services = true;
+  bool start_paused = false;                // only the latched topics go out until resumed
+  std::optional<double> playback_duration;  // s of log time from the start (offset) to play, then end
+  std::optional<double> playback_until;     // simulated time (s) past which a pass ends
+  double delay = 0.0;                       // s to wait before the first message of the first pass
+  double service_wait_s = 10.0;             // how long seek, play_next and burst wait for the loop
+};
+
+// Where the player stands (Replay::status(), from any thread).
+struct PlayerStatus {
+  std::uint64_t log_time = 0;             // the player's clock, log time (ns)
+  std::optional<std::uint64_t> sim_time;  // the simulated time of the last message published (ns)
+  double rate = 1.0;                      // 0: as fast as possible
+  bool paused = false;
 };
 
 class Replay {
@@ -58,14 +76,19 @@ class Replay {
   // A second consumer of what is published (rbsim replay --foxglove): `message` gets every message
   // as it is published, with the index of its output (outputs()) and its simulated time (the
   // message's own stamp; the log time for messages without one), `pass` is called at the start of
-  // every play(). Called on the thread that plays; must not block.
+  // every play() and after every seek (a new session: the timeline jumped). Called on the thread that plays;
+  // must not block.
   struct Tap {
     std::function<void()> pass;
     std::function<void(std::size_t output, std::uint64_t sim_time_ns, std::span<const std::byte> cdr)>
         message;
   };
-  // Plays the log once from the start offset; Ok(false) when `stop` turned true on the way.
+  // Plays the log once from the start offset (latched topics first, then the rest paced by the
+  // player's clock; the player's requests carried out on the way: a seek re-sends the latched
+  // topics as of the place it lands and makes /clock jump there); Ok(false) when `stop` turned true
+  // on the way.
   Result<bool> play(bool (*stop)(), const Tap* tap = nullptr);
+  PlayerStatus status() const;
   // Waits (bounded) until the subscribers acknowledged everything published, so nothing in
   // flight is lost when the replay exits.
   [[nodiscard]] Status finish(double timeout_s = 30.0);

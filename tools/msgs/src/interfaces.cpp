@@ -2,6 +2,8 @@
 // (CdrWriter) and the one cursor (through detail::Reader).
 #include "rbsim/interfaces.hpp"
 
+#include <type_traits>
+
 #include "cdr.hpp"
 #include "cdr_reader.hpp"
 
@@ -377,6 +379,72 @@ void get(Reader& r, ApplyImpulseResponse& m) {
   m.step = r.get<std::uint64_t>();
 }
 
+// rosbag2_interfaces: empty halves are the placeholder byte, as TriggerRequest.
+template <class T>
+requires(std::is_empty_v<T>) void put(CdrWriter& w, const T&) {
+  w.u8(0);
+}
+template <class T>
+requires(std::is_empty_v<T>) void get(Reader& r, T&) {
+  (void)r.get<std::uint8_t>();
+}
+void put(CdrWriter& w, const IsPausedResponse& m) {
+  w.boolean(m.paused);
+}
+void get(Reader& r, IsPausedResponse& m) {
+  m.paused = r.get<std::uint8_t>() != 0;
+}
+void put(CdrWriter& w, const GetRateResponse& m) {
+  w.f64(m.rate);
+}
+void get(Reader& r, GetRateResponse& m) {
+  m.rate = r.get<double>();
+}
+void put(CdrWriter& w, const SetRateRequest& m) {
+  w.f64(m.rate);
+}
+void get(Reader& r, SetRateRequest& m) {
+  m.rate = r.get<double>();
+}
+void put(CdrWriter& w, const SetRateResponse& m) {
+  w.boolean(m.success);
+}
+void get(Reader& r, SetRateResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+}
+void put(CdrWriter& w, const SeekRequest& m) {
+  w.i32(m.time.sec);
+  w.u32(m.time.nanosec);
+}
+void get(Reader& r, SeekRequest& m) {
+  m.time.sec = r.get<std::int32_t>();
+  m.time.nanosec = r.get<std::uint32_t>();
+}
+void put(CdrWriter& w, const SeekResponse& m) {
+  w.boolean(m.success);
+}
+void get(Reader& r, SeekResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+}
+void put(CdrWriter& w, const PlayNextResponse& m) {
+  w.boolean(m.success);
+}
+void get(Reader& r, PlayNextResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+}
+void put(CdrWriter& w, const BurstRequest& m) {
+  w.u64(m.num_messages);
+}
+void get(Reader& r, BurstRequest& m) {
+  m.num_messages = r.get<std::uint64_t>();
+}
+void put(CdrWriter& w, const BurstResponse& m) {
+  w.u64(m.actually_burst);
+}
+void get(Reader& r, BurstResponse& m) {
+  m.actually_burst = r.get<std::uint64_t>();
+}
+
 // "rcl_interfaces/msg/Parameter", or "std_srvs/srv/Trigger request" for a service half.
 template <class T>
 std::string name_of(std::string_view half) {
@@ -443,6 +511,24 @@ RBSIM_INTERFACE_CODEC(StepRequest, " request")
 RBSIM_INTERFACE_CODEC(StepResponse, " response")
 RBSIM_INTERFACE_CODEC(ApplyImpulseRequest, " request")
 RBSIM_INTERFACE_CODEC(ApplyImpulseResponse, " response")
+RBSIM_INTERFACE_CODEC(PauseRequest, " request")
+RBSIM_INTERFACE_CODEC(PauseResponse, " response")
+RBSIM_INTERFACE_CODEC(ResumeRequest, " request")
+RBSIM_INTERFACE_CODEC(ResumeResponse, " response")
+RBSIM_INTERFACE_CODEC(TogglePausedRequest, " request")
+RBSIM_INTERFACE_CODEC(TogglePausedResponse, " response")
+RBSIM_INTERFACE_CODEC(IsPausedRequest, " request")
+RBSIM_INTERFACE_CODEC(IsPausedResponse, " response")
+RBSIM_INTERFACE_CODEC(GetRateRequest, " request")
+RBSIM_INTERFACE_CODEC(GetRateResponse, " response")
+RBSIM_INTERFACE_CODEC(SetRateRequest, " request")
+RBSIM_INTERFACE_CODEC(SetRateResponse, " response")
+RBSIM_INTERFACE_CODEC(SeekRequest, " request")
+RBSIM_INTERFACE_CODEC(SeekResponse, " response")
+RBSIM_INTERFACE_CODEC(PlayNextRequest, " request")
+RBSIM_INTERFACE_CODEC(PlayNextResponse, " response")
+RBSIM_INTERFACE_CODEC(BurstRequest, " request")
+RBSIM_INTERFACE_CODEC(BurstResponse, " response")
 #undef RBSIM_INTERFACE_CODEC
 
 }  // namespace rbsim::msgs

@@ -1,9 +1,9 @@
 // ROS 2 service and parameter interfaces as plain structs with CDR codecs: rcl_interfaces' parameter
-// messages and its six parameter services, std_srvs/srv/Trigger, and rbsim_msgs' Step and
-// ApplyImpulse services. Field order and types follow the .msg/.srv definitions (ros2/rcl_interfaces,
-// ros2/common_interfaces, tools/msgs/definitions); the bytes are those of msgs.hpp's CDR (XCDR1,
-// little endian, 4-byte encapsulation header), the body of a service sample without the request
-// header rmw_cyclonedds_cpp puts before it (node/include/rbsim/service.hpp adds and strips that).
+// messages and its six parameter services, std_srvs/srv/Trigger, rbsim_msgs' Step and
+// ApplyImpulse services, and rosbag2_interfaces' player services. Field order and types follow the .msg/.srv
+// definitions (ros2/rcl_interfaces, ros2/common_interfaces, tools/msgs/definitions); the bytes are those of
+// msgs.hpp's CDR (XCDR1, little endian, 4-byte encapsulation header), the body of a service sample without
+// the request header rmw_cyclonedds_cpp puts before it (node/include/rbsim/service.hpp adds and strips that).
 //
 // decode() reads untrusted bytes: a truncated message, a length that runs past the data or a wrong
 // encapsulation header is an error naming the type and the byte offset, never a crash; every
@@ -248,6 +248,71 @@ struct ApplyImpulseResponse {
   bool operator==(const ApplyImpulseResponse&) const = default;
 };
 
+// rosbag2_interfaces (Jazzy): the player's services (rbsim replay's /rbsim_player/...). A half with
+// no fields is rosidl's one placeholder member on the wire, as TriggerRequest.
+#define RBSIM_EMPTY_HALF(Name, service)                   \
+  struct Name {                                           \
+    static constexpr std::string_view kService = service; \
+    bool operator==(const Name&) const = default;         \
+  };
+RBSIM_EMPTY_HALF(PauseRequest, "rosbag2_interfaces/srv/Pause")
+RBSIM_EMPTY_HALF(PauseResponse, "rosbag2_interfaces/srv/Pause")
+RBSIM_EMPTY_HALF(ResumeRequest, "rosbag2_interfaces/srv/Resume")
+RBSIM_EMPTY_HALF(ResumeResponse, "rosbag2_interfaces/srv/Resume")
+RBSIM_EMPTY_HALF(TogglePausedRequest, "rosbag2_interfaces/srv/TogglePaused")
+RBSIM_EMPTY_HALF(TogglePausedResponse, "rosbag2_interfaces/srv/TogglePaused")
+RBSIM_EMPTY_HALF(IsPausedRequest, "rosbag2_interfaces/srv/IsPaused")
+RBSIM_EMPTY_HALF(GetRateRequest, "rosbag2_interfaces/srv/GetRate")
+RBSIM_EMPTY_HALF(PlayNextRequest, "rosbag2_interfaces/srv/PlayNext")
+#undef RBSIM_EMPTY_HALF
+struct IsPausedResponse {
+  static constexpr std::string_view kService = IsPausedRequest::kService;
+  bool paused = false;
+  bool operator==(const IsPausedResponse&) const = default;
+};
+struct GetRateResponse {
+  static constexpr std::string_view kService = GetRateRequest::kService;
+  double rate = 0.0;
+  bool operator==(const GetRateResponse&) const = default;
+};
+struct SetRateRequest {
+  static constexpr std::string_view kService = "rosbag2_interfaces/srv/SetRate";
+  double rate = 0.0;
+  bool operator==(const SetRateRequest&) const = default;
+};
+struct SetRateResponse {
+  static constexpr std::string_view kService = SetRateRequest::kService;
+  bool success = false;  // a rate > 0 was set
+  bool operator==(const SetRateResponse&) const = default;
+};
+struct SeekRequest {
+  static constexpr std::string_view kService = "rosbag2_interfaces/srv/Seek";
+  Time time;  // builtin_interfaces/Time
+  bool operator==(const SeekRequest& o) const {
+    return time.sec == o.time.sec && time.nanosec == o.time.nanosec;
+  }
+};
+struct SeekResponse {
+  static constexpr std::string_view kService = SeekRequest::kService;
+  bool success = false;
+  bool operator==(const SeekResponse&) const = default;
+};
+struct PlayNextResponse {
+  static constexpr std::string_view kService = PlayNextRequest::kService;
+  bool success = false;  // only while paused
+  bool operator==(const PlayNextResponse&) const = default;
+};
+struct BurstRequest {
+  static constexpr std::string_view kService = "rosbag2_interfaces/srv/Burst";
+  std::uint64_t num_messages = 0;  // 0: the rest of the log
+  bool operator==(const BurstRequest&) const = default;
+};
+struct BurstResponse {
+  static constexpr std::string_view kService = BurstRequest::kService;
+  std::uint64_t actually_burst = 0;
+  bool operator==(const BurstResponse&) const = default;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Codecs: encode() replaces `out` with the message's CDR (encapsulation header included);
 // decode() fills `out` (replaced whole) or fails naming the type and the offset, `out` then
@@ -281,6 +346,24 @@ RBSIM_INTERFACE_CODEC(StepRequest)
 RBSIM_INTERFACE_CODEC(StepResponse)
 RBSIM_INTERFACE_CODEC(ApplyImpulseRequest)
 RBSIM_INTERFACE_CODEC(ApplyImpulseResponse)
+RBSIM_INTERFACE_CODEC(PauseRequest)
+RBSIM_INTERFACE_CODEC(PauseResponse)
+RBSIM_INTERFACE_CODEC(ResumeRequest)
+RBSIM_INTERFACE_CODEC(ResumeResponse)
+RBSIM_INTERFACE_CODEC(TogglePausedRequest)
+RBSIM_INTERFACE_CODEC(TogglePausedResponse)
+RBSIM_INTERFACE_CODEC(IsPausedRequest)
+RBSIM_INTERFACE_CODEC(IsPausedResponse)
+RBSIM_INTERFACE_CODEC(GetRateRequest)
+RBSIM_INTERFACE_CODEC(GetRateResponse)
+RBSIM_INTERFACE_CODEC(SetRateRequest)
+RBSIM_INTERFACE_CODEC(SetRateResponse)
+RBSIM_INTERFACE_CODEC(SeekRequest)
+RBSIM_INTERFACE_CODEC(SeekResponse)
+RBSIM_INTERFACE_CODEC(PlayNextRequest)
+RBSIM_INTERFACE_CODEC(PlayNextResponse)
+RBSIM_INTERFACE_CODEC(BurstRequest)
+RBSIM_INTERFACE_CODEC(BurstResponse)
 #undef RBSIM_INTERFACE_CODEC
 
 }  // namespace rbsim::msgs
