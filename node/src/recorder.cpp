@@ -174,7 +174,8 @@ Status Recorder::add_channels() {
 
 Status Recorder::split_now() {
   if (options_.bag.empty() || options_.snapshot_duration_ns > 0) {
-    return Error{"splitting needs a bag directory being recorded (not one .mcap file, not snapshot mode)"};
+    return Error{"splitting needs a bag directory being recorded (not one .mcap file, not snapshot mode)",
+                 ErrorCode::InvalidArgument};
   }
   if (file_start_ == 0) return Ok{};  // nothing in the open file yet: it stays the new one
   return split(file_start_ > 0 ? std::max(file_start_, wall_ns()) : wall_ns());
@@ -196,8 +197,9 @@ void Recorder::keep(Topic& t, const Received& sample, std::uint64_t log_time, st
 }
 
 Result<std::uint64_t> Recorder::snapshot() {
-  if (options_.snapshot_duration_ns == 0)
-    return Error{"not recording in snapshot mode (--snapshot-duration)"};
+  if (options_.snapshot_duration_ns == 0) {
+    return Error{"not recording in snapshot mode (--snapshot-duration)", ErrorCode::InvalidArgument};
+  }
   if (Status st = release_held(); !st) return st.error();
   if (kept_.empty()) return std::uint64_t{0};
   if (Status st = open_file(); !st) return st.error();
@@ -239,6 +241,11 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   Received sample;
   for (Topic& t : topics_) {
     while (t.subscription.take(sample)) {
+      if (paused()) {  // taken, so no writer waits on us, and not recorded
+        ++skipped_paused_;
+        any = true;
+        continue;
+      }
       any = true;
       auto newest = std::find_if(t.newest.begin(), t.newest.end(),
                                  [&](const auto& w) { return w.first == sample.writer; });

@@ -1667,6 +1667,67 @@ def case_record_snapshot(ctx):
         ctx.rbrun(f"render-{i}", "render", os.path.join(bag, f), "--out", ctx.path(f"frames-{i}"), "--fps", 2)
 
 
+def case_record_services(ctx):
+    """rosbag2's recorder services on /rbsim_recorder, called by an independent Python cyclonedds
+    client: pause holds (no steps recorded while paused, is_paused says so), resume goes on,
+    split_bagfile starts a new file at once, snapshot outside snapshot mode fails; in snapshot mode
+    the snapshot service writes the last second to the bag's next file."""
+    from player_client import Player
+
+    scene = ctx.scene("chain.xml")
+    bag = ctx.path("bag")
+    names = ("pause", "resume", "is_paused", "split_bagfile", "snapshot")
+    rec = ctx.rb("record", *record_args(ctx, bag, "--wall-duration", 60))
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", 4, "--wait-for-subscribers", 1))
+    client = Player(ctx.domain, "/rbsim_recorder", "file://" + ctx.loopback_xml, names=names)
+    ctx.require(client.wait_matched(20), "the Python client did not match the recorder's five services in 20 s")
+
+    def call(name):
+        r = client.call(name)
+        ctx.require(r is not None, f"no reply to {name}")
+        return r
+    time.sleep(0.8)
+    call("pause")
+    paused_at = time.time_ns()
+    ctx.check(call("is_paused").paused, "is_paused false after pause")
+    time.sleep(0.8)
+    call("resume")
+    resumed_at = time.time_ns()
+    ctx.check(not call("is_paused").paused, "is_paused true after resume")
+    call("split_bagfile")
+    ctx.check(not call("snapshot").success, "snapshot succeeded outside snapshot mode")
+    exited_ok(ctx, node, 60)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 30)
+    meta = bag_metadata(bag)
+    ctx.check(len(meta["relative_file_paths"]) == 2, f"split_bagfile made {meta['relative_file_paths']}, want 2 files")
+    check_bag_with_rosbags(ctx, bag, "bag with a pause and a split")
+    states = [m for f in meta["relative_file_paths"] for m in Log(os.path.join(bag, f)).messages
+              if m[0].endswith("/body_states")]
+    inside = [m for m in states if paused_at + 100_000_000 < m[2] < resumed_at - 100_000_000]
+    ctx.check(not inside, f"{len(inside)} body states recorded while paused")
+    steps = [step_of(m[5]) for m in states]
+    gap = max(b - a for a, b in zip(steps, steps[1:]))
+    ctx.log(f"largest step gap {gap} (the pause), {len(steps)} steps recorded")
+    ctx.check(gap >= 500, f"the pause left a gap of {gap} steps, want >= 500 (0.8 s at 1 kHz)")
+
+    snap = ctx.path("snap")
+    rec = ctx.rb("record-snap", *record_args(ctx, snap, "--snapshot-duration", 1, "--wall-duration", 60))
+    node = ctx.rb("node-snap", *node_args(ctx, scene, "--rate", 1, "--duration", 3, "--wait-for-subscribers", 1))
+    client = Player(ctx.domain, "/rbsim_recorder", "file://" + ctx.loopback_xml, names=names)
+    ctx.require(client.wait_matched(20), "no match with the snapshot recorder's services")
+    time.sleep(1.8)
+    ctx.check(call("snapshot").success, "snapshot failed in snapshot mode")
+    exited_ok(ctx, node, 60)
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 30)
+    meta = bag_metadata(snap)
+    ctx.check(meta["relative_file_paths"] == ["snap_0.mcap"], f"snapshot files {meta['relative_file_paths']}")
+    states = [m for m in Log(os.path.join(snap, "snap_0.mcap")).messages if m[0].endswith("/body_states")]
+    span = (states[-1][2] - states[0][2]) / 1e9
+    ctx.check(0.9 <= span <= 1.0, f"the snapshot holds {span:.3f} s of log time, want the last 1 s")
+
+
 def rss_kib(pid):
     try:
         with open(f"/proc/{pid}/status") as f:
@@ -1754,6 +1815,7 @@ CASES = {
     "record_bag": case_record_bag,
     "record_bag_sigkill": case_record_bag_sigkill,
     "record_snapshot": case_record_snapshot,
+    "record_services": case_record_services,
     "record_sigkill": case_record_sigkill,
     "soak": case_soak,
 }

@@ -82,7 +82,15 @@ def player_types():
         seq: types.int64
         actually_burst: types.uint64
 
+    @dataclass
+    class Snapshot_Response_(IdlStruct, typename="rosbag2_interfaces::srv::dds_::Snapshot_Response_"):
+        guid: types.uint64
+        seq: types.int64
+        success: bool
+
     return {
+        "snapshot": (empty("Snapshot", "Request"), Snapshot_Response_),  # the recorder's
+        "split_bagfile": (empty("SplitBagfile", "Request"), empty("SplitBagfile", "Response")),
         "pause": (empty("Pause", "Request"), empty("Pause", "Response")),
         "resume": (empty("Resume", "Request"), empty("Resume", "Response")),
         "toggle_paused": (empty("TogglePaused", "Request"), empty("TogglePaused", "Response")),
@@ -96,9 +104,12 @@ def player_types():
 
 
 class Player:
-    """One rmw_cyclonedds-style client per service of the player node `node` ("/rbsim_player")."""
+    """One rmw_cyclonedds-style client per service of the player node `node` ("/rbsim_player"), or
+    of the services named in `names` (the recorder's: snapshot, split_bagfile, pause, resume, is_paused)."""
 
-    def __init__(self, domain, node, config_uri=None):
+    PLAYER = ("pause", "resume", "toggle_paused", "is_paused", "get_rate", "set_rate", "seek", "play_next", "burst")
+
+    def __init__(self, domain, node, config_uri=None, names=PLAYER):
         import os
         if config_uri:  # read by Cyclone when the domain is created (rbsim's loopback configuration)
             os.environ["CYCLONEDDS_URI"] = config_uri
@@ -113,6 +124,8 @@ class Player:
         self.types, self.Time = player_types()
         self.clients = {}
         for name, (req, rep) in self.types.items():
+            if name not in names:
+                continue
             c = {"guid": random.getrandbits(63) | 1, "seq": 0, "req": req, "matches": {"w": 0, "r": 0}}
             qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(10),
                       Policy.Durability.Volatile, Policy.Userdata(f"clientid={name};".encode()))

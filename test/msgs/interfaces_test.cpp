@@ -150,6 +150,10 @@ TEST(InterfacesCodec, EveryTypeRoundTrips) {
   expect_round_trip(PlayNextResponse{true});
   expect_round_trip(BurstRequest{1ull << 40});
   expect_round_trip(BurstResponse{7});
+  expect_round_trip(SnapshotRequest{});
+  expect_round_trip(SnapshotResponse{true});
+  expect_round_trip(SplitBagfileRequest{});
+  expect_round_trip(SplitBagfileResponse{});
 }
 
 // rosbag2_interfaces (Jazzy): empty halves are the placeholder byte; Seek's builtin_interfaces/Time
@@ -168,6 +172,10 @@ TEST(InterfacesCodec, PlayerServicesLayout) {
   EXPECT_EQ(cdr, bytes({0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0xf0, 0x3f}));
   encode(IsPausedResponse{true}, cdr);
   EXPECT_EQ(cdr, bytes({0, 1, 0, 3, 1, 0, 0, 0}));
+  encode(SnapshotResponse{true}, cdr);  // the recorder's
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 3, 1, 0, 0, 0}));
+  encode(SplitBagfileRequest{}, cdr);
+  EXPECT_EQ(cdr, bytes({0, 1, 0, 3, 0, 0, 0, 0}));
 }
 
 // CDR offsets count from the end of the 4-byte encapsulation header; the message is padded to a

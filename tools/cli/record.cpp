@@ -105,6 +105,9 @@ int record_command(RecordArgs a) {
     return fail("record", recorder.error().message,
                 recorder.error().code == ErrorCode::InvalidArgument ? 2 : 1);
   }
+  // rosbag2's recorder services on the recorder's node (/rbsim_recorder/snapshot, ...).
+  auto services = node::RecorderServices::create(participant.value(), *recorder.value());
+  if (!services) return fail("record", services.error().message);
   install_stop_handlers();
   install_snapshot_handler();
   if (!a.quiet) {
@@ -125,6 +128,10 @@ int record_command(RecordArgs a) {
       break;
     }
     if (a.rec.max_messages > 0 && recorder.value()->received() >= a.rec.max_messages) break;
+    if (Status st = services.value()->carry_out(a.quiet); !st) {
+      failure = st.error().message;
+      break;
+    }
     if (a.rec.snapshot_duration_ns > 0 && snapshot_requested()) {
       Result<std::uint64_t> n = recorder.value()->snapshot();
       if (!n) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -71,6 +72,10 @@ class Recorder {
   Result<std::uint64_t> snapshot();
   // A new file now (bag only, not in snapshot mode), as a split does.
   [[nodiscard]] Status split_now();
+  // Paused: samples are still taken from DDS (nobody waits on us) but not recorded. Any thread.
+  void set_paused(bool paused) { paused_.store(paused, std::memory_order_relaxed); }
+  bool paused() const { return paused_.load(std::memory_order_relaxed); }
+  std::uint64_t skipped_paused() const { return skipped_paused_; }
   std::uint64_t received() const { return received_; }
   // The files written so far (the last one open until close()); one unless a bag was split.
   const std::vector<std::string>& files() const { return files_; }
@@ -111,6 +116,8 @@ class Recorder {
   RecorderOptions options_;
   mcap::Writer writer_;
   std::vector<std::string> files_;
+  std::atomic<bool> paused_{false};
+  std::uint64_t skipped_paused_ = 0;
   std::vector<std::size_t> channel_order_;  // topics_ indices in the order their channels were added
   std::uint64_t file_start_ = 0;            // log time of the open file's first message (0: none yet)
   std::uint64_t file_bytes_ = 0;            // the open file's size as last seen (every 16 messages)
@@ -161,6 +168,29 @@ class Recorder {
   std::vector<Held> held_;
   [[nodiscard]] Status write(Topic& topic, const Received& sample, std::uint64_t log_time);
   [[nodiscard]] Status release_held();
+};
+
+// The recorder's services, as rosbag2's recorder node offers them under its name
+// (/rbsim_recorder/...): pause, resume, is_paused (rosbag2_interfaces' Pause, Resume, IsPaused),
+// split_bagfile (SplitBagfile) and snapshot (Snapshot), served on their own thread. Pause and resume
+// take effect at once; a split or a snapshot is carried out by the recording loop at its next
+// carry_out() (it polls every 100 ms) and answered then, or after 5 s unsuccessfully (Snapshot's
+// success false; SplitBagfile's reply has no field to say so). A snapshot outside snapshot mode, or
+// a split of one .mcap file or in snapshot mode, fails (success false; the split is not made).
+class RecorderServices {
+ public:
+  static Result<std::unique_ptr<RecorderServices>> create(const Participant& participant, Recorder& recorder);
+  ~RecorderServices();
+  RecorderServices(const RecorderServices&) = delete;
+  RecorderServices& operator=(const RecorderServices&) = delete;
+  // The recording loop's thread: carries out the splits and snapshots asked for since the last
+  // call, and says what it did on stderr (unless quiet). A failure to write is returned.
+  [[nodiscard]] Status carry_out(bool quiet);
+
+ private:
+  RecorderServices() = default;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace rbsim::node

@@ -388,6 +388,12 @@ template <class T>
 requires(std::is_empty_v<T>) void get(Reader& r, T&) {
   (void)r.get<std::uint8_t>();
 }
+void put(CdrWriter& w, const SnapshotResponse& m) {
+  w.boolean(m.success);
+}
+void get(Reader& r, SnapshotResponse& m) {
+  m.success = r.get<std::uint8_t>() != 0;
+}
 void put(CdrWriter& w, const IsPausedResponse& m) {
   w.boolean(m.paused);
 }
@@ -529,6 +535,10 @@ RBSIM_INTERFACE_CODEC(PlayNextRequest, " request")
 RBSIM_INTERFACE_CODEC(PlayNextResponse, " response")
 RBSIM_INTERFACE_CODEC(BurstRequest, " request")
 RBSIM_INTERFACE_CODEC(BurstResponse, " response")
+RBSIM_INTERFACE_CODEC(SnapshotRequest, " request")
+RBSIM_INTERFACE_CODEC(SnapshotResponse, " response")
+RBSIM_INTERFACE_CODEC(SplitBagfileRequest, " request")
+RBSIM_INTERFACE_CODEC(SplitBagfileResponse, " response")
 #undef RBSIM_INTERFACE_CODEC
 
 }  // namespace rbsim::msgs

@@ -264,7 +264,17 @@ RBSIM_EMPTY_HALF(TogglePausedResponse, "rosbag2_interfaces/srv/TogglePaused")
 RBSIM_EMPTY_HALF(IsPausedRequest, "rosbag2_interfaces/srv/IsPaused")
 RBSIM_EMPTY_HALF(GetRateRequest, "rosbag2_interfaces/srv/GetRate")
 RBSIM_EMPTY_HALF(PlayNextRequest, "rosbag2_interfaces/srv/PlayNext")
+RBSIM_EMPTY_HALF(SnapshotRequest, "rosbag2_interfaces/srv/Snapshot")
+RBSIM_EMPTY_HALF(SplitBagfileRequest, "rosbag2_interfaces/srv/SplitBagfile")
+RBSIM_EMPTY_HALF(SplitBagfileResponse, "rosbag2_interfaces/srv/SplitBagfile")
 #undef RBSIM_EMPTY_HALF
+// The recorder's (rbsim record's /rbsim_recorder/...): snapshot, split_bagfile, and the player's
+// pause, resume and is_paused types.
+struct SnapshotResponse {
+  static constexpr std::string_view kService = SnapshotRequest::kService;
+  bool success = false;
+  bool operator==(const SnapshotResponse&) const = default;
+};
 struct IsPausedResponse {
   static constexpr std::string_view kService = IsPausedRequest::kService;
   bool paused = false;
@@ -364,6 +374,10 @@ RBSIM_INTERFACE_CODEC(PlayNextRequest)
 RBSIM_INTERFACE_CODEC(PlayNextResponse)
 RBSIM_INTERFACE_CODEC(BurstRequest)
 RBSIM_INTERFACE_CODEC(BurstResponse)
+RBSIM_INTERFACE_CODEC(SnapshotRequest)
+RBSIM_INTERFACE_CODEC(SnapshotResponse)
+RBSIM_INTERFACE_CODEC(SplitBagfileRequest)
+RBSIM_INTERFACE_CODEC(SplitBagfileResponse)
 #undef RBSIM_INTERFACE_CODEC
 
 }  // namespace rbsim::msgs
