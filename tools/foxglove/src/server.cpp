@@ -13,6 +13,7 @@
 // nothing.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <thread>
@@ -20,6 +21,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "access.hpp"
 #include "rbsim/foxglove.hpp"
 #include "services.hpp"
 #include "transport.hpp"
@@ -510,6 +512,15 @@ void Server::Impl::serve_publish(detail::ConnectionId id, ClientMessage message)
 
 Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
                                               std::vector<ChannelSpec> channels) {
+  if (options.token.empty() && !options.allow_insecure && !is_loopback(options.address)) {
+    return Error{"refusing to serve " + websocket_url(options.address, options.port) +
+                     " beyond this host without a token (or allow_insecure)",
+                 ErrorCode::InvalidArgument};
+  }
+  if (!options.token.empty()) {
+    if (const std::string problem = token_problem(options.token); !problem.empty())
+      return Error{problem, ErrorCode::InvalidArgument};
+  }
   std::unique_ptr<Server> s(new Server());
   s->impl_ = std::make_unique<Impl>();
   Impl& im = *s->impl_;
@@ -543,8 +554,20 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
     std::lock_guard lock(p->mu);
     ++p->totals.refused;
   };
+  h.admit = detail::admission(options, [p](detail::AccessGate::Verdict v) {
+    std::lock_guard lock(p->mu);
+    ++(v == detail::AccessGate::Verdict::Unauthorized  ? p->totals.unauthorized
+       : v == detail::AccessGate::Verdict::RateLimited ? p->totals.rate_limited
+                                                       : p->totals.full);
+  });
+  h.on_handshake_timeout = [p] {
+    std::lock_guard lock(p->mu);
+    ++p->totals.handshake_timeouts;
+  };
   const std::string err =
-      im.transport->listen(options.address, options.port, kMaxReadFrame, kTickMs, std::move(h));
+      im.transport->listen({options.address, options.port, kMaxReadFrame, kTickMs,
+                            static_cast<int>(std::lround(options.handshake_timeout_s * 1000))},
+                           std::move(h));
   if (!err.empty()) {
     return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
   }

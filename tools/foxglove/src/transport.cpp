@@ -12,6 +12,7 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 namespace rbsim::foxglove::detail {
@@ -25,10 +26,10 @@ class AsioTransport final : public Transport {
  public:
   ~AsioTransport() override { stop(); }
 
-  std::string listen(const std::string& address, std::uint16_t port, std::size_t max_message_size,
-                     int tick_ms, TransportHandlers handlers) override {
+  std::string listen(const TransportOptions& options, TransportHandlers handlers) override {
     handlers_ = std::move(handlers);
-    tick_ = std::chrono::milliseconds(tick_ms);
+    tick_ = std::chrono::milliseconds(options.tick_ms);
+    const std::string& address = options.address;
     // websocketpp logs to stdout by default; the server reports what matters itself.
     ws_.clear_access_channels(websocketpp::log::alevel::all);
     ws_.clear_error_channels(websocketpp::log::elevel::all);
@@ -38,7 +39,13 @@ class AsioTransport final : public Transport {
     // Lets a restarted server take its port while old connections sit in TIME_WAIT (on Linux it
     // does not let two servers listen on one port: a second one still gets "address in use").
     ws_.set_reuse_addr(true);
-    ws_.set_max_message_size(max_message_size);
+    ws_.set_max_message_size(options.max_message_size);
+    // A socket that never completes its opening handshake (one that connects and says nothing, or
+    // dribbles its request) is closed this long after it was accepted. The request's header is
+    // limited by websocketpp itself (http::max_header_size, 16,000 bytes: 431 beyond), and a
+    // handshake has no body.
+    ws_.set_open_handshake_timeout(options.handshake_timeout_ms);
+    ws_.set_max_http_body_size(0);
     ws_.set_listen_backlog(64);
     // Per-step messages are small and come every step: with Nagle on, the kernel holds each one
     // until the previous segment is acknowledged, and the client's delayed ACK turns that into
@@ -53,7 +60,7 @@ class AsioTransport final : public Transport {
     ws_.set_validate_handler([this](Hdl h) { return validate(h); });
     ws_.set_open_handler([this](Hdl h) { opened(h); });
     ws_.set_close_handler([this](Hdl h) { closed(h); });
-    ws_.set_fail_handler([this](Hdl h) { closed(h); });
+    ws_.set_fail_handler([this](Hdl h) { failed(h); });
     ws_.set_message_handler([this](Hdl h, WsServer::message_ptr m) {
       const auto it = ids_.find(h);
       if (it == ids_.end() || !handlers_.on_message) return;
@@ -62,7 +69,7 @@ class AsioTransport final : public Transport {
     asio::error_code aec;
     const asio::ip::address ip = asio::ip::make_address(address, aec);
     if (aec) return "bad address \"" + address + "\": " + aec.message();
-    const asio::ip::tcp::endpoint endpoint(ip, port);
+    const asio::ip::tcp::endpoint endpoint(ip, options.port);
     ws_.listen(endpoint, ec);
     if (ec) return bind_error(endpoint, ec.message());
     const asio::ip::tcp::endpoint local = ws_.get_local_endpoint(aec);
@@ -203,6 +210,28 @@ class AsioTransport final : public Transport {
     websocketpp::lib::error_code ec;
     WsServer::connection_ptr con = ws_.get_con_from_hdl(h, ec);
     if (ec) return false;
+    if (handlers_.admit) {
+      Handshake hs;
+      asio::error_code aec;
+      const asio::ip::tcp::endpoint remote = con->get_raw_socket().remote_endpoint(aec);
+      if (!aec) {
+        asio::ip::address a = remote.address();
+        if (a.is_v6() && a.to_v6().is_v4_mapped())
+          a = asio::ip::make_address_v4(asio::ip::v4_mapped, a.to_v6());
+        hs.remote_address = a.to_string();
+      }
+      hs.resource = con->get_resource();
+      hs.authorization = con->get_request_header("Authorization");
+      hs.admitted = admitted_.size();
+      const Admission verdict = handlers_.admit(hs);
+      if (verdict.status != 0) {
+        con->set_status(static_cast<websocketpp::http::status_code::value>(verdict.status));
+        if (verdict.status == 401) con->append_header("WWW-Authenticate", "Bearer realm=\"rbsim\"");
+        if (verdict.status == 429 || verdict.status == 503) con->append_header("Retry-After", "10");
+        con->set_body(verdict.body);
+        return false;
+      }
+    }
     const std::string chosen =
         handlers_.choose_subprotocol ? handlers_.choose_subprotocol(con->get_requested_subprotocols()) : "";
     if (chosen.empty()) {
@@ -214,7 +243,20 @@ class AsioTransport final : public Transport {
       return false;
     }
     con->select_subprotocol(chosen, ec);
-    return !ec;
+    if (ec) return false;
+    admitted_.insert(h);
+    return true;
+  }
+
+  void failed(Hdl h) {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws_.get_con_from_hdl(h, ec);
+    if (!ec &&
+        con->get_ec() == websocketpp::error::make_error_code(websocketpp::error::open_handshake_timeout) &&
+        handlers_.on_handshake_timeout) {
+      handlers_.on_handshake_timeout();
+    }
+    closed(h);
   }
 
   void opened(Hdl h) {
@@ -225,6 +267,7 @@ class AsioTransport final : public Transport {
   }
 
   void closed(Hdl h) {
+    admitted_.erase(h);
     const auto it = ids_.find(h);
     if (it == ids_.end()) return;  // a failed handshake: never opened
     const ConnectionId id = it->second;
@@ -303,6 +346,9 @@ class AsioTransport final : public Transport {
   ConnectionId next_id_ = 1;
   std::map<Hdl, ConnectionId, std::owner_less<Hdl>> ids_;
   std::map<ConnectionId, Hdl> hdls_;
+  // Handshakes admitted (validated) and not closed yet: the opened connections and those whose
+  // answer is being written, so two handshakes at once cannot both take the last place.
+  std::set<Hdl, std::owner_less<Hdl>> admitted_;
 };
 
 }  // namespace
