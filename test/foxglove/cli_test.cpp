@@ -386,6 +386,46 @@ TEST(FoxgloveCli, ATokenIsAskedAndPrintedOnlyWithPrintToken) {
   EXPECT_NE(printed.err.find("%2F%3Ftoken%3D" + token + "\n"), std::string::npos) << printed;
 }
 
+// --foxglove-tls CERT KEY: wss:// in the listening line and the link; a certificate that cannot
+// be read or a key that is not the certificate's is an error naming the file. (Clients over wss://:
+// foxglove_client.tls.)
+TEST(FoxgloveCli, TlsServesWssWithACertificateAndItsKey) {
+  test::TempDir dir;
+  const auto make = [&](const std::string& name) {
+    const std::string cert = (dir / (name + ".crt")).string(), key = (dir / (name + ".key")).string();
+    const test::Outcome o = test::run_process("/usr/bin/openssl",
+                                              {"req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout",
+                                               key, "-out", cert, "-days", "1", "-subj", "/CN=127.0.0.1"},
+                                              std::chrono::seconds(60));
+    EXPECT_EQ(o.exit_code, 0) << o;
+    return std::pair{cert, key};
+  };
+  const auto [cert, key] = make("a");
+  const auto [other_cert, other_key] = make("b");
+  const auto node = [&](const std::string& c, const std::string& k) {
+    return rbsim({"node", scene_path(), "--foxglove", "0", "--foxglove-tls", c, k, "--domain", kDomain,
+                  "--namespace", "fox_tls", "--duration", "0.01", "--rate", "0"},
+                 std::chrono::seconds(60));
+  };
+  const test::Outcome ok = node(cert, key);
+  EXPECT_EQ(ok.exit_code, 0) << ok;
+  EXPECT_NE(ok.err.find("foxglove: listening on wss://127.0.0.1:"), std::string::npos) << ok;
+  EXPECT_NE(ok.err.find("ds.url=wss%3A%2F%2F127.0.0.1%3A"), std::string::npos) << ok;
+  const std::string missing = (dir / "missing.crt").string();
+  const test::Outcome no_cert = node(missing, key);
+  EXPECT_EQ(no_cert.exit_code, 1) << no_cert;
+  EXPECT_NE(no_cert.err.find("cannot listen on wss://127.0.0.1:0: TLS certificate " + missing),
+            std::string::npos)
+      << no_cert;
+  const test::Outcome mismatch = node(cert, other_key);
+  EXPECT_EQ(mismatch.exit_code, 1) << mismatch;
+  EXPECT_NE(mismatch.err.find("TLS key " + other_key + ": key values mismatch"), std::string::npos)
+      << mismatch;
+  const test::Outcome one = rbsim({"node", scene_path(), "--foxglove", "0", "--foxglove-tls", cert});
+  EXPECT_EQ(one.exit_code, 2) << one;
+  EXPECT_NE(one.err.find("--foxglove-tls"), std::string::npos) << one;
+}
+
 TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {
   test::TempDir dir;
   const std::string log = (dir / "air.mcap").string();

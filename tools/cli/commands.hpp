@@ -45,6 +45,7 @@ struct FoxgloveArgs {
   bool insecure = false;               // --foxglove-insecure: no token beyond loopback
   bool print_token = false;            // --print-token: the printed links carry the token
   std::uint32_t max_clients = 16;      // --foxglove-max-clients
+  std::vector<std::string> tls;        // --foxglove-tls CERT KEY: wss://
 };
 // --foxglove and the options above (foxglove.cpp): a bad value is a usage error naming the option.
 CLI::Option* add_foxglove_option(CLI::App* app, FoxgloveArgs& args, bool required = false);

@@ -59,8 +59,14 @@ CLI::Option* add_foxglove_option(CLI::App* app, FoxgloveArgs& args, bool require
   app->add_flag("--print-token", args.print_token, "Print the --foxglove links with the token in them");
   app->add_option("--foxglove-max-clients", args.max_clients,
                   "Foxglove connections served at once; more get HTTP 503")
-      ->check(CLI::Range(1u, 1024u))
+      ->check(CLI::Range(1u, 1024u).description(""))
+      ->type_name("N (1..1024)")
       ->default_str("16");
+  app->add_option("--foxglove-tls", args.tls,
+                  "Serve --foxglove as wss:// (TLS 1.2 or later) with the PEM certificate chain CERT and its "
+                  "private key KEY")
+      ->expected(2)
+      ->type_name("CERT KEY");
   return o;
 }
 
@@ -91,6 +97,11 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
         ErrorCode::InvalidArgument};
   }
   options.allow_insecure = args.insecure;
+  if (args.tls.size() == 2) {
+    options.tls_cert = args.tls[0];
+    options.tls_key = args.tls[1];
+  }
+  const bool tls = !options.tls_cert.empty();
   options.max_clients = args.max_clients;
   options.steering = steering;
   options.node = node;
@@ -99,7 +110,7 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
   const std::uint16_t port = server.value()->port();
   // The line tests and scripts read the port from (port 0 picks one).
   RBSIM_LOG(Info, "%s: foxglove: listening on %s%s\n", command,
-            foxglove::websocket_url(options.address, port).c_str(),
+            foxglove::websocket_url(options.address, port, tls).c_str(),
             options.token.empty() ? ""
             : args.print_token    ? " (token required)"
                                   : " (token required: add /?token=TOKEN, or --print-token to print it)");
@@ -107,7 +118,7 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
   std::string host = options.address;
   if (host == "0.0.0.0") host = "127.0.0.1";
   if (host == "::") host = "::1";
-  std::string url = foxglove::websocket_url(host, port);
+  std::string url = foxglove::websocket_url(host, port, tls);
   if (!options.token.empty() && args.print_token) url = foxglove::url_with_token(url, options.token);
   RBSIM_LOG(Info, "%s: foxglove: open %s\n", command, foxglove::foxglove_app_link(url).c_str());
   RBSIM_LOG(Info, "%s: foxglove: layout %s (Foxglove: Layouts > Import from file)\n", command,

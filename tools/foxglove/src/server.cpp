@@ -537,7 +537,8 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   im.subscribers = std::make_unique<std::atomic<std::uint32_t>[]>(im.channels.size());
   for (std::size_t i = 0; i < im.channels.size(); ++i) im.subscribers[i] = 0;
   im.new_session_locked();
-  im.transport = detail::Transport::create();
+  const bool tls = !options.tls_cert.empty();
+  im.transport = detail::Transport::create(tls);
   detail::TransportHandlers h;
   h.choose_subprotocol = [](const std::vector<std::string>& offered) {
     const auto chosen = choose_subprotocol(offered);
@@ -564,12 +565,12 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
     std::lock_guard lock(p->mu);
     ++p->totals.handshake_timeouts;
   };
-  const std::string err =
-      im.transport->listen({options.address, options.port, kMaxReadFrame, kTickMs,
-                            static_cast<int>(std::lround(options.handshake_timeout_s * 1000))},
-                           std::move(h));
+  const std::string err = im.transport->listen(
+      {options.address, options.port, kMaxReadFrame, kTickMs,
+       static_cast<int>(std::lround(options.handshake_timeout_s * 1000)), options.tls_cert, options.tls_key},
+      std::move(h));
   if (!err.empty()) {
-    return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
+    return Error{"cannot listen on " + websocket_url(options.address, options.port, tls) + ": " + err};
   }
   if (options.steering != nullptr) {
     im.link->server = &im;

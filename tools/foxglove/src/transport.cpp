@@ -2,6 +2,7 @@
 // Everything here runs on the one I/O thread, except wake() and stop(), which post to it.
 #include "transport.hpp"
 
+#include <websocketpp/config/asio.hpp>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
@@ -14,15 +15,20 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <type_traits>
 
 namespace rbsim::foxglove::detail {
 
 namespace {
 
-using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
 
+// Config: websocketpp::config::asio (ws://) or asio_tls (wss://, options.tls_cert and tls_key).
+template <class Config>
 class AsioTransport final : public Transport {
+  using WsServer = websocketpp::server<Config>;
+  using ConPtr = typename WsServer::connection_ptr;
+
  public:
   ~AsioTransport() override { stop(); }
 
@@ -38,6 +44,9 @@ class AsioTransport final : public Transport {
     if (ec) return ec.message();
     // Lets a restarted server take its port while old connections sit in TIME_WAIT (on Linux it
     // does not let two servers listen on one port: a second one still gets "address in use").
+    if constexpr (std::is_same_v<Config, websocketpp::config::asio_tls>) {
+      if (std::string err = tls_context(options); !err.empty()) return err;
+    }
     ws_.set_reuse_addr(true);
     ws_.set_max_message_size(options.max_message_size);
     // A socket that never completes its opening handshake (one that connects and says nothing, or
@@ -52,7 +61,7 @@ class AsioTransport final : public Transport {
     // bursts many steps apart. Set on the accepted socket (the init handler runs before accept).
     ws_.set_tcp_post_init_handler([this](Hdl h) {
       websocketpp::lib::error_code hec;
-      WsServer::connection_ptr con = ws_.get_con_from_hdl(h, hec);
+      ConPtr con = ws_.get_con_from_hdl(h, hec);
       if (hec) return;
       asio::error_code nec;
       con->get_raw_socket().set_option(asio::ip::tcp::no_delay(true), nec);
@@ -61,7 +70,7 @@ class AsioTransport final : public Transport {
     ws_.set_open_handler([this](Hdl h) { opened(h); });
     ws_.set_close_handler([this](Hdl h) { closed(h); });
     ws_.set_fail_handler([this](Hdl h) { failed(h); });
-    ws_.set_message_handler([this](Hdl h, WsServer::message_ptr m) {
+    ws_.set_message_handler([this](Hdl h, typename WsServer::message_ptr m) {
       const auto it = ids_.find(h);
       if (it == ids_.end() || !handlers_.on_message) return;
       handlers_.on_message(it->second, m->get_payload(), m->get_opcode() != websocketpp::frame::opcode::text);
@@ -132,7 +141,7 @@ class AsioTransport final : public Transport {
   }
 
   bool send(ConnectionId id, std::string& data, bool binary) override {
-    WsServer::connection_ptr con = find(id);
+    ConPtr con = find(id);
     if (!con) return false;
     // A prepared message is written as it is: websocketpp's own preparation would copy the
     // payload twice (into a message, then into a framed one). A server frame is unmasked and we
@@ -156,12 +165,12 @@ class AsioTransport final : public Transport {
   }
 
   std::size_t buffered(ConnectionId id) const override {
-    WsServer::connection_ptr con = find(id);
+    ConPtr con = find(id);
     return con ? con->get_buffered_amount() : 0;
   }
 
   void drop(ConnectionId id) override {
-    WsServer::connection_ptr con = find(id);
+    ConPtr con = find(id);
     if (!con) return;
     // A peer that does not read would never let a close frame through: close the socket, which
     // fails the pending read and write and makes websocketpp end the connection.
@@ -170,11 +179,11 @@ class AsioTransport final : public Transport {
   }
 
  private:
-  WsServer::connection_ptr find(ConnectionId id) const {
+  ConPtr find(ConnectionId id) const {
     const auto it = hdls_.find(id);
     if (it == hdls_.end()) return nullptr;
     websocketpp::lib::error_code ec;
-    WsServer::connection_ptr con = const_cast<WsServer&>(ws_).get_con_from_hdl(it->second, ec);
+    ConPtr con = const_cast<WsServer&>(ws_).get_con_from_hdl(it->second, ec);
     return ec ? nullptr : con;
   }
 
@@ -195,6 +204,26 @@ class AsioTransport final : public Transport {
     return h;
   }
 
+  // One TLS context for every connection: TLS 1.2 or later, the certificate chain and key read
+  // (and checked against each other) once, at listen.
+  std::string tls_context(const TransportOptions& options) {
+    auto ctx = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_server);
+    asio::error_code ec;
+    ctx->set_options(asio::ssl::context::default_workarounds | asio::ssl::context::no_sslv2 |
+                         asio::ssl::context::no_sslv3 | asio::ssl::context::no_tlsv1 |
+                         asio::ssl::context::no_tlsv1_1 | asio::ssl::context::single_dh_use,
+                     ec);
+    if (!ec) SSL_CTX_set_min_proto_version(ctx->native_handle(), TLS1_2_VERSION);
+    if (!ec) ctx->use_certificate_chain_file(options.tls_cert, ec);
+    if (ec) return "TLS certificate " + options.tls_cert + ": " + ec.message();
+    ctx->use_private_key_file(options.tls_key, asio::ssl::context::pem, ec);
+    if (ec) return "TLS key " + options.tls_key + ": " + ec.message();
+    if (SSL_CTX_check_private_key(ctx->native_handle()) != 1)
+      return "TLS key " + options.tls_key + " does not match the certificate " + options.tls_cert;
+    ws_.set_tls_init_handler([ctx](Hdl) { return ctx; });
+    return {};
+  }
+
   // websocketpp reports a failed bind as "Underlying Transport Error"; a bind of our own says
   // what went wrong ("Address already in use").
   std::string bind_error(const asio::ip::tcp::endpoint& endpoint, const std::string& fallback) {
@@ -208,7 +237,7 @@ class AsioTransport final : public Transport {
 
   bool validate(Hdl h) {
     websocketpp::lib::error_code ec;
-    WsServer::connection_ptr con = ws_.get_con_from_hdl(h, ec);
+    ConPtr con = ws_.get_con_from_hdl(h, ec);
     if (ec) return false;
     if (handlers_.admit) {
       Handshake hs;
@@ -250,7 +279,7 @@ class AsioTransport final : public Transport {
 
   void failed(Hdl h) {
     websocketpp::lib::error_code ec;
-    WsServer::connection_ptr con = ws_.get_con_from_hdl(h, ec);
+    ConPtr con = ws_.get_con_from_hdl(h, ec);
     if (!ec &&
         con->get_ec() == websocketpp::error::make_error_code(websocketpp::error::open_handshake_timeout) &&
         handlers_.on_handshake_timeout) {
@@ -307,7 +336,7 @@ class AsioTransport final : public Transport {
     // Close every connection; a peer that does not answer the close is dropped by websocketpp's
     // close-handshake timeout. Then nothing is left for io_.run() and the thread ends.
     for (const auto& entry : hdls_) {
-      WsServer::connection_ptr con = ws_.get_con_from_hdl(entry.second, ec);
+      ConPtr con = ws_.get_con_from_hdl(entry.second, ec);
       if (ec) continue;
       if (con->get_buffered_amount() > 0) {
         asio::error_code aec;
@@ -326,7 +355,7 @@ class AsioTransport final : public Transport {
     });
   }
 
-  using Message = websocketpp::config::asio::message_type;
+  using Message = typename Config::message_type;
   static constexpr std::size_t kSpareMax = 64;
   // Buffers of written messages (I/O thread). Declared before ws_, whose connections may still
   // hold messages when it is destroyed.
@@ -353,8 +382,9 @@ class AsioTransport final : public Transport {
 
 }  // namespace
 
-std::unique_ptr<Transport> Transport::create() {
-  return std::make_unique<AsioTransport>();
+std::unique_ptr<Transport> Transport::create(bool tls) {
+  if (tls) return std::make_unique<AsioTransport<websocketpp::config::asio_tls>>();
+  return std::make_unique<AsioTransport<websocketpp::config::asio>>();
 }
 
 }  // namespace rbsim::foxglove::detail

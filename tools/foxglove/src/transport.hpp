@@ -36,6 +36,8 @@ struct TransportOptions {
   // A connection that has not completed its opening handshake this long after it was accepted is
   // closed.
   int handshake_timeout_ms = 5000;
+  // wss:// (a transport created with tls): the PEM certificate chain and private key files.
+  std::string tls_cert, tls_key;
 };
 
 struct TransportHandlers {
@@ -56,7 +58,8 @@ struct TransportHandlers {
 class Transport {
  public:
   // Listens on address:port; "" on success, else why not ("address already in use").
-  static std::unique_ptr<Transport> create();
+  // `tls`: wss:// (TLS 1.2 or later; listen() reads TransportOptions' certificate and key).
+  static std::unique_ptr<Transport> create(bool tls = false);
   virtual ~Transport() = default;
   virtual std::string listen(const TransportOptions& options, TransportHandlers handlers) = 0;
   virtual std::uint16_t port() const = 0;

@@ -326,6 +326,9 @@ struct ServerOptions {
   // Without a token, start() refuses an address other hosts reach (not 127.0.0.0/8 or ::1)
   // unless this is set (rbsim's --foxglove-insecure).
   bool allow_insecure = false;
+  // wss:// when set (TLS 1.2 or later, OpenSSL): the PEM certificate chain and its private key,
+  // read at start() (a file that cannot be read, or a key not the certificate's, is an error).
+  std::string tls_cert, tls_key;
 };
 
 // Tokens: at least kMinTokenLength characters, printable ASCII without spaces (33..126).
@@ -344,8 +347,8 @@ std::string url_with_token(std::string_view url, std::string_view token);
 // "127.0.0.1:8765", "8765" (the default address), "0.0.0.0:0", "[::1]:8765" -> options.address
 // and options.port; the error says what is wrong.
 [[nodiscard]] Status parse_listen_address(std::string_view text, ServerOptions& options);
-// "ws://127.0.0.1:8765" ("ws://[::1]:8765" for IPv6).
-std::string websocket_url(std::string_view address, std::uint16_t port);
+// "ws://127.0.0.1:8765" ("ws://[::1]:8765" for IPv6; wss:// with `tls`).
+std::string websocket_url(std::string_view address, std::uint16_t port, bool tls = false);
 // The link that opens Foxglove on `url`: https://app.foxglove.dev/?ds=foxglove-websocket&ds.url=...
 std::string foxglove_app_link(std::string_view url);
 
