@@ -28,7 +28,7 @@ struct RecorderServices::Impl {
   std::mutex mutex;  // guards `requests` and every Request's done and ok
   std::condition_variable answered;
   std::vector<std::shared_ptr<Request>> requests;  // shared: a handler that gave up may be gone
-  ServiceSet services;  // last: stopped before the rest goes
+  ServiceSet services;                             // last: stopped before the rest goes
 
   // The handler's side: queues `r` and waits (bounded) for the loop to carry it out.
   bool ask(bool snapshot) {
@@ -86,10 +86,11 @@ Result<std::unique_ptr<RecorderServices>> RecorderServices::create(const Partici
                  [](const Error&) { return std::optional<SplitBagfileResponse>(); }));
   }
   if (st) {
-    st = add("snapshot", SnapshotRequest::kService,
-             typed_handler<SnapshotRequest, SnapshotResponse>(
-                 [&im](const RequestHeader&, const SnapshotRequest&) { return SnapshotResponse{im.ask(true)}; },
-                 [](const Error&) { return std::optional<SnapshotResponse>(SnapshotResponse{false}); }));
+    st = add(
+        "snapshot", SnapshotRequest::kService,
+        typed_handler<SnapshotRequest, SnapshotResponse>(
+            [&im](const RequestHeader&, const SnapshotRequest&) { return SnapshotResponse{im.ask(true)}; },
+            [](const Error&) { return std::optional<SnapshotResponse>(SnapshotResponse{false}); }));
   }
   if (!st) return st.error();
   im.services.start();
@@ -127,7 +128,8 @@ Status RecorderServices::carry_out(bool quiet) {
       const Status st = im.recorder.split_now();
       ok.push_back(st.ok());
       if (!st && st.error().code != ErrorCode::InvalidArgument && failure) failure = st;
-      if (st && !quiet) RBSIM_LOG(Info, "rbsim record: split: now writing %s\n", im.recorder.files().back().c_str());
+      if (st && !quiet)
+        RBSIM_LOG(Info, "rbsim record: split: now writing %s\n", im.recorder.files().back().c_str());
     }
   }
   {

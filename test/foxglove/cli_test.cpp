@@ -11,11 +11,13 @@
 #include <nlohmann/json.hpp>
 
 #include <poll.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <csignal>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <regex>
 #include <set>
@@ -293,6 +295,135 @@ TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
                                                       "clientPublish"}));
   EXPECT_EQ(seen.services, (std::vector<std::string>{"/fox_e2e/pause", "/fox_e2e/resume", "/fox_e2e/reset",
                                                      "/fox_e2e/step", "/fox_e2e/apply_impulse"}));
+}
+
+// Binding an address other hosts reach without a token refuses to start, saying how to add one.
+TEST(FoxgloveCli, AnAddressOtherHostsReachNeedsATokenOrInsecure) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"node", scene_path(), "--foxglove", "0.0.0.0:0", "--domain", kDomain,
+                                 "--namespace", "fox_open", "--duration", "0.01", "--rate", "0"},
+        std::vector<std::string>{"bridge", "--foxglove", "0.0.0.0:0", "--domain", kDomain, "--namespace",
+                                 "fox_open"}}) {
+    const test::Outcome o = rbsim(args, std::chrono::seconds(60));
+    EXPECT_EQ(o.exit_code, 2) << o;
+    EXPECT_NE(o.err.find("error: --foxglove 0.0.0.0:0 serves other hosts"), std::string::npos) << o;
+    EXPECT_NE(o.err.find("--foxglove-token-file FILE"), std::string::npos) << o;
+    EXPECT_NE(o.err.find("--foxglove-insecure"), std::string::npos) << o;
+  }
+  const test::Outcome insecure =
+      rbsim({"node", scene_path(), "--foxglove", "0.0.0.0:0", "--foxglove-insecure", "--domain", kDomain,
+             "--namespace", "fox_open", "--duration", "0.01", "--rate", "0"},
+            std::chrono::seconds(60));
+  EXPECT_EQ(insecure.exit_code, 0) << insecure;
+  EXPECT_NE(insecure.err.find("listening on ws://0.0.0.0:"), std::string::npos) << insecure;
+}
+
+std::string write_token(const test::TempDir& dir, const std::string& name, const std::string& text,
+                        mode_t mode) {
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << text;
+  ::chmod(path.c_str(), mode);
+  return path;
+}
+
+TEST(FoxgloveCli, ABadTokenIsAUsageErrorNamingTheFileOrVariableAndTheRule) {
+  test::TempDir dir;
+  const std::string shared = write_token(dir, "shared", "0123456789abcdefgh\n", 0644);
+  const std::string shorter = write_token(dir, "short", "0123456789\n", 0600);
+  const std::vector<std::string> node{"node",       scene_path(), "--foxglove",  "0",
+                                      "--domain",   kDomain,      "--namespace", "fox_token_bad",
+                                      "--duration", "0.01",       "--rate",      "0"};
+  for (const auto& [file, rule] :
+       std::vector<std::pair<std::string, std::string>>{{shared, "chmod 600"},
+                                                        {shorter, "at least 16 characters"},
+                                                        {(dir / "none").string(), "No such file"}}) {
+    std::vector<std::string> args = node;
+    args.insert(args.end(), {"--foxglove-token-file", file});
+    const test::Outcome o = rbsim(args, std::chrono::seconds(60));
+    EXPECT_EQ(o.exit_code, 2) << o;
+    EXPECT_NE(o.err.find("rbsim node: error: token file " + file), std::string::npos) << o;
+    EXPECT_NE(o.err.find(rule), std::string::npos) << o;
+  }
+  const test::Outcome env =
+      test::run_process(RBSIM_EXE, node, std::chrono::seconds(60), {"RBSIM_FOXGLOVE_TOKEN=short"});
+  EXPECT_EQ(env.exit_code, 2) << env;
+  EXPECT_NE(env.err.find("RBSIM_FOXGLOVE_TOKEN: a token must be at least 16"), std::string::npos) << env;
+}
+
+// A node with a token: clients without it get 401 (counted in the end line), with it they are
+// served; the link carries the token only with --print-token.
+TEST(FoxgloveCli, ATokenIsAskedAndPrintedOnlyWithPrintToken) {
+  test::TempDir dir;
+  const std::string token = "tok-0123456789-abcdef";
+  const std::string file = write_token(dir, "token", token + "\n", 0600);
+  {
+    Child node({"node", scene_path(), "--foxglove", "0", "--foxglove-token-file", file, "--domain", kDomain,
+                "--namespace", "fox_token", "--rate", "1", "--duration", "3"});
+    const std::uint16_t port = node.port();
+    ASSERT_GT(port, 0) << node.err();
+    foxglove::test::WsClient without;
+    EXPECT_EQ(without.connect(port, {"foxglove.websocket.v1"}), 401) << without.response();
+    foxglove::test::WsClient with;
+    ASSERT_EQ(with.connect(port, {"foxglove.websocket.v1"}, 0, "/?token=" + token), 101) << with.response();
+    const auto info = with.read();
+    ASSERT_TRUE(info);
+    EXPECT_NE(info->data.find("serverInfo"), std::string::npos);
+    with.close();
+    EXPECT_EQ(node.stop(), 0) << node.err();
+    EXPECT_NE(node.err().find("(token required: add /?token=TOKEN, or --print-token to print it)"),
+              std::string::npos)
+        << node.err();
+    EXPECT_EQ(node.err().find(token), std::string::npos) << node.err();
+    EXPECT_NE(node.err().find("foxglove: 1 client,"), std::string::npos) << node.err();
+    EXPECT_NE(node.err().find(", 1 refused without the right token"), std::string::npos) << node.err();
+  }
+  const test::Outcome printed =
+      test::run_process(RBSIM_EXE,
+                        {"node", scene_path(), "--foxglove", "0", "--print-token", "--domain", kDomain,
+                         "--namespace", "fox_token", "--duration", "0.01", "--rate", "0"},
+                        std::chrono::seconds(60), {"RBSIM_FOXGLOVE_TOKEN=" + token});
+  EXPECT_EQ(printed.exit_code, 0) << printed;
+  EXPECT_NE(printed.err.find("%2F%3Ftoken%3D" + token + "\n"), std::string::npos) << printed;
+}
+
+// --foxglove-tls CERT KEY: wss:// in the listening line and the link; a certificate that cannot
+// be read or a key that is not the certificate's is an error naming the file. (Clients over wss://:
+// foxglove_client.tls.)
+TEST(FoxgloveCli, TlsServesWssWithACertificateAndItsKey) {
+  test::TempDir dir;
+  const auto make = [&](const std::string& name) {
+    const std::string cert = (dir / (name + ".crt")).string(), key = (dir / (name + ".key")).string();
+    const test::Outcome o = test::run_process("/usr/bin/openssl",
+                                              {"req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout",
+                                               key, "-out", cert, "-days", "1", "-subj", "/CN=127.0.0.1"},
+                                              std::chrono::seconds(60));
+    EXPECT_EQ(o.exit_code, 0) << o;
+    return std::pair{cert, key};
+  };
+  const auto [cert, key] = make("a");
+  const auto [other_cert, other_key] = make("b");
+  const auto node = [&](const std::string& c, const std::string& k) {
+    return rbsim({"node", scene_path(), "--foxglove", "0", "--foxglove-tls", c, k, "--domain", kDomain,
+                  "--namespace", "fox_tls", "--duration", "0.01", "--rate", "0"},
+                 std::chrono::seconds(60));
+  };
+  const test::Outcome ok = node(cert, key);
+  EXPECT_EQ(ok.exit_code, 0) << ok;
+  EXPECT_NE(ok.err.find("foxglove: listening on wss://127.0.0.1:"), std::string::npos) << ok;
+  EXPECT_NE(ok.err.find("ds.url=wss%3A%2F%2F127.0.0.1%3A"), std::string::npos) << ok;
+  const std::string missing = (dir / "missing.crt").string();
+  const test::Outcome no_cert = node(missing, key);
+  EXPECT_EQ(no_cert.exit_code, 1) << no_cert;
+  EXPECT_NE(no_cert.err.find("cannot listen on wss://127.0.0.1:0: TLS certificate " + missing),
+            std::string::npos)
+      << no_cert;
+  const test::Outcome mismatch = node(cert, other_key);
+  EXPECT_EQ(mismatch.exit_code, 1) << mismatch;
+  EXPECT_NE(mismatch.err.find("TLS key " + other_key + ": key values mismatch"), std::string::npos)
+      << mismatch;
+  const test::Outcome one = rbsim({"node", scene_path(), "--foxglove", "0", "--foxglove-tls", cert});
+  EXPECT_EQ(one.exit_code, 2) << one;
+  EXPECT_NE(one.err.find("--foxglove-tls"), std::string::npos) << one;
 }
 
 TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {

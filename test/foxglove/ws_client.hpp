@@ -29,7 +29,9 @@ class WsClient {
 
   // Connects and performs the handshake; returns the HTTP status line's code (101 on success) or
   // -1 on a socket error. `rcvbuf` > 0 shrinks the receive buffer (a slow client's window).
-  int connect(std::uint16_t port, const std::vector<std::string>& subprotocols, int rcvbuf = 0) {
+  // `target` is the request target ("/?token=..."), `headers` more header lines ("Name: value\r\n").
+  int connect(std::uint16_t port, const std::vector<std::string>& subprotocols, int rcvbuf = 0,
+              const std::string& target = "/", const std::string& headers = "") {
     fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
     if (fd_ < 0) return -1;
     if (rcvbuf > 0) ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
@@ -39,9 +41,10 @@ class WsClient {
     a.sin_port = htons(port);
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return -1;
-    std::string req =
-        "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n";
+    std::string req = "GET " + target +
+                      " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                      "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n" +
+                      headers;
     if (!subprotocols.empty()) {
       req += "Sec-WebSocket-Protocol: ";
       for (std::size_t i = 0; i < subprotocols.size(); ++i) req += (i ? ", " : "") + subprotocols[i];
@@ -59,6 +62,19 @@ class WsClient {
     response_ = head;
     if (head.size() < 12) return -1;
     return std::atoi(head.substr(9, 3).c_str());
+  }
+
+  // Only the TCP connection (no handshake): a socket that never speaks.
+  bool open_only(std::uint16_t port) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (fd_ < 0) return false;
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) return true;
+    close();
+    return false;
   }
 
   const std::string& response() const { return response_; }

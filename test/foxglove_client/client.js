@@ -10,7 +10,8 @@
 // topics at once; a new session per loop), hostile (bad input gets a status error or a clean close),
 // slow_client (one that stops reading loses messages and is disconnected, another loses nothing),
 // faults (killed, cycling and stalled clients do not slow the node; another loses nothing), steer
-// (parameters and services through the client's own calls: values, updates, pause/step/resume).
+// (parameters and services through the client's own calls: values, updates, pause/step/resume),
+// tls (wss:// with a certificate made here by the openssl CLI: trusted, untrusted, plain ws://).
 // Messages are matched by log time, which is simulated time. Only 127.0.0.1; every loop bounded.
 const fs = require("fs");
 const path = require("path");
@@ -500,8 +501,43 @@ async function caseSteer(check) {
   check(/foxglove: .*\d+ requests/.test(node.err), `the end line counts no requests\n${node.err}`);
 }
 
+// `rbsim node --foxglove-tls CERT KEY` serves wss://: a client trusting the test certificate
+// (made here with the openssl CLI for 127.0.0.1) gets serverInfo and the node's messages; one that
+// does not trust it is refused by its own certificate check, and a plain ws:// client gets no
+// WebSocket.
+async function caseTls(check) {
+  const cert = path.join(workdir, "cert.pem");
+  const key = path.join(workdir, "key.pem");
+  const r = require("child_process").spawnSync("openssl", ["req", "-x509", "-newkey", "rsa:2048", "-nodes",
+    "-keyout", key, "-out", cert, "-days", "1", "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1"],
+  { encoding: "utf8" });
+  if (r.status !== 0) throw new Failure(`openssl req: ${r.stderr}`);
+  const node = new Proc("node", [A.rbsim, ...nodeArgs(scene("airplane.xml"), "--rate", 1, "--duration", 30),
+    "--foxglove", "127.0.0.1:0", "--foxglove-tls", cert, key].map(String), { logDir: workdir });
+  const url = (await node.waitFor(/foxglove: listening on (wss:\/\/127\.0\.0\.1:\d+)/, 20000))[1];
+  check(/foxglove: open https:\/\/app\.foxglove\.dev\/\?ds=foxglove-websocket&ds\.url=wss%3A%2F%2F127\.0\.0\.1/
+    .test(node.err), "the printed link is not wss://");
+  const c = await new Client(need, url, { name: "trusting", wsOptions: { ca: fs.readFileSync(cert) } }).ready();
+  check(c.serverInfo.capabilities.includes("parameters"), `serverInfo capabilities ${c.serverInfo.capabilities}`);
+  await until("messages over wss://", 10000, () => c.messages.length >= 20);
+  const untrusting = new Client(need, url, { name: "untrusting", decode: false });
+  await until("the untrusting client's refusal", 10000, () => untrusting.error || untrusting.closed);
+  check(!untrusting.serverInfo, "a client that does not trust the certificate got serverInfo");
+  check(/certificate/i.test(String(untrusting.error?.message ?? untrusting.error)),
+    `untrusting client: ${untrusting.error?.message ?? "no error"}, want a certificate error`);
+  const plain = new Client(need, url.replace("wss://", "ws://"), { name: "plain", decode: false });
+  await until("the plain ws:// client's refusal", 10000, () => plain.error || plain.closed);
+  check(!plain.serverInfo, "a plain ws:// client got serverInfo from the wss:// server");
+  const before = c.messages.length;
+  await until("messages after the refused clients", 10000, () => c.messages.length > before + 10);
+  node.kill("SIGINT");
+  check((await node.wait(30000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  check(/foxglove: 1 client,/.test(node.err), `end line: want 1 client\n${node.output()}`);
+  log(`${c.messages.length} messages over wss://`);
+}
+
 const cases = { bytes: caseBytes, late_joiner: caseLateJoiner, hostile: caseHostile, slow_client: caseSlowClient,
-  faults: caseFaults, steer: caseSteer };
+  faults: caseFaults, steer: caseSteer, tls: caseTls };
 if (A.case === "child") caseChild();
 else if (!cases[A.case]) throw new Error(`unknown case ${A.case}`);
 else runMain(`foxglove_client.${A.case}`, cases[A.case]);

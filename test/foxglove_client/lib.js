@@ -117,7 +117,8 @@ function endLine(proc) {
 // A Foxglove WebSocket client: FoxgloveClient over `ws`, decoding every message from its
 // channel's advertised ros2msg schema with @foxglove/rosmsg + @foxglove/rosmsg2-serialization.
 class Client {
-  constructor(need, url, { protocol, name = "client", subscribeAll = true, decode = true } = {}) {
+  // `wsOptions`: more options for `ws` (wss://: `ca`, the certificate to trust).
+  constructor(need, url, { protocol, name = "client", subscribeAll = true, decode = true, wsOptions = {} } = {}) {
     const { FoxgloveClient } = need("@foxglove/ws-protocol");
     const WebSocket = need("ws");
     this.need = need;
@@ -132,7 +133,7 @@ class Client {
     this.error = undefined;
     this.decode = decode;
     this.subscribeAll = subscribeAll;
-    this.ws = new WebSocket(url, protocol ?? FoxgloveClient.SUPPORTED_SUBPROTOCOL, { maxPayload: 64 << 20 });
+    this.ws = new WebSocket(url, protocol ?? FoxgloveClient.SUPPORTED_SUBPROTOCOL, { maxPayload: 64 << 20, ...wsOptions });
     this.client = new FoxgloveClient({ ws: this.ws });
     this.client.on("serverInfo", (info) => (this.serverInfo = info));
     this.client.on("status", (s) => this.statuses.push(s));

@@ -15,7 +15,7 @@ namespace rbsim::cli {
 
 namespace {
 struct BridgeArgs {
-  std::optional<std::string> foxglove;  // [ADDR:]PORT (required)
+  FoxgloveArgs foxglove;  // --foxglove [ADDR:]PORT and its access options
   std::string ns = "rbsim";
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   node::NodeName node{"/", "rbsim_bridge"};             // as foxglove_bridge names its node
@@ -54,9 +54,9 @@ int bridge_command(const BridgeArgs& a) {
   steer.node = target->fully_qualified();
   auto steering = node::RemoteSteering::create(participant.value(), steer);
   if (!steering) return fail("bridge", steering.error().message);
-  auto started = start_foxglove("rbsim bridge", *a.foxglove, std::move(channels.value()),
+  auto started = start_foxglove("rbsim bridge", a.foxglove, std::move(channels.value()),
                                 steering.value().get(), steer.node);
-  if (!started) return fail("bridge", started.error().message);
+  if (!started) return fail("bridge", started.error().message, foxglove_exit_status(started.error()));
   foxglove::Server& server = *started.value();
   install_stop_handlers();
   if (!a.quiet) {

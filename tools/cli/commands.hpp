@@ -38,17 +38,30 @@ Subcommand add_bridge_command(CLI::App& parent);     // bridge.cpp: DDS -> Foxgl
 // the command's own footer.
 CLI::Option* add_domain_option(CLI::App* app, std::uint32_t& domain);
 
-// --foxglove [ADDR:]PORT (foxglove.cpp): a bad value is a usage error naming the option.
-CLI::Option* add_foxglove_option(CLI::App* app, std::optional<std::string>& address, bool required = false);
-// Starts the Foxglove server on `address` and prints, prefixed with `command`, the line
+// --foxglove [ADDR:]PORT and its access options, shared by rbsim node, replay and bridge.
+struct FoxgloveArgs {
+  std::optional<std::string> address;  // [ADDR:]PORT; unset: no server
+  std::string token_file;              // --foxglove-token-file (else RBSIM_FOXGLOVE_TOKEN)
+  bool insecure = false;               // --foxglove-insecure: no token beyond loopback
+  bool print_token = false;            // --print-token: the printed links carry the token
+  std::uint32_t max_clients = 16;      // --foxglove-max-clients
+  std::vector<std::string> tls;        // --foxglove-tls CERT KEY: wss://
+};
+// --foxglove and the options above (foxglove.cpp): a bad value is a usage error naming the option.
+CLI::Option* add_foxglove_option(CLI::App* app, FoxgloveArgs& args, bool required = false);
+// Starts the Foxglove server on `args.address` and prints, prefixed with `command`, the line
 // "foxglove: listening on ws://ADDR:PORT" (the actual port), the app.foxglove.dev link and where the
-// layout file is. Errors: a port in use, an address not on this host.
+// layout file is. Errors: a port in use, an address not on this host; with ErrorCode::InvalidArgument
+// (a usage error, exit 2) a token file or RBSIM_FOXGLOVE_TOKEN refused, a non-loopback address
+// without a token or --foxglove-insecure.
 // With a steering (rbsim node's controller, rbsim bridge's relay; `node`, the steered node's fully
 // qualified name, prefixes the services) the server offers parameters and services; replay has none.
-Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const std::string& address,
+Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const FoxgloveArgs& args,
                                                          std::vector<foxglove::ChannelSpec> channels,
                                                          control::Steering* steering = nullptr,
                                                          const std::string& node = "/rbsim");
+// The exit status for start_foxglove's error: 2 for a usage error, else 1.
+int foxglove_exit_status(const Error& error);
 // "foxglove: 2 clients, 1200 messages queued, 0 dropped for slow clients" for a command's end line.
 std::string foxglove_summary(const foxglove::Server& server);
 

@@ -25,7 +25,7 @@ struct NodeArgs {
   std::int32_t wait_for = 0;
   bool quiet = false;
   std::string topics;
-  std::optional<std::string> foxglove;  // [ADDR:]PORT
+  FoxgloveArgs foxglove;  // --foxglove [ADDR:]PORT and its access options
 };
 
 std::vector<std::string>& ros_args() {
@@ -86,7 +86,7 @@ int node_command(const NodeArgs& a) {
   std::unique_ptr<foxglove::Server> server;
   std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
   foxglove::ChannelId commands_channel = 0;  // /<ns>/commands to viewers, as on DDS
-  if (a.foxglove) {
+  if (a.foxglove.address) {
     foxglove::SinkOptions fo;
     fo.publish_every = settings.publish_every;
     fo.topics = a.node.topics;
@@ -97,9 +97,9 @@ int node_command(const NodeArgs& a) {
     served.set(static_cast<std::size_t>(msgs::TopicId::Commands));
     auto channels = foxglove::ros2_channels(served, a.node.ns, &ids);
     if (!channels) return fail("node", channels.error().message);
-    auto started = start_foxglove("rbsim node", *a.foxglove, std::move(channels.value()), &controller,
+    auto started = start_foxglove("rbsim node", a.foxglove, std::move(channels.value()), &controller,
                                   name->fully_qualified());
-    if (!started) return fail("node", started.error().message);
+    if (!started) return fail("node", started.error().message, foxglove_exit_status(started.error()));
     server = std::move(started.value());
     commands_channel = ids[static_cast<std::size_t>(msgs::TopicId::Commands)];
     foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);

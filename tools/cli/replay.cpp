@@ -27,7 +27,7 @@ struct ReplayArgs {
   bool loop = false;
   std::int32_t wait_for = 0;
   bool quiet = false;
-  std::optional<std::string> foxglove;  // [ADDR:]PORT
+  FoxgloveArgs foxglove;  // --foxglove [ADDR:]PORT and its access options
 };
 
 // The progress line on a terminal (stderr): the player's clock, the simulated time, the rate and
@@ -90,7 +90,7 @@ int replay_command(ReplayArgs a) {
   std::unique_ptr<foxglove::Server> server;
   node::Replay::Tap tap;
   std::uint64_t last_time = 0;
-  if (a.foxglove) {
+  if (a.foxglove.address) {
     std::vector<foxglove::ChannelSpec> channels;
     for (const auto& o : replay.outputs()) {
       foxglove::ChannelSpec c;
@@ -100,8 +100,8 @@ int replay_command(ReplayArgs a) {
       c.latched = o.latched;
       channels.push_back(std::move(c));
     }
-    auto started = start_foxglove("rbsim replay", *a.foxglove, std::move(channels));
-    if (!started) return fail("replay", started.error().message);
+    auto started = start_foxglove("rbsim replay", a.foxglove, std::move(channels));
+    if (!started) return fail("replay", started.error().message, foxglove_exit_status(started.error()));
     server = std::move(started.value());
     foxglove::Server* srv = server.get();
     tap.pass = [srv, &last_time] {

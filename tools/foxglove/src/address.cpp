@@ -37,9 +37,9 @@ Status parse_listen_address(std::string_view text, ServerOptions& options) {
   return Ok{};
 }
 
-std::string websocket_url(std::string_view address, std::uint16_t port) {
+std::string websocket_url(std::string_view address, std::uint16_t port, bool tls) {
   const bool v6 = address.find(':') != std::string_view::npos;
-  return "ws://" + (v6 ? "[" + std::string(address) + "]" : std::string(address)) + ":" +
+  return (tls ? "wss://" : "ws://") + (v6 ? "[" + std::string(address) + "]" : std::string(address)) + ":" +
          std::to_string(port);
 }
 

@@ -13,6 +13,7 @@
 // nothing.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <thread>
@@ -20,6 +21,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "access.hpp"
 #include "rbsim/foxglove.hpp"
 #include "services.hpp"
 #include "transport.hpp"
@@ -510,6 +512,15 @@ void Server::Impl::serve_publish(detail::ConnectionId id, ClientMessage message)
 
 Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
                                               std::vector<ChannelSpec> channels) {
+  if (options.token.empty() && !options.allow_insecure && !is_loopback(options.address)) {
+    return Error{"refusing to serve " + websocket_url(options.address, options.port) +
+                     " beyond this host without a token (or allow_insecure)",
+                 ErrorCode::InvalidArgument};
+  }
+  if (!options.token.empty()) {
+    if (const std::string problem = token_problem(options.token); !problem.empty())
+      return Error{problem, ErrorCode::InvalidArgument};
+  }
   std::unique_ptr<Server> s(new Server());
   s->impl_ = std::make_unique<Impl>();
   Impl& im = *s->impl_;
@@ -526,7 +537,8 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   im.subscribers = std::make_unique<std::atomic<std::uint32_t>[]>(im.channels.size());
   for (std::size_t i = 0; i < im.channels.size(); ++i) im.subscribers[i] = 0;
   im.new_session_locked();
-  im.transport = detail::Transport::create();
+  const bool tls = !options.tls_cert.empty();
+  im.transport = detail::Transport::create(tls);
   detail::TransportHandlers h;
   h.choose_subprotocol = [](const std::vector<std::string>& offered) {
     const auto chosen = choose_subprotocol(offered);
@@ -543,10 +555,22 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
     std::lock_guard lock(p->mu);
     ++p->totals.refused;
   };
-  const std::string err =
-      im.transport->listen(options.address, options.port, kMaxReadFrame, kTickMs, std::move(h));
+  h.admit = detail::admission(options, [p](detail::AccessGate::Verdict v) {
+    std::lock_guard lock(p->mu);
+    ++(v == detail::AccessGate::Verdict::Unauthorized  ? p->totals.unauthorized
+       : v == detail::AccessGate::Verdict::RateLimited ? p->totals.rate_limited
+                                                       : p->totals.full);
+  });
+  h.on_handshake_timeout = [p] {
+    std::lock_guard lock(p->mu);
+    ++p->totals.handshake_timeouts;
+  };
+  const std::string err = im.transport->listen(
+      {options.address, options.port, kMaxReadFrame, kTickMs,
+       static_cast<int>(std::lround(options.handshake_timeout_s * 1000)), options.tls_cert, options.tls_key},
+      std::move(h));
   if (!err.empty()) {
-    return Error{"cannot listen on " + websocket_url(options.address, options.port) + ": " + err};
+    return Error{"cannot listen on " + websocket_url(options.address, options.port, tls) + ": " + err};
   }
   if (options.steering != nullptr) {
     im.link->server = &im;

@@ -2,6 +2,7 @@
 // Everything here runs on the one I/O thread, except wake() and stop(), which post to it.
 #include "transport.hpp"
 
+#include <websocketpp/config/asio.hpp>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
@@ -12,23 +13,29 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
+#include <type_traits>
 
 namespace rbsim::foxglove::detail {
 
 namespace {
 
-using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
 
+// Config: websocketpp::config::asio (ws://) or asio_tls (wss://, options.tls_cert and tls_key).
+template <class Config>
 class AsioTransport final : public Transport {
+  using WsServer = websocketpp::server<Config>;
+  using ConPtr = typename WsServer::connection_ptr;
+
  public:
   ~AsioTransport() override { stop(); }
 
-  std::string listen(const std::string& address, std::uint16_t port, std::size_t max_message_size,
-                     int tick_ms, TransportHandlers handlers) override {
+  std::string listen(const TransportOptions& options, TransportHandlers handlers) override {
     handlers_ = std::move(handlers);
-    tick_ = std::chrono::milliseconds(tick_ms);
+    tick_ = std::chrono::milliseconds(options.tick_ms);
+    const std::string& address = options.address;
     // websocketpp logs to stdout by default; the server reports what matters itself.
     ws_.clear_access_channels(websocketpp::log::alevel::all);
     ws_.clear_error_channels(websocketpp::log::elevel::all);
@@ -37,15 +44,24 @@ class AsioTransport final : public Transport {
     if (ec) return ec.message();
     // Lets a restarted server take its port while old connections sit in TIME_WAIT (on Linux it
     // does not let two servers listen on one port: a second one still gets "address in use").
+    if constexpr (std::is_same_v<Config, websocketpp::config::asio_tls>) {
+      if (std::string err = tls_context(options); !err.empty()) return err;
+    }
     ws_.set_reuse_addr(true);
-    ws_.set_max_message_size(max_message_size);
+    ws_.set_max_message_size(options.max_message_size);
+    // A socket that never completes its opening handshake (one that connects and says nothing, or
+    // dribbles its request) is closed this long after it was accepted. The request's header is
+    // limited by websocketpp itself (http::max_header_size, 16,000 bytes: 431 beyond), and a
+    // handshake has no body.
+    ws_.set_open_handshake_timeout(options.handshake_timeout_ms);
+    ws_.set_max_http_body_size(0);
     ws_.set_listen_backlog(64);
     // Per-step messages are small and come every step: with Nagle on, the kernel holds each one
     // until the previous segment is acknowledged, and the client's delayed ACK turns that into
     // bursts many steps apart. Set on the accepted socket (the init handler runs before accept).
     ws_.set_tcp_post_init_handler([this](Hdl h) {
       websocketpp::lib::error_code hec;
-      WsServer::connection_ptr con = ws_.get_con_from_hdl(h, hec);
+      ConPtr con = ws_.get_con_from_hdl(h, hec);
       if (hec) return;
       asio::error_code nec;
       con->get_raw_socket().set_option(asio::ip::tcp::no_delay(true), nec);
@@ -53,8 +69,8 @@ class AsioTransport final : public Transport {
     ws_.set_validate_handler([this](Hdl h) { return validate(h); });
     ws_.set_open_handler([this](Hdl h) { opened(h); });
     ws_.set_close_handler([this](Hdl h) { closed(h); });
-    ws_.set_fail_handler([this](Hdl h) { closed(h); });
-    ws_.set_message_handler([this](Hdl h, WsServer::message_ptr m) {
+    ws_.set_fail_handler([this](Hdl h) { failed(h); });
+    ws_.set_message_handler([this](Hdl h, typename WsServer::message_ptr m) {
       const auto it = ids_.find(h);
       if (it == ids_.end() || !handlers_.on_message) return;
       handlers_.on_message(it->second, m->get_payload(), m->get_opcode() != websocketpp::frame::opcode::text);
@@ -62,7 +78,7 @@ class AsioTransport final : public Transport {
     asio::error_code aec;
     const asio::ip::address ip = asio::ip::make_address(address, aec);
     if (aec) return "bad address \"" + address + "\": " + aec.message();
-    const asio::ip::tcp::endpoint endpoint(ip, port);
+    const asio::ip::tcp::endpoint endpoint(ip, options.port);
     ws_.listen(endpoint, ec);
     if (ec) return bind_error(endpoint, ec.message());
     const asio::ip::tcp::endpoint local = ws_.get_local_endpoint(aec);
@@ -125,7 +141,7 @@ class AsioTransport final : public Transport {
   }
 
   bool send(ConnectionId id, std::string& data, bool binary) override {
-    WsServer::connection_ptr con = find(id);
+    ConPtr con = find(id);
     if (!con) return false;
     // A prepared message is written as it is: websocketpp's own preparation would copy the
     // payload twice (into a message, then into a framed one). A server frame is unmasked and we
@@ -149,12 +165,12 @@ class AsioTransport final : public Transport {
   }
 
   std::size_t buffered(ConnectionId id) const override {
-    WsServer::connection_ptr con = find(id);
+    ConPtr con = find(id);
     return con ? con->get_buffered_amount() : 0;
   }
 
   void drop(ConnectionId id) override {
-    WsServer::connection_ptr con = find(id);
+    ConPtr con = find(id);
     if (!con) return;
     // A peer that does not read would never let a close frame through: close the socket, which
     // fails the pending read and write and makes websocketpp end the connection.
@@ -163,11 +179,11 @@ class AsioTransport final : public Transport {
   }
 
  private:
-  WsServer::connection_ptr find(ConnectionId id) const {
+  ConPtr find(ConnectionId id) const {
     const auto it = hdls_.find(id);
     if (it == hdls_.end()) return nullptr;
     websocketpp::lib::error_code ec;
-    WsServer::connection_ptr con = const_cast<WsServer&>(ws_).get_con_from_hdl(it->second, ec);
+    ConPtr con = const_cast<WsServer&>(ws_).get_con_from_hdl(it->second, ec);
     return ec ? nullptr : con;
   }
 
@@ -188,6 +204,26 @@ class AsioTransport final : public Transport {
     return h;
   }
 
+  // One TLS context for every connection: TLS 1.2 or later, the certificate chain and key read
+  // (and checked against each other) once, at listen.
+  std::string tls_context(const TransportOptions& options) {
+    auto ctx = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_server);
+    asio::error_code ec;
+    ctx->set_options(asio::ssl::context::default_workarounds | asio::ssl::context::no_sslv2 |
+                         asio::ssl::context::no_sslv3 | asio::ssl::context::no_tlsv1 |
+                         asio::ssl::context::no_tlsv1_1 | asio::ssl::context::single_dh_use,
+                     ec);
+    if (!ec) SSL_CTX_set_min_proto_version(ctx->native_handle(), TLS1_2_VERSION);
+    if (!ec) ctx->use_certificate_chain_file(options.tls_cert, ec);
+    if (ec) return "TLS certificate " + options.tls_cert + ": " + ec.message();
+    ctx->use_private_key_file(options.tls_key, asio::ssl::context::pem, ec);
+    if (ec) return "TLS key " + options.tls_key + ": " + ec.message();
+    if (SSL_CTX_check_private_key(ctx->native_handle()) != 1)
+      return "TLS key " + options.tls_key + " does not match the certificate " + options.tls_cert;
+    ws_.set_tls_init_handler([ctx](Hdl) { return ctx; });
+    return {};
+  }
+
   // websocketpp reports a failed bind as "Underlying Transport Error"; a bind of our own says
   // what went wrong ("Address already in use").
   std::string bind_error(const asio::ip::tcp::endpoint& endpoint, const std::string& fallback) {
@@ -201,8 +237,30 @@ class AsioTransport final : public Transport {
 
   bool validate(Hdl h) {
     websocketpp::lib::error_code ec;
-    WsServer::connection_ptr con = ws_.get_con_from_hdl(h, ec);
+    ConPtr con = ws_.get_con_from_hdl(h, ec);
     if (ec) return false;
+    if (handlers_.admit) {
+      Handshake hs;
+      asio::error_code aec;
+      const asio::ip::tcp::endpoint remote = con->get_raw_socket().remote_endpoint(aec);
+      if (!aec) {
+        asio::ip::address a = remote.address();
+        if (a.is_v6() && a.to_v6().is_v4_mapped())
+          a = asio::ip::make_address_v4(asio::ip::v4_mapped, a.to_v6());
+        hs.remote_address = a.to_string();
+      }
+      hs.resource = con->get_resource();
+      hs.authorization = con->get_request_header("Authorization");
+      hs.admitted = admitted_.size();
+      const Admission verdict = handlers_.admit(hs);
+      if (verdict.status != 0) {
+        con->set_status(static_cast<websocketpp::http::status_code::value>(verdict.status));
+        if (verdict.status == 401) con->append_header("WWW-Authenticate", "Bearer realm=\"rbsim\"");
+        if (verdict.status == 429 || verdict.status == 503) con->append_header("Retry-After", "10");
+        con->set_body(verdict.body);
+        return false;
+      }
+    }
     const std::string chosen =
         handlers_.choose_subprotocol ? handlers_.choose_subprotocol(con->get_requested_subprotocols()) : "";
     if (chosen.empty()) {
@@ -214,7 +272,20 @@ class AsioTransport final : public Transport {
       return false;
     }
     con->select_subprotocol(chosen, ec);
-    return !ec;
+    if (ec) return false;
+    admitted_.insert(h);
+    return true;
+  }
+
+  void failed(Hdl h) {
+    websocketpp::lib::error_code ec;
+    ConPtr con = ws_.get_con_from_hdl(h, ec);
+    if (!ec &&
+        con->get_ec() == websocketpp::error::make_error_code(websocketpp::error::open_handshake_timeout) &&
+        handlers_.on_handshake_timeout) {
+      handlers_.on_handshake_timeout();
+    }
+    closed(h);
   }
 
   void opened(Hdl h) {
@@ -225,6 +296,7 @@ class AsioTransport final : public Transport {
   }
 
   void closed(Hdl h) {
+    admitted_.erase(h);
     const auto it = ids_.find(h);
     if (it == ids_.end()) return;  // a failed handshake: never opened
     const ConnectionId id = it->second;
@@ -264,7 +336,7 @@ class AsioTransport final : public Transport {
     // Close every connection; a peer that does not answer the close is dropped by websocketpp's
     // close-handshake timeout. Then nothing is left for io_.run() and the thread ends.
     for (const auto& entry : hdls_) {
-      WsServer::connection_ptr con = ws_.get_con_from_hdl(entry.second, ec);
+      ConPtr con = ws_.get_con_from_hdl(entry.second, ec);
       if (ec) continue;
       if (con->get_buffered_amount() > 0) {
         asio::error_code aec;
@@ -283,7 +355,7 @@ class AsioTransport final : public Transport {
     });
   }
 
-  using Message = websocketpp::config::asio::message_type;
+  using Message = typename Config::message_type;
   static constexpr std::size_t kSpareMax = 64;
   // Buffers of written messages (I/O thread). Declared before ws_, whose connections may still
   // hold messages when it is destroyed.
@@ -303,12 +375,16 @@ class AsioTransport final : public Transport {
   ConnectionId next_id_ = 1;
   std::map<Hdl, ConnectionId, std::owner_less<Hdl>> ids_;
   std::map<ConnectionId, Hdl> hdls_;
+  // Handshakes admitted (validated) and not closed yet: the opened connections and those whose
+  // answer is being written, so two handshakes at once cannot both take the last place.
+  std::set<Hdl, std::owner_less<Hdl>> admitted_;
 };
 
 }  // namespace
 
-std::unique_ptr<Transport> Transport::create() {
-  return std::make_unique<AsioTransport>();
+std::unique_ptr<Transport> Transport::create(bool tls) {
+  if (tls) return std::make_unique<AsioTransport<websocketpp::config::asio_tls>>();
+  return std::make_unique<AsioTransport<websocketpp::config::asio>>();
 }
 
 }  // namespace rbsim::foxglove::detail

@@ -309,26 +309,63 @@ struct ServerOptions {
   // beyond which its requests are refused unanswered (one status error per backlog).
   std::uint32_t max_pending_commands = 32;
   std::size_t max_reply_backlog_bytes = 4u << 20;
+
+  // Access, decided before the WebSocket upgrade (the HTTP status and a one-line body):
+  //  - with a token (non-empty), a client must present it, as ?token=... in the URL (percent-
+  //    decoded) or an `Authorization: Bearer ...` header, else 401; compared in constant time;
+  //  - a remote address with auth_failures_max failures within auth_failure_window_s gets 429
+  //    (without its token being looked at) until the oldest of them is that old (0: no limit);
+  //  - beyond max_clients connections (admitted and not closed), 503;
+  //  - a connection that has not completed its handshake handshake_timeout_s after it was accepted
+  //    is closed.
+  std::string token;
+  std::uint32_t auth_failures_max = 5;
+  double auth_failure_window_s = 10.0;
+  std::uint32_t max_clients = 16;
+  double handshake_timeout_s = 5.0;
+  // Without a token, start() refuses an address other hosts reach (not 127.0.0.0/8 or ::1)
+  // unless this is set (rbsim's --foxglove-insecure).
+  bool allow_insecure = false;
+  // wss:// when set (TLS 1.2 or later, OpenSSL): the PEM certificate chain and its private key,
+  // read at start() (a file that cannot be read, or a key not the certificate's, is an error).
+  std::string tls_cert, tls_key;
 };
+
+// Tokens: at least kMinTokenLength characters, printable ASCII without spaces (33..126).
+inline constexpr std::size_t kMinTokenLength = 16;
+// "" when `token` is one, else the rule it breaks.
+std::string token_problem(std::string_view token);
+// The token in `path`: the file's text without its trailing newline (\n or \r\n). Refused: a
+// file group or others may read or write (chmod 600 it), one that cannot be read, and a token
+// token_problem() refuses; the error names the file and the rule.
+Result<std::string> read_token_file(const std::string& path);
+// True for 127.0.0.0/8 and ::1 (and ::ffff:127.x.y.z): addresses only this host reaches.
+bool is_loopback(std::string_view address);
+// `url` with ?token=... appended (the token percent-encoded).
+std::string url_with_token(std::string_view url, std::string_view token);
 
 // "127.0.0.1:8765", "8765" (the default address), "0.0.0.0:0", "[::1]:8765" -> options.address
 // and options.port; the error says what is wrong.
 [[nodiscard]] Status parse_listen_address(std::string_view text, ServerOptions& options);
-// "ws://127.0.0.1:8765" ("ws://[::1]:8765" for IPv6).
-std::string websocket_url(std::string_view address, std::uint16_t port);
+// "ws://127.0.0.1:8765" ("ws://[::1]:8765" for IPv6; wss:// with `tls`).
+std::string websocket_url(std::string_view address, std::uint16_t port, bool tls = false);
 // The link that opens Foxglove on `url`: https://app.foxglove.dev/?ds=foxglove-websocket&ds.url=...
 std::string foxglove_app_link(std::string_view url);
 
 // Counts over the server's life.
 struct ServerStats {
-  std::uint64_t clients = 0;           // connections accepted
-  std::uint64_t refused = 0;           // handshakes refused (no foxglove subprotocol)
-  std::uint64_t dropped = 0;           // per-step frames dropped for slow clients
-  std::uint64_t warnings = 0;          // overflow bursts warned about
-  std::uint64_t disconnected = 0;      // clients disconnected for not reading
-  std::uint64_t published = 0;         // messages handed to the server (publish calls that queued)
-  std::uint64_t requests = 0;          // parameter requests and service calls carried out
-  std::uint64_t refused_requests = 0;  // refused for a client's backlog or commands in flight
+  std::uint64_t clients = 0;             // connections accepted
+  std::uint64_t refused = 0;             // handshakes refused for their subprotocols
+  std::uint64_t dropped = 0;             // per-step frames dropped for slow clients
+  std::uint64_t warnings = 0;            // overflow bursts warned about
+  std::uint64_t disconnected = 0;        // clients disconnected for not reading
+  std::uint64_t published = 0;           // messages handed to the server (publish calls that queued)
+  std::uint64_t requests = 0;            // parameter requests and service calls carried out
+  std::uint64_t refused_requests = 0;    // refused for a client's backlog or commands in flight
+  std::uint64_t unauthorized = 0;        // handshakes refused for a missing or wrong token (401)
+  std::uint64_t rate_limited = 0;        // handshakes refused for their address's failures (429)
+  std::uint64_t full = 0;                // handshakes refused beyond max_clients (503)
+  std::uint64_t handshake_timeouts = 0;  // connections closed for not completing the handshake
 };
 
 // Serves a fixed set of channels on its own I/O thread. publish(), time() and new_session() are
