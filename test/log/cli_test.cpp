@@ -630,6 +630,10 @@ TEST(LogCli, BagDirectoryIsReadWhereverAFileIs) {
   }
   EXPECT_EQ(read_text(fs::path(bag + ".frames") / "frame00001.png"),
             read_text(fs::path(file + ".frames") / "frame00001.png"));
+  const Outcome doctor = rbsim({"log", "doctor", bag});
+  EXPECT_EQ(doctor.exit_code, 0) << describe(doctor);
+  EXPECT_NE(doctor.out.find("Examining " + (fs::path(bag) / "run_0.mcap").string()), std::string::npos)
+      << doctor.out;
   const Outcome info = rbsim({"log", "info", bag});
   EXPECT_EQ(info.exit_code, 0) << describe(info);
   EXPECT_NE(info.out.find("(rosbag2, 1 file)"), std::string::npos) << info.out;

@@ -122,24 +122,30 @@ int info_command(const LogOptions& o) {
   return 0;
 }
 
+// A bag directory: each of its files in turn; the first file with an error fails the command.
 int doctor_command(const LogOptions& o) {
   mcap_tools::DoctorOptions options;
   options.strict_message_order = o.strict_message_order;
-  std::printf("Examining %s\n", o.file.c_str());
-  const mcap_tools::DoctorReport report = mcap_tools::doctor(o.file, options);
-  for (const mcap_tools::DoctorFinding& f : report.findings) {
-    std::printf("%s: %s\n", f.error ? "error" : "warning", f.text.c_str());
+  const Result<std::vector<std::string>> files = log::recording_files(o.file);
+  if (!files) return fail("log doctor", files.error().message);
+  int status = 0;
+  for (const std::string& file : files.value()) {
+    std::printf("Examining %s\n", file.c_str());
+    const mcap_tools::DoctorReport report = mcap_tools::doctor(file, options);
+    for (const mcap_tools::DoctorFinding& f : report.findings) {
+      std::printf("%s: %s\n", f.error ? "error" : "warning", f.text.c_str());
+    }
+    std::printf("%llu errors, %llu warnings\n", static_cast<unsigned long long>(report.errors),
+                static_cast<unsigned long long>(report.warnings));
+    std::fflush(stdout);
+    if (!report.ok() && status == 0) {
+      const std::string more =
+          report.errors > 1 ? " (and " + std::to_string(report.errors - 1) + " more errors, listed on stdout)"
+                            : "";
+      status = fail("log doctor", file + ": " + report.first_error() + more);
+    }
   }
-  std::printf("%llu errors, %llu warnings\n", static_cast<unsigned long long>(report.errors),
-              static_cast<unsigned long long>(report.warnings));
-  std::fflush(stdout);
-  if (!report.ok()) {
-    const std::string more =
-        report.errors > 1 ? " (and " + std::to_string(report.errors - 1) + " more errors, listed on stdout)"
-                          : "";
-    return fail("log doctor", o.file + ": " + report.first_error() + more);
-  }
-  return 0;
+  return status;
 }
 
 int recover_command(const LogOptions& o) {
@@ -303,7 +309,7 @@ Subcommand add_log_command(CLI::App& parent) {
       "doctor",
       "Check a recording's structure the way 'mcap doctor' does: magic, header/footer, records, chunk CRCs "
       "and decompression, message and chunk indexes, statistics, summary offsets, data and summary CRCs");
-  doctor->add_option("file", o->file, "MCAP file")->required();
+  doctor->add_option("file", o->file, "MCAP file or rosbag2 bag directory (each of its files)")->required();
   doctor->add_flag("--strict-message-order", o->strict_message_order,
                    "Messages out of log-time order are errors (by default warnings)");
   doctor->footer(

@@ -36,7 +36,9 @@ void emit_nanoseconds(YAML::Emitter& y, const char* key, const char* unit, std::
 }  // namespace
 
 bool is_bag_output(std::string_view path) {
-  return !(path.size() >= 5 && path.substr(path.size() - 5) == ".mcap");
+  std::error_code ec;
+  return !(path.size() >= 5 && path.substr(path.size() - 5) == ".mcap") &&
+         !fs::is_regular_file(fs::path(path), ec);
 }
 
 std::string bag_file(const std::string& dir, std::size_t index) {

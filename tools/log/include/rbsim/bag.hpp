@@ -1,6 +1,7 @@
 // rosbag2's bag directory, as ROS 2 Jazzy's recorder writes it with the mcap storage: DIR/metadata.yaml
 // (what `ros2 bag info DIR` and the `rosbags` library open) beside the recording files DIR/DIR_0.mcap,
-// DIR_1.mcap, ... An output path ending in ".mcap" is one file; any other is a bag directory.
+// DIR_1.mcap, ... An output path ending in ".mcap" is one file, as is an existing file (a script's
+// temporary, replaced with --overwrite); any other path is a bag directory.
 #pragma once
 
 #include <cstddef>
@@ -19,7 +20,7 @@ inline constexpr std::string_view kBagMetadataFile = "metadata.yaml";
 // The rosbag2 metadata version Jazzy writes (QoS policies by name).
 inline constexpr int kBagMetadataVersion = 9;
 
-// True when an output path names a bag directory (it does not end in ".mcap").
+// True when an output path names a bag directory (not ending in ".mcap", not an existing file).
 bool is_bag_output(std::string_view path);
 // The path of file `index` of bag `dir`: "runs/bag" -> "runs/bag/bag_0.mcap".
 std::string bag_file(const std::string& dir, std::size_t index);
