@@ -102,13 +102,14 @@ RecorderServices::~RecorderServices() {
   impl_->services.stop();
 }
 
-Status RecorderServices::carry_out(bool quiet) {
+Status RecorderServices::carry_out(bool quiet, bool snapshot) {
   Impl& im = *impl_;
   std::vector<std::shared_ptr<Impl::Request>> now;
   {
     const std::lock_guard lock(im.mutex);
     now.swap(im.requests);
   }
+  if (snapshot) now.push_back(std::make_shared<Impl::Request>(Impl::Request{true}));
   if (now.empty()) return Ok{};
   Status failure = Ok{};
   std::vector<bool> ok;

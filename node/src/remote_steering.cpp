@@ -7,7 +7,7 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/relay.hpp"
-#include "rbsim/type_hash.hpp"
+#include "service_set.hpp"
 
 namespace rbsim::node {
 
@@ -41,22 +41,11 @@ CommandResult failed(std::string message) {
 }
 
 // One call: `request` encoded, sent once the node's service matched, its reply decoded as `Res`.
-template <class Res, class Req>
-Result<Res> call(ServiceClient& client, const Req& request, const RemoteSteeringOptions& o) {
-  if (!client.server_ready() && !client.wait_for_server(o.match_timeout_s)) {
-    return Error{"node " + o.node + " does not serve " + std::string(Req::kService) +
-                 " (is it running, on this domain?)"};
-  }
-  Bytes body;
-  msgs::encode(request, body);
-  Result<Bytes> reply = client.call(body, o.call_timeout_s);
-  if (!reply) return Error{"node " + o.node + ": " + reply.error().message};
-  Res res;
-  if (Status st = msgs::decode(reply.value(), res); !st) {
-    return Error{"node " + o.node + " replied with a malformed " + std::string(Req::kService) + ": " +
-                 st.error().message};
-  }
-  return res;
+// Waits (bounded) for `client`'s server to match; the error names the node and the service type.
+Status matched(ServiceClient& client, std::string_view service, const RemoteSteeringOptions& o) {
+  if (client.server_ready() || client.wait_for_server(o.match_timeout_s)) return Ok{};
+  return Error{"node " + o.node + " does not serve " + std::string(service) +
+               " (is it running, on this domain?)"};
 }
 
 struct Request {
@@ -118,6 +107,17 @@ Result<Res> decode_reply(std::span<const std::byte> reply, const RemoteSteeringO
                  " response: " + st.error().message};
   }
   return res;
+}
+
+// One call, waited for: `request` sent once the node's service matched, its reply decoded.
+template <class Res, class Req>
+Result<Res> call(ServiceClient& client, const Req& request, const RemoteSteeringOptions& o) {
+  if (Status st = matched(client, Req::kService, o); !st) return st.error();
+  Bytes body;
+  msgs::encode(request, body);
+  Result<Bytes> reply = client.call(body, o.call_timeout_s);
+  if (!reply) return Error{"node " + o.node + ": " + reply.error().message};
+  return decode_reply<Res>(reply.value(), o);
 }
 
 // A reply of a control service as a result; `step` the boundary it applied at when the reply says.
@@ -188,12 +188,8 @@ Result<std::unique_ptr<RemoteSteering>> RemoteSteering::create(const Participant
   s->options_ = options;
   auto add = [&](std::string_view name, std::string_view type) -> Status {
     ClientOptions co;
-    if (has_type_hashes(participant.distro())) {
-      Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(type);
-      if (!h) return h.error();
-      co.request_user_data = msgs::typehash_user_data(h->request);
-      co.reply_user_data = msgs::typehash_user_data(h->reply);
-    }
+    if (Status st = type_hash_user_data(participant, type, co.request_user_data, co.reply_user_data); !st)
+      return st;
     Result<ServiceClient> c =
         ServiceClient::create(participant, options.node + "/" + std::string(name), type, co);
     if (!c) return c.error();
@@ -329,9 +325,8 @@ void RemoteSteering::send(Pending pending, std::vector<InFlight>& out) {
     return;
   }
   ServiceClient& c = client(request->client);
-  if (!c.server_ready() && !c.wait_for_server(options_.match_timeout_s)) {
-    pending.done(failed("node " + options_.node + " does not serve " + request->service +
-                        " (is it running, on this domain?)"));
+  if (Status st = matched(c, request->service, options_); !st) {
+    pending.done(failed(st.error().message));
     return;
   }
   Result<std::int64_t> seq = c.send(request->body);

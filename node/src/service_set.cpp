@@ -8,6 +8,16 @@
 
 namespace rbsim::node {
 
+Status type_hash_user_data(const Participant& participant, std::string_view srv_type, std::string& request,
+                           std::string& reply) {
+  if (!has_type_hashes(participant.distro())) return Ok{};
+  Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
+  if (!h) return h.error();
+  request = msgs::typehash_user_data(h->request);
+  reply = msgs::typehash_user_data(h->reply);
+  return Ok{};
+}
+
 ServiceSet::~ServiceSet() {
   stop();
 }
@@ -15,12 +25,8 @@ ServiceSet::~ServiceSet() {
 Status ServiceSet::add(const Participant& participant, const std::string& node, std::string_view name,
                        std::string_view srv_type, ServiceServer::Handler handler) {
   ServiceOptions so;
-  if (has_type_hashes(participant.distro())) {
-    Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
-    if (!h) return h.error();
-    so.request_user_data = msgs::typehash_user_data(h->request);
-    so.reply_user_data = msgs::typehash_user_data(h->reply);
-  }
+  if (Status st = type_hash_user_data(participant, srv_type, so.request_user_data, so.reply_user_data); !st)
+    return st;
   so.on_arrival = [this] {
     {
       const std::lock_guard lock(mutex_);

@@ -18,6 +18,11 @@
 
 namespace rbsim::node {
 
+// The USER_DATA "typehash=RIHS01_...;" of a service's request and reply endpoints (a server's or a
+// client's), as rmw_cyclonedds_cpp writes it; left empty under Humble, which has no type hashes.
+[[nodiscard]] Status type_hash_user_data(const Participant& participant, std::string_view srv_type,
+                                         std::string& request, std::string& reply);
+
 class ServiceSet {
  public:
   ServiceSet() = default;

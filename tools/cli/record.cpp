@@ -128,21 +128,9 @@ int record_command(RecordArgs a) {
       break;
     }
     if (a.rec.max_messages > 0 && recorder.value()->received() >= a.rec.max_messages) break;
-    if (Status st = services.value()->carry_out(a.quiet); !st) {
+    if (Status st = services.value()->carry_out(a.quiet, snapshot_requested()); !st) {
       failure = st.error().message;
       break;
-    }
-    if (a.rec.snapshot_duration_ns > 0 && snapshot_requested()) {
-      Result<std::uint64_t> n = recorder.value()->snapshot();
-      if (!n) {
-        failure = n.error().message;
-        break;
-      }
-      if (!a.quiet) {
-        RBSIM_LOG(Info, "rbsim record: snapshot: %llu messages written to %s\n",
-                  static_cast<unsigned long long>(n.value()),
-                  n.value() > 0 ? recorder.value()->files().back().c_str() : "nothing (none kept yet)");
-      }
     }
   }
   // Whatever stopped us, finish a valid indexed file.

@@ -184,8 +184,9 @@ class RecorderServices {
   RecorderServices(const RecorderServices&) = delete;
   RecorderServices& operator=(const RecorderServices&) = delete;
   // The recording loop's thread: carries out the splits and snapshots asked for since the last
-  // call, and says what it did on stderr (unless quiet). A failure to write is returned.
-  [[nodiscard]] Status carry_out(bool quiet);
+  // call, and one more snapshot with `snapshot` (SIGUSR1), and says what it did on stderr (unless
+  // quiet). A failure to write is returned.
+  [[nodiscard]] Status carry_out(bool quiet, bool snapshot = false);
 
  private:
   RecorderServices() = default;

@@ -8,7 +8,6 @@
 #include <sys/stat.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -60,23 +59,6 @@ bool is_loopback(std::string_view address) {
   if (inet_pton(AF_INET6, a.c_str(), &a6) != 1) return false;
   if (IN6_IS_ADDR_LOOPBACK(&a6)) return true;
   return IN6_IS_ADDR_V4MAPPED(&a6) && a6.s6_addr[12] == 127;
-}
-
-std::string url_with_token(std::string_view url, std::string_view token) {
-  std::string out(url);
-  out += "/?token=";
-  for (const char ch : token) {
-    const auto c = static_cast<unsigned char>(ch);
-    if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
-        c == '.' || c == '~') {
-      out.push_back(ch);
-    } else {
-      char hex[4];
-      std::snprintf(hex, sizeof hex, "%%%02X", c);
-      out += hex;
-    }
-  }
-  return out;
 }
 
 namespace detail {

@@ -1,11 +1,31 @@
 // The server's listen address and the links a command prints (rbsim/foxglove.hpp).
 #include <arpa/inet.h>
 
+#include <cstdio>
 #include <string>
 
 #include "rbsim/foxglove.hpp"
 
 namespace rbsim::foxglove {
+
+namespace {
+// RFC 3986: every byte but the unreserved characters as %XX.
+std::string percent_encode(std::string_view text) {
+  std::string out;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
+        c == '.' || c == '~') {
+      out.push_back(ch);
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", c);
+      out += hex;
+    }
+  }
+  return out;
+}
+}  // namespace
 
 Status parse_listen_address(std::string_view text, ServerOptions& options) {
   std::string address = "127.0.0.1";
@@ -44,19 +64,11 @@ std::string websocket_url(std::string_view address, std::uint16_t port, bool tls
 }
 
 std::string foxglove_app_link(std::string_view url) {
-  std::string encoded;
-  for (const char ch : url) {
-    const auto c = static_cast<unsigned char>(ch);
-    if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
-        c == '.' || c == '~') {
-      encoded.push_back(ch);
-    } else {
-      char hex[4];
-      std::snprintf(hex, sizeof hex, "%%%02X", c);
-      encoded += hex;
-    }
-  }
-  return "https://app.foxglove.dev/?ds=foxglove-websocket&ds.url=" + encoded;
+  return "https://app.foxglove.dev/?ds=foxglove-websocket&ds.url=" + percent_encode(url);
+}
+
+std::string url_with_token(std::string_view url, std::string_view token) {
+  return std::string(url) + "/?token=" + percent_encode(token);
 }
 
 }  // namespace rbsim::foxglove
