@@ -141,11 +141,17 @@ Status Recorder::open_file() {
   return Ok{};
 }
 
+// Closes the open file of the bag and lists it in metadata.yaml (each file's summary read once).
+Status Recorder::close_bag_file() {
+  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
+  if (Status st = bag_metadata_.add(options_.path); !st) return st;
+  return bag_metadata_.write(options_.bag);
+}
+
 // Closes the open file, lists it in the bag's metadata and opens the next, which defines every
 // channel under its old id and starts with the latched topics' latest messages at `log_time`.
 Status Recorder::split(std::uint64_t log_time) {
-  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
-  if (Status st = log::write_bag_metadata(options_.bag, files_); !st) return st;
+  if (Status st = close_bag_file(); !st) return st;
   if (Status st = open_file(); !st) return st;
   if (Status st = add_channels(); !st) return st;
   file_start_ = log_time;
@@ -178,7 +184,7 @@ Status Recorder::split_now() {
                  ErrorCode::InvalidArgument};
   }
   if (file_start_ == 0) return Ok{};  // nothing in the open file yet: it stays the new one
-  return split(file_start_ > 0 ? std::max(file_start_, wall_ns()) : wall_ns());
+  return split(std::max(file_start_, wall_ns()));
 }
 
 // Snapshot mode: the sample is kept (copied) instead of written; the oldest go once they are
@@ -221,8 +227,7 @@ Result<std::uint64_t> Recorder::snapshot() {
   }
   kept_.clear();
   kept_bytes_ = 0;
-  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
-  if (Status st = log::write_bag_metadata(options_.bag, files_); !st) return st.error();
+  if (Status st = close_bag_file(); !st) return st.error();
   return n;
 }
 
@@ -391,8 +396,8 @@ Status Recorder::close() {
   if (Status st = release_held(); !st) return st;
   if (options_.snapshot_duration_ns > 0)
     return Ok{};  // what a snapshot did not take is dropped, as rosbag2's
+  if (!options_.bag.empty() && received_ > 0) return close_bag_file();
   if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
-  if (!options_.bag.empty() && received_ > 0) return log::write_bag_metadata(options_.bag, files_);
   return Ok{};
 }
 

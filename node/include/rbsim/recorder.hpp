@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "rbsim/bag.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/mcap.hpp"
 
@@ -123,6 +124,8 @@ class Recorder {
   std::uint64_t file_bytes_ = 0;            // the open file's size as last seen (every 16 messages)
   std::uint64_t written_ = 0;
   [[nodiscard]] Status open_file();
+  [[nodiscard]] Status close_bag_file();
+  log::BagMetadata bag_metadata_;  // the bag's closed files
   [[nodiscard]] Status split(std::uint64_t log_time);
   [[nodiscard]] Status add_channels();
   // Snapshot mode's buffer: per-step and event messages in arrival order.

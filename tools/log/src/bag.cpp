@@ -17,11 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TopicInfo {
-  std::string type, qos, hash;
-  std::uint64_t count = 0;
-};
-
 std::string value_of(const mcap::KeyValueMap& m, const std::string& key) {
   const auto it = m.find(key);
   return it == m.end() ? std::string() : it->second;
@@ -64,42 +59,48 @@ Status make_bag_directory(const std::string& dir) {
   return Ok{};
 }
 
-Status write_bag_metadata(const std::string& dir, const std::vector<std::string>& files) {
-  std::map<std::string, TopicInfo> topics;  // by name: rosbag2 lists each topic once
-  std::vector<std::string> topic_order;
-  struct FileInfo {
-    std::string name;
-    std::uint64_t start = 0, end = 0, count = 0;
-  };
-  std::vector<FileInfo> infos;
-  for (const std::string& file : files) {
-    mcap::IndexedReader reader;
-    if (Status st = reader.open(file); !st) return Error{file + ": " + mcap_tools::read_error(st.error())};
-    FileInfo info{fs::path(file).filename().string()};
-    if (const auto& stats = reader.statistics()) {
-      info.start = stats->message_start_time;
-      info.end = stats->message_end_time;
-      info.count = stats->message_count;
-    }
-    for (const auto& [id, channel] : reader.channels()) {
-      auto [it, fresh] = topics.try_emplace(channel.topic);
-      if (fresh) {
-        topic_order.push_back(channel.topic);
-        const auto schema = reader.schemas().find(channel.schema_id);
-        it->second.type = schema == reader.schemas().end() ? std::string() : schema->second.name;
-        it->second.qos = value_of(channel.metadata, "offered_qos_profiles");
-        it->second.hash = value_of(channel.metadata, "topic_type_hash");
-      }
-      if (const auto& stats = reader.statistics()) {
-        if (const auto n = stats->channel_message_counts.find(id); n != stats->channel_message_counts.end())
-          it->second.count += n->second;
-      }
-    }
-    infos.push_back(info);
+Status BagMetadata::add(const std::string& file) {
+  mcap::IndexedReader reader;
+  if (Status st = reader.open(file); !st) return Error{file + ": " + mcap_tools::read_error(st.error())};
+  File info{fs::path(file).filename().string()};
+  const auto& stats = reader.statistics();
+  if (stats) {
+    info.start = stats->message_start_time;
+    info.end = stats->message_end_time;
+    info.count = stats->message_count;
   }
+  for (const auto& [id, channel] : reader.channels()) {
+    auto it =
+        std::find_if(topics_.begin(), topics_.end(), [&](const Topic& t) { return t.name == channel.topic; });
+    if (it == topics_.end()) {  // rosbag2 lists each topic once, as first recorded
+      const auto schema = reader.schemas().find(channel.schema_id);
+      topics_.push_back({channel.topic,
+                         schema == reader.schemas().end() ? std::string() : schema->second.name,
+                         value_of(channel.metadata, "offered_qos_profiles"),
+                         value_of(channel.metadata, "topic_type_hash")});
+      it = topics_.end() - 1;
+    }
+    if (stats) {
+      if (const auto n = stats->channel_message_counts.find(id); n != stats->channel_message_counts.end())
+        it->count += n->second;
+    }
+  }
+  files_.push_back(std::move(info));
+  return Ok{};
+}
+
+Status write_bag_metadata(const std::string& dir, const std::vector<std::string>& files) {
+  BagMetadata metadata;
+  for (const std::string& file : files) {
+    if (Status st = metadata.add(file); !st) return st;
+  }
+  return metadata.write(dir);
+}
+
+Status BagMetadata::write(const std::string& dir) const {
   std::uint64_t start = 0, end = 0, count = 0;
   bool any = false;
-  for (const FileInfo& f : infos) {
+  for (const File& f : files_) {
     count += f.count;
     if (f.count == 0) continue;
     start = any ? std::min(start, f.start) : f.start;
@@ -114,8 +115,8 @@ Status write_bag_metadata(const std::string& dir, const std::vector<std::string>
   emit_nanoseconds(y, "starting_time", "nanoseconds_since_epoch", start);
   y << YAML::Key << "message_count" << YAML::Value << count;
   y << YAML::Key << "topics_with_message_count" << YAML::Value << YAML::BeginSeq;
-  for (const std::string& name : topic_order) {
-    const TopicInfo& t = topics.at(name);
+  for (const Topic& t : topics_) {
+    const std::string& name = t.name;
     y << YAML::BeginMap << YAML::Key << "topic_metadata" << YAML::Value << YAML::BeginMap;
     y << YAML::Key << "name" << YAML::Value << name << YAML::Key << "type" << YAML::Value << t.type;
     y << YAML::Key << "serialization_format" << YAML::Value << "cdr";
@@ -127,9 +128,9 @@ Status write_bag_metadata(const std::string& dir, const std::vector<std::string>
   y << YAML::Key << "compression_format" << YAML::Value << "" << YAML::Key << "compression_mode"
     << YAML::Value << "";
   y << YAML::Key << "relative_file_paths" << YAML::Value << YAML::BeginSeq;
-  for (const FileInfo& f : infos) y << f.name;
+  for (const File& f : files_) y << f.name;
   y << YAML::EndSeq << YAML::Key << "files" << YAML::Value << YAML::BeginSeq;
-  for (const FileInfo& f : infos) {
+  for (const File& f : files_) {
     y << YAML::BeginMap << YAML::Key << "path" << YAML::Value << f.name;
     emit_nanoseconds(y, "starting_time", "nanoseconds_since_epoch", f.start);
     emit_nanoseconds(y, "duration", "nanoseconds", f.end - f.start);

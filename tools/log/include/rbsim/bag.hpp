@@ -36,6 +36,26 @@ std::vector<OutputPath> bag_outputs(const std::string& dir, const std::string& o
 // QoS and type hash (the channel metadata rosbag2's mcap storage writes) and message count, each
 // file's start, duration and count, and the bag's. Fails naming a file that cannot be read.
 [[nodiscard]] Status write_bag_metadata(const std::string& dir, const std::vector<std::string>& files);
+// The same, file by file, for a writer that adds files as it closes them (a splitting recorder):
+// add() reads a finished file's summary once, write() (re)writes `dir`/metadata.yaml atomically
+// from every file added so far.
+class BagMetadata {
+ public:
+  [[nodiscard]] Status add(const std::string& file);
+  [[nodiscard]] Status write(const std::string& dir) const;
+
+ private:
+  struct Topic {
+    std::string name, type, qos, hash;
+    std::uint64_t count = 0;
+  };
+  struct File {
+    std::string name;
+    std::uint64_t start = 0, end = 0, count = 0;
+  };
+  std::vector<Topic> topics_;  // in the order first recorded
+  std::vector<File> files_;
+};
 
 // The recording files `path` names: itself for a file; for a directory, the files its
 // metadata.yaml lists, in order (errors name the directory and what is wrong: no metadata.yaml, a
