@@ -36,6 +36,7 @@ MODULES = {
     "node": ("node", {"core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
     "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden", "control"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "control", "msgs"}),
+    "python": ("python", {"core", "scene", "io", "control", "msgs", "mcap", "log", "check"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"rbsim/([A-Za-z0-9_]+\.hpp)"', re.M)

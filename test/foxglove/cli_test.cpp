@@ -217,7 +217,8 @@ struct Seen {
   nlohmann::json capabilities;        // the first serverInfo's
   std::vector<std::string> services;  // advertised
 };
-Seen watch(std::uint16_t port, int frames, const std::string& stop_topic = "", int stop_count = 0) {
+// Reads up to `frames` frames, or until every topic in `until` has arrived at least that often.
+Seen watch(std::uint16_t port, int frames, const std::map<std::string, int>& until = {}) {
   Seen seen;
   foxglove::test::WsClient c;
   EXPECT_EQ(c.connect(port, {"foxglove.sdk.v1"}), 101);
@@ -269,7 +270,10 @@ Seen watch(std::uint16_t port, int frames, const std::string& stop_topic = "", i
     if (seen.last_time.count(topic) > 0 && t < seen.last_time[topic]) seen.decreasing.insert(topic);
     seen.last_time[topic] = t;
     seen.max_time[topic] = std::max(seen.max_time[topic], t);
-    if (!stop_topic.empty() && seen.counts[stop_topic] >= stop_count) break;
+    if (!until.empty() && std::all_of(until.begin(), until.end(),
+                                      [&](const auto& u) { return seen.counts[u.first] >= u.second; })) {
+      break;
+    }
   }
   return seen;
 }
@@ -436,7 +440,7 @@ TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {
   const std::uint16_t port = replay.port();
   ASSERT_GT(port, 0) << replay.err();
   // 0.1 s of log at half speed: a pass every 0.2 s; watch a few.
-  const Seen seen = watch(port, 3000, "/fox_rp/scene", 3);
+  const Seen seen = watch(port, 3000, {{"/fox_rp/scene", 3}});
   EXPECT_EQ(replay.stop(), 0) << replay.err();
   EXPECT_GE(seen.counts.at("/fox_rp/scene"), 3) << "the scene again in every pass";
   EXPECT_GE(seen.server_infos, 2);
@@ -456,7 +460,9 @@ TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {
   ASSERT_GT(port, 0) << bridge.err();
   Child node({"node", scene_path(), "--domain", kDomain, "--namespace", "fox_br", "--rate", "1", "--duration",
               "20"});
-  const Seen seen = watch(port, 2000, "/fox_br/body_states", 100);
+  // Discovery matches each reader on its own: the scene may reach the bridge after the first body
+  // states, so wait for both.
+  const Seen seen = watch(port, 4000, {{"/fox_br/body_states", 100}, {"/fox_br/scene", 1}});
   EXPECT_EQ(node.stop(), 0) << node.err();
   EXPECT_EQ(bridge.stop(), 0) << bridge.err();
   EXPECT_GE(seen.counts.count("/fox_br/body_states") ? seen.counts.at("/fox_br/body_states") : 0, 100)

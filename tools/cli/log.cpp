@@ -86,7 +86,7 @@ int merge_command(const LogOptions& o) {
                 2);
   }
   for (const std::string& ns : o.namespaces) {
-    if (const std::string problem = ns == "/" ? "" : ros_namespace_problem(ns); !problem.empty())
+    if (const std::string problem = ns == "/" ? "" : msgs::ros_namespace_problem(ns); !problem.empty())
       return fail("log merge", "--namespaces: \"" + ns + "\" is not a ROS 2 namespace: it " + problem, 2);
   }
   return rewrite_command("log merge", m, inputs, [&](const log::OutputOptions& output) {

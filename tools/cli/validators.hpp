@@ -29,36 +29,10 @@ inline CLI::Validator at_least(double min, bool strict) {
       },
       std::string(strict ? "> " : ">= ") + bound);
 }
-// A ROS 2 namespace as rbsim uses it ("rbsim", "robots/arm_1"; a leading '/' is allowed): tokens
-// of letters, digits and underscores, none starting with a digit, separated by single '/', no
-// trailing '/', no repeated underscores (the ROS 2 topic and namespace name rules).
-inline std::string ros_namespace_problem(const std::string& ns) {
-  if (ns.empty()) return "must not be empty";
-  const std::size_t begin = ns[0] == '/' ? 1 : 0;
-  if (begin == ns.size()) return "must name at least one token (\"/\" alone is the root)";
-  if (ns.back() == '/') return "must not end with '/'";
-  bool token_start = true;
-  for (std::size_t i = begin; i < ns.size(); ++i) {
-    const char c = ns[i];
-    if (c == '/') {
-      if (token_start) return "must not contain \"//\"";
-      token_start = true;
-      continue;
-    }
-    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
-    const bool digit = c >= '0' && c <= '9';
-    if (!letter && !digit && c != '_')
-      return std::string("may hold only letters, digits, '_' and '/' (got '") + c + "')";
-    if (token_start && digit) return "a token must not start with a digit";
-    if (c == '_' && i > begin && ns[i - 1] == '_') return "must not contain repeated underscores";
-    token_start = false;
-  }
-  return {};
-}
 inline CLI::Validator ros_namespace() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
-        const std::string problem = ros_namespace_problem(value);
+        const std::string problem = msgs::ros_namespace_problem(value);
         if (!problem.empty()) return "\"" + value + "\" is not a ROS 2 namespace: it " + problem;
         if (value[0] == '/') value.erase(0, 1);  // topics are /<namespace>/<name> either way
         return {};

@@ -202,6 +202,20 @@ class World {
   std::span<const double> vx() const { return vx_; }
   std::span<const double> vy() const { return vy_; }
   std::span<const double> omega() const { return omega_; }
+  // The same arrays, writable in place, for an adapter that hands out views of the world's own
+  // memory (the Python package's NumPy views). Writing them between steps sets the state the next
+  // step starts from, as set_state() does; after writing theta, call sync_rotations() before the
+  // next step (or spring_state()), since springs and wind read the rotations derived from it.
+  struct StateColumns {
+    std::span<double> x, y, theta, vx, vy, omega;
+  };
+  StateColumns state_columns() { return {x_, y_, theta_, vx_, vy_, omega_}; }
+  void sync_rotations() {
+    if (uses_rotations()) update_rotations();
+  }
+  std::span<const double> masses() const { return mass_; }
+  std::span<const double> inertias() const { return inertia_; }
+  std::span<const double> radii() const { return radius_; }
 
   // The first non-finite value in the state or in a quantity derived from it, if any (checked
   // after each step by runners, so a diverging scene stops with a clear error instead of writing

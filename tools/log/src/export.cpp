@@ -22,6 +22,48 @@
 
 namespace rbsim::log {
 
+// The energies of a recorded step as World::energy() holds them (see the bit-exactness notes at
+// the top of this file).
+Energy recorded_energy(const msgs::SceneMessage& s, const msgs::EnergyTermsMessage& en,
+                       const msgs::BodyStatesMessage* body_states) {
+  constexpr auto kGravity = static_cast<std::uint8_t>(msgs::EnergyTermsMessage::ForceKind::Gravity);
+  double u_gravity = 0.0;
+  if (en.has_split) {
+    u_gravity = en.potential_gravity;
+  } else if (s.gravity.size() == 1) {
+    for (const auto& f : en.forces) {
+      if (f.kind == kGravity) {
+        u_gravity = f.potential;
+        break;
+      }
+    }
+  } else if (body_states != nullptr) {
+    for (const GravityDef& g : s.gravity) {
+      const double ax = g.acceleration.x(), ay = g.acceleration.y();
+      for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+        const Vec2& x = body_states->bodies[b].state.position;
+        u_gravity -= s.bodies[b].mass * (ax * x.x() + ay * x.y());
+      }
+    }
+  }
+  double u_spring = en.potential_spring;
+  if (!en.has_split) {
+    for (const auto& f : en.forces) {
+      if (f.kind != kGravity) u_spring += f.potential;
+    }
+  }
+  Energy e;
+  e.u_gravity = u_gravity;
+  e.u_spring = u_spring;
+  e.t_point = en.kinetic_point;
+  e.t_spin = en.kinetic_spin;
+  return e;
+}
+
+bool recorded_energy_needs_states(const msgs::SceneMessage& s, const msgs::EnergyTermsMessage& en) {
+  return !en.has_split && s.gravity.size() > 1;
+}
+
 namespace {
 
 class Exporter {
@@ -60,8 +102,8 @@ class Exporter {
   // One step's rows; the reader has checked the messages against the scene description.
   Status write(const RecordedStep& d) {
     const msgs::SceneMessage& s = *scene_;
-    const bool need_states = csv_.is_open() || (energy_.is_open() && s.gravity.size() > 1 &&
-                                                d.energy != nullptr && !d.energy->has_split);
+    const bool need_states = csv_.is_open() || (energy_.is_open() && d.energy != nullptr &&
+                                                recorded_energy_needs_states(s, *d.energy));
     if ((need_states && d.body_states == nullptr) || d.energy == nullptr) {
       report_.warnings.push_back("step " + std::to_string(d.step) + ": no " +
                                  std::string(d.energy != nullptr ? "BodyStates" : "EnergyTerms") +
@@ -82,37 +124,7 @@ class Exporter {
       if (Status st = csv_.flush_if_full(); !st) return st;
     }
     if (energy_.is_open()) {
-      constexpr auto kGravity = static_cast<std::uint8_t>(msgs::EnergyTermsMessage::ForceKind::Gravity);
-      double u_gravity = 0.0;
-      if (en.has_split) {
-        u_gravity = en.potential_gravity;
-      } else if (s.gravity.size() == 1) {
-        for (const auto& f : en.forces) {
-          if (f.kind == kGravity) {
-            u_gravity = f.potential;
-            break;
-          }
-        }
-      } else {
-        for (const GravityDef& g : s.gravity) {
-          const double ax = g.acceleration.x(), ay = g.acceleration.y();
-          for (std::size_t b = 0; b < n; ++b) {
-            const Vec2& x = d.body_states->bodies[b].state.position;
-            u_gravity -= s.bodies[b].mass * (ax * x.x() + ay * x.y());
-          }
-        }
-      }
-      double u_spring = en.potential_spring;
-      if (!en.has_split) {
-        for (const auto& f : en.forces) {
-          if (f.kind != kGravity) u_spring += f.potential;
-        }
-      }
-      Energy e;
-      e.u_gravity = u_gravity;
-      e.u_spring = u_spring;
-      e.t_point = en.kinetic_point;
-      e.t_spin = en.kinetic_spin;
+      const Energy e = recorded_energy(s, en, d.body_states);
       append_energy_row(energy_.rows(), step, t, e, SceneTotals{en.momentum, en.angular_momentum});
       if (Status st = energy_.flush_if_full(); !st) return st;
     }

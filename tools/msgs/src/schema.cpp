@@ -144,6 +144,30 @@ std::vector<TopicId> topic_ids(const TopicSet& set) {
   return out;
 }
 
+std::string ros_namespace_problem(std::string_view ns) {
+  if (ns.empty()) return "must not be empty";
+  const std::size_t begin = ns[0] == '/' ? 1 : 0;
+  if (begin == ns.size()) return "must name at least one token (\"/\" alone is the root)";
+  if (ns.back() == '/') return "must not end with '/'";
+  bool token_start = true;
+  for (std::size_t i = begin; i < ns.size(); ++i) {
+    const char c = ns[i];
+    if (c == '/') {
+      if (token_start) return "must not contain \"//\"";
+      token_start = true;
+      continue;
+    }
+    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+    const bool digit = c >= '0' && c <= '9';
+    if (!letter && !digit && c != '_')
+      return std::string("may hold only letters, digits, '_' and '/' (got '") + c + "')";
+    if (token_start && digit) return "a token must not start with a digit";
+    if (c == '_' && i > begin && ns[i - 1] == '_') return "must not contain repeated underscores";
+    token_start = false;
+  }
+  return {};
+}
+
 std::string topic_name(const TopicSpec& spec, std::string_view ns) {
   if (spec.id == TopicId::Clock || spec.id == TopicId::Tf || ns.empty())
     return "/" + std::string(spec.suffix);

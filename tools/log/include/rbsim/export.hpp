@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
+#include "rbsim/msgs.hpp"
 
 namespace rbsim::log {
 
@@ -23,5 +24,13 @@ struct ExportReport {
 // recorded steps. Topics are found by type (rbsim_msgs/msg/SceneDescription, BodyStates,
 // EnergyTerms); their schemas must equal this build's.
 Result<ExportReport> export_csv(const std::string& path, const ExportOptions& options);
+
+// A recorded step's energies exactly as World::energy() held them, so U, T and E by Energy's own
+// formulas are the energy CSV's (the message's own potential and total associate differently).
+// A recording made before the potential split, of a scene with several gravity fields, needs the
+// step's body states for U_gravity (recorded_energy_needs_states; without them U_gravity is 0).
+Energy recorded_energy(const msgs::SceneMessage& scene, const msgs::EnergyTermsMessage& energy,
+                       const msgs::BodyStatesMessage* body_states);
+bool recorded_energy_needs_states(const msgs::SceneMessage& scene, const msgs::EnergyTermsMessage& energy);
 
 }  // namespace rbsim::log

@@ -67,6 +67,11 @@ const TopicSpec* topic_for_type(std::string_view type);
 // Whether a topic name given on a command line names `topic`: the whole name
 // ("/rbsim/body_states") or its trailing part(s) after a '/' ("body_states", "rbsim/body_states").
 bool names_topic(std::string_view requested, std::string_view topic);
+// Why `ns` is not a ROS 2 namespace as rbsim uses it ("rbsim", "robots/arm_1"; a leading '/' is
+// allowed): tokens of letters, digits and underscores, none starting with a digit, separated by
+// single '/', no trailing '/', no repeated underscores (the ROS 2 topic and namespace name
+// rules). Empty when it is one.
+std::string ros_namespace_problem(std::string_view ns);
 // "/rbsim/body_states" for namespace "rbsim"; "/clock" and "/tf" always live at the root.
 std::string topic_name(const TopicSpec& spec, std::string_view ns);
 
