@@ -191,6 +191,8 @@ def main():
     ap.add_argument("--seconds", type=float, default=60.0, help="simulated = wall seconds at --rate 1")
     ap.add_argument("--check", type=int, default=1, help="1: rbsim check live.mcap against run.mcap")
     ap.add_argument("--keep", default="", help="keep the work folder here (default: removed)")
+    ap.add_argument("--security", action="store_true",
+                    help="node and recorder secured (DDS Security, Enforce): a keystore made by rbsim security")
     a = ap.parse_args()
     seconds = a.seconds
     steps = math.ceil(round(seconds / DT, 9))
@@ -214,6 +216,14 @@ def main():
         # One binary for every process, even if the build is replaced while the benchmark runs.
         rbsim = os.path.join(work, "rbsim")
         shutil.copy2(a.rbsim, rbsim)
+        if a.security:
+            # The node's enclave is its name (/<ns>), the recorder's /rbsim_recorder, both allowed /<ns>'s topics.
+            ks = os.path.join(work, "keystore")
+            subprocess.run([rbsim, "security", "create-keystore", ks], check=True, capture_output=True, timeout=60)
+            for enclave in ("/" + ns, "/rbsim_recorder"):
+                subprocess.run([rbsim, "security", "create-enclave", ks, enclave, "--namespace", ns], check=True,
+                               capture_output=True, timeout=60)
+            env.update(ROS_SECURITY_ENABLE="true", ROS_SECURITY_STRATEGY="Enforce", ROS_SECURITY_KEYSTORE=ks)
         scene = os.path.join(work, f"grid{BODIES}.xml")
         with open(scene, "w") as f:
             subprocess.run([sys.executable, os.path.join(a.root, "bench", "make_grid_scene.py"), str(BODIES), str(DT),
@@ -278,7 +288,7 @@ def main():
 
         # 3. The figures.
         end = re.search(r"rbsim node: (done|stopped) after (\d+) steps in (.+?) \(([\d.e+]+) steps/s\), "
-                        r"(\d+) messages published(?:; (foxglove: .*))?", node.stderr())
+                        r"(\d+) messages published[^;\n]*(?:; (foxglove: .*))?", node.stderr())
         if node.code != 0 or not end:
             raise Failure(f"rbsim node failed (exit {node.code})\n{node.output()}")
         node_steps, node_rate, node_published = int(end.group(2)), float(end.group(4)), int(end.group(5))

@@ -16,6 +16,7 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/rosout.hpp"
+#include "rbsim/security.hpp"
 #include "rbsim/type_hash.hpp"
 #include "topics.hpp"
 
@@ -131,10 +132,15 @@ Result<Participant> Participant::create(std::uint32_t domain, const NodeName& no
     }
   }
   // Otherwise Cyclone configures the domain itself: from CYCLONEDDS_URI, or its defaults.
+  auto security =
+      resolve_security(env, node, s.domain, domain == kDomainFromEnvironment ? "ROS_DOMAIN_ID" : "--domain");
+  if (!security) return security.error();
+  for (const std::string& w : security->warnings) log(LogLevel::Warn, "rbsim: warning: " + w);
   // rmw_cyclonedds_cpp's participant USER_DATA: the security enclave, "/" without ROS security.
   dds_qos_t* qos = dds_create_qos();
-  constexpr std::string_view kEnclave = "enclave=/;";
-  dds_qset_userdata(qos, kEnclave.data(), kEnclave.size());
+  const std::string enclave = "enclave=" + (security->enabled ? security->enclave : std::string("/")) + ";";
+  dds_qset_userdata(qos, enclave.data(), enclave.size());
+  if (security->enabled) set_security_properties(qos, security.value());
   const dds_entity_t p = dds_create_participant(s.domain, qos, nullptr);
   dds_delete_qos(qos);
   if (p < 0) {
@@ -142,9 +148,14 @@ Result<Participant> Participant::create(std::uint32_t domain, const NodeName& no
         s.from_cyclonedds_uri
             ? "domain " + std::to_string(s.domain) + " (check CYCLONEDDS_URI=" + *env.cyclonedds_uri + ")"
             : s.describe();
-    return dds_error("cannot create a DDS participant on " + where, p);
+    return dds_error(
+        "cannot create a DDS participant on " + where +
+            (security->enabled ? ", " + security->describe() + " from " + security->directory : ""),
+        p);
   }
-  Participant participant(p, s.domain, s.describe(), node, s.distro);
+  // Security asked for: every command's start line says whether it runs secured.
+  Participant participant(
+      p, s.domain, s.describe() + (security->requested ? ", " + security->describe() : ""), node, s.distro);
   auto graph = Graph::create(participant, node, s.distro);
   if (!graph) return Error{"cannot publish the node on ros_discovery_info: " + graph.error().message};
   participant.graph_ = std::move(graph.value());

@@ -106,9 +106,11 @@ RosEnvironment RosEnvironment::from_process() {
     const char* v = std::getenv(name);
     return v != nullptr ? std::optional<std::string>(v) : std::nullopt;
   };
-  return {get("ROS_DOMAIN_ID"),    get("ROS_AUTOMATIC_DISCOVERY_RANGE"),
-          get("ROS_STATIC_PEERS"), get("ROS_LOCALHOST_ONLY"),
-          get("CYCLONEDDS_URI"),   get("ROS_DISTRO")};
+  return {get("ROS_DOMAIN_ID"),         get("ROS_AUTOMATIC_DISCOVERY_RANGE"),
+          get("ROS_STATIC_PEERS"),      get("ROS_LOCALHOST_ONLY"),
+          get("CYCLONEDDS_URI"),        get("ROS_DISTRO"),
+          get("ROS_SECURITY_ENABLE"),   get("ROS_SECURITY_STRATEGY"),
+          get("ROS_SECURITY_KEYSTORE"), get("ROS_SECURITY_ENCLAVE_OVERRIDE")};
 }
 
 std::size_t gid_size(RosDistro distro) {

@@ -3,7 +3,13 @@
 #include "rbsim/atomic_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
 
 #include <algorithm>
 #include <filesystem>
@@ -48,11 +54,11 @@ class AtomicFileTest : public ::testing::Test {
 TEST_F(AtomicFileTest, CommitMovesTheWholeFileIntoPlace) {
   AtomicFile f;
   ASSERT_TRUE(f.open(path("out.csv")).ok());
-  EXPECT_EQ(f.temp_path(), path("out.csv") + ".tmp." + std::to_string(::getpid()));
+  EXPECT_EQ(f.temp_path(), "") << "unnamed until commit (O_TMPFILE)";
   ASSERT_TRUE(f.write("a,b\n", 4).ok());
   ASSERT_TRUE(f.write("1,2\n", 4).ok());
   EXPECT_EQ(f.bytes_written(), 8u);
-  EXPECT_EQ(names(), std::vector<std::string>{"out.csv.tmp." + std::to_string(::getpid())});
+  EXPECT_TRUE(names().empty()) << testing::PrintToString(names());
   ASSERT_TRUE(f.commit().ok());
   EXPECT_EQ(names(), std::vector<std::string>{"out.csv"});
   EXPECT_EQ(read(path("out.csv")), "a,b\n1,2\n");
@@ -136,6 +142,98 @@ TEST_F(AtomicFileTest, OpenExternalDestroyedRemovesTheWritersFile) {
     write_text(f.temp_path(), "half a recording");
   }
   EXPECT_TRUE(names().empty());
+}
+
+// O_TMPFILE (every file system the suite runs on has it: ext4, tmpfs, overlayfs): while it is
+// written, the output has no name at all.
+TEST_F(AtomicFileTest, OpenWritesAnUnnamedFileUntilCommit) {
+  AtomicFile f;
+  ASSERT_TRUE(f.open(path("out.csv")).ok());
+  ASSERT_TRUE(f.write("abc", 3).ok());
+  EXPECT_TRUE(names().empty()) << "an unnamed temporary: " << testing::PrintToString(names());
+  EXPECT_TRUE(f.temp_path().empty());
+  ASSERT_TRUE(f.commit().ok());
+  EXPECT_EQ(names(), std::vector<std::string>{"out.csv"});
+  EXPECT_EQ(read(path("out.csv")), "abc");
+}
+
+TEST_F(AtomicFileTest, AWriterKilledMidWriteLeavesNothing) {
+  write_text(path("out.csv"), "old");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    AtomicFile f;
+    if (!f.open(path("out.csv")).ok() || !f.write("partial", 7).ok()) ::_exit(3);
+    ::kill(::getpid(), SIGKILL);
+    ::_exit(4);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+  EXPECT_EQ(names(), std::vector<std::string>{"out.csv"}) << "no temporary survives SIGKILL";
+  EXPECT_EQ(read(path("out.csv")), "old");
+}
+
+// ulimit -f: with SIGXFSZ ignored (as rbsim's main does) the write fails with EFBIG, and the error
+// names the file and the bytes written before it.
+TEST_F(AtomicFileTest, AFileSizeLimitIsAnErrorNamingTheFileAndTheBytesWritten) {
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(pipe_fds[0]);
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{64 * 1024, 64 * 1024};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    AtomicFile f;
+    std::string message = "open failed";
+    if (f.open(path("big.csv")).ok()) {
+      const std::string block(4096, 'x');
+      Status st;
+      for (int i = 0; i < 64 && st.ok(); ++i) st = f.write(block.data(), block.size());
+      if (st.ok()) st = f.commit();
+      message = st.ok() ? "no error" : st.error().message;
+    }
+    const ssize_t n = ::write(pipe_fds[1], message.data(), message.size());
+    ::_exit(n < 0 ? 5 : 0);
+  }
+  ::close(pipe_fds[1]);
+  std::string message;
+  char buf[512];
+  for (ssize_t n; (n = ::read(pipe_fds[0], buf, sizeof buf)) > 0;)
+    message.append(buf, static_cast<std::size_t>(n));
+  ::close(pipe_fds[0]);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  EXPECT_NE(message.find(path("big.csv") + ": write failed after "), std::string::npos) << message;
+  EXPECT_NE(message.find(" bytes: " + std::string(std::strerror(EFBIG))), std::string::npos) << message;
+  EXPECT_TRUE(names().empty()) << testing::PrintToString(names());
+}
+
+// An external writer's temporary, left by a killed process: removed at the next start for an output
+// that is redone (Remove), kept for a recording that `rbsim log recover` saves (Keep).
+TEST_F(AtomicFileTest, OpenExternalRemovesADeadProcesssLeftoversOnlyWhenAsked) {
+  pid_t dead = 4000000;
+  while (::kill(dead, 0) == 0 || errno != ESRCH) ++dead;
+  const std::string left = "out.mp4.tmp." + std::to_string(dead);
+  const std::string alive = "out.mp4.tmp." + std::to_string(::getppid());  // a running process's
+  write_text(path(left), "partial");
+  write_text(path(alive), "in use");
+  write_text(path("out.mp4.tmp.notapid"), "other");
+  {
+    AtomicFile keep;
+    keep.open_external(path("out.mp4"));
+  }
+  const auto sorted = [](std::vector<std::string> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  EXPECT_EQ(names(), sorted({left, alive, "out.mp4.tmp.notapid"}));
+  AtomicFile f;
+  f.open_external(path("out.mp4"), AtomicFile::Leftovers::Remove);
+  EXPECT_EQ(names(), sorted({alive, "out.mp4.tmp.notapid"}));
 }
 
 }  // namespace

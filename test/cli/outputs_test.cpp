@@ -111,3 +111,27 @@ TEST(LogOutputs, ExportAndRecoverRefuseExistingOutputsAndTheirInput) {
 
 }  // namespace
 }  // namespace rbsim
+
+namespace rbsim {
+namespace {
+
+// ulimit -f: the run stops with one line naming the output and the bytes that reached it, exit 1,
+// and leaves nothing behind (its CSV was an unnamed file until commit).
+TEST(RunOutputs, AFileSizeLimitStopsTheRunNamingTheFileAndTheBytes) {
+  test::TempDir dir;
+  const std::string csv = (dir / "big.csv").string();
+  const std::string scene = std::string(RBSIM_TEST_DATA_DIR) + "/../../scenes/cantilever.xml";
+  const test::Outcome o = test::run_process(
+      "/bin/sh",
+      {"-c", "ulimit -f 128 && exec \"$0\" run \"$1\" --steps 3000 --csv \"$2\" -q", RBSIM_EXE, scene, csv});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_NE(o.err.find("rbsim run: error: " + csv + ": write failed after "), std::string::npos) << o;
+  EXPECT_NE(o.err.find(" bytes: File too large"), std::string::npos) << o;
+  EXPECT_EQ(test::lines_of(o.err).size(), 1u) << o;
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir.path())) left.push_back(e.path().filename().string());
+  EXPECT_TRUE(left.empty()) << testing::PrintToString(left);
+}
+
+}  // namespace
+}  // namespace rbsim

@@ -180,7 +180,9 @@ class Ctx:
         env = dict(os.environ)
         env.pop("CYCLONEDDS_URI", None)  # the compiled-in loopback configuration
         # rbsim honours ROS 2's variables: none of a developer's settings (SUBNET...) gets in.
-        for name in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY"):
+        for name in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY",
+                     "ROS_SECURITY_ENABLE", "ROS_SECURITY_STRATEGY", "ROS_SECURITY_KEYSTORE",
+                     "ROS_SECURITY_ENCLAVE_OVERRIDE"):
             env.pop(name, None)
         if uri:
             env["CYCLONEDDS_URI"] = uri
@@ -1152,11 +1154,11 @@ class TwoHosts:
         self.ctx.check(self.a not in left and self.b not in left, f"namespaces left behind: {left}")
         return False
 
-    def rb(self, name, side, *args):
+    def rb(self, name, side, *args, extra_env=None):
         """Starts rbsim in namespace `side` ("a" or "b") with that side's configuration."""
         ns, cfg = (self.a, self.cfg_a) if side == "a" else (self.b, self.cfg_b)
         return self.ctx.start(name, ["ip", "netns", "exec", ns, self.ctx.rbsim, *map(str, args)],
-                              env=self.ctx.env(uri="file://" + cfg))
+                              env={**self.ctx.env(uri="file://" + cfg), **(extra_env or {})})
 
     def rx_bytes(self):
         r = ip(self.ctx, "-n", self.b, "-s", "-j", "link", "show", "dev", self.vb)
@@ -1194,6 +1196,84 @@ def case_netns(ctx):
         rx = net.rx_bytes() - rx0
         ctx.check(rx > payload, f"veth {net.vb} received {rx} bytes, less than the {payload} payload bytes recorded")
         ctx.log(f"veth {net.vb} (namespace b) received {rx} bytes for {payload} payload bytes")
+    return 0
+
+
+def case_security(ctx):
+    """DDS Security on two hosts (network namespaces): keystore and enclaves made by `rbsim security`;
+    a secured node in a and a secured recorder in b lose nothing and record what `rbsim run --record`
+    records; an unsecured recorder and one whose identity comes from another keystore's CA receive
+    nothing; an enclave whose permissions omit a topic cannot read it; a tampered permissions file is
+    refused, naming it."""
+    with TwoHosts(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return SKIP
+        domain = 17  # inside the namespaces only: no other case is there, and security needs <= 230
+        ks, other = ctx.path("keystore"), ctx.path("other-keystore")
+        ctx.rbrun("keystore", "security", "create-keystore", ks)
+        ctx.rbrun("enclave-node", "security", "create-enclave", ks, "/" + ctx.ns, "--namespace", ctx.ns)
+        ctx.rbrun("enclave-recorder", "security", "create-enclave", ks, "/rbsim_recorder", "--namespace", ctx.ns)
+        ctx.rbrun("enclave-restricted", "security", "create-enclave", ks, "/restricted", "--namespace", ctx.ns,
+                  "--topics", "scene,markers")
+        ctx.rbrun("keystore-other", "security", "create-keystore", other)
+        ctx.rbrun("enclave-other", "security", "create-enclave", other, "/rbsim_recorder", "--namespace", ctx.ns)
+        tampered = os.path.join(ks, "enclaves", "tampered")
+        shutil.copytree(os.path.join(ks, "enclaves", "rbsim_recorder"), tampered, symlinks=True)
+        p7s = os.path.join(tampered, "permissions.p7s")
+        with open(p7s) as f:
+            text = f.read()
+        with open(p7s, "w") as f:
+            f.write(text.replace("<default>DENY</default>", "<default>ALLOW</default"))
+        secured = {"ROS_SECURITY_ENABLE": "true", "ROS_SECURITY_STRATEGY": "Enforce", "ROS_SECURITY_KEYSTORE": ks}
+
+        scene, every = ctx.scene("airplane.xml"), 100
+        run = ctx.path("run.mcap")
+        # 3 s of real time: long enough for the outsiders to have discovered an unsecured node.
+        ctx.rbrun("run-record", "run", scene, "--duration", 3, "--record", run, "--record-every", every,
+                  "--namespace", ctx.ns)
+        want = Log(run)
+        n = len(want.messages)
+        out, plain, foreign = ctx.path("secured.mcap"), ctx.path("plain.mcap"), ctx.path("foreign.mcap")
+        rec = net.rb("record-secured", "b", *record_args(ctx, out, "--max-messages", n, "--wall-duration", 90,
+                                                         domain=domain), extra_env=secured)
+        outsider = net.rb("record-unsecured", "b", *record_args(ctx, plain, "--wall-duration", 6, domain=domain))
+        stranger = net.rb("record-other-ca", "b", *record_args(ctx, foreign, "--wall-duration", 6, domain=domain),
+                          extra_env={**secured, "ROS_SECURITY_KEYSTORE": other})
+        node = net.rb("node-secured", "a", *node_args(ctx, scene, "--duration", 3, "--rate", 1, "--publish-every", every,
+                                                      "--wait-for-subscribers", 1, domain=domain),
+                      extra_env=secured)
+        exited_ok(ctx, node, 90, "secured node in namespace a")
+        exited_ok(ctx, rec, 90, "secured recorder in namespace b")
+        ctx.check(f"secured as enclave /{ctx.ns} (Enforce)" in node.stderr(),
+                  f"the node does not say it runs secured:\n{node.stderr()}")
+        ctx.check("secured as enclave /rbsim_recorder (Enforce)" in rec.stderr(),
+                  f"the recorder does not say it runs secured:\n{rec.stderr()}")
+        ctx.check(counts_line(rec) == (n, 0), f"secured recorder counts {counts_line(rec)}, want ({n}, 0)")
+        got = Log(out)
+        expect_indexed(ctx, got, n)
+        same_payloads(ctx, got, want, "secured recording across the veth pair vs rbsim run --record")
+        rc, _, err = ctx.rbrun("check-secured", "check", out, run, "--ignore-log-time", ok=False)
+        ctx.check(rc == 0, f"rbsim check of the secured recording: exit {rc}\n{err}")
+        for proc, what in ((outsider, "an unsecured recorder"), (stranger, "a recorder of another CA")):
+            rc = proc.wait(60)
+            ctx.check(rc == 1 and "nothing received" in proc.stderr(),
+                      f"{what} exited {rc}, want 1 having received nothing:\n{proc.output()}")
+        for path in (plain, foreign):
+            ctx.check(not os.path.exists(path), f"{path} was written by a recorder that should see nothing")
+
+        narrow = net.rb("record-restricted", "b", *record_args(ctx, ctx.path("narrow.mcap"), "--wall-duration", 5,
+                                                               domain=domain),
+                        extra_env={**secured, "ROS_SECURITY_ENCLAVE_OVERRIDE": "/restricted"})
+        rc = narrow.wait(60)
+        ctx.check(rc == 1 and "Not Allowed By Security" in narrow.stderr(),
+                  f"an enclave without body_states exited {rc}, want 1 refused by security:\n{narrow.output()}")
+        bad = net.rb("record-tampered", "b", *record_args(ctx, ctx.path("tampered.mcap"), "--wall-duration", 5,
+                                                          domain=domain),
+                     extra_env={**secured, "ROS_SECURITY_ENCLAVE_OVERRIDE": "/tampered"})
+        rc = bad.wait(60)
+        ctx.check(rc == 1 and f"{p7s}: its signature does not verify" in bad.stderr(),
+                  f"a tampered permissions file: exit {rc}, want 1 naming it:\n{bad.output()}")
     return 0
 
 
@@ -1344,7 +1424,7 @@ def case_ros_env(ctx):
     for p in (rec_zero, rec_off):
         p.signal(signal.SIGINT)
         p.wait(30)
-    ctx.check(f"on domain {d}," in node.stderr(), f"the node does not say it runs on domain {d}:\n{node.stderr()}")
+    ctx.check(f"on domain {d} (" in node.stderr(), f"the node does not say it runs on domain {d}:\n{node.stderr()}")
     ctx.check(f"on domain {d} (LOCALHOST)" in rec_env.stderr(),
               f"record-env does not say domain {d} (LOCALHOST):\n{rec_env.stderr()}")
     ctx.check(f"on domain {d} (LOCALHOST, static peers localhost)" in rec_flag.stderr(),
@@ -1812,6 +1892,7 @@ CASES = {
     "python_subscriber": case_python_subscriber,
     "netns": case_netns,
     "netns_link_flap": case_netns_link_flap,
+    "security": case_security,
     "bad_input": case_bad_input,
     "ros_env": case_ros_env,
     "ros_graph": case_ros_graph,

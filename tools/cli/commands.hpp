@@ -31,6 +31,7 @@ Subcommand add_replay_command(CLI::App& parent);     // replay.cpp
 Subcommand add_log_command(CLI::App& parent);        // log.cpp: info, doctor, recover, export
 Subcommand add_check_command(CLI::App& parent);      // check.cpp: golden-log comparison
 Subcommand add_bridge_command(CLI::App& parent);     // bridge.cpp: DDS -> Foxglove relay
+Subcommand add_security_command(CLI::App& parent);   // security.cpp: SROS2 keystore and enclaves
 
 // The DDS commands' --domain (record.cpp): bound to `domain`, which starts as ROS_DOMAIN_ID (or 0),
 // so the command line wins; an invalid ROS_DOMAIN_ID leaves node::kDomainFromEnvironment for

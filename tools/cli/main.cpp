@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -40,6 +41,9 @@ int usage_error(CLI::App* command, const std::string& what) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG and the command stops with an error
+  // naming the file and the bytes written, instead of SIGXFSZ killing it mid-write.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"rbsim: 2D rigid-body simulator for FOSSSim scenes", "rbsim"};
   app.set_version_flag("--version", std::string("rbsim ") + rbsim::version());
   app.require_subcommand(1);
@@ -47,11 +51,12 @@ int main(int argc, char** argv) {
       "Run 'rbsim <command> --help' (or 'rbsim help <command>') for a command's options.\n"
       "Exit status: 0 success, 1 failure (the command's help says which), 2 usage error.");
   const std::vector<rbsim::cli::Subcommand> subcommands = {
-      rbsim::cli::add_run_command(app),    rbsim::cli::add_grade_command(app),
-      rbsim::cli::add_render_command(app), rbsim::cli::add_plot_command(app),
-      rbsim::cli::add_node_command(app),   rbsim::cli::add_record_command(app),
-      rbsim::cli::add_replay_command(app), rbsim::cli::add_log_command(app),
-      rbsim::cli::add_check_command(app),  rbsim::cli::add_bridge_command(app),
+      rbsim::cli::add_run_command(app),      rbsim::cli::add_grade_command(app),
+      rbsim::cli::add_render_command(app),   rbsim::cli::add_plot_command(app),
+      rbsim::cli::add_node_command(app),     rbsim::cli::add_record_command(app),
+      rbsim::cli::add_replay_command(app),   rbsim::cli::add_log_command(app),
+      rbsim::cli::add_check_command(app),    rbsim::cli::add_bridge_command(app),
+      rbsim::cli::add_security_command(app),
   };
   if (argc == 1) return usage_error(&app, "no command given (commands: " + command_names(app) + ")");
   // `rbsim help [command [subcommand]]`, as git has it: the same as `rbsim command --help`.

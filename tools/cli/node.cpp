@@ -106,9 +106,8 @@ int node_command(const NodeArgs& a) {
   }
   install_stop_handlers();
   if (!a.quiet) {
-    RBSIM_LOG(Info,
-              "rbsim node: %s on domain %u, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
-              scene.name.c_str(), a.node.domain, a.node.ns.c_str(),
+    RBSIM_LOG(Info, "rbsim node: %s on %s, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
+              scene.name.c_str(), participant.value().description().c_str(), a.node.ns.c_str(),
               settings.rate > 0 ? (std::to_string(settings.rate) + "x").c_str() : "as fast as possible",
               static_cast<long long>(steps),
               a.loop            ? ", looping"

@@ -64,9 +64,6 @@ int record_command(RecordArgs a) {
   const Result<mcap::Compression> codec = compression_option(a.compression, a.rec.compression_level);
   if (!codec) return fail("record", codec.error().message);
   a.rec.compression = codec.value();
-  // Past a file-size limit (ulimit -f) a write must fail with EFBIG and the recorder stop with an
-  // error, leaving a recoverable file, instead of SIGXFSZ killing it.
-  std::signal(SIGXFSZ, SIG_IGN);
   // OUT ending in .mcap is one file; any other path a rosbag2 bag directory, holding file 0.
   std::string bag;
   std::vector<OutputPath> outputs{{a.rec.path, "OUT"}};

@@ -24,13 +24,17 @@ std::string_view to_string(DiscoveryRange range);  // "LOCALHOST", "SUBNET", "OF
 
 // The variables as found; nullopt: not set. An empty value means the same as not set.
 struct RosEnvironment {
-  std::optional<std::string> ros_domain_id;                  // ROS_DOMAIN_ID
-  std::optional<std::string> ros_automatic_discovery_range;  // ROS_AUTOMATIC_DISCOVERY_RANGE
-  std::optional<std::string> ros_static_peers;               // ROS_STATIC_PEERS
-  std::optional<std::string> ros_localhost_only;             // ROS_LOCALHOST_ONLY (deprecated in ROS 2)
-  std::optional<std::string> cyclonedds_uri;                 // CYCLONEDDS_URI
-  std::optional<std::string> ros_distro;                     // ROS_DISTRO
-  static RosEnvironment from_process();                      // reads the process environment
+  std::optional<std::string> ros_domain_id;                    // ROS_DOMAIN_ID
+  std::optional<std::string> ros_automatic_discovery_range;    // ROS_AUTOMATIC_DISCOVERY_RANGE
+  std::optional<std::string> ros_static_peers;                 // ROS_STATIC_PEERS
+  std::optional<std::string> ros_localhost_only;               // ROS_LOCALHOST_ONLY (deprecated in ROS 2)
+  std::optional<std::string> cyclonedds_uri;                   // CYCLONEDDS_URI
+  std::optional<std::string> ros_distro;                       // ROS_DISTRO
+  std::optional<std::string> ros_security_enable{};            // ROS_SECURITY_ENABLE (rbsim/security.hpp)
+  std::optional<std::string> ros_security_strategy{};          // ROS_SECURITY_STRATEGY
+  std::optional<std::string> ros_security_keystore{};          // ROS_SECURITY_KEYSTORE
+  std::optional<std::string> ros_security_enclave_override{};  // ROS_SECURITY_ENCLAVE_OVERRIDE
+  static RosEnvironment from_process();                        // reads the process environment
 };
 
 // The ROS 2 wire format rbsim speaks on the graph (ROS_DISTRO). Humble (and Foxy, Galactic):

@@ -1,11 +1,14 @@
 #include "rbsim/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 namespace rbsim {
 
@@ -31,9 +34,31 @@ AtomicFile::~AtomicFile() {
   discard();
 }
 
+// How many bytes reached the file (a failed write's report): its size, else what was handed to it.
+std::uint64_t on_disk(std::FILE* file, std::uint64_t handed) {
+  struct stat st {};
+  if (file != nullptr && ::fstat(::fileno(file), &st) == 0) return static_cast<std::uint64_t>(st.st_size);
+  return handed;
+}
+
+// An unnamed file in `path`'s folder (O_TMPFILE), linked into place by commit(): nothing of it is
+// left when the process dies, SIGKILL included. -1 where the file system cannot (errno says why).
+int open_unnamed(const std::string& path) {
+  std::string dir = path.substr(0, path.find_last_of('/') + 1);
+  if (dir.empty()) dir = ".";
+  return ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);  // less the umask, as fopen's
+}
+
 Status AtomicFile::open(const std::string& path) {
   open_external(path);
-  file_ = std::fopen(temp_path_.c_str(), "wb");
+  const int fd = open_unnamed(path);
+  if (fd >= 0) {
+    temp_path_.clear();  // unnamed until commit()
+    file_ = ::fdopen(fd, "wb");
+    if (file_ == nullptr) ::close(fd);
+  } else {
+    file_ = std::fopen(temp_path_.c_str(), "wb");  // a file system without O_TMPFILE: a named temporary
+  }
   if (file_ == nullptr) {
     pending_ = false;
     return io_error("cannot create output file", path, errno);
@@ -43,8 +68,27 @@ Status AtomicFile::open(const std::string& path) {
   return Ok{};
 }
 
-void AtomicFile::open_external(const std::string& path) {
+// Removes `<path>.tmp.<pid>` files whose process is gone: a killed writer's leftovers.
+static void remove_leftovers(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  const std::string prefix = p.filename().string() + ".tmp.";
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const auto pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    fs::remove(entry.path(), ec);
+  }
+}
+
+void AtomicFile::open_external(const std::string& path, Leftovers leftovers) {
   discard();
+  if (leftovers == Leftovers::Remove) remove_leftovers(path);
   path_ = path;
   temp_path_ = path + ".tmp." + std::to_string(::getpid());
   pending_ = true;
@@ -53,7 +97,10 @@ void AtomicFile::open_external(const std::string& path) {
 
 Status AtomicFile::write(const void* data, std::size_t size) {
   if (file_ == nullptr) return Error{path_ + ": write to a file that is not open"};
-  if (size != 0 && std::fwrite(data, 1, size, file_) != size) return io_error("write failed", path_, errno);
+  if (size != 0 && std::fwrite(data, 1, size, file_) != size) {
+    const int error = errno;
+    return io_error("write failed after " + std::to_string(on_disk(file_, bytes_)) + " bytes", path_, error);
+  }
   bytes_ += size;
   return Ok{};
 }
@@ -63,19 +110,37 @@ Status AtomicFile::commit(Durability durability) {
   const bool sync = durability == Durability::Fsync;
   bool written = true;
   int error = 0;
+  std::uint64_t reached = bytes_;
+  const bool external = file_ == nullptr;
   if (file_ != nullptr) {
     const bool flushed = std::fflush(file_) == 0 && (!sync || ::fsync(::fileno(file_)) == 0);
-    error = errno;  // the flush's, if it failed; else the close's
+    error = errno;  // the flush's, if it failed; else the link's or the close's
+    bool linked = true;
+    if (flushed && temp_path_.empty()) {
+      // The unnamed file gets a name beside its path (linkat cannot replace one), then the
+      // rename below moves it over the path.
+      temp_path_ = path_ + ".tmp." + std::to_string(::getpid());
+      std::remove(temp_path_.c_str());
+      const std::string self = "/proc/self/fd/" + std::to_string(::fileno(file_));
+      linked = ::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, temp_path_.c_str(), AT_SYMLINK_FOLLOW) == 0;
+      if (!linked) {
+        error = errno;
+        temp_path_.clear();
+      }
+    }
+    if (!flushed || !linked) reached = on_disk(file_, bytes_);
     const bool closed = std::fclose(file_) == 0;
-    if (flushed) error = errno;
-    written = flushed && closed;
+    if (flushed && linked) error = errno;
+    written = flushed && linked && closed;
     file_ = nullptr;
   } else if (sync) {
     written = sync_path(temp_path_);
     error = errno;
   }
   if (!written) {
-    Error e = io_error("write failed", path_, error);
+    // An external writer's bytes are its own: only ours are counted.
+    Error e = io_error(external ? "write failed" : "write failed after " + std::to_string(reached) + " bytes",
+                       path_, error);
     discard();
     return e;
   }
@@ -94,7 +159,7 @@ void AtomicFile::discard() {
     file_ = nullptr;
   }
   if (pending_) {
-    std::remove(temp_path_.c_str());
+    if (!temp_path_.empty()) std::remove(temp_path_.c_str());  // an unnamed one went with its file
     pending_ = false;
   }
 }

@@ -38,7 +38,7 @@ class Output {
  public:
   Status open(const std::string& path, const std::string& profile, const OutputOptions& options) {
     path_ = path;
-    file_.open_external(path);
+    file_.open_external(path, AtomicFile::Leftovers::Remove);  // a killed rewrite is redone, not recovered
     mcap::WriterOptions wo = writer_options(options.compression, options.chunk_size);
     wo.profile = profile;
     if (Status st = writer_.open(file_.temp_path(), wo); !st.ok()) return fail(st.error());

@@ -238,7 +238,7 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   const mcap::Header header = std::get<mcap::Header>(entry.record);
 
   AtomicFile output;  // the MCAP writer creates the temporary; commit() moves it into place
-  output.open_external(out);
+  output.open_external(out, AtomicFile::Leftovers::Remove);
   Recoverer rec(report);
   if (has_summary(file)) {
     mcap::IndexedReader summary;

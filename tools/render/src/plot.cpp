@@ -92,7 +92,7 @@ Status plot(const std::string& input, const PlotOptions& o) {
   if (!samples) return samples.error();
 
   AtomicFile png;  // gnuplot writes it; data and script are scratch files beside it
-  png.open_external(o.out_png);
+  png.open_external(o.out_png, AtomicFile::Leftovers::Remove);
   const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp";
   {
     std::ofstream f(data);

@@ -231,7 +231,7 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
 
 Status make_movie(const std::string& frames_dir, double fps, std::int64_t frames, const std::string& mp4) {
   AtomicFile movie;
-  movie.open_external(mp4);
+  movie.open_external(mp4, AtomicFile::Leftovers::Remove);
   char rate[32];
   std::snprintf(rate, sizeof rate, "%g", fps);
   // -f mp4: the temporary's name does not end in .mp4, so ffmpeg is told the container.
