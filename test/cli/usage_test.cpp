@@ -185,3 +185,35 @@ TEST(Help, ReplayDescribesThePlayer) {
 
 }  // namespace
 }  // namespace rbsim
+
+namespace rbsim {
+namespace {
+
+// rbsim security: a keystore once (never over an existing one), enclaves with their permissions,
+// bad enclave names as usage errors.
+TEST(SecurityCli, CreateKeystoreAndEnclaveAsRos2SecurityDoes) {
+  test::TempDir dir;
+  const std::string ks = (dir / "ks").string();
+  test::Outcome o = test::rbsim({"security", "create-keystore", ks});
+  ASSERT_EQ(o.exit_code, 0) << o;
+  o = test::rbsim({"security", "create-keystore", ks});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  EXPECT_NE(o.err.find("already a keystore"), std::string::npos) << o;
+  o = test::rbsim(
+      {"security", "create-enclave", ks, "/arm", "--namespace", "robots", "--topics", "scene,markers"});
+  ASSERT_EQ(o.exit_code, 0) << o;
+  const std::string permissions = test::read_text(dir / "ks/enclaves/arm/permissions.xml");
+  EXPECT_NE(permissions.find("<topic>rt/robots/markers</topic>"), std::string::npos) << permissions;
+  EXPECT_EQ(permissions.find("rt/robots/*"), std::string::npos) << permissions;
+  o = test::rbsim({"security", "create-enclave", ks, "arm"});
+  EXPECT_EQ(o.exit_code, 2) << o;
+  EXPECT_NE(o.err.find("enclave \"arm\": an absolute path"), std::string::npos) << o;
+  o = test::rbsim({"security", "create-enclave", (dir / "none").string(), "/arm"});
+  EXPECT_EQ(o.exit_code, 1) << o;
+  o = test::rbsim({"security", "--help"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  EXPECT_NE(o.out.find("ROS_SECURITY_ENABLE"), std::string::npos) << o;
+}
+
+}  // namespace
+}  // namespace rbsim

@@ -10,13 +10,13 @@ namespace rbsim::cli {
 
 namespace {
 struct SecurityArgs {
-  std::string keystore, enclave, topics;
+  std::string keystore, enclave;
   node::EnclaveOptions enclave_options;
   CLI::App* keystore_app = nullptr;
   CLI::App* enclave_app = nullptr;
 };
 
-int security_command(SecurityArgs& a) {
+int security_command(const SecurityArgs& a) {
   if (a.keystore_app->parsed()) {
     if (Status st = node::create_keystore(a.keystore); !st) return fail("security", st.error().message);
     std::printf(
@@ -24,16 +24,6 @@ int security_command(SecurityArgs& a) {
         "enclaves/governance.p7s\n",
         a.keystore.c_str());
     return 0;
-  }
-  if (!a.topics.empty()) {
-    std::string rest = a.topics;
-    for (std::size_t at = 0; at <= rest.size();) {
-      const std::size_t comma = rest.find(',', at);
-      const std::string t = rest.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
-      if (!t.empty()) a.enclave_options.topics.push_back(t);
-      if (comma == std::string::npos) break;
-      at = comma + 1;
-    }
   }
   if (Status st = node::create_enclave(a.keystore, a.enclave, a.enclave_options); !st)
     return fail("security", st.error().message, st.code() == ErrorCode::InvalidArgument ? 2 : 1);
@@ -61,9 +51,11 @@ Subcommand add_security_command(CLI::App& parent) {
       ->add_option("--namespace", a->enclave_options.ns,
                    "Namespace whose topics and services the enclave may use")
       ->default_str("rbsim");
-  a->enclave_app->add_option("--topics", a->topics,
-                             "Only these rbsim topics of the namespace (comma-separated suffixes: "
-                             "scene,body_states); default: all of them");
+  a->enclave_app
+      ->add_option("--topics", a->enclave_options.topics,
+                   "Only these rbsim topics of the namespace (comma-separated suffixes: "
+                   "scene,body_states); default: all of them")
+      ->delimiter(',');
   app->footer(
       "A process uses enclave <keystore>/enclaves/<node name> (ROS_SECURITY_ENCLAVE_OVERRIDE names another) "
       "when ROS_SECURITY_ENABLE=true and ROS_SECURITY_KEYSTORE=<keystore>; ROS_SECURITY_STRATEGY=Enforce "
