@@ -1571,6 +1571,39 @@ def case_record_disk_full(ctx):
     check_recover(ctx, out, "recorder past its file-size limit")
 
 
+def case_disk_full(ctx):
+    """A full file system (a 256 KiB tmpfs mounted in a mount namespace the test creates): `rbsim run
+    --csv` and `rbsim run --record` stop with one line naming the file, the bytes that reached it and
+    ENOSPC, exit 1, and nothing behind: the CSV was an unnamed temporary, and the run discards its
+    unfinished recording (`rbsim record`'s is kept for `rbsim log recover`: record_disk_full)."""
+    if shutil.which("unshare") is None:
+        print("SKIP: no unshare (util-linux): no mount namespace")
+        return SKIP
+    small = ctx.path("small")
+    os.makedirs(small, exist_ok=True)
+    scene = ctx.scene("cantilever.xml")
+    script = ('mount -t tmpfs -o size=256k rbsim-e2e "$1" || exit 77; shift; "$@"; rc=$?; ls -A "$0"; '
+              'exit $rc')
+    for what, out in (("csv", "out.csv"), ("record", "out.mcap")):
+        path = os.path.join(small, out)
+        rc, listing, err = ctx.run(f"full-{what}", ["unshare", "--mount", "--propagation", "private", "sh", "-c",
+                                                   script, small, small, ctx.rbsim, "run", scene, "--steps", "20000",
+                                                   "--compression" if what == "record" else "-q",
+                                                   *(("none", "-q") if what == "record" else ()),
+                                                   f"--{what}", path], timeout=120)
+        if rc == 77:
+            print(f"SKIP: cannot mount a tmpfs in a mount namespace here:\n{err}")
+            return SKIP
+        ctx.check(rc == 1, f"run --{what} on a full file system exited {rc}, want 1:\n{err}")
+        lines = [l for l in err.splitlines() if l.strip()]
+        want = f"rbsim run: error: {path}"
+        ctx.check(len(lines) == 1 and lines[0].startswith(want) and "No space left on device" in lines[0] and
+                  "write failed after " in lines[0],
+                  f"run --{what}: want one line naming {path}, the bytes and ENOSPC:\n{err}")
+        ctx.check(listing.split() == [], f"run --{what} left {listing.split()} on the full file system")
+    return 0
+
+
 def case_record_sigkill(ctx):
     """The recorder SIGKILLed at random moments (seeded; the seed is printed, RBSIM_E2E_SEED
     repeats a run): every message of every complete chunk in the killed file survives
@@ -1897,6 +1930,7 @@ CASES = {
     "ros_env": case_ros_env,
     "ros_graph": case_ros_graph,
     "record_disk_full": case_record_disk_full,
+    "disk_full": case_disk_full,
     "record_bag": case_record_bag,
     "record_bag_sigkill": case_record_bag_sigkill,
     "record_snapshot": case_record_snapshot,

@@ -138,16 +138,20 @@ class FileSink final : public ByteSink {
   static constexpr std::size_t kDirect = 16 * 1024;  // writes from this size bypass the buffer
 
   // Calls `put(done)` (a write, writev or pwrite of what remains after `done` bytes, returning its
-  // result) until `size` bytes are out, retrying on EINTR.
+  // result) until `size` bytes are out, retrying on EINTR. A failure says how many bytes the file
+  // holds (ENOSPC, EDQUOT, EFBIG, EIO).
   template <class Put>
-  static Status write_fully(std::size_t size, Put put) {
+  Status write_fully(std::size_t size, Put put) {
     std::size_t done = 0;
     while (done < size) {  // bounded: every pass writes at least one byte or returns
       const ssize_t n = put(done);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) {
-        return Error{std::string("write failed: ") + std::strerror(errno != 0 ? errno : EIO),
-                     ErrorCode::IoError};
+        const int error = errno != 0 ? errno : EIO;
+        struct stat st {};
+        const std::string held =
+            ::fstat(fd_, &st) == 0 ? " after " + std::to_string(st.st_size) + " bytes" : std::string();
+        return Error{"write failed" + held + ": " + std::strerror(error), ErrorCode::IoError};
       }
       done += static_cast<std::size_t>(n);
     }
