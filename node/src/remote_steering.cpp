@@ -282,6 +282,7 @@ std::vector<std::string> RemoteSteering::names() const {
 }
 
 void RemoteSteering::on_command(std::function<void(const Command&, const CommandResult&)> observer) {
+  const std::lock_guard lock(observers_mutex_);
   observers_.push_back(std::move(observer));
 }
 
@@ -386,6 +387,7 @@ void RemoteSteering::take_events() {
     Command c;
     c.kind = CommandKind::SetParameters;
     c.source = "parameter event";
+    const std::lock_guard lock(observers_mutex_);
     for (const auto& observer : observers_) observer(c, r);
   }
 }

@@ -58,12 +58,13 @@ TEST(RemoteSteering, RelaysParametersAndControlsToTheNodesServices) {
       [&s = *services.value()](const Command& c, const CommandResult& r) { s.command_applied(c, r); });
   auto run = std::async(std::launch::async, [&] { return test::run(scene, 120, &controller); });
 
+  // Before the steering: its thread may call the observer until the steering is destroyed.
+  std::mutex mu;
+  std::vector<msgs::Parameter> updates;
   Participant bridge = participant("remote_steering_bridge");
   auto steering = RemoteSteering::create(bridge, {"/" + node});
   ASSERT_TRUE(steering.ok()) << steering.error().message;
   RemoteSteering& remote = *steering.value();
-  std::mutex mu;
-  std::vector<msgs::Parameter> updates;
   remote.on_command([&](const Command&, const CommandResult& r) {
     const std::lock_guard lock(mu);
     updates.insert(updates.end(), r.changed.begin(), r.changed.end());

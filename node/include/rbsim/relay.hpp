@@ -114,6 +114,9 @@ class RemoteSteering final : public control::Steering {
   std::vector<ServiceClient> clients_;  // list, get, set, set atomically, then control_services()
   std::optional<Subscription> events_;  // /parameter_events
   Received event_sample_;
+  // Added from any thread (on_command), called on the run thread: guarded by its own mutex, held
+  // while they run (an observer must not add another).
+  std::mutex observers_mutex_;
   std::vector<std::function<void(const control::Command&, const control::CommandResult&)>> observers_;
 
   mutable std::mutex mutex_;  // guards everything below
