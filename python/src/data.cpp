@@ -162,17 +162,12 @@ struct Column {
   std::vector<double> values;
 };
 
-nb::object to_numpy(std::vector<double>&& values, std::size_t rows, std::size_t cols) {
-  auto* owned = new std::vector<double>(std::move(values));
-  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<double>*>(p); });
-  if (cols == 0) return nb::cast(nb::ndarray<nb::numpy, double, nb::ndim<1>>(owned->data(), {rows}, owner));
-  return nb::cast(nb::ndarray<nb::numpy, double, nb::ndim<2>>(owned->data(), {rows, cols}, owner));
-}
-
-nb::object steps_to_numpy(std::vector<std::uint64_t>&& steps) {
-  auto* owned = new std::vector<std::uint64_t>(std::move(steps));
-  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<std::uint64_t>*>(p); });
-  return nb::cast(nb::ndarray<nb::numpy, std::uint64_t, nb::ndim<1>>(owned->data(), {owned->size()}, owner));
+template <class T>
+nb::object to_numpy(std::vector<T>&& values, std::size_t rows, std::size_t cols = 0) {
+  auto* owned = new std::vector<T>(std::move(values));
+  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+  if (cols == 0) return nb::cast(nb::ndarray<nb::numpy, T, nb::ndim<1>>(owned->data(), {rows}, owner));
+  return nb::cast(nb::ndarray<nb::numpy, T, nb::ndim<2>>(owned->data(), {rows, cols}, owner));
 }
 
 msgs::TopicId topic_id(const std::string& topic) {
@@ -284,8 +279,8 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
   std::vector<double> t(rows);
   for (std::size_t i = 0; i < rows; ++i) t[i] = static_cast<double>(steps[i]) * scene.dt;  // World::time()
   nb::dict out;
-  out["step"] = steps_to_numpy(std::move(steps));
-  out["t"] = to_numpy(std::move(t), rows, 0);
+  out["step"] = to_numpy(std::move(steps), rows);
+  out["t"] = to_numpy(std::move(t), rows);
   for (Column& c : columns) out[c.name.c_str()] = to_numpy(std::move(c.values), rows, width);
   return out;
 }
@@ -310,9 +305,9 @@ nb::dict recording_info(const std::string& path, const std::string& ns) {
     radius.push_back(b.radius);
   }
   const std::size_t n = s.bodies.size();
-  scene["mass"] = to_numpy(std::move(mass), n, 0);
-  scene["inertia"] = to_numpy(std::move(inertia), n, 0);
-  scene["radius"] = to_numpy(std::move(radius), n, 0);
+  scene["mass"] = to_numpy(std::move(mass), n);
+  scene["inertia"] = to_numpy(std::move(inertia), n);
+  scene["radius"] = to_numpy(std::move(radius), n);
   nb::list topics;
   for (const log::RecordedChannel& c : rec->channels()) topics.append(c.channel->topic);
   nb::dict per_step;
