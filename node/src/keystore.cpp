@@ -1,10 +1,15 @@
 // An SROS2 keystore and its enclaves (rbsim/security.hpp), laid out as `ros2 security` lays them
 // out (sros2/keystore: _keystore.py, _enclave.py; policy templates governance.xml, permissions.xsl).
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "openssl_util.hpp"
+#include "rbsim/atomic_file.hpp"
 #include "rbsim/msgs.hpp"
 #include "rbsim/security.hpp"
 
@@ -121,12 +126,23 @@ std::string permissions_xml(const std::string& enclave, const EnclaveOptions& o)
   return x.str();
 }
 
-Status write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) return Error{path.string() + ": cannot be written"};
-  return Ok{};
+// Every file of a keystore is written whole and moved into place (AtomicFile): a killed `rbsim
+// security` leaves no half-written key, certificate or signed document. A private key is its
+// owner's alone (0600) before its first byte is written.
+enum class Access { Shared, OwnerOnly };
+
+Status write_file(const fs::path& path, const std::string& text, Access access = Access::Shared) {
+  AtomicFile file;
+  if (Status st = file.open(path.string()); !st) return st;
+  if (access == Access::OwnerOnly && ::fchmod(::fileno(file.stream()), 0600) != 0)
+    return Error{path.string() + ": cannot be made private (" + std::strerror(errno) + ")"};
+  if (Status st = file.write(text.data(), text.size()); !st) return st;
+  return file.commit();
+}
+
+Status write_file(const fs::path& path, const Result<std::string>& text, Access access = Access::Shared) {
+  if (!text) return text.error();
+  return write_file(path, text.value(), access);
 }
 
 Status make_dirs(const fs::path& dir) {
@@ -173,10 +189,11 @@ Status create_keystore(const std::string& dir) {
   if (!key) return key.error();
   Result<ssl::X509Ptr> cert = ssl::make_certificate(kCommonName, *key.value(), nullptr, *key.value());
   if (!cert) return cert.error();
-  if (Status st = ssl::write_private_key((root / "private/ca.key.pem").string(), *key.value()); !st)
+  const fs::path ca_key = root / "private/ca.key.pem", ca_cert = root / "public/ca.cert.pem";
+  if (Status st = write_file(ca_key, ssl::private_key_pem(*key.value(), ca_key.string()), Access::OwnerOnly);
+      !st)
     return st;
-  if (Status st = ssl::write_certificate((root / "public/ca.cert.pem").string(), *cert.value()); !st)
-    return st;
+  if (Status st = write_file(ca_cert, ssl::certificate_pem(*cert.value(), ca_cert.string())); !st) return st;
   for (const char* role : {"identity_ca", "permissions_ca"}) {
     if (Status st = link(root / "public/ca.cert.pem", root / "public" / (std::string(role) + ".cert.pem"));
         !st)
@@ -186,9 +203,10 @@ Status create_keystore(const std::string& dir) {
       return st;
   }
   const std::string governance = governance_xml();
-  if (Status st = write_text(root / "enclaves/governance.xml", governance); !st) return st;
-  return ssl::write_smime((root / "enclaves/governance.p7s").string(), governance, *cert.value(),
-                          *key.value());
+  if (Status st = write_file(root / "enclaves/governance.xml", governance); !st) return st;
+  const fs::path signed_governance = root / "enclaves/governance.p7s";
+  return write_file(signed_governance,
+                    ssl::smime(governance, *cert.value(), *key.value(), signed_governance.string()));
 }
 
 Status create_enclave(const std::string& keystore, const std::string& enclave,
@@ -214,11 +232,19 @@ Status create_enclave(const std::string& keystore, const std::string& enclave,
   if (!key) return key.error();
   Result<ssl::X509Ptr> cert = ssl::make_certificate(enclave, *key.value(), ca->cert.get(), *ca->key);
   if (!cert) return cert.error();
-  if (Status st = ssl::write_private_key((dir / "key.pem").string(), *key.value()); !st) return st;
-  if (Status st = ssl::write_certificate((dir / "cert.pem").string(), *cert.value()); !st) return st;
+  if (Status st = write_file(dir / "key.pem", ssl::private_key_pem(*key.value(), (dir / "key.pem").string()),
+                             Access::OwnerOnly);
+      !st)
+    return st;
+  if (Status st =
+          write_file(dir / "cert.pem", ssl::certificate_pem(*cert.value(), (dir / "cert.pem").string()));
+      !st)
+    return st;
   const std::string permissions = permissions_xml(enclave, options);
-  if (Status st = write_text(dir / "permissions.xml", permissions); !st) return st;
-  return ssl::write_smime((dir / "permissions.p7s").string(), permissions, *ca->cert, *ca->key);
+  if (Status st = write_file(dir / "permissions.xml", permissions); !st) return st;
+  const fs::path signed_permissions = dir / "permissions.p7s";
+  return write_file(signed_permissions,
+                    ssl::smime(permissions, *ca->cert, *ca->key, signed_permissions.string()));
 }
 
 }  // namespace rbsim::node

@@ -7,9 +7,6 @@
 #include <openssl/pkcs7.h>
 #include <openssl/rand.h>
 #include <openssl/x509v3.h>
-#include <sys/stat.h>
-
-#include <cstdio>
 
 namespace rbsim::node::ssl {
 
@@ -119,32 +116,41 @@ Result<X509Ptr> make_certificate(const std::string& common_name, EVP_PKEY& subje
   return cert;
 }
 
-Status write_certificate(const std::string& path, X509& cert) {
-  BioPtr out(BIO_new_file(path.c_str(), "w"));
-  if (!out || PEM_write_bio_X509(out.get(), &cert) != 1) return failure(path, "cannot be written");
-  return Ok{};
+namespace {
+
+// What a memory BIO holds, as text.
+std::string contents(BIO& bio) {
+  char* data = nullptr;
+  const long size = BIO_get_mem_data(&bio, &data);
+  return size > 0 ? std::string(data, static_cast<std::size_t>(size)) : std::string();
 }
 
-Status write_private_key(const std::string& path, EVP_PKEY& key) {
-  const mode_t old = umask(077);  // the key is its owner's alone from its first byte
-  BioPtr out(BIO_new_file(path.c_str(), "w"));
-  umask(old);
+}  // namespace
+
+Result<std::string> certificate_pem(X509& cert, const std::string& what) {
+  BioPtr out(BIO_new(BIO_s_mem()));
+  if (!out || PEM_write_bio_X509(out.get(), &cert) != 1) return failure(what, "cannot be encoded");
+  return contents(*out);
+}
+
+Result<std::string> private_key_pem(EVP_PKEY& key, const std::string& what) {
+  BioPtr out(BIO_new(BIO_s_mem()));
   if (!out || PEM_write_bio_PrivateKey(out.get(), &key, nullptr, nullptr, 0, nullptr, nullptr) != 1)
-    return failure(path, "cannot be written");
-  return Ok{};
+    return failure(what, "cannot be encoded");
+  return contents(*out);
 }
 
-Status write_smime(const std::string& path, const std::string& text, X509& signer, EVP_PKEY& key) {
+Result<std::string> smime(const std::string& text, X509& signer, EVP_PKEY& key, const std::string& what) {
   constexpr int kFlags = PKCS7_DETACHED | PKCS7_TEXT;
   BioPtr data(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())));
   PKCS7* p7 = PKCS7_sign(&signer, &key, nullptr, data.get(), kFlags);
-  if (p7 == nullptr) return failure(path, "cannot be signed");
+  if (p7 == nullptr) return failure(what, "cannot be signed");
   BioPtr again(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())));  // PKCS7_sign read the first
-  BioPtr out(BIO_new_file(path.c_str(), "w"));
+  BioPtr out(BIO_new(BIO_s_mem()));
   const bool ok = out && SMIME_write_PKCS7(out.get(), p7, again.get(), kFlags) == 1;
   PKCS7_free(p7);
-  if (!ok) return failure(path, "cannot be written");
-  return Ok{};
+  if (!ok) return failure(what, "cannot be encoded");
+  return contents(*out);
 }
 
 }  // namespace rbsim::node::ssl

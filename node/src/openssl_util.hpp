@@ -37,11 +37,11 @@ Result<KeyPtr> generate_key();
 // `issuer` is null (a CA, BasicConstraints CA:TRUE, pathlen 1), else signed by the issuer's key.
 Result<X509Ptr> make_certificate(const std::string& common_name, EVP_PKEY& subject_key, X509* issuer,
                                  EVP_PKEY& issuer_key);
-// Writes PEM files (the key readable by its owner only), and an S/MIME signed copy of `text`
-// (detached, text/plain, SHA-256: what sros2's create_smime_signed_file writes).
-[[nodiscard]] Status write_certificate(const std::string& path, X509& cert);
-[[nodiscard]] Status write_private_key(const std::string& path, EVP_PKEY& key);
-[[nodiscard]] Status write_smime(const std::string& path, const std::string& text, X509& signer,
-                                 EVP_PKEY& key);
+// PEM text of a certificate and of a private key (unencrypted PKCS#8), and an S/MIME signed copy of
+// `text` (detached, text/plain, SHA-256: what sros2's create_smime_signed_file writes). The keystore
+// writes them (src/keystore.cpp, through AtomicFile); `what` names the file in an error.
+Result<std::string> certificate_pem(X509& cert, const std::string& what);
+Result<std::string> private_key_pem(EVP_PKEY& key, const std::string& what);
+Result<std::string> smime(const std::string& text, X509& signer, EVP_PKEY& key, const std::string& what);
 
 }  // namespace rbsim::node::ssl

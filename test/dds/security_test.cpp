@@ -134,7 +134,15 @@ TEST_F(Security, CreateKeystoreAndEnclaveLayOutSros2sFiles) {
                         "private/ca.key.pem", "enclaves/governance.xml", "enclaves/governance.p7s"}) {
     EXPECT_TRUE(fs::exists(ks() / f)) << f;
   }
-  EXPECT_EQ(fs::status(ks() / "private/ca.key.pem").permissions() & fs::perms::group_read, fs::perms::none);
+  for (const char* key : {"private/ca.key.pem", "enclaves/sec_node/key.pem"}) {
+    EXPECT_EQ(fs::status(ks() / key).permissions() & fs::perms::all,
+              fs::perms::owner_read | fs::perms::owner_write)
+        << key;
+  }
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(ks())) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
+        << "a temporary left: " << e.path();
+  }
   EXPECT_TRUE(verify_enclave((ks() / "enclaves/sec_node").string()));
   const std::string permissions = test::read_text(ks() / "enclaves/sec_node/permissions.xml");
   EXPECT_NE(permissions.find("<subject_name>CN=/sec_node</subject_name>"), std::string::npos);
