@@ -1571,36 +1571,69 @@ def case_record_disk_full(ctx):
     check_recover(ctx, out, "recorder past its file-size limit")
 
 
+# Mounts a file system that fails writes in one way at "$2", inside the mount namespace the test
+# made, then runs the command after it and lists "$2". enospc: a 256 KiB tmpfs. edquot: a btrfs
+# (on a loop device, its image on a scratch tmpfs) whose quota group allows 256 KiB. eio: an ext4
+# mounted sync (each write reaches the device) whose loop device is then cut to 2 of its 16 MiB:
+# every write beyond the end is an I/O error. Loop devices mounted with -o loop detach themselves
+# when the namespace's mounts go. Exit 77: this machine cannot make that file system.
+FAULTY_FS_SCRIPT = r"""
+kind=$1 dir=$2; shift 2
+scratch=$(mktemp -d) || exit 77
+mount -t tmpfs -o size=200m rbsim-e2e-img "$scratch" || exit 77
+case $kind in
+enospc) mount -t tmpfs -o size=256k rbsim-e2e "$dir" || exit 77 ;;
+edquot)
+  { truncate -s 128M "$scratch/img" && mkfs.btrfs -q "$scratch/img" >/dev/null && mount -o loop "$scratch/img" "$dir" &&
+    btrfs quota enable "$dir" && btrfs qgroup limit 256K "$dir"; } || exit 77 ;;
+eio)
+  { truncate -s 16M "$scratch/img" && mkfs.ext4 -q -O ^has_journal "$scratch/img" &&
+    mount -o loop,sync,errors=continue "$scratch/img" "$dir" && rmdir "$dir/lost+found" &&
+    dev=$(findmnt -n -o SOURCE "$dir") && truncate -s 2M "$scratch/img" && losetup -c "$dev"; } || exit 77 ;;
+esac
+"$@"; rc=$?; ls -A "$dir"; exit $rc
+"""
+
+
 def case_disk_full(ctx):
-    """A full file system (a 256 KiB tmpfs mounted in a mount namespace the test creates): `rbsim run
-    --csv` and `rbsim run --record` stop with one line naming the file, the bytes that reached it and
-    ENOSPC, exit 1, and nothing behind: the CSV was an unnamed temporary, and the run discards its
-    unfinished recording (`rbsim record`'s is kept for `rbsim log recover`: record_disk_full)."""
+    """Write errors from real file systems, each mounted in a mount namespace the test creates: a
+    full tmpfs (ENOSPC), a btrfs over its quota (EDQUOT) and an ext4 whose device fails writes
+    (EIO). `rbsim run --csv` and `rbsim run --record` stop with one line naming the file, the bytes
+    that reached it and the system's reason, exit 1, and nothing behind: the CSV was an unnamed
+    temporary, and the run discards its unfinished recording (`rbsim record`'s is kept for
+    `rbsim log recover`: record_disk_full). EFBIG (`ulimit -f`) is RunOutputs' unit test."""
     if shutil.which("unshare") is None:
         print("SKIP: no unshare (util-linux): no mount namespace")
         return SKIP
-    small = ctx.path("small")
-    os.makedirs(small, exist_ok=True)
     scene = ctx.scene("cantilever.xml")
-    script = ('mount -t tmpfs -o size=256k rbsim-e2e "$1" || exit 77; shift; "$@"; rc=$?; ls -A "$0"; '
-              'exit $rc')
-    for what, out in (("csv", "out.csv"), ("record", "out.mcap")):
-        path = os.path.join(small, out)
-        rc, listing, err = ctx.run(f"full-{what}", ["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                                                   script, small, small, ctx.rbsim, "run", scene, "--steps", "20000",
-                                                   "--compression" if what == "record" else "-q",
-                                                   *(("none", "-q") if what == "record" else ()),
-                                                   f"--{what}", path], timeout=120)
-        if rc == 77:
-            print(f"SKIP: cannot mount a tmpfs in a mount namespace here:\n{err}")
-            return SKIP
-        ctx.check(rc == 1, f"run --{what} on a full file system exited {rc}, want 1:\n{err}")
-        lines = [l for l in err.splitlines() if l.strip()]
-        want = f"rbsim run: error: {path}"
-        ctx.check(len(lines) == 1 and lines[0].startswith(want) and "No space left on device" in lines[0] and
-                  "write failed after " in lines[0],
-                  f"run --{what}: want one line naming {path}, the bytes and ENOSPC:\n{err}")
-        ctx.check(listing.split() == [], f"run --{what} left {listing.split()} on the full file system")
+    faults = (("enospc", "No space left on device"), ("edquot", "Disk quota exceeded"),
+              ("eio", "Input/output error"))
+    made = []
+    for kind, reason in faults:
+        mnt = ctx.path(kind)
+        os.makedirs(mnt, exist_ok=True)
+        for what, out in (("csv", "out.csv"), ("record", "out.mcap")):
+            path = os.path.join(mnt, out)
+            extra = ("--compression", "none") if what == "record" else ()
+            rc, listing, err = ctx.run(f"{kind}-{what}", ["unshare", "--mount", "--propagation", "private", "sh", "-c",
+                                                         FAULTY_FS_SCRIPT, "faulty-fs", kind, mnt, ctx.rbsim, "run",
+                                                         scene, "--steps", "20000", "-q", *extra, f"--{what}", path],
+                                       timeout=120)
+            if rc == 77:
+                ctx.note(f"{kind}: this machine cannot make that file system here (not tested):\n{err}")
+                break
+            ctx.check(rc == 1, f"run --{what} on the {kind} file system exited {rc}, want 1:\n{err}")
+            lines = [l for l in err.splitlines() if l.strip()]
+            want = f"rbsim run: error: {path}: write failed after "
+            ctx.check(len(lines) == 1 and lines[0].startswith(want) and lines[0].endswith(f" bytes: {reason}"),
+                      f"run --{what} on {kind}: want one line \"{want}N bytes: {reason}\":\n{err}")
+            ctx.check(listing.split() == [], f"run --{what} left {listing.split()} on the {kind} file system")
+        else:
+            made.append(kind)
+    if "enospc" not in made:
+        print("SKIP: cannot mount a tmpfs in a mount namespace here")
+        return SKIP
+    ctx.log(f"write errors tested on: {', '.join(made)}")
     return 0
 
 
