@@ -425,6 +425,10 @@ TEST(FoxgloveCli, TlsServesWssWithACertificateAndItsKey) {
   EXPECT_EQ(mismatch.exit_code, 1) << mismatch;
   EXPECT_NE(mismatch.err.find("TLS key " + other_key + ": key values mismatch"), std::string::npos)
       << mismatch;
+  std::filesystem::permissions(key, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  const test::Outcome exposed = node(cert, key);
+  EXPECT_EQ(exposed.exit_code, 1) << exposed;
+  EXPECT_NE(exposed.err.find("TLS key " + key + ": other users may read it"), std::string::npos) << exposed;
   const test::Outcome one = rbsim({"node", scene_path(), "--foxglove", "0", "--foxglove-tls", cert});
   EXPECT_EQ(one.exit_code, 2) << one;
   EXPECT_NE(one.err.find("--foxglove-tls"), std::string::npos) << one;

@@ -7,6 +7,7 @@
 #include <websocketpp/server.hpp>
 
 #include <sys/eventfd.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <asio/posix/stream_descriptor.hpp>
@@ -216,6 +217,11 @@ class AsioTransport final : public Transport {
     if (!ec) SSL_CTX_set_min_proto_version(ctx->native_handle(), TLS1_2_VERSION);
     if (!ec) ctx->use_certificate_chain_file(options.tls_cert, ec);
     if (ec) return "TLS certificate " + options.tls_cert + ": " + ec.message();
+    // The key is the server's identity: one any user of this host can read is refused (group
+    // access is allowed: Debian's ssl-cert group holds keys at 0640).
+    if (struct stat st{}; ::stat(options.tls_key.c_str(), &st) == 0 && (st.st_mode & S_IRWXO) != 0)
+      return "TLS key " + options.tls_key +
+             ": other users may read it; a private key must not be (chmod 600 " + options.tls_key + ")";
     ctx->use_private_key_file(options.tls_key, asio::ssl::context::pem, ec);
     if (ec) return "TLS key " + options.tls_key + ": " + ec.message();
     if (SSL_CTX_check_private_key(ctx->native_handle()) != 1)

@@ -327,7 +327,8 @@ struct ServerOptions {
   // unless this is set (rbsim's --foxglove-insecure).
   bool allow_insecure = false;
   // wss:// when set (TLS 1.2 or later, OpenSSL): the PEM certificate chain and its private key,
-  // read at start() (a file that cannot be read, or a key not the certificate's, is an error).
+  // read at start() (a file that cannot be read, a key not the certificate's, or a key other
+  // users may read is an error).
   std::string tls_cert, tls_key;
 };
 
