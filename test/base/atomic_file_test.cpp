@@ -174,6 +174,35 @@ TEST_F(AtomicFileTest, AWriterKilledMidWriteLeavesNothing) {
   EXPECT_EQ(read(path("out.csv")), "old");
 }
 
+// An external writer of an output that is redone (Remove: a movie, a plot, a log tool's output)
+// writes an unnamed file by its /proc path: nothing has a name until commit, and a writer killed
+// mid-write leaves nothing.
+TEST_F(AtomicFileTest, OpenExternalRemoveGivesTheWriterAnUnnamedFile) {
+  AtomicFile f;
+  f.open_external(path("movie.mp4"), AtomicFile::Leftovers::Remove);
+  EXPECT_EQ(f.writer_path().rfind("/proc/" + std::to_string(::getpid()) + "/fd/", 0), 0u) << f.writer_path();
+  write_text(f.writer_path(), "frames");
+  EXPECT_TRUE(names().empty()) << "unnamed until commit";
+  ASSERT_TRUE(f.commit().ok());
+  EXPECT_EQ(names(), std::vector<std::string>{"movie.mp4"});
+  EXPECT_EQ(read(path("movie.mp4")), "frames");
+
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    AtomicFile g;
+    g.open_external(path("movie.mp4"), AtomicFile::Leftovers::Remove);
+    write_text(g.writer_path(), "partial");
+    ::kill(::getpid(), SIGKILL);
+    ::_exit(4);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+  EXPECT_EQ(names(), std::vector<std::string>{"movie.mp4"}) << "no temporary survives SIGKILL";
+  EXPECT_EQ(read(path("movie.mp4")), "frames");
+}
+
 // ulimit -f: with SIGXFSZ ignored (as rbsim's main does) the write fails with EFBIG, and the error
 // names the file and the bytes written before it.
 TEST_F(AtomicFileTest, AFileSizeLimitIsAnErrorNamingTheFileAndTheBytesWritten) {

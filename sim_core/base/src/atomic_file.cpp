@@ -51,6 +51,7 @@ int open_unnamed(const std::string& path) {
 
 Status AtomicFile::open(const std::string& path) {
   open_external(path);
+  external_ = false;
   const int fd = open_unnamed(path);
   if (fd >= 0) {
     temp_path_.clear();  // unnamed until commit()
@@ -88,15 +89,35 @@ static void remove_leftovers(const std::string& path) {
 
 void AtomicFile::open_external(const std::string& path, Leftovers leftovers) {
   discard();
-  if (leftovers == Leftovers::Remove) remove_leftovers(path);
   path_ = path;
   temp_path_ = path + ".tmp." + std::to_string(::getpid());
   pending_ = true;
   bytes_ = 0;
+  external_ = true;
+  if (leftovers == Leftovers::Keep) return;
+  remove_leftovers(path);
+  // Nothing of a killed writer may stay: the writer gets an unnamed file, which this process
+  // holds open (and links at commit), by its /proc path.
+  const int fd = open_unnamed(path);
+  if (fd < 0) return;
+  file_ = ::fdopen(fd, "wb");
+  if (file_ == nullptr) {
+    ::close(fd);
+    return;
+  }
+  temp_path_.clear();
+}
+
+std::string AtomicFile::writer_path() const {
+  return file_ != nullptr ? open_file_path(::fileno(file_)) : temp_path_;
+}
+
+std::string open_file_path(int fd) {
+  return "/proc/" + std::to_string(::getpid()) + "/fd/" + std::to_string(fd);
 }
 
 Status AtomicFile::write(const void* data, std::size_t size) {
-  if (file_ == nullptr) return Error{path_ + ": write to a file that is not open"};
+  if (file_ == nullptr || external_) return Error{path_ + ": write to a file that is not open"};
   if (size != 0 && std::fwrite(data, 1, size, file_) != size) {
     const int error = errno;
     return io_error("write failed after " + std::to_string(on_disk(file_, bytes_)) + " bytes", path_, error);
@@ -111,7 +132,7 @@ Status AtomicFile::commit(Durability durability) {
   bool written = true;
   int error = 0;
   std::uint64_t reached = bytes_;
-  const bool external = file_ == nullptr;
+  const bool external = external_;
   if (file_ != nullptr) {
     const bool flushed = std::fflush(file_) == 0 && (!sync || ::fsync(::fileno(file_)) == 0);
     error = errno;  // the flush's, if it failed; else the link's or the close's

@@ -40,8 +40,8 @@ class McapFileSink final : public McapSink {
       if (Status st = make_bag_directory(bag_); !st) return st;
     }
     file_.open_external(path_);
-    if (auto st = writer_.open(file_.temp_path(), writer_options(options_.compression, options_.chunk_size,
-                                                                 options_.compression_level));
+    if (auto st = writer_.open(file_.writer_path(), writer_options(options_.compression, options_.chunk_size,
+                                                                   options_.compression_level));
         !st.ok()) {
       return fail(path_, st.error());
     }

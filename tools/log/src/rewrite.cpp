@@ -41,7 +41,7 @@ class Output {
     file_.open_external(path, AtomicFile::Leftovers::Remove);  // a killed rewrite is redone, not recovered
     mcap::WriterOptions wo = writer_options(options.compression, options.chunk_size);
     wo.profile = profile;
-    if (Status st = writer_.open(file_.temp_path(), wo); !st.ok()) return fail(st.error());
+    if (Status st = writer_.open(file_.writer_path(), wo); !st.ok()) return fail(st.error());
     return Ok{};
   }
 

@@ -250,7 +250,7 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   wo.background_compression = true;
   wo.profile = header.profile;
   wo.library = header.library;
-  if (Status s = rec.writer().open(output.temp_path(), wo); !s.ok())
+  if (Status s = rec.writer().open(output.writer_path(), wo); !s.ok())
     return Error{out + ": " + s.error().message};
   auto abandon = [&](const std::string& why) -> Result<RecoverReport> {
     (void)rec.writer().close();

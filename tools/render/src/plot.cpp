@@ -1,9 +1,14 @@
 // Energy and momentum over time, drawn by gnuplot.
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <sstream>
 
 #include "process.hpp"
 #include "rbsim/atomic_file.hpp"
@@ -91,39 +96,38 @@ Status plot(const std::string& input, const PlotOptions& o) {
       is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
   if (!samples) return samples.error();
 
-  AtomicFile png;  // gnuplot writes it; data and script are scratch files beside it
+  AtomicFile png;  // gnuplot writes it
   png.open_external(o.out_png, AtomicFile::Leftovers::Remove);
-  const std::string data = o.out_png + ".data.tmp", script = o.out_png + ".gp.tmp";
-  {
-    std::ofstream f(data);
-    for (const Sample& s : samples.value()) {
-      char line[256];
-      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t, s.t_point,
-                    s.t_spin, s.u, s.e, s.px, s.py, s.l);
-      f << line;
-    }
-    if (!f) return Error{o.out_png + ": cannot write temporary data beside it"};
+  // gnuplot's data and script: unnamed scratch files (tmpfile), read by their /proc paths, so a
+  // killed plot leaves neither.
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> data(std::tmpfile(), &std::fclose),
+      script(std::tmpfile(), &std::fclose);
+  if (!data || !script) return Error{o.out_png + ": no scratch file for gnuplot: " + std::strerror(errno)};
+  for (const Sample& s : samples.value()) {
+    std::fprintf(data.get(), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t, s.t_point, s.t_spin,
+                 s.u, s.e, s.px, s.py, s.l);
   }
-  {
-    std::ofstream f(script);
-    f << "set terminal pngcairo size " << o.width << "," << o.height << " enhanced font 'DejaVu Sans,11'\n"
-      << "set output '" << png.temp_path() << "'\n"
-      << "set datafile separator ','\nset grid\nset key outside right top\nset xlabel 'time (s)'\n"
-      << "set multiplot layout 2,1 title '" << fs::path(input).filename().string() << "'\n"
-      << "set title 'Energy'\nset ylabel 'energy'\n"
-      << "plot '" << data << "' using 1:2 with lines lw 1.5 title 'T_{point} (centre of mass)', "
-      << "'' using 1:3 with lines lw 1.5 title 'T_{spin}', '' using 1:4 with lines lw 1.5 title 'U "
-         "(potential)', "
-      << "'' using 1:5 with lines lw 2.5 title 'E = T + U'\n"
-      << "set title 'Momentum'\nset ylabel 'momentum'\n"
-      << "plot '" << data
-      << "' using 1:6 with lines lw 1.5 title 'P_x', '' using 1:7 with lines lw 1.5 title 'P_y', "
-      << "'' using 1:8 with lines lw 2 title 'L = L_{point} + L_{spin}'\n"
-      << "unset multiplot\n";
-  }
-  Result<int> code = detail::run_process({"gnuplot", script});
-  std::remove(data.c_str());
-  std::remove(script.c_str());
+  const std::string data_path = open_file_path(::fileno(data.get()));
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size " << o.width << "," << o.height << " enhanced font 'DejaVu Sans,11'\n"
+     << "set output '" << png.writer_path() << "'\n"
+     << "set datafile separator ','\nset grid\nset key outside right top\nset xlabel 'time (s)'\n"
+     << "set multiplot layout 2,1 title '" << fs::path(input).filename().string() << "'\n"
+     << "set title 'Energy'\nset ylabel 'energy'\n"
+     << "plot '" << data_path << "' using 1:2 with lines lw 1.5 title 'T_{point} (centre of mass)', "
+     << "'' using 1:3 with lines lw 1.5 title 'T_{spin}', '' using 1:4 with lines lw 1.5 title 'U "
+        "(potential)', "
+     << "'' using 1:5 with lines lw 2.5 title 'E = T + U'\n"
+     << "set title 'Momentum'\nset ylabel 'momentum'\n"
+     << "plot '" << data_path
+     << "' using 1:6 with lines lw 1.5 title 'P_x', '' using 1:7 with lines lw 1.5 title 'P_y', "
+     << "'' using 1:8 with lines lw 2 title 'L = L_{point} + L_{spin}'\n"
+     << "unset multiplot\n";
+  const std::string text = gp.str();
+  std::fwrite(text.data(), 1, text.size(), script.get());
+  if (std::fflush(data.get()) != 0 || std::fflush(script.get()) != 0)
+    return Error{o.out_png + ": cannot write gnuplot's scratch files: " + std::strerror(errno)};
+  Result<int> code = detail::run_process({"gnuplot", open_file_path(::fileno(script.get()))});
   if (!code) return Error{"gnuplot: " + code.error().message};
   if (code.value() != 0) return Error{"gnuplot failed drawing " + o.out_png};
   return png.commit();

@@ -236,7 +236,7 @@ Status make_movie(const std::string& frames_dir, double fps, std::int64_t frames
   std::snprintf(rate, sizeof rate, "%g", fps);
   // -f mp4: the temporary's name does not end in .mp4, so ffmpeg is told the container.
   const std::string input = (fs::path(frames_dir) / "frame%05d.png").string();
-  const std::string& output = movie.temp_path();
+  const std::string output = movie.writer_path();
   Result<int> code =
       detail::run_process({"ffmpeg", "-y",        "-loglevel",  "error",     "-framerate",
                            rate,     "-i",        input,        "-frames:v", std::to_string(frames),
