@@ -11,13 +11,11 @@
 
 #include "bindings.hpp"
 #include "interrupt.hpp"
-#include "rbsim/bag.hpp"
 #include "rbsim/check.hpp"
-#include "rbsim/command_script.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_sink.hpp"
-#include "rbsim/outputs.hpp"
+#include "rbsim/offline_run.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/sink.hpp"
@@ -71,83 +69,47 @@ log::RecordOptions record_options(const RunArgs& a) {
   return ro;
 }
 
-// The outputs `rbsim run` would write with the same options, and the steps done. Mirrors
-// tools/cli/run.cpp's stages: outputs checked, commands read whole, then one pass of the driver.
+// The outputs `rbsim run` would write with the same options (control::OfflineRun, as `rbsim run`
+// runs), and the steps done.
 std::int64_t run(const RunArgs& a) {
   Result<Scene> loaded = load_scene(a.scene);
   if (!loaded) raise_scene_error(a.scene, loaded.error().message);
-  const Scene& scene = loaded.value();
-  std::int64_t steps = scene.step_count();
-  if (a.duration) {
-    if (!(*a.duration >= 0.0)) throw nb::value_error("rbsim.run: duration must be >= 0");
-    steps = steps_for(*a.duration, scene.world.dt);
-  }
-  if (a.steps) steps = *a.steps;
-  if (steps < 0) throw nb::value_error("rbsim.run: steps must be >= 0");
-  const log::RecordOptions ro = record_options(a);
-
-  std::vector<std::string> inputs{a.scene};
-  if (!a.commands.empty()) inputs.push_back(a.commands);
-  std::vector<OutputPath> outputs = {
-      {a.csv, "csv"}, {a.energy_csv, "energy_csv"}, {a.fosssim_out, "fosssim_out"}};
-  if (!a.record.empty() && log::is_bag_output(a.record)) {
-    for (OutputPath& p : log::bag_outputs(a.record, "record")) outputs.push_back(std::move(p));
-  } else {
-    outputs.push_back({a.record, "record"});
-  }
-  check(check_outputs(outputs, inputs, a.overwrite));
-
-  std::optional<control::ScriptedRun> script;
-  if (!a.commands.empty()) {
-    Result<std::vector<control::ScriptedCommand>> commands = control::load_commands(a.commands, scene, steps);
-    if (!commands) raise_error(commands.error().message);
-    script.emplace(scene, steps, std::move(commands.value()));
-  }
-  Result<Driver> created = Driver::create(scene);
-  if (!created) raise_error(scene.path + ": " + created.error().message);
-  Driver& driver = created.value();
-  std::vector<std::unique_ptr<Sink>> sinks;
-  if (!a.csv.empty()) sinks.push_back(make_csv_sink(a.csv));
-  if (!a.energy_csv.empty()) sinks.push_back(make_energy_csv_sink(a.energy_csv));
-  if (!a.fosssim_out.empty()) sinks.push_back(make_fosssim_sink(a.fosssim_out));
-  if (!a.record.empty()) {
-    std::unique_ptr<log::McapSink> mcap = log::make_mcap_sink(a.record, ro);
-    if (script) script->record_to(*mcap);
-    sinks.push_back(std::move(mcap));
-  }
-  for (auto& sink : sinks) driver.add(*sink);
+  control::OfflineRunDef def;
+  def.scene = a.scene;
+  def.steps = a.steps;
+  def.duration = a.duration;
+  def.commands = a.commands;
+  def.csv = {a.csv, "csv"};
+  def.energy_csv = {a.energy_csv, "energy_csv"};
+  def.fosssim_out = {a.fosssim_out, "fosssim_out"};
+  def.record = {a.record, "record"};
+  def.recording = record_options(a);
+  def.overwrite = a.overwrite;
+  Result<std::unique_ptr<control::OfflineRun>> prepared =
+      control::OfflineRun::prepare(def, std::move(loaded.value()));
+  if (!prepared) raise_error(prepared.error().message);
+  control::OfflineRun& offline = *prepared.value();
 
   InterruptPoll poll;
   Result<PassEnd> end = Error{""};
-  Status finished;
   {
     nb::gil_scoped_release unlocked;
     ScopedStop stop(poll);
-    if (Status st = driver.begin(); !st) {
-      end = st.error();
-    } else {
-      DriverOptions options;
-      options.steps = steps;
-      options.allow_nonfinite = a.allow_nonfinite;
-      options.stop = &ScopedStop::requested;
-      if (script) options.control = &script->controller();
-      end = driver.run(options);
-      if (end) finished = driver.finish();
-    }
+    DriverOptions options;
+    options.allow_nonfinite = a.allow_nonfinite;
+    options.stop = &ScopedStop::requested;
+    end = offline.run(options);
   }
   if (!end) raise_error(end.error().message);
-  check(finished);
-  const std::int64_t done = driver.world().step_index();
+  const std::int64_t done = offline.driver().world().step_index();
   if (end.value() == PassEnd::Diverged) {
-    raise_divergence(describe_divergence(driver.divergence()) + ". Outputs hold steps 0.." +
+    raise_divergence(describe_divergence(offline.driver().divergence()) + ". Outputs hold steps 0.." +
                      std::to_string(done - 1) + " (allow_nonfinite=True keeps going).");
   }
-  if (script) {
-    if (Status st = script->finish(a.commands); !st) {
-      std::string named;
-      for (const std::string& m : script->mismatches()) named += "\n  " + m;
-      raise_error(st.error().message + named + "; outputs hold the run");
-    }
+  if (Status st = offline.finish_commands(); !st) {
+    std::string named;
+    for (const std::string& m : offline.script()->mismatches()) named += "\n  " + m;
+    raise_error(st.error().message + named + "; outputs hold the run");
   }
   if (end.value() == PassEnd::Stopped) raise_interrupt();
   return done;

@@ -6,12 +6,10 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
-#include "rbsim/bag.hpp"
 #include "rbsim/command_script.hpp"
 #include "rbsim/control.hpp"
 #include "rbsim/csv.hpp"
-#include "rbsim/mcap_sink.hpp"
-#include "rbsim/outputs.hpp"
+#include "rbsim/offline_run.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
 #include "rbsim/sink.hpp"
@@ -42,94 +40,63 @@ struct RunOptions {
 };
 
 int run(const RunOptions& o) {
-  Result<Scene> loaded = load_scene(o.scene);
-  if (!loaded) return fail("run", loaded.error().message);
-  const Scene& scene = loaded.value();
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
-
-  std::int64_t steps = scene.step_count();
-  if (o.duration) steps = steps_for(*o.duration, scene.world.dt);
-  if (o.steps) steps = *o.steps;
-
-  std::vector<std::string> inputs{o.scene};
-  if (!o.commands.empty()) inputs.push_back(o.commands);
-  // Every output path is checked before step 0: a run never ends by throwing its result away.
-  std::vector<OutputPath> outputs = {{o.csv, "--csv"},
-                                     {o.energy_csv, "--energy-csv"},
-                                     {o.fosssim_out, "--fosssim-out"},
-                                     {o.frames, "--frames", true}};
-  if (!o.record.empty() && log::is_bag_output(o.record)) {  // a bag directory (rbsim/bag.hpp)
-    for (OutputPath& p : log::bag_outputs(o.record, "--record")) outputs.push_back(std::move(p));
-  } else {
-    outputs.push_back({o.record, "--record"});
-  }
-  if (Status st = check_outputs(outputs, inputs, o.overwrite); !st) return fail("run", st.error().message);
-
-  // The commands are read whole before step 0: a bad script entry is a usage error naming its line,
-  // a recording that lost commands an error naming the first missing one.
-  std::optional<control::ScriptedRun> script;
-  if (!o.commands.empty()) {
-    Result<std::vector<control::ScriptedCommand>> commands = control::load_commands(o.commands, scene, steps);
-    if (!commands)
-      return fail("run", commands.error().message,
-                  commands.error().code == ErrorCode::InvalidArgument ? 2 : 1);
-    script.emplace(scene, steps, std::move(commands.value()));
-  }
-
-  Result<Driver> created = Driver::create(scene);
-  if (!created) return fail("run", scene.path + ": " + created.error().message);
-  Driver& driver = created.value();
-
-  std::vector<std::unique_ptr<Sink>> sinks;
-  log::McapSink* recorder = nullptr;
-  if (!o.csv.empty()) sinks.push_back(make_csv_sink(o.csv));
-  if (!o.energy_csv.empty()) sinks.push_back(make_energy_csv_sink(o.energy_csv));
-  if (!o.fosssim_out.empty()) sinks.push_back(make_fosssim_sink(o.fosssim_out));
+  control::OfflineRunDef def;
+  def.scene = o.scene;
+  def.steps = o.steps;
+  def.duration = o.duration;
+  def.commands = o.commands;
+  def.csv = {o.csv, "--csv"};
+  def.energy_csv = {o.energy_csv, "--energy-csv"};
+  def.fosssim_out = {o.fosssim_out, "--fosssim-out"};
+  def.record = {o.record, "--record"};
+  def.more_outputs = {{o.frames, "--frames", true}};
+  def.overwrite = o.overwrite;
+  def.recording.every = o.record_every;
+  def.recording.ns = o.ns;
+  def.recording.topics = o.topic_set;
   if (!o.record.empty()) {
-    log::RecordOptions ro;
-    ro.every = o.record_every;
-    ro.ns = o.ns;
-    ro.topics = o.topic_set;
     const Result<mcap::Compression> codec = compression_option(o.compression, o.compression_level);
     if (!codec) return fail("run", codec.error().message);
-    ro.compression = codec.value();
-    ro.compression_level = o.compression_level;
-    std::unique_ptr<log::McapSink> mcap = log::make_mcap_sink(o.record, ro);
-    recorder = mcap.get();
-    sinks.push_back(std::move(mcap));
+    def.recording.compression = codec.value();
+    def.recording.compression_level = o.compression_level;
   }
-  // A steered run records its commands as the node publishes them (/<ns>/commands), so it can be
-  // re-run in turn.
-  if (script && recorder != nullptr) script->record_to(*recorder);
-
+  int width = 0, height = 0;
   if (!o.frames.empty()) {
-    int width = 0, height = 0;
     if (!render::parse_size(o.size, width, height))
       return fail("run", "invalid --size \"" + o.size + "\" (expected WxH)");
     if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("run", "--fps must be in (0, 1000]");
-    sinks.push_back(render::make_frame_sink(
-        o.frames, width, height, o.fps,
-        render::run_duration(steps, scene.world.dt, scene.duration, scene.step_count()), o.overwrite));
   }
-  for (auto& sink : sinks) driver.add(*sink);
-  if (Status st = driver.begin(); !st) return fail("run", st.error().message);
+  Result<std::unique_ptr<control::OfflineRun>> prepared = control::OfflineRun::prepare(def);
+  if (!prepared) {
+    // A commands script's own mistake is a usage error (its file, line and field named).
+    return fail("run", prepared.error().message, prepared.error().code == ErrorCode::InvalidArgument ? 2 : 1);
+  }
+  control::OfflineRun& offline = *prepared.value();
+  const Scene& scene = offline.scene();
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  const std::int64_t steps = offline.steps();
+  std::unique_ptr<Sink> frames;
+  if (!o.frames.empty()) {
+    frames = render::make_frame_sink(
+        o.frames, width, height, o.fps,
+        render::run_duration(steps, scene.world.dt, scene.duration, scene.step_count()), o.overwrite);
+    offline.add(*frames);
+  }
 
   install_stop_handlers();
   Progress progress(steps, o.progress == "always"  ? Progress::Mode::Always
                            : o.progress == "never" ? Progress::Mode::Never
                                                    : Progress::Mode::Auto);
   DriverOptions options;
-  options.steps = steps;
   options.allow_nonfinite = o.allow_nonfinite;
   options.stop = stop_requested;
   options.progress = [&progress](std::int64_t step) { progress.update(step); };
-  if (script) options.control = &script->controller();
   const auto start = std::chrono::steady_clock::now();
-  const Result<PassEnd> end = driver.run(options);
+  const Result<PassEnd> end = offline.run(options);
   if (!end) return fail("run", end.error().message);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.finish();
-  if (Status st = driver.finish(); !st) return fail("run", st.error().message);
+  const Driver& driver = offline.driver();
   const World& world = driver.world();
   if (end.value() == PassEnd::Diverged) {
     return fail("run", describe_divergence(driver.divergence()) + ". Outputs hold steps 0.." +
@@ -145,8 +112,8 @@ int run(const RunOptions& o) {
         count_of(world.spring_count(), "spring", "springs").c_str(), count_of(done, "step", "steps").c_str(),
         world.time(), format_seconds(wall).c_str(), rate, rate * world.body_count());
   }
-  if (script) {
-    const Status applied = script->finish(o.commands);
+  if (const control::ScriptedRun* script = offline.script()) {
+    const Status applied = offline.finish_commands();
     for (const std::string& m : script->mismatches()) std::fprintf(stderr, "rbsim run: %s\n", m.c_str());
     if (const std::optional<std::int64_t> k = script->ended_paused()) {
       std::fprintf(

@@ -2,6 +2,7 @@
 // line (the run driver and MCAP sink of `rbsim run --record`, the comparer and report of
 // `rbsim check`, the verifier of `rbsim check --verify-golden`).
 #include "rbsim/testing.hpp"
+#include "rbsim/offline_run.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -9,9 +10,7 @@
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/check.hpp"
-#include "rbsim/command_script.hpp"
 #include "rbsim/golden.hpp"
-#include "rbsim/mcap_sink.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/read_file.hpp"
 #include "rbsim/run.hpp"
@@ -29,64 +28,43 @@ namespace {
 
 ::testing::AssertionResult RecordScene(const std::string& scene_path, const std::string& out_mcap,
                                        const RecordOptions& options) {
-  Result<Scene> loaded = load_scene(scene_path);
-  if (!loaded) return failure("RecordScene", loaded.error().message);
-  const Scene& scene = loaded.value();
-  std::int64_t steps = scene.step_count();
-  if (options.duration) {
-    if (!(*options.duration >= 0.0)) return failure("RecordScene", "duration must be >= 0");
-    steps = steps_for(*options.duration, scene.world.dt);
-  }
-  if (options.steps) steps = *options.steps;
-  if (steps < 0) return failure("RecordScene", "steps must be >= 0 (got " + std::to_string(steps) + ")");
   if (options.record_every < 1) {
     return failure("RecordScene",
                    "record_every must be >= 1 (got " + std::to_string(options.record_every) + ")");
   }
-  std::vector<std::string> inputs{scene_path};
-  if (!options.commands.empty()) inputs.push_back(options.commands);
-  if (Status st = check_outputs({{out_mcap, "out_mcap"}}, inputs, options.overwrite); !st) {
-    return failure("RecordScene",
-                   st.error().message + (options.overwrite ? "" : " (RecordOptions::overwrite)"));
-  }
-  log::RecordOptions ro;
-  ro.every = options.record_every;
-  ro.ns = options.ns;
+  control::OfflineRunDef def;
+  def.scene = scene_path;
+  def.steps = options.steps;
+  def.duration = options.duration;
+  def.commands = options.commands;
+  def.record = {out_mcap, "out_mcap"};
+  def.overwrite = options.overwrite;
+  def.recording.every = options.record_every;
+  def.recording.ns = options.ns;
   if (!options.topics.empty()) {
     std::string list;
     for (const std::string& name : options.topics) list += (list.empty() ? "" : ",") + name;
     Result<msgs::TopicSet> topics = msgs::parse_topic_set(list, options.ns);
     if (!topics) return failure("RecordScene", topics.error().message);
-    ro.topics = topics.value();
+    def.recording.topics = topics.value();
   }
-
-  std::optional<control::ScriptedRun> script;
-  if (!options.commands.empty()) {
-    Result<std::vector<control::ScriptedCommand>> commands =
-        control::load_commands(options.commands, scene, steps);
-    if (!commands) return failure("RecordScene", commands.error().message);
-    script.emplace(scene, steps, std::move(commands.value()));
+  Result<std::unique_ptr<control::OfflineRun>> run = control::OfflineRun::prepare(def);
+  if (!run) {
+    const bool exists = run.error().message.find("exists") != std::string::npos;
+    return failure("RecordScene",
+                   run.error().message + (exists && !options.overwrite ? " (RecordOptions::overwrite)" : ""));
   }
-  Result<Driver> created = Driver::create(scene);
-  if (!created) return failure("RecordScene", scene.path + ": " + created.error().message);
-  std::unique_ptr<log::McapSink> sink = log::make_mcap_sink(out_mcap, ro);
-  created->add(*sink);
-  DriverOptions run;
-  run.steps = steps;
-  if (script) {
-    script->record_to(*sink);
-    run.control = &script->controller();
-  }
-  if (Status st = created->run_pass(run); !st) return failure("RecordScene", st.error().message);
-  if (script) {
-    if (Status st = script->finish(options.commands); !st) {
-      std::string named;
-      for (const std::string& m : script->mismatches()) named += "\n  " + m;
-      return failure("RecordScene", st.error().message + named);
-    }
+  Result<PassEnd> end = run.value()->run({});
+  if (!end) return failure("RecordScene", end.error().message);
+  if (end.value() == PassEnd::Diverged)
+    return failure("RecordScene", describe_divergence(run.value()->driver().divergence()));
+  if (Status st = run.value()->finish_commands(); !st) {
+    std::string named;
+    for (const std::string& m : run.value()->script()->mismatches()) named += "\n  " + m;
+    return failure("RecordScene", st.error().message + named);
   }
   return ::testing::AssertionSuccess()
-         << "recorded " << steps << " steps of " << scene_path << " to " << out_mcap;
+         << "recorded " << run.value()->steps() << " steps of " << scene_path << " to " << out_mcap;
 }
 
 ::testing::AssertionResult CheckLogs(const std::string& actual_mcap, const std::string& golden_mcap,
