@@ -195,93 +195,81 @@ void PlayerControl::close() {
   answer_.notify_all();
 }
 
-Status add_player_services(ServiceSet& set, const Participant& participant, const std::string& node,
-                           PlayerControl& control, double wait_s) {
+std::vector<PlayerService> player_services(PlayerControl& control, double wait_s) {
   using namespace msgs;
+  std::vector<PlayerService> out;
   // A malformed request to a service whose response has no field to say so gets no reply.
   auto add = [&](std::string_view name, std::string_view type, ServiceServer::Handler h) {
-    return set.add(participant, node, name, type, std::move(h));
+    out.push_back({std::string(name), std::string(type), std::move(h)});
   };
-  if (Status st = add("pause", PauseRequest::kService,
-                      typed_handler<PauseRequest, PauseResponse>(
-                          [&control](const RequestHeader&, const PauseRequest&) {
-                            control.pause();
-                            return PauseResponse{};
-                          },
-                          [](const Error&) { return std::optional<PauseResponse>(); }));
-      !st)
-    return st;
-  if (Status st = add("resume", ResumeRequest::kService,
-                      typed_handler<ResumeRequest, ResumeResponse>(
-                          [&control](const RequestHeader&, const ResumeRequest&) {
-                            control.resume();
-                            return ResumeResponse{};
-                          },
-                          [](const Error&) { return std::optional<ResumeResponse>(); }));
-      !st)
-    return st;
-  if (Status st = add("toggle_paused", TogglePausedRequest::kService,
-                      typed_handler<TogglePausedRequest, TogglePausedResponse>(
-                          [&control](const RequestHeader&, const TogglePausedRequest&) {
-                            (void)control.toggle_paused();
-                            return TogglePausedResponse{};
-                          },
-                          [](const Error&) { return std::optional<TogglePausedResponse>(); }));
-      !st)
-    return st;
-  if (Status st = add("is_paused", IsPausedRequest::kService,
-                      typed_handler<IsPausedRequest, IsPausedResponse>(
-                          [&control](const RequestHeader&, const IsPausedRequest&) {
-                            return IsPausedResponse{control.paused()};
-                          },
-                          [](const Error&) { return std::optional<IsPausedResponse>(); }));
-      !st)
-    return st;
-  if (Status st = add("get_rate", GetRateRequest::kService,
-                      typed_handler<GetRateRequest, GetRateResponse>(
-                          [&control](const RequestHeader&, const GetRateRequest&) {
-                            return GetRateResponse{control.rate()};
-                          },
-                          [](const Error&) { return std::optional<GetRateResponse>(); }));
-      !st)
-    return st;
-  if (Status st =
-          add("set_rate", SetRateRequest::kService,
-              typed_handler<SetRateRequest, SetRateResponse>(
-                  [&control](const RequestHeader&, const SetRateRequest& req) {
-                    return SetRateResponse{control.set_rate(req.rate)};
-                  },
-                  [](const Error&) { return std::optional<SetRateResponse>(SetRateResponse{false}); }));
-      !st)
-    return st;
-  if (Status st = add("seek", SeekRequest::kService,
-                      typed_handler<SeekRequest, SeekResponse>(
-                          [&control, wait_s](const RequestHeader&, const SeekRequest& req) {
-                            const std::uint64_t sim_ns =
-                                req.time.sec < 0
-                                    ? 0
-                                    : static_cast<std::uint64_t>(req.time.sec) * 1'000'000'000ull +
-                                          req.time.nanosec;
-                            return SeekResponse{control.seek(sim_ns, wait_s)};
-                          },
-                          [](const Error&) { return std::optional<SeekResponse>(SeekResponse{false}); }));
-      !st)
-    return st;
-  if (Status st =
-          add("play_next", PlayNextRequest::kService,
-              typed_handler<PlayNextRequest, PlayNextResponse>(
-                  [&control, wait_s](const RequestHeader&, const PlayNextRequest&) {
-                    return PlayNextResponse{control.burst(1, wait_s) == 1};
-                  },
-                  [](const Error&) { return std::optional<PlayNextResponse>(PlayNextResponse{false}); }));
-      !st)
-    return st;
-  return add("burst", BurstRequest::kService,
-             typed_handler<BurstRequest, BurstResponse>(
-                 [&control, wait_s](const RequestHeader&, const BurstRequest& req) {
-                   return BurstResponse{control.burst(req.num_messages, wait_s)};
-                 },
-                 [](const Error&) { return std::optional<BurstResponse>(BurstResponse{0}); }));
+  add("pause", PauseRequest::kService,
+      typed_handler<PauseRequest, PauseResponse>(
+          [&control](const RequestHeader&, const PauseRequest&) {
+            control.pause();
+            return PauseResponse{};
+          },
+          [](const Error&) { return std::optional<PauseResponse>(); }));
+  add("resume", ResumeRequest::kService,
+      typed_handler<ResumeRequest, ResumeResponse>(
+          [&control](const RequestHeader&, const ResumeRequest&) {
+            control.resume();
+            return ResumeResponse{};
+          },
+          [](const Error&) { return std::optional<ResumeResponse>(); }));
+  add("toggle_paused", TogglePausedRequest::kService,
+      typed_handler<TogglePausedRequest, TogglePausedResponse>(
+          [&control](const RequestHeader&, const TogglePausedRequest&) {
+            (void)control.toggle_paused();
+            return TogglePausedResponse{};
+          },
+          [](const Error&) { return std::optional<TogglePausedResponse>(); }));
+  add("is_paused", IsPausedRequest::kService,
+      typed_handler<IsPausedRequest, IsPausedResponse>(
+          [&control](const RequestHeader&, const IsPausedRequest&) {
+            return IsPausedResponse{control.paused()};
+          },
+          [](const Error&) { return std::optional<IsPausedResponse>(); }));
+  add("get_rate", GetRateRequest::kService,
+      typed_handler<GetRateRequest, GetRateResponse>(
+          [&control](const RequestHeader&, const GetRateRequest&) { return GetRateResponse{control.rate()}; },
+          [](const Error&) { return std::optional<GetRateResponse>(); }));
+  add("set_rate", SetRateRequest::kService,
+      typed_handler<SetRateRequest, SetRateResponse>(
+          [&control](const RequestHeader&, const SetRateRequest& req) {
+            return SetRateResponse{control.set_rate(req.rate)};
+          },
+          [](const Error&) { return std::optional<SetRateResponse>(SetRateResponse{false}); }));
+  add("seek", SeekRequest::kService,
+      typed_handler<SeekRequest, SeekResponse>(
+          [&control, wait_s](const RequestHeader&, const SeekRequest& req) {
+            const std::uint64_t sim_ns =
+                req.time.sec < 0
+                    ? 0
+                    : static_cast<std::uint64_t>(req.time.sec) * 1'000'000'000ull + req.time.nanosec;
+            return SeekResponse{control.seek(sim_ns, wait_s)};
+          },
+          [](const Error&) { return std::optional<SeekResponse>(SeekResponse{false}); }));
+  add("play_next", PlayNextRequest::kService,
+      typed_handler<PlayNextRequest, PlayNextResponse>(
+          [&control, wait_s](const RequestHeader&, const PlayNextRequest&) {
+            return PlayNextResponse{control.burst(1, wait_s) == 1};
+          },
+          [](const Error&) { return std::optional<PlayNextResponse>(PlayNextResponse{false}); }));
+  add("burst", BurstRequest::kService,
+      typed_handler<BurstRequest, BurstResponse>(
+          [&control, wait_s](const RequestHeader&, const BurstRequest& req) {
+            return BurstResponse{control.burst(req.num_messages, wait_s)};
+          },
+          [](const Error&) { return std::optional<BurstResponse>(BurstResponse{0}); }));
+  return out;
+}
+
+Status add_player_services(ServiceSet& set, const Participant& participant, const std::string& node,
+                           PlayerControl& control, double wait_s) {
+  for (PlayerService& s : player_services(control, wait_s)) {
+    if (Status st = set.add(participant, node, s.name, s.type, std::move(s.handler)); !st) return st;
+  }
+  return Ok{};
 }
 
 }  // namespace rbsim::node

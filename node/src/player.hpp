@@ -9,8 +9,10 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "rbsim/replay.hpp"
+#include "rbsim/service.hpp"
 
 namespace rbsim::node {
 
@@ -72,6 +74,18 @@ class PlayerControl {
   bool burst_active_ = false;
   bool closed_ = false;
 };
+
+// One of the player's services: its name under the node, its type and its handler on CDR.
+struct PlayerService {
+  std::string name;  // "pause"
+  std::string type;  // "rosbag2_interfaces/srv/Pause"
+  ServiceServer::Handler handler;
+};
+// The player's services, as rosbag2's player offers them (rosbag2_interfaces): pause, resume,
+// toggle_paused, is_paused, get_rate, set_rate, seek, play_next, burst. Seek, play_next and burst
+// wait up to `wait_s` for the loop. Served over DDS (add_player_services) and, through
+// Replay::player_services(), by the Foxglove server.
+std::vector<PlayerService> player_services(PlayerControl& control, double wait_s);
 
 class ServiceSet;
 // The player's services on `set` (rosbag2_interfaces, as rosbag2's player offers them):

@@ -207,6 +207,20 @@ PlayerStatus Replay::status() const {
   return impl_->control->status();
 }
 
+std::vector<Replay::PlayerService> Replay::player_services() const {
+  std::vector<PlayerService> out;
+  for (node::PlayerService& s : node::player_services(*impl_->control, impl_->options.service_wait_s)) {
+    out.push_back(
+        {std::move(s.name), std::move(s.type),
+         [handler = std::move(s.handler)](std::span<const std::byte> request) -> std::optional<Bytes> {
+           Bytes reply;
+           if (!handler(RequestHeader{}, request, reply)) return std::nullopt;
+           return reply;
+         }});
+  }
+  return out;
+}
+
 bool Replay::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
   const Publisher& pub = impl_->publishers[impl_->wait_publisher];
   while (pub.matched() < count) {

@@ -454,8 +454,10 @@ TEST(FoxgloveCli, ReplayServesARecordingWithANewSessionEveryLoop) {
       << "log times increase within a pass: " << testing::PrintToString(seen.decreasing);
   EXPECT_LE(seen.max_time.at("/fox_rp/body_states"), 100'000'000ull) << "log time is simulated time";
   EXPECT_NE(replay.err().find("rbsim replay: foxglove: open https://app.foxglove.dev/"), std::string::npos);
-  EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time"})) << "nothing to steer in a replay";
-  EXPECT_TRUE(seen.services.empty());
+  EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time", "services"}))
+      << "the player's services, no parameters";
+  EXPECT_EQ(seen.services.size(), 9u) << testing::PrintToString(seen.services);
+  EXPECT_NE(std::find(seen.services.begin(), seen.services.end(), "/rbsim_player/seek"), seen.services.end());
 }
 
 TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {

@@ -45,6 +45,9 @@ TEST(FoxgloveControlProtocol, ServerInfoOffersSteeringOnlyWithAController) {
   const Json without = Json::parse(server_info_json("rbsim", "1-1"));
   EXPECT_EQ(without["capabilities"], Json::array({"time"}));
   EXPECT_FALSE(without.contains("supportedEncodings"));
+  const Json hosted = Json::parse(server_info_json("rbsim", "1-1", false, true));
+  EXPECT_EQ(hosted["capabilities"], Json::array({"time", "services"}));
+  EXPECT_EQ(hosted["supportedEncodings"], Json::array({"cdr"}));
 }
 
 TEST(FoxgloveControlProtocol, AdvertiseServicesGivesBothSchemaForms) {

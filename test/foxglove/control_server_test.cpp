@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <future>
 #include <thread>
 
 #include "../control/control_test_util.hpp"
@@ -495,6 +496,76 @@ TEST(FoxgloveSteering, AFloodOfPublishedCommandsIsBoundedPerClient) {
   EXPECT_EQ(statuses, 995);  // and the one read above
   const ServerStats st = s.server->stats();
   EXPECT_EQ(st.refused_requests, 996u) << st.requests;
+}
+
+}  // namespace
+}  // namespace rbsim::foxglove
+
+namespace rbsim::foxglove {
+namespace {
+
+// Hosted services (rbsim replay's player): offered with no steering, the services capability in
+// cdr; each call answered by its handler on the server's service thread (one that blocks holds
+// no other client up), a json request or a handler's error a serviceCallFailure.
+TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  ServerOptions o;
+  o.port = 0;
+  o.hosted_services.push_back(
+      {service_spec("/player", "set_rate", "rosbag2_interfaces/srv/SetRate"),
+       [](std::string_view request) -> Result<std::string> {
+         msgs::SetRateRequest req;
+         if (Status st =
+                 msgs::decode({reinterpret_cast<const std::byte*>(request.data()), request.size()}, req);
+             !st)
+           return st.error();
+         if (!(req.rate > 0)) return Error{"rate must be > 0"};
+         return cdr(msgs::SetRateResponse{true});
+       }});
+  o.hosted_services.push_back({service_spec("/player", "pause", "rosbag2_interfaces/srv/Pause"),
+                               [released](std::string_view) -> Result<std::string> {
+                                 released.wait_for(10s);
+                                 return cdr(msgs::PauseResponse{});
+                               }});
+  auto server = Server::start(o, {});
+  ASSERT_TRUE(server) << server.error().message;
+  WsClient c;
+  const Json info = connect(c, server.value()->port());
+  EXPECT_EQ(info["capabilities"], Json::array({"time", "services"}));
+  const Json services = next_op(c, "advertiseServices")["services"];
+  ASSERT_EQ(services.size(), 2u);
+  EXPECT_EQ(services[0]["name"], "/player/set_rate");
+  EXPECT_EQ(services[0]["type"], "rosbag2_interfaces/srv/SetRate");
+  EXPECT_EQ(services[0]["requestSchema"], "float64 rate\n");
+
+  ASSERT_TRUE(c.send_binary(call_frame(1, 7, "cdr", cdr(msgs::SetRateRequest{2.0}))));
+  auto r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->service, 1u);
+  EXPECT_EQ(r->call, 7u);
+  msgs::SetRateResponse set;
+  ASSERT_TRUE(
+      msgs::decode({reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, set).ok());
+  EXPECT_TRUE(set.success);
+  ASSERT_TRUE(c.send_binary(call_frame(1, 8, "cdr", cdr(msgs::SetRateRequest{-1.0}))));
+  Json f = next_op(c, "serviceCallFailure");
+  EXPECT_EQ(f["callId"], 8);
+  EXPECT_EQ(f["message"], "rate must be > 0");
+  ASSERT_TRUE(c.send_binary(call_frame(1, 9, "json", R"({"rate":2.0})")));
+  f = next_op(c, "serviceCallFailure");
+  EXPECT_EQ(f["callId"], 9);
+  EXPECT_EQ(f["message"], "/player/set_rate takes its request in cdr only");
+
+  // A handler that blocks: the server still serves a new client meanwhile, then the answer comes.
+  ASSERT_TRUE(c.send_binary(call_frame(2, 10, "cdr", cdr(msgs::PauseRequest{}))));
+  WsClient other;
+  EXPECT_EQ(connect(other, server.value()->port())["capabilities"], Json::array({"time", "services"}));
+  release.set_value();
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->service, 2u);
+  EXPECT_EQ(r->call, 10u);
 }
 
 }  // namespace

@@ -56,11 +56,13 @@ CLI::Option* add_foxglove_option(CLI::App* app, FoxgloveArgs& args, bool require
 // (a usage error, exit 2) a token file or RBSIM_FOXGLOVE_TOKEN refused, a non-loopback address
 // without a token or --foxglove-insecure.
 // With a steering (rbsim node's controller, rbsim bridge's relay; `node`, the steered node's fully
-// qualified name, prefixes the services) the server offers parameters and services; replay has none.
+// qualified name, prefixes the services) the server offers parameters and services; `hosted`
+// services are offered too (rbsim replay's player, with no steering).
 Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const FoxgloveArgs& args,
                                                          std::vector<foxglove::ChannelSpec> channels,
                                                          control::Steering* steering = nullptr,
-                                                         const std::string& node = "/rbsim");
+                                                         const std::string& node = "/rbsim",
+                                                         std::vector<foxglove::HostedService> hosted = {});
 // The exit status for start_foxglove's error: 2 for a usage error, else 1.
 int foxglove_exit_status(const Error& error);
 // "foxglove: 2 clients, 1200 messages queued, 0 dropped for slow clients" for a command's end line.

@@ -76,8 +76,8 @@ int foxglove_exit_status(const Error& error) {
 
 Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, const FoxgloveArgs& args,
                                                          std::vector<foxglove::ChannelSpec> channels,
-                                                         control::Steering* steering,
-                                                         const std::string& node) {
+                                                         control::Steering* steering, const std::string& node,
+                                                         std::vector<foxglove::HostedService> hosted) {
   foxglove::ServerOptions options;
   if (Status st = foxglove::parse_listen_address(args.address.value_or(""), options); !st) return st.error();
   if (!args.token_file.empty()) {
@@ -105,6 +105,7 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
   options.max_clients = args.max_clients;
   options.steering = steering;
   options.node = node;
+  options.hosted_services = std::move(hosted);
   auto server = foxglove::Server::start(options, std::move(channels));
   if (!server) return server.error();
   const std::uint16_t port = server.value()->port();

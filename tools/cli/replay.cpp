@@ -75,6 +75,24 @@ class ProgressLine {
   std::thread thread_;
 };
 
+// The player's services for Foxglove's Service Call panel, <node>/pause ... burst in cdr: the same
+// handlers as the player's DDS services. A request too malformed to answer fails the call.
+std::vector<foxglove::HostedService> player_services(const node::Replay& replay, const std::string& node) {
+  std::vector<foxglove::HostedService> hosted;
+  for (node::Replay::PlayerService& s : replay.player_services()) {
+    foxglove::HostedService h;
+    h.spec = foxglove::service_spec(node, s.name, s.type);
+    h.call = [call = std::move(s.call), type = s.type](std::string_view request) -> Result<std::string> {
+      const std::optional<Bytes> reply =
+          call({reinterpret_cast<const std::byte*>(request.data()), request.size()});
+      if (!reply) return Error{"a malformed " + type + " request", ErrorCode::InvalidArgument};
+      return std::string(reinterpret_cast<const char*>(reply->data()), reply->size());
+    };
+    hosted.push_back(std::move(h));
+  }
+  return hosted;
+}
+
 int replay_command(ReplayArgs a) {
   if (!a.ns.empty()) a.replay.ns = a.ns;
   auto participant = node::Participant::create(a.domain, a.node);
@@ -100,7 +118,9 @@ int replay_command(ReplayArgs a) {
       c.latched = o.latched;
       channels.push_back(std::move(c));
     }
-    auto started = start_foxglove("rbsim replay", a.foxglove, std::move(channels));
+    auto started = start_foxglove("rbsim replay", a.foxglove, std::move(channels), nullptr,
+                                  participant.value().node().fully_qualified(),
+                                  player_services(replay, participant.value().node().fully_qualified()));
     if (!started) return fail("replay", started.error().message, foxglove_exit_status(started.error()));
     server = std::move(started.value());
     foxglove::Server* srv = server.get();
@@ -227,7 +247,8 @@ Subcommand add_replay_command(CLI::App& parent) {
       "order. "
       "Ctrl-C stops cleanly. --foxglove also serves them to Foxglove with the recording's schemas (log time "
       "= "
-      "the messages' simulated time; a new session on every --loop pass).\n"
+      "the messages' simulated time; a new session on every --loop pass), with the player services below "
+      "for its Service Call panel (cdr).\n"
       "Player services (rosbag2_interfaces/srv, as ros2 bag play offers them) under the node name "
       "(--node-name, default /rbsim_player): pause, resume, toggle_paused, is_paused, get_rate, set_rate "
       "(> 0 only), seek (simulated time; the latched topics are sent again and /clock jumps), play_next and "

@@ -89,6 +89,15 @@ class Replay {
   // on the way.
   Result<bool> play(bool (*stop)(), const Tap* tap = nullptr);
   PlayerStatus status() const;
+  // The player's services as functions of a CDR request (rosbag2_interfaces types), the handlers
+  // its DDS services run, for another front end (rbsim replay --foxglove); a nullopt answer: a
+  // malformed request the response has no field to refuse. Valid while the replay lives.
+  struct PlayerService {
+    std::string name;  // "pause"
+    std::string type;  // "rosbag2_interfaces/srv/Pause"
+    std::function<std::optional<Bytes>(std::span<const std::byte> request)> call;
+  };
+  std::vector<PlayerService> player_services() const;
   // Waits (bounded) until the subscribers acknowledged everything published, so nothing in
   // flight is lost when the replay exits.
   [[nodiscard]] Status finish(double timeout_s = 30.0);

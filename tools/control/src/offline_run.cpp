@@ -13,11 +13,13 @@ Result<std::int64_t> resolve_steps(const OfflineRunDef& def, const Scene& scene)
   std::int64_t steps = scene.step_count();
   if (def.duration) {
     if (!(*def.duration >= 0.0))
-      return Error{"duration must be >= 0 (got " + std::to_string(*def.duration) + ")", ErrorCode::InvalidArgument};
+      return Error{"duration must be >= 0 (got " + std::to_string(*def.duration) + ")",
+                   ErrorCode::InvalidArgument};
     steps = steps_for(*def.duration, scene.world.dt);
   }
   if (def.steps) steps = *def.steps;
-  if (steps < 0) return Error{"steps must be >= 0 (got " + std::to_string(steps) + ")", ErrorCode::InvalidArgument};
+  if (steps < 0)
+    return Error{"steps must be >= 0 (got " + std::to_string(steps) + ")", ErrorCode::InvalidArgument};
   return steps;
 }
 
@@ -28,7 +30,8 @@ Status check_run_outputs(const OfflineRunDef& def) {
   std::vector<OutputPath> outputs = {def.csv, def.energy_csv, def.fosssim_out};
   for (const OutputPath& p : def.more_outputs) outputs.push_back(p);
   if (!def.record.path.empty() && log::is_bag_output(def.record.path)) {  // a bag directory
-    for (OutputPath& p : log::bag_outputs(def.record.path, def.record.option)) outputs.push_back(std::move(p));
+    for (OutputPath& p : log::bag_outputs(def.record.path, def.record.option))
+      outputs.push_back(std::move(p));
   } else {
     outputs.push_back(def.record);
   }

@@ -19,7 +19,8 @@ std::optional<std::string_view> choose_subprotocol(std::span<const std::string> 
   return std::nullopt;
 }
 
-std::string server_info_json(std::string_view name, std::string_view session_id, bool control) {
+std::string server_info_json(std::string_view name, std::string_view session_id, bool control,
+                             bool services) {
   nlohmann::json j = {{"op", "serverInfo"},
                       {"name", std::string(name)},
                       {"capabilities", nlohmann::json::array({"time"})},
@@ -30,6 +31,9 @@ std::string server_info_json(std::string_view name, std::string_view session_id,
       j["capabilities"].push_back(c);
     j["supportedEncodings"] = nlohmann::json::array();
     for (std::string_view e : kServiceEncodings) j["supportedEncodings"].push_back(std::string(e));
+  } else if (services) {
+    j["capabilities"].push_back("services");
+    j["supportedEncodings"] = nlohmann::json::array({"cdr"});
   }
   return j.dump();
 }
@@ -75,6 +79,14 @@ std::string advertise_json(std::span<const ChannelSpec> channels) {
                     {"schemaEncoding", c.schema_encoding}});
   }
   return nlohmann::json{{"op", "advertise"}, {"channels", std::move(list)}}.dump();
+}
+
+std::string problems_status_json(std::string_view op, const std::vector<std::string>& problems) {
+  if (problems.empty()) return {};
+  std::string m = std::string(op) + ": ";
+  for (std::size_t k = 0; k < problems.size() && k < 5; ++k) m += (k ? "; " : "") + problems[k];
+  if (problems.size() > 5) m += "; and " + std::to_string(problems.size() - 5) + " more";
+  return status_json(StatusLevel::Error, m);
 }
 
 std::string status_json(StatusLevel level, std::string_view message) {

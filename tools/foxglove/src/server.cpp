@@ -22,6 +22,7 @@
 #include <unordered_set>
 
 #include "access.hpp"
+#include "hosted.hpp"
 #include "rbsim/foxglove.hpp"
 #include "services.hpp"
 #include "transport.hpp"
@@ -107,7 +108,9 @@ struct Server::Impl {
   ClientProtocol::Outcome outcome;
 
   // Steering (options.steering set): fixed for the server's life but the table (under `mu`).
+  // services: the steering's (1..control_services), then options.hosted_services.
   std::vector<ServiceSpec> services;
+  std::size_t control_services = 0;
   std::string advertise_services;
   std::string command_in;  // <node>/command_in, the clientPublish topic
   std::shared_ptr<const ParameterTable> table = std::make_shared<ParameterTable>(std::vector<std::string>{});
@@ -138,7 +141,7 @@ struct Server::Impl {
                         std::chrono::system_clock::now().time_since_epoch())
                         .count();
     server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions),
-                                   options.steering != nullptr);
+                                   options.steering != nullptr, !services.empty());
     for (Latched& l : latched) l.has = false;
   }
 
@@ -251,6 +254,8 @@ struct Server::Impl {
     link->deliver(id, replies, answered);
   }
 
+  std::unique_ptr<detail::HostedCalls> hosted;  // options.hosted_services' calls, after the steering's
+
   // I/O thread, without `mu`.
   void serve_parameters(detail::ConnectionId id, ParameterRequest r);
   void serve_call(detail::ConnectionId id, ServiceCall call);
@@ -343,18 +348,6 @@ void ReplyLink::changed(const std::vector<msgs::Parameter>& parameters) {
   if (queued) server->transport->wake();
 }
 
-namespace {
-// One status error naming the problems of a request ("" when none).
-void add_problems(std::vector<Reply>& replies, const std::string& op,
-                  const std::vector<std::string>& problems) {
-  if (problems.empty()) return;
-  std::string m = op + ": ";
-  for (std::size_t k = 0; k < problems.size() && k < 5; ++k) m += (k ? "; " : "") + problems[k];
-  if (problems.size() > 5) m += "; and " + std::to_string(problems.size() - 5) + " more";
-  replies.push_back({status_json(StatusLevel::Error, m), false});
-}
-}  // namespace
-
 void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r) {
   using Op = ParameterRequest::Op;
   control::Steering& steering = *options.steering;
@@ -422,7 +415,8 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
     }
   }
   if (r.op != Op::Set) {
-    add_problems(replies, op, problems);
+    if (std::string m = problems_status_json(op, problems); !m.empty())
+      replies.push_back({std::move(m), false});
     reply(id, replies, false);
     return;
   }
@@ -459,12 +453,17 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
                       }
                       out.push_back({parameter_values_json(known, answer), false});
                     }
-                    add_problems(out, "setParameters", refused);
+                    if (std::string m = problems_status_json("setParameters", refused); !m.empty())
+                      out.push_back({std::move(m), false});
                     link->deliver(id, out, true);
                   });
 }
 
 void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {
+  if (call.service > control_services) {
+    hosted->call(id, std::move(call));
+    return;
+  }
   const control::ControlService& service = control::control_services()[call.service - 1];
   Result<control::Command> command = detail::decode_request(service, call.encoding, call.payload);
   if (!command) {
@@ -530,10 +529,12 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   im.latched.resize(im.channels.size());
   if (options.steering != nullptr) {
     im.services = detail::control_service_specs(options.node);
-    im.advertise_services = advertise_services_json(im.services);
+    im.control_services = im.services.size();
     im.command_in = options.node + "/" + std::string(kCommandInSuffix);
     im.refresh_parameters();
   }
+  for (const HostedService& h : options.hosted_services) im.services.push_back(h.spec);
+  if (!im.services.empty()) im.advertise_services = advertise_services_json(im.services);
   im.subscribers = std::make_unique<std::atomic<std::uint32_t>[]>(im.channels.size());
   for (std::size_t i = 0; i < im.channels.size(); ++i) im.subscribers[i] = 0;
   im.new_session_locked();
@@ -572,8 +573,15 @@ Result<std::unique_ptr<Server>> Server::start(const ServerOptions& options,
   if (!err.empty()) {
     return Error{"cannot listen on " + websocket_url(options.address, options.port, tls) + ": " + err};
   }
+  if (options.steering != nullptr || !options.hosted_services.empty()) im.link->server = &im;
+  if (!options.hosted_services.empty()) {
+    im.hosted = std::make_unique<detail::HostedCalls>(
+        im.options.hosted_services, static_cast<ServiceId>(im.control_services + 1),
+        [link = im.link](std::uint64_t id, std::string frame, bool binary) {
+          link->deliver(id, {Reply{std::move(frame), binary}}, true);
+        });
+  }
   if (options.steering != nullptr) {
-    im.link->server = &im;
     options.steering->on_command([link = im.link](const control::Command&, const control::CommandResult& r) {
       link->changed(r.changed);
     });
@@ -592,6 +600,7 @@ void Server::stop() {
     const std::lock_guard lock(impl_->link->mu);  // the steering's callbacks do nothing from here
     impl_->link->server = nullptr;
   }
+  if (impl_->hosted) impl_->hosted->stop();
   if (impl_->transport) impl_->transport->stop();
 }
 

@@ -7,6 +7,25 @@
 #include <cstring>
 #include <limits>
 
+namespace rbsim::foxglove {
+
+ServiceSpec service_spec(std::string_view node, std::string_view name, std::string_view type) {
+  const std::string text(msgs::definition(type));
+  // The .srv text: the request, a line "---", the response.
+  const std::size_t split = text.rfind("---", 0) == 0 ? 0 : text.find("\n---");
+  ServiceSpec spec;
+  spec.name = std::string(node) + "/" + std::string(name);
+  spec.type = std::string(type);
+  if (split != std::string::npos) {
+    spec.request_schema = text.substr(0, split == 0 ? 0 : split + 1);
+    const std::size_t response = text.find('\n', split == 0 ? 0 : split + 1);
+    spec.response_schema = response == std::string::npos ? std::string() : text.substr(response + 1);
+  }
+  return spec;
+}
+
+}  // namespace rbsim::foxglove
+
 namespace rbsim::foxglove::detail {
 
 namespace {
@@ -62,20 +81,8 @@ Result<Request> decode_cdr(std::string_view payload) {
 
 std::vector<ServiceSpec> control_service_specs(std::string_view node) {
   std::vector<ServiceSpec> specs;
-  for (const control::ControlService& s : control::control_services()) {
-    const std::string text(msgs::definition(s.type));
-    // The .srv text: the request, a line "---", the response.
-    const std::size_t split = text.rfind("---", 0) == 0 ? 0 : text.find("\n---");
-    ServiceSpec spec;
-    spec.name = std::string(node) + "/" + std::string(s.name);
-    spec.type = std::string(s.type);
-    if (split != std::string::npos) {
-      spec.request_schema = text.substr(0, split == 0 ? 0 : split + 1);
-      const std::size_t response = text.find('\n', split == 0 ? 0 : split + 1);
-      spec.response_schema = response == std::string::npos ? std::string() : text.substr(response + 1);
-    }
-    specs.push_back(std::move(spec));
-  }
+  for (const control::ControlService& s : control::control_services())
+    specs.push_back(service_spec(node, s.name, s.type));
   return specs;
 }
 

@@ -20,16 +20,16 @@
 namespace rbsim::control {
 
 struct OfflineRunDef {
-  std::string scene;                      // the scene file
-  std::optional<std::int64_t> steps;      // else ceil(duration / dt), else the scene's own
-  std::optional<double> duration;         // simulated seconds
-  std::string commands;                   // a commands script or a recording to re-simulate
+  std::string scene;                  // the scene file
+  std::optional<std::int64_t> steps;  // else ceil(duration / dt), else the scene's own
+  std::optional<double> duration;     // simulated seconds
+  std::string commands;               // a commands script or a recording to re-simulate
   // Each output's path (empty: not written) and how its caller names it in errors ("--csv").
   OutputPath csv, energy_csv, fosssim_out;
-  OutputPath record;                      // an .mcap file, or a bag directory (rbsim/bag.hpp)
-  log::RecordOptions recording;           // how `record` is written
-  std::vector<OutputPath> more_outputs;   // checked with the rest (rbsim run's --frames)
-  bool overwrite = false;                 // replace outputs that exist
+  OutputPath record;                     // an .mcap file, or a bag directory (rbsim/bag.hpp)
+  log::RecordOptions recording;          // how `record` is written
+  std::vector<OutputPath> more_outputs;  // checked with the rest (rbsim run's --frames)
+  bool overwrite = false;                // replace outputs that exist
 };
 
 class OfflineRun {

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -77,11 +78,16 @@ using CallId = std::uint32_t;
 // its response in the same one. cdr is first: Foxglove Studio calls in the first one it knows.
 inline constexpr std::string_view kServiceEncodings[] = {"cdr", "json"};
 
-// `control`: the capabilities above and supportedEncodings; else only `time`.
-std::string server_info_json(std::string_view name, std::string_view session_id, bool control = false);
+// `control`: the capabilities above and supportedEncodings; else `time`, and with `services` alone
+// (rbsim replay's player) the services capability, in cdr.
+std::string server_info_json(std::string_view name, std::string_view session_id, bool control = false,
+                             bool services = false);
 // Every channel of `channels`, channel i (0-based) with id i + 1.
 std::string advertise_json(std::span<const ChannelSpec> channels);
 std::string status_json(StatusLevel level, std::string_view message);
+// One status error naming a request's problems ("OP: a; b", the first five, then how many more);
+// "" when there are none.
+std::string problems_status_json(std::string_view op, const std::vector<std::string>& problems);
 
 // A service the server offers (ids are 1-based positions in the server's service list).
 struct ServiceSpec {
@@ -89,6 +95,17 @@ struct ServiceSpec {
   std::string type;             // "std_srvs/srv/Trigger"
   std::string request_schema;   // ros2msg text of <type>_Request
   std::string response_schema;  // ros2msg text of <type>_Response
+};
+// The spec of service <node>/<name> of ROS 2 type `type` (its .srv text from msgs::definition, split
+// into the request and response schemas).
+ServiceSpec service_spec(std::string_view node, std::string_view name, std::string_view type);
+// A service the server offers beside the steering's (rbsim replay's player services): its spec,
+// and its handler, given a request's CDR payload, returning the response's (an error: the call
+// fails with its message). Handlers run on the server's one service thread, one call at a time,
+// so one may block for a while (a seek waits for the player); a call only takes encoding cdr.
+struct HostedService {
+  ServiceSpec spec;
+  std::function<Result<std::string>(std::string_view request)> call;
 };
 // Each service with `request` and `response` (encoding cdr, schemaEncoding ros2msg) and, for
 // clients of the older form (Foxglove Studio 1.x), `requestSchema` and `responseSchema`.
@@ -304,6 +321,9 @@ struct ServerOptions {
   // offered.
   control::Steering* steering = nullptr;
   std::string node = "/rbsim";
+  // More services, after the steering's (or alone: the services capability without parameters).
+  // What their handlers use must outlive the server.
+  std::vector<HostedService> hosted_services;
   // Per client: parameter sets and service calls submitted and not yet answered (more are refused:
   // a serviceCallFailure or a status error), and the unread replies and other frames never dropped
   // beyond which its requests are refused unanswered (one status error per backlog).

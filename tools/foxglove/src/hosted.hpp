@@ -1,0 +1,53 @@
+// The hosted services' calls (ServerOptions::hosted_services: rbsim replay's player), served one at
+// a time on a thread of their own, so a handler may block (a seek waits for the player) without
+// holding up the server's I/O thread. Each call's answer, a serviceCallResponse frame or a
+// serviceCallFailure, goes to `answer` from that thread.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rbsim/foxglove.hpp"
+
+namespace rbsim::foxglove::detail {
+
+class HostedCalls {
+ public:
+  // A frame for the client `connection` that made the call: binary (the response) or text.
+  using Answer = std::function<void(std::uint64_t connection, std::string frame, bool binary)>;
+  // `services` are offered with ids first_id, first_id + 1, ...; they outlive this.
+  HostedCalls(const std::vector<HostedService>& services, ServiceId first_id, Answer answer);
+  ~HostedCalls();  // stop()
+  HostedCalls(const HostedCalls&) = delete;
+  HostedCalls& operator=(const HostedCalls&) = delete;
+
+  // Queues a call of one of the services (a json one is refused at once: they take cdr only). The
+  // server bounds the calls in flight per client.
+  void call(std::uint64_t connection, ServiceCall call);
+  // Joins the thread; calls still queued are dropped unanswered (the server is going).
+  void stop();
+
+ private:
+  struct Pending {
+    std::uint64_t connection = 0;
+    ServiceCall call;
+  };
+  void serve();
+
+  const std::vector<HostedService>& services_;
+  const ServiceId first_id_;
+  const Answer answer_;
+  std::mutex mu_;
+  std::condition_variable wake_;
+  std::deque<Pending> pending_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+}  // namespace rbsim::foxglove::detail
