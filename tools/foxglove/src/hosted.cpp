@@ -13,9 +13,9 @@ HostedCalls::~HostedCalls() {
 void HostedCalls::call(std::uint64_t connection, ServiceCall call) {
   if (call.encoding != "cdr") {
     answer_(connection,
-            service_call_failure_json(call.service, call.call,
-                                      services_[call.service - first_id_].spec.name +
-                                          " takes its request in cdr only"),
+            service_call_failure_json(
+                call.service, call.call,
+                services_[call.service - first_id_].spec.name + " takes its request in cdr only"),
             false);
     return;
   }
@@ -48,7 +48,8 @@ void HostedCalls::serve() {
     const ServiceCall& call = next.call;
     const Result<std::string> response = services_[call.service - first_id_].call(call.payload);
     if (!response) {
-      answer_(next.connection, service_call_failure_json(call.service, call.call, response.error().message), false);
+      answer_(next.connection, service_call_failure_json(call.service, call.call, response.error().message),
+              false);
       continue;
     }
     std::string frame;

@@ -286,6 +286,13 @@ Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc) {
   return decompressor.decompress(chunk, chunk.records, out, verify_crc);
 }
 
+ChunkDecompressor::ChunkDecompressor() : impl_(std::make_unique<detail::Decompressor>()) {}
+ChunkDecompressor::~ChunkDecompressor() = default;
+
+Status ChunkDecompressor::decompress(const Chunk& chunk, Bytes& out, bool verify_crc) {
+  return impl_->decompress(chunk, chunk.records, out, verify_crc);
+}
+
 bool parse_compression(std::string_view name, Compression& out) {
   if (name == "zstd") return out = Compression::Zstd, true;
   if (name == "lz4") return out = Compression::Lz4, true;

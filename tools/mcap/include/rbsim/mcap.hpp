@@ -23,6 +23,10 @@
 #include "rbsim/bytes.hpp"
 #include "rbsim/status.hpp"
 
+namespace rbsim::mcap::detail {
+class Decompressor;
+}  // namespace rbsim::mcap::detail
+
 namespace rbsim::mcap {
 
 using rbsim::Bytes;
@@ -207,6 +211,20 @@ std::string check_compression_level(Compression compression, int level);
 // Decompresses chunk.records into `out`, checking the size against uncompressed_size and, when
 // verify_crc and the chunk has one, the CRC. Never allocates much beyond the real output.
 Status decompress_chunk(const Chunk& chunk, Bytes& out, bool verify_crc = true);
+// The same for chunk after chunk, keeping the codec contexts between them (with an `out` kept
+// between calls too, nothing is allocated once the largest chunk was seen): a tool that checks or
+// reads many chunks on one thread.
+class ChunkDecompressor {
+ public:
+  ChunkDecompressor();
+  ~ChunkDecompressor();
+  ChunkDecompressor(const ChunkDecompressor&) = delete;
+  ChunkDecompressor& operator=(const ChunkDecompressor&) = delete;
+  Status decompress(const Chunk& chunk, Bytes& out, bool verify_crc = true);
+
+ private:
+  std::unique_ptr<detail::Decompressor> impl_;
+};
 
 // ---------------------------------------------------------------------------------------------
 // Writer
