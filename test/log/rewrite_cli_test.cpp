@@ -116,19 +116,24 @@ TEST(LogFilter, CopiesWholeChunksAndChecksThem) {
   EXPECT_EQ(rbsim({"log", "cat", copied}).out, rbsim({"log", "cat", anew}).out);
   EXPECT_EQ(rbsim({"check", copied, anew, "--strict-metadata"}).exit_code, 0);
 
-  mcap::Bytes bytes = read_bytes(in);  // a byte of the middle chunk's compressed records flipped
-  const auto records = top_level_records(bytes);
+  // A byte of one chunk's compressed records flipped: the middle one, then its neighbour (the
+  // copied chunks' checks alternate between two threads: each is caught).
+  const mcap::Bytes original = read_bytes(in);
+  const auto records = top_level_records(original);
   std::size_t chunks = 0;
   for (const RawRecord& r : records) chunks += r.opcode == static_cast<std::uint8_t>(mcap::Opcode::Chunk);
-  const RawRecord middle = find_record(records, mcap::Opcode::Chunk, chunks / 2);
-  bytes[middle.offset + middle.length - 100] ^= std::byte{0x55};
-  const std::string damaged = (dir / "damaged.mcap").string(), out = (dir / "out.mcap").string();
-  write_bytes(damaged, bytes);
-  Outcome bad = rbsim({"log", "filter", damaged, out, "--start", "0.2", "--end", "0.8"});
-  EXPECT_EQ(bad.exit_code, 1) << describe(bad);
-  EXPECT_NE(bad.err.find(damaged + ": chunk at offset " + std::to_string(middle.offset)), std::string::npos)
-      << bad.err;
-  EXPECT_FALSE(fs::exists(out));
+  for (const std::size_t k : {chunks / 2, chunks / 2 + 1}) {
+    mcap::Bytes bytes = original;
+    const RawRecord chunk = find_record(records, mcap::Opcode::Chunk, k);
+    bytes[chunk.offset + chunk.length - 100] ^= std::byte{0x55};
+    const std::string damaged = (dir / "damaged.mcap").string(), out = (dir / "out.mcap").string();
+    write_bytes(damaged, bytes);
+    Outcome bad = rbsim({"log", "filter", damaged, out, "--start", "0.2", "--end", "0.8"});
+    EXPECT_EQ(bad.exit_code, 1) << describe(bad);
+    EXPECT_NE(bad.err.find(damaged + ": chunk at offset " + std::to_string(chunk.offset)), std::string::npos)
+        << bad.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 TEST(LogFilter, TopicsKeepsAndExcludeTopicsLeavesOut) {
