@@ -82,15 +82,16 @@ Status Pacer::begin(const Scene&, const World& world) {
 }
 
 void Pacer::rebase(const World& world) {
+  // The step at hand went out before the pause (or is the reset's step 0): the next one is due now.
   start_ns_ = monotonic_ns();
-  start_step_ = world.step_index();
+  start_step_ = world.step_index() + 1;
 }
 
-Status Pacer::write(const World& world) {
-  if (rate_ <= 0.0 || world.step_index() % every_ != 0) return Ok{};
-  const double due = static_cast<double>(world.step_index() - start_step_) * world.dt() / rate_;
+void Pacer::wait(const World& world) const {
+  const std::int64_t next = world.step_index() + 1;
+  if (rate_ <= 0.0 || next % every_ != 0) return;
+  const double due = static_cast<double>(next - start_step_) * world.dt() / rate_;
   sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
-  return Ok{};
 }
 
 }  // namespace rbsim::node

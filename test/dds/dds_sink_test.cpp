@@ -26,9 +26,10 @@ TEST(DdsSink, PublishEveryBelowOneIsRefusedAtCreate) {
   EXPECT_TRUE(sink.ok()) << sink.error().message;
 }
 
-// The pacer after a pause or a reset (Sink::rebase) and a change of pace (set_pace): the next
-// step is due one dt / rate after the rebase, not at the time the original start implies (a burst
-// to catch up, or a long wait after a reset).
+// The pacer after a pause or a reset (Sink::rebase) and a change of pace (set_pace): the step
+// after the rebase goes out at once, the next one dt / rate after it, not at the time the original
+// start implies (a burst to catch up, or a long wait after a reset). The wait comes before the
+// boundary of the step it is for (Pacer::wait, DriverOptions::pace).
 TEST(Pacer, RebaseAndSetPaceCountTheNextStepFromNow) {
   WorldDef def;
   def.bodies.push_back(BodyDef{{{-1.0, 0.0}, {1.0, 0.0}}, {1.0, 1.0}});
@@ -38,27 +39,32 @@ TEST(Pacer, RebaseAndSetPaceCountTheNextStepFromNow) {
   World& w = world.value();
   Pacer pacer(1.0, 1);
   ASSERT_TRUE(pacer.begin(Scene{}, w).ok());
-  const auto timed_write = [&](std::int64_t step) {
+  const auto timed_wait = [&](std::int64_t step) {  // before the boundary of step + 1
     w.set_step_index(step);
     const auto start = std::chrono::steady_clock::now();
-    EXPECT_TRUE(pacer.write(w).ok());
+    pacer.wait(w);
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  // A reset: from step 100 (never reached in wall time) back to 0; step 1 is due dt from now.
+  // From begin() at step 0: step 1 is due dt later.
+  EXPECT_GE(timed_wait(0), 0.009);
+  // A reset: from step 100 (never reached in wall time) back to 0; step 1 goes at once, step 2
+  // dt after it.
   w.set_step_index(100);
   pacer.rebase(w);
   w.set_step_index(0);
   pacer.rebase(w);
-  const double after_reset = timed_write(1);
+  EXPECT_LT(timed_wait(0), 0.005);
+  const double after_reset = timed_wait(1);
   EXPECT_GE(after_reset, 0.009);
   EXPECT_LT(after_reset, 0.5);
   // Half the rate: two dt per step, counted from the rebase at step 40 (not from begin()).
   pacer.set_pace(0.5, 1);
   w.set_step_index(40);
   pacer.rebase(w);
-  const double slower = timed_write(41);
+  EXPECT_LT(timed_wait(40), 0.005);
+  const double slower = timed_wait(41);
   EXPECT_GE(slower, 0.019);
-  EXPECT_LT(slower, 0.5);  // from begin() at step 0, step 41 would be due 0.82 s later
+  EXPECT_LT(slower, 0.5);  // from begin() at step 0, step 42 would be due 0.84 s later
 }
 
 }  // namespace

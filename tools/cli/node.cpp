@@ -156,6 +156,7 @@ int node_command(const NodeArgs& a) {
   options.allow_nonfinite = a.allow_nonfinite;
   options.stop = stop_requested;
   options.control = &controller;
+  options.pace = [&pacer](const World& world) { pacer.wait(world); };
   do {
     if (Status st = driver.begin(); !st) return fail("node", st.error().message);
     const Result<PassEnd> end = driver.run(options);

@@ -55,25 +55,30 @@ class DdsSink final : public Sink {
   std::uint64_t published_ = 0;
 };
 
-// Paces a run to wall time: published step n (every k-th) is released at start + (n - n0) dt /
-// rate, with n0 and start taken at begin() (so each --loop pass starts afresh). Added to the
-// Driver before the sinks that publish, so they all send a step the moment it is due: the
-// Foxglove server's non-blocking hand-off first, then the DDS writes.
+// Paces a run to wall time: published step n (every k-th) is computed and released at start +
+// (n - n0) dt / rate, with n0 and start taken at begin() (so each --loop pass starts afresh). The
+// wait comes before the step's boundary (DriverOptions::pace calls wait()), not after computing
+// it: a command that arrives while the run waits applies at that boundary and shows in the very
+// step released next, one step sooner than a wait between computing and publishing would allow.
+// A sink only for begin() and rebase().
 class Pacer final : public Sink {
  public:
   Pacer(double rate, std::int64_t publish_every)
       : rate_(rate), every_(publish_every < 1 ? 1 : publish_every) {}
   Status begin(const Scene& scene, const World& world) override;
-  Status write(const World& world) override;
+  Status write(const World&) override { return Ok{}; }
   Status finish() override { return Ok{}; }
+  // Before the boundary of the step after `world`'s: waits until that step is due (when it is
+  // one that is published).
+  void wait(const World& world) const;
   // A live change of pace (a control command, between steps). The Driver then calls rebase(),
   // from which the new pace counts.
   void set_pace(double rate, std::int64_t publish_every) {
     rate_ = rate;
     every_ = publish_every < 1 ? 1 : publish_every;
   }
-  // After a pause, a reset or a change of pace: the next steps are due from now, counted from
-  // `world`'s step (no burst to catch up the time spent paused).
+  // After a pause, a reset or a change of pace: the next step is due now, the ones after it
+  // counted from there (no burst to catch up the time spent paused).
   void rebase(const World& world) override;
 
  private:

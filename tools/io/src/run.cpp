@@ -46,6 +46,7 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
   double limit = std::min(bound, std::max(1.0, 2.0 * world.peak_velocity()));
   if (options.control != nullptr) options.control->start(world);
   while (world.step_index() < options.steps) {
+    if (options.pace) options.pace(world);
     if (options.stop != nullptr && options.stop()) return PassEnd::Stopped;
     if (options.control != nullptr) {
       const StepHook::Boundary boundary = options.control->boundary(world, options.stop);

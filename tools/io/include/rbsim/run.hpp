@@ -55,6 +55,10 @@ struct DriverOptions {
   bool (*stop)() = nullptr;
   // Called after every step's writes with the step index; must not block.
   std::function<void(std::int64_t)> progress;
+  // Called before each step's boundary with the world as it stands; may block (rbsim node's
+  // Pacer waits there until the next step is due, so what the boundary applies then, a command
+  // that arrived meanwhile included, shows in that very step).
+  std::function<void(const World&)> pace;
   // Control at step boundaries (pause, step, reset, parameters, impulses); null: none, and the
   // loop is exactly the one without control.
   StepHook* control = nullptr;
