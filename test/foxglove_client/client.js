@@ -19,25 +19,12 @@ const net = require("net");
 const lib = require("./lib");
 const { Failure, sleep, until, Proc, startServer, endLine, Client, readMcap, runMain } = lib;
 
-function args() {
-  const a = {};
-  const argv = process.argv.slice(2);
-  for (let i = 0; i < argv.length; i += 2) a[argv[i].replace(/^--/, "")] = argv[i + 1];
-  for (const k of ["case", "rbsim", "source-dir", "workdir", "npm", "index"]) {
-    if (a[k] === undefined) throw new Error(`missing --${k}`);
-  }
-  return a;
-}
-
-const A = args();
+const { A, workdir } = lib.caseArgs(["case", "rbsim", "source-dir", "workdir", "npm", "index"]);
 const need = lib.npmModules(A.npm);
-const workdir = path.resolve(A.workdir);
-fs.rmSync(workdir, { recursive: true, force: true });
-fs.mkdirSync(workdir, { recursive: true });
 const ns = `fg_${A.case}_${process.pid}`;
 const domain = lib.domainFor(Number(A.index));
 const scene = (name) => path.join(A["source-dir"], "scenes", name);
-const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
+const log = lib.log;
 const nodeArgs = (sceneFile, ...extra) => ["node", sceneFile, "--domain", domain, "--namespace", ns, ...extra];
 const start = (name, argv) => startServer(A.rbsim, argv, { name, logDir: workdir });
 

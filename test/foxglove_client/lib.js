@@ -268,5 +268,22 @@ function runMain(title, main) {
     });
 }
 
+// A test script's options (--key value pairs; each of `required` must be there) and its work
+// folder (--workdir), emptied: { A, workdir }.
+function caseArgs(required) {
+  const A = {};
+  for (let i = 2; i < process.argv.length; i += 2) A[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
+  for (const k of required) {
+    if (A[k] === undefined) throw new Error(`missing --${k}`);
+  }
+  const workdir = path.resolve(A.workdir);
+  fs.rmSync(workdir, { recursive: true, force: true });
+  fs.mkdirSync(workdir, { recursive: true });
+  return { A, workdir };
+}
+
+// A line of the test's log, with the seconds since it started.
+const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
+
 module.exports = { Failure, npmModules, sleep, until, rbsimEnv, Proc, startServer, endLine, Client, readMcap, domainFor,
-  sceneColours, runMain };
+  sceneColours, runMain, caseArgs, log };

@@ -11,23 +11,15 @@
 // get_rate; seek to 2 s then play_next: the message of step 2000; toggle_paused: the replay plays on
 // from there; pause: it stops again. A json request and an unknown service are refused.
 // Only 127.0.0.1 and its own DDS domain; every wait bounded.
-const fs = require("fs");
 const path = require("path");
 const lib = require("./lib");
 const { Failure, until, sleep, Proc, startServer, Client, runMain } = lib;
 
-const A = {};
-for (let i = 2; i < process.argv.length; i += 2) A[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
-for (const k of ["rbsim", "source-dir", "workdir", "npm", "index"]) {
-  if (A[k] === undefined) throw new Error(`missing --${k}`);
-}
+const { A, workdir } = lib.caseArgs(["rbsim", "source-dir", "workdir", "npm", "index"]);
 const need = lib.npmModules(A.npm);
-const workdir = path.resolve(A.workdir);
-fs.rmSync(workdir, { recursive: true, force: true });
-fs.mkdirSync(workdir, { recursive: true });
 const ns = `fg_player_${process.pid}`;
 const domain = lib.domainFor(Number(A.index));
-const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
+const log = lib.log;
 
 async function main(check) {
   // 4 s of the chain at dt 0.001, body states recorded every 10 steps: 401 messages, step = 10 k.

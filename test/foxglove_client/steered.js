@@ -20,18 +20,11 @@ const path = require("path");
 const lib = require("./lib");
 const { Failure, until, Proc, startServer, Client, readMcap, runMain } = lib;
 
-const A = {};
-for (let i = 2; i < process.argv.length; i += 2) A[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
-for (const k of ["rbsim", "source-dir", "workdir", "npm", "index"]) {
-  if (A[k] === undefined) throw new Error(`missing --${k}`);
-}
+const { A, workdir } = lib.caseArgs(["rbsim", "source-dir", "workdir", "npm", "index"]);
 const need = lib.npmModules(A.npm);
-const workdir = path.resolve(A.workdir);
-fs.rmSync(workdir, { recursive: true, force: true });
-fs.mkdirSync(workdir, { recursive: true });
 const ns = `fg_steered_${process.pid}`;
 const domain = lib.domainFor(Number(A.index));
-const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
+const log = lib.log;
 const bigint = (k, v) => (typeof v === "bigint" ? Number(v) : v);
 const viaBridge = A.via === "bridge";
 if (A.via !== undefined && !viaBridge) throw new Error(`--via ${A.via}: only "bridge"`);

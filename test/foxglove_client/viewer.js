@@ -22,16 +22,12 @@ const path = require("path");
 const lib = require("./lib");
 const { Failure, until, startServer, Client, runMain } = lib;
 
-const A = {};
-for (let i = 2; i < process.argv.length; i += 2) A[process.argv[i].replace(/^--/, "")] = process.argv[i + 1];
+const { A, workdir } = lib.caseArgs(["case", "rbsim", "source-dir", "workdir", "npm", "index"]);
 const need = lib.npmModules(A.npm);
 const src = path.resolve(A["source-dir"]);
-const workdir = path.resolve(A.workdir);
-fs.rmSync(workdir, { recursive: true, force: true });
-fs.mkdirSync(workdir, { recursive: true });
 const CASES = { colours: ["foxglove_client.viewer", caseColours], parameters: ["foxglove_client.viewer_parameters", caseParameters] };
 if (!CASES[A.case]) throw new Error(`unknown --case ${A.case}`);
-const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(2)}] ${msg}`);
+const log = lib.log;
 
 const CHROMIUM = "/usr/bin/chromium";
 // Headless, software WebGL (SwiftShader), and nothing that reaches for the network: the closed
