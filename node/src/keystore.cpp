@@ -1,10 +1,5 @@
 // An SROS2 keystore and its enclaves (rbsim/security.hpp), laid out as `ros2 security` lays them
 // out (sros2/keystore: _keystore.py, _enclave.py; policy templates governance.xml, permissions.xsl).
-#include <sys/stat.h>
-
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <sstream>
 
@@ -133,9 +128,7 @@ enum class Access { Shared, OwnerOnly };
 
 Status write_file(const fs::path& path, const std::string& text, Access access = Access::Shared) {
   AtomicFile file;
-  if (Status st = file.open(path.string()); !st) return st;
-  if (access == Access::OwnerOnly && ::fchmod(::fileno(file.stream()), 0600) != 0)
-    return Error{path.string() + ": cannot be made private (" + std::strerror(errno) + ")"};
+  if (Status st = file.open(path.string(), access == Access::OwnerOnly ? 0600 : 0666); !st) return st;
   if (Status st = file.write(text.data(), text.size()); !st) return st;
   return file.commit();
 }

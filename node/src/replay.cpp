@@ -207,6 +207,10 @@ PlayerStatus Replay::status() const {
   return impl_->control->status();
 }
 
+void Replay::close_player() {
+  impl_->control->close();
+}
+
 std::vector<Replay::PlayerService> Replay::player_services() const {
   std::vector<PlayerService> out;
   for (node::PlayerService& s : node::player_services(*impl_->control, impl_->options.service_wait_s)) {

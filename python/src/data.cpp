@@ -74,6 +74,8 @@ log::RecordOptions record_options(const RunArgs& a) {
 std::int64_t run(const RunArgs& a) {
   Result<Scene> loaded = load_scene(a.scene);
   if (!loaded) raise_scene_error(a.scene, loaded.error().message);
+  if (a.duration && !(*a.duration >= 0.0)) throw nb::value_error("rbsim.run: duration must be >= 0");
+  if (a.steps && *a.steps < 0) throw nb::value_error("rbsim.run: steps must be >= 0");
   control::OfflineRunDef def;
   def.scene = a.scene;
   def.steps = a.steps;
@@ -99,6 +101,9 @@ std::int64_t run(const RunArgs& a) {
     options.allow_nonfinite = a.allow_nonfinite;
     options.stop = &ScopedStop::requested;
     end = offline.run(options);
+    if (end) {
+      if (Status st = offline.finish(); !st) end = st.error();
+    }
   }
   if (!end) raise_error(end.error().message);
   const std::int64_t done = offline.driver().world().step_index();

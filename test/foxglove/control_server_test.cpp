@@ -506,7 +506,7 @@ namespace {
 
 // Hosted services (rbsim replay's player): offered with no steering, the services capability in
 // cdr; each call answered by its handler on the server's service thread (one that blocks holds
-// no other client up), a json request or a handler's error a serviceCallFailure.
+// up no other client's connection), a json request or a handler's error a serviceCallFailure.
 TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
   std::promise<void> release;
   std::shared_future<void> released = release.get_future().share();

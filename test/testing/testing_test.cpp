@@ -92,6 +92,23 @@ TEST(RecordScene, ReportsBadInput) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A run that diverges is a failure naming the step, and writes nothing: an older file at out_mcap
+// (a golden being updated with overwrite) stays as it was.
+TEST(RecordScene, ADivergingRunWritesNothing) {
+  TempDir dir;
+  std::string text = read_text(RBSIM_SOURCE_DIR "/test/data/fosssim/scenes/springtests/test00ee.xml");
+  const std::string k = "k=\"";
+  for (std::size_t at = text.find(k); at != std::string::npos; at = text.find(k, at + 1))
+    text.replace(at + k.size(), text.find('"', at + k.size()) - (at + k.size()), "1e9");
+  const std::string stiff = dir.path() / "stiff.xml", out = dir.path() / "run.mcap";
+  write_text(stiff, text);
+  write_text(out, "an older golden");
+  const auto r = RecordScene(stiff, out, {.overwrite = true});
+  EXPECT_FALSE(r);
+  EXPECT_NE(message(r).find("not finite"), std::string::npos) << message(r);
+  EXPECT_EQ(read_text(out), "an older golden");
+}
+
 TEST(CheckLogs, MatchesAnIdenticalRun) {
   TempDir dir;
   const std::string a = dir.path() / "a.mcap", b = dir.path() / "b.mcap";

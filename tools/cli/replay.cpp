@@ -106,6 +106,12 @@ int replay_command(ReplayArgs a) {
   // --foxglove: one channel per replayed output with the recording's own schema; the replay's
   // pacing is the one clock, the server is fed from the tap as each message goes out over DDS.
   std::unique_ptr<foxglove::Server> server;
+  // Before the server goes (its service thread may be serving a seek that waits for the loop),
+  // the player is closed: that seek is answered at once.
+  struct ClosePlayer {
+    node::Replay& replay;
+    ~ClosePlayer() { replay.close_player(); }
+  } close_player{replay};
   node::Replay::Tap tap;
   std::uint64_t last_time = 0;
   if (a.foxglove.address) {

@@ -66,14 +66,17 @@ int run(const RunOptions& o) {
       return fail("run", "invalid --size \"" + o.size + "\" (expected WxH)");
     if (!(o.fps > 0.0 && o.fps <= 1000.0)) return fail("run", "--fps must be in (0, 1000]");
   }
-  Result<std::unique_ptr<control::OfflineRun>> prepared = control::OfflineRun::prepare(def);
+  Result<Scene> loaded = load_scene(o.scene);
+  if (!loaded) return fail("run", loaded.error().message);
+  for (const std::string& w : loaded->warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  Result<std::unique_ptr<control::OfflineRun>> prepared =
+      control::OfflineRun::prepare(def, std::move(loaded.value()));
   if (!prepared) {
     // A commands script's own mistake is a usage error (its file, line and field named).
     return fail("run", prepared.error().message, prepared.error().code == ErrorCode::InvalidArgument ? 2 : 1);
   }
   control::OfflineRun& offline = *prepared.value();
   const Scene& scene = offline.scene();
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "%s\n", w.c_str());
   const std::int64_t steps = offline.steps();
   std::unique_ptr<Sink> frames;
   if (!o.frames.empty()) {
@@ -93,9 +96,10 @@ int run(const RunOptions& o) {
   options.progress = [&progress](std::int64_t step) { progress.update(step); };
   const auto start = std::chrono::steady_clock::now();
   const Result<PassEnd> end = offline.run(options);
-  if (!end) return fail("run", end.error().message);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.finish();
+  if (!end) return fail("run", end.error().message);
+  if (Status st = offline.finish(); !st) return fail("run", st.error().message);
   const Driver& driver = offline.driver();
   const World& world = driver.world();
   if (end.value() == PassEnd::Diverged) {

@@ -98,6 +98,9 @@ class Replay {
     std::function<std::optional<Bytes>(std::span<const std::byte> request)> call;
   };
   std::vector<PlayerService> player_services() const;
+  // No more playing: the player's requests waiting for the loop (seek, play_next, burst) are
+  // answered at once and new ones refused, so a front end serving them can stop without waiting.
+  void close_player();
   // Waits (bounded) until the subscribers acknowledged everything published, so nothing in
   // flight is lost when the replay exits.
   [[nodiscard]] Status finish(double timeout_s = 30.0);

@@ -43,22 +43,27 @@ std::uint64_t on_disk(std::FILE* file, std::uint64_t handed) {
 
 // An unnamed file in `path`'s folder (O_TMPFILE), linked into place by commit(): nothing of it is
 // left when the process dies, SIGKILL included. -1 where the file system cannot (errno says why).
-int open_unnamed(const std::string& path) {
+int open_unnamed(const std::string& path, unsigned mode = 0666) {
   std::string dir = path.substr(0, path.find_last_of('/') + 1);
   if (dir.empty()) dir = ".";
-  return ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);  // less the umask, as fopen's
+  return ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, mode);  // less the umask, as fopen's
 }
 
-Status AtomicFile::open(const std::string& path) {
+Status AtomicFile::open(const std::string& path, unsigned mode) {
   open_external(path);
   external_ = false;
-  const int fd = open_unnamed(path);
+  int fd = open_unnamed(path, mode);
   if (fd >= 0) {
     temp_path_.clear();  // unnamed until commit()
+  } else {
+    // A file system without O_TMPFILE: a named temporary, created here with `mode` (never an
+    // existing file or a link: a private file is private from its first byte).
+    std::remove(temp_path_.c_str());
+    fd = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, mode);
+  }
+  if (fd >= 0) {
     file_ = ::fdopen(fd, "wb");
     if (file_ == nullptr) ::close(fd);
-  } else {
-    file_ = std::fopen(temp_path_.c_str(), "wb");  // a file system without O_TMPFILE: a named temporary
   }
   if (file_ == nullptr) {
     pending_ = false;

@@ -90,10 +90,7 @@ Result<PassEnd> OfflineRun::run(DriverOptions options) {
   options.steps = steps_;
   options.control = script_ ? &script_->controller() : nullptr;
   if (Status st = driver_->begin(); !st) return st.error();
-  Result<PassEnd> end = driver_->run(options);
-  if (!end) return end;
-  if (Status st = driver_->finish(); !st) return st.error();
-  return end;
+  return driver_->run(options);
 }
 
 Status OfflineRun::finish_commands() {

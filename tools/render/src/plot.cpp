@@ -125,7 +125,8 @@ Status plot(const std::string& input, const PlotOptions& o) {
      << "unset multiplot\n";
   const std::string text = gp.str();
   std::fwrite(text.data(), 1, text.size(), script.get());
-  if (std::fflush(data.get()) != 0 || std::fflush(script.get()) != 0)
+  if (std::fflush(data.get()) != 0 || std::fflush(script.get()) != 0 || std::ferror(data.get()) != 0 ||
+      std::ferror(script.get()) != 0)
     return Error{o.out_png + ": cannot write gnuplot's scratch files: " + std::strerror(errno)};
   Result<int> code = detail::run_process({"gnuplot", open_file_path(::fileno(script.get()))});
   if (!code) return Error{"gnuplot: " + code.error().message};

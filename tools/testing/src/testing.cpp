@@ -56,8 +56,10 @@ namespace {
   }
   Result<PassEnd> end = run.value()->run({});
   if (!end) return failure("RecordScene", end.error().message);
+  // A diverged run is never finished: nothing is written (an older file at out_mcap stays).
   if (end.value() == PassEnd::Diverged)
     return failure("RecordScene", describe_divergence(run.value()->driver().divergence()));
+  if (Status st = run.value()->finish(); !st) return failure("RecordScene", st.error().message);
   if (Status st = run.value()->finish_commands(); !st) {
     std::string named;
     for (const std::string& m : run.value()->script()->mismatches()) named += "\n  " + m;

@@ -32,8 +32,9 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
   ~AtomicFile();
 
-  // Creates the temporary and opens it for write() and stream().
-  [[nodiscard]] Status open(const std::string& path);
+  // Creates the temporary, with permissions `mode` less the umask (0600: a private key), and
+  // opens it for write() and stream().
+  [[nodiscard]] Status open(const std::string& path, unsigned mode = 0666);
   // For a writer that opens the file itself by a path (the MCAP writer, ffmpeg, gnuplot): it
   // writes writer_path() (opening it truncates), commit() moves that into place. Keep: the
   // temporary is named `<path>.tmp.<pid>` from the start, and a killed writer's stays for

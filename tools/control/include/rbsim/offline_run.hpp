@@ -34,6 +34,10 @@ struct OfflineRunDef {
 
 class OfflineRun {
  public:
+  // Held where it was made: the script and the driver keep references to its scene and sinks.
+  OfflineRun(const OfflineRun&) = delete;
+  OfflineRun& operator=(const OfflineRun&) = delete;
+
   // Stages up to the pass: errors name the scene, output or script (a script's own mistake has
   // code InvalidArgument, a usage error). Warnings of the scene are in scene().warnings.
   [[nodiscard]] static Result<std::unique_ptr<OfflineRun>> prepare(const OfflineRunDef& def);
@@ -45,9 +49,12 @@ class OfflineRun {
   Driver& driver() { return *driver_; }
   void add(Sink& sink) { driver_->add(sink); }  // another sink (frames), before run()
 
-  // begin, one pass of steps() steps with the script's controller, finish. `options` carries the
+  // begin, then one pass of steps() steps with the script's controller. `options` carries the
   // caller's stop, progress and allow_nonfinite; its steps and control are this run's.
   [[nodiscard]] Result<PassEnd> run(DriverOptions options);
+  // After run(): the outputs completed and moved into place (a diverged or stopped run's hold the
+  // steps before; a caller that wants none of them does not call this, and they are discarded).
+  [[nodiscard]] Status finish() { return driver_->finish(); }
 
   // After run(): the commands' outcome (ScriptedRun::finish), Ok without a script.
   [[nodiscard]] Status finish_commands();
