@@ -523,8 +523,73 @@ async function caseTls(check) {
   log(`${c.messages.length} messages over wss://`);
 }
 
+// A node serving with a token (RBSIM_FOXGLOVE_TOKEN) under attack on its Foxglove port while an
+// authenticated viewer watches at 1 kHz: 200 clients with wrong tokens (401, then 429 once the
+// address is rate-limited), 100 sockets that never speak (closed at the 5 s handshake timeout), an
+// oversized header; once the failure window passed, a wrong token then the right one. The viewer
+// loses no step (every body_states in order, 0 dropped in the end line) and the node keeps its
+// real-time step rate; the end line counts each refusal.
+async function caseAccess(check) {
+  const token = "rbsim-access-test-token-0123456789";
+  const env = { ...lib.rbsimEnv(), RBSIM_FOXGLOVE_TOKEN: token };
+  const duration = 25;
+  const [node, url] = await startServer(A.rbsim, nodeArgs(scene("chain.xml"), "--rate", 1, "--duration", duration),
+    { name: "node", logDir: workdir, env });
+  check(/token required/.test(node.err), `the listening line does not say a token is required:\n${node.err}`);
+  const viewer = new Client(need, `${url}/?token=${token}`, { name: "viewer", subscribeAll: false, decode: "later" });
+  viewer.client.on("advertise", (chans) => chans.filter((c) => c.topic === `/${ns}/body_states`).forEach((c) => viewer.subscribe(c)));
+  await viewer.ready();
+  await until("the viewer's first body states", 10000, () => viewer.messages.length > 100);
+
+  const refused = (query, headers = {}) => new Promise((resolve) => {
+    const WebSocket = need("ws");
+    const ws = new WebSocket(`${url}/${query}`, ["foxglove.websocket.v1"], { headers });
+    const done = (v) => { ws.terminate(); resolve(v); };
+    ws.on("unexpected-response", (_req, res) => done(res.statusCode));
+    ws.on("open", () => done(101));
+    ws.on("error", (e) => done(e.message));
+  });
+  const codes = new Map();
+  for (let batch = 0; batch < 10; batch++) {
+    const got = await Promise.all(Array.from({ length: 20 }, (_, i) => refused(`?token=wrong-${batch}-${i}`)));
+    for (const c of got) codes.set(c, (codes.get(c) ?? 0) + 1);
+  }
+  check([...codes.keys()].every((c) => c === 401 || c === 429) && (codes.get(401) ?? 0) >= 1,
+    `200 wrong tokens: ${JSON.stringify([...codes])}, want only 401 and 429`);
+  const silent = Array.from({ length: 100 }, () => net.connect(Number(new URL(url).port), "127.0.0.1"));
+  const closed = silent.map((s) => new Promise((resolve) => s.on("close", resolve)));
+  silent.forEach((s) => s.on("error", () => {}));
+  const big = await refused(`?token=${token}`, { "X-Padding": "x".repeat(20000) });
+  check(big === 431 || big === 429 || typeof big === "string", `an oversized header got ${big}`);
+  await Promise.race([Promise.all(closed), sleep(12000)]);
+  check(silent.every((s) => s.destroyed), `${silent.filter((s) => !s.destroyed).length} silent sockets still open`);
+  await sleep(10500); // the failure window (10 s) passes: the address is no longer rate-limited
+  check((await refused("?token=still-wrong")) === 401, "a wrong token after the window: want 401");
+  const late = new Client(need, `${url}/?token=${token}`, { name: "late", subscribeAll: false, decode: false });
+  await late.ready();
+  check(!!late.serverInfo, "the right token after the attack got no serverInfo");
+  late.close();
+
+  check((await node.wait(60000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+  await until("the viewer's last body states", 5000, () => viewer.closed).catch(() => {});
+  viewer.decodeAll();
+  const steps = viewer.messages.map((m) => Number(m.decoded.step));
+  const gaps = steps.filter((s, i) => i > 0 && s !== steps[i - 1] + 1).length;
+  check(gaps === 0, `the viewer's body states have ${gaps} gaps (${steps.length} received, ${steps[0]}..${steps.at(-1)})`);
+  check(steps.at(-1) === duration * 1000, `the viewer's last step ${steps.at(-1)}, want ${duration * 1000}`);
+  const end = endLine(node);
+  check(end, `no end line:\n${node.err}`);
+  if (end && !A.sanitized) check(end.rate > 950 && end.rate < 1050, `the node's step rate ${end.rate}, want 1000 (real time)`);
+  check(/ 0 dropped for slow clients/.test(node.err), `end line: want 0 dropped\n${node.err}`);
+  const counted = Number(/(\d+) refused without the right token/.exec(node.err)?.[1] ?? 0) +
+    Number(/(\d+) rate-limited/.exec(node.err)?.[1] ?? 0);
+  check(counted >= 201, `end line: ${counted} refused or rate-limited, want >= 201\n${node.err}`);
+  check(/100 closed for an unfinished handshake/.test(node.err), `end line: want 100 handshake timeouts\n${node.err}`);
+  log(`viewer: ${steps.length} steps, no gap; refusals ${JSON.stringify([...codes])}; node ${end?.rate} steps/s`);
+}
+
 const cases = { bytes: caseBytes, late_joiner: caseLateJoiner, hostile: caseHostile, slow_client: caseSlowClient,
-  faults: caseFaults, steer: caseSteer, tls: caseTls };
+  faults: caseFaults, steer: caseSteer, tls: caseTls, access: caseAccess };
 if (A.case === "child") caseChild();
 else if (!cases[A.case]) throw new Error(`unknown case ${A.case}`);
 else runMain(`foxglove_client.${A.case}`, cases[A.case]);
