@@ -87,6 +87,7 @@ std::int64_t run(const RunArgs& a) {
   def.record = {a.record, "record"};
   def.recording = record_options(a);
   def.overwrite = a.overwrite;
+  def.overwrite_option = "overwrite=True";
   Result<std::unique_ptr<control::OfflineRun>> prepared =
       control::OfflineRun::prepare(def, std::move(loaded.value()));
   if (!prepared) raise_error(prepared.error().message);

@@ -66,7 +66,7 @@ def test_run_writes_a_bag_directory_as_the_command_does(tmp_path):
 def test_run_refuses_what_the_command_refuses(tmp_path):
     out = tmp_path / "r.mcap"
     out.write_bytes(b"mine")
-    with pytest.raises(rbsim.Error, match="exists"):
+    with pytest.raises(rbsim.Error, match=r"exists \(use overwrite=True to replace it\)"):
         rbsim.run(CANTILEVER, steps=5, record=out)
     assert out.read_bytes() == b"mine"
     assert rbsim.run(CANTILEVER, steps=5, record=out, overwrite=True) == 5

@@ -73,7 +73,8 @@ TEST(RecordScene, RefusesAnExistingOutputUnlessOverwrite) {
   write_text(out, "mine");
   const auto refused = RecordScene(kPendulum, out, {.steps = 5});
   EXPECT_FALSE(refused);
-  EXPECT_NE(message(refused).find("exists"), std::string::npos) << message(refused);
+  EXPECT_NE(message(refused).find("exists (use RecordOptions::overwrite to replace it)"), std::string::npos)
+      << message(refused);
   EXPECT_EQ(read_text(out), "mine");
   EXPECT_TRUE(RecordScene(kPendulum, out, {.steps = 5, .overwrite = true}));
   EXPECT_NE(read_text(out), "mine");

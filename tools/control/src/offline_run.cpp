@@ -35,7 +35,7 @@ Status check_run_outputs(const OfflineRunDef& def) {
   } else {
     outputs.push_back(def.record);
   }
-  return check_outputs(outputs, inputs, def.overwrite);
+  return check_outputs(outputs, inputs, def.overwrite, def.overwrite_option);
 }
 
 }  // namespace

@@ -18,7 +18,7 @@ bool same_file(const std::string& a, const std::string& b) {
 }
 
 Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs,
-                     bool overwrite) {
+                     bool overwrite, std::string_view overwrite_option) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const OutputPath& o = outputs[i];
     if (o.path.empty()) continue;
@@ -41,7 +41,7 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
       }
     } else if (exists) {
       if (fs::is_directory(st)) return fail("is a folder (give a file name)");
-      if (!overwrite) return fail("exists (use --overwrite to replace it)");
+      if (!overwrite) return fail("exists (use " + std::string(overwrite_option) + " to replace it)");
     }
     // The file (or the folder to create) goes into its parent folder, which must exist and take it.
     fs::path parent = fs::path(o.path).parent_path();

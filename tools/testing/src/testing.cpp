@@ -39,6 +39,7 @@ namespace {
   def.commands = options.commands;
   def.record = {out_mcap, "out_mcap"};
   def.overwrite = options.overwrite;
+  def.overwrite_option = "RecordOptions::overwrite";
   def.recording.every = options.record_every;
   def.recording.ns = options.ns;
   if (!options.topics.empty()) {
@@ -49,11 +50,7 @@ namespace {
     def.recording.topics = topics.value();
   }
   Result<std::unique_ptr<control::OfflineRun>> run = control::OfflineRun::prepare(def);
-  if (!run) {
-    const bool exists = run.error().message.find("exists") != std::string::npos;
-    return failure("RecordScene",
-                   run.error().message + (exists && !options.overwrite ? " (RecordOptions::overwrite)" : ""));
-  }
+  if (!run) return failure("RecordScene", run.error().message);
   Result<PassEnd> end = run.value()->run({});
   if (!end) return failure("RecordScene", end.error().message);
   // A diverged run is never finished: nothing is written (an older file at out_mcap stays).

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rbsim/core.hpp"
@@ -19,9 +20,11 @@ struct OutputPath {
 // Ok when every wanted output can be written: its folder exists and is writable, it is not a
 // folder (or, for a folder output, not a file), no two outputs are the same file, none is one of
 // `inputs` (never, even with `overwrite`), and a file output does not exist yet unless
-// `overwrite`. The Error names the option, the path and the rule.
+// `overwrite`. The Error names the option, the path and the rule (an existing file: how the caller
+// names `overwrite`, "--overwrite" on the command line).
 [[nodiscard]] Status check_outputs(const std::vector<OutputPath>& outputs,
-                                   const std::vector<std::string>& inputs, bool overwrite);
+                                   const std::vector<std::string>& inputs, bool overwrite,
+                                   std::string_view overwrite_option = "--overwrite");
 
 // Whether two paths name the same file (existing or not: compared by canonical path).
 bool same_file(const std::string& a, const std::string& b);
