@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <future>
 #include <optional>
@@ -411,6 +412,34 @@ TEST(ControllerClose, AnswersWhatIsQueuedAndRefusesLaterCommands) {
     EXPECT_NE(r.message.find("the node stopped"), std::string::npos);
   }
   EXPECT_FALSE(wait(never).successful);  // answered when the controller went away
+}
+
+// A running loop (not paused, nothing queued) ends its pass at its next boundary once closed,
+// rather than running on to its last step.
+TEST(ControllerClose, EndsARunningPassAtItsNextBoundary) {
+  const Scene scene = test::control_scene();
+  constexpr std::int64_t kMany = 1'000'000'000;  // minutes of stepping if close() did not end it
+  static std::atomic<bool> give_up{false};       // ends the pass should close() not
+  Controller controller(scene, kMany, RunSettings{0.0, 1, false});
+  Result<Driver> driver = Driver::create(scene);
+  ASSERT_TRUE(driver);
+  ASSERT_TRUE(driver.value().begin());
+  std::future<Result<PassEnd>> pass = std::async(std::launch::async, [&] {
+    DriverOptions options;
+    options.steps = kMany;
+    options.control = &controller;
+    options.stop = [] { return give_up.load(); };
+    return driver.value().run(options);
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  controller.close("the node stopped");
+  const bool ended = pass.wait_for(std::chrono::seconds(10)) == std::future_status::ready;
+  give_up = true;
+  ASSERT_TRUE(ended) << "still stepping 10 s after close()";
+  const Result<PassEnd> end = pass.get();
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end.value(), PassEnd::Stopped);
+  EXPECT_LT(driver.value().world().step_index(), kMany);
 }
 
 // Several threads submit parameter sets, bad sets, reads and `step 1` requests while the run,

@@ -95,7 +95,8 @@ void Controller::close(const std::string& reason) {
     }
     refused.swap(incoming_);
     counters_.commands += refused.size();
-    has_incoming_.store(false, std::memory_order_release);
+    // Takes a running loop off its fast path: its next boundary sees closed_ and stops the pass.
+    has_incoming_.store(true, std::memory_order_release);
     wake_.notify_all();
   }
   for (Pending& p : refused) {

@@ -134,8 +134,8 @@ class Controller final : public StepHook, public Steering {
   std::vector<std::string> names() const override { return list({}, kDepthRecursive).names; }
   RunSettings settings() const;
   ControlCounters counters() const;
-  // Answers every queued command with failure (`reason`) and refuses later ones at once. Also
-  // wakes a paused loop, which then ends its pass as stopped.
+  // Answers every queued command with failure (`reason`) and refuses later ones at once. A
+  // running loop ends its pass as stopped at its next boundary; a paused one is woken to do so.
   void close(const std::string& reason);
 
   // ---- Set up before the run (not thread-safe against a running loop).
