@@ -8,6 +8,7 @@ Jobs (input bytes / wall seconds, median of --runs interleaved rounds):
   filter window   A -> the middle half of its log time, every topic
   filter topics   A -> every message but /tf and /clock
   merge           A + B -> one file
+Outputs are zstd-compressed as the inputs are (--compression lz4 or none for the others' cost).
 The plain copy of a job copies its input file(s) whole. Ratios printed: copy time / rbsim time
 (target >= 0.5) and python time / rbsim time. Exit status 1 when a copy ratio misses its target."""
 
@@ -50,6 +51,8 @@ def main():
     ap.add_argument("--steps", type=int, default=1500)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--target", type=float, default=0.5, help="rbsim / plain copy throughput to reach")
+    ap.add_argument("--compression", choices=("zstd", "lz4", "none"), default="zstd",
+                    help="chunk compression of every job's output, rbsim's and Python's (inputs: zstd)")
     args = ap.parse_args()
     import mcap_reference
 
@@ -67,20 +70,22 @@ def main():
                             "--record", path], check=True)
         size_a, size_b = os.path.getsize(a), os.path.getsize(b)
         start, end = 0.25 * args.steps / 1000, 0.75 * args.steps / 1000
-        rb = lambda *cmd: (lambda: subprocess.run([args.rbsim, "log", *cmd, "-q"], check=True))  # noqa: E731
+        rb = lambda *cmd: (lambda: subprocess.run(  # noqa: E731
+            [args.rbsim, "log", *cmd, "-q", "--compression", args.compression], check=True))
+        z = args.compression
         out = at("out.mcap")
         jobs = [
             ("filter window", size_a, lambda: plain_copy([a], out),
              rb("filter", a, out, "--start", str(start), "--end", str(end)),
-             lambda: mcap_reference.filter_file(a, out, int(start * 1e9), int(end * 1e9))),
+             lambda: mcap_reference.filter_file(a, out, int(start * 1e9), int(end * 1e9), compression=z)),
             ("filter topics", size_a, lambda: plain_copy([a], out),
              rb("filter", a, out, "--exclude-topics", "/tf,/clock"),
-             lambda: mcap_reference.filter_file(a, out, topics=_topics_but(a, {"/tf", "/clock"}))),
+             lambda: mcap_reference.filter_file(a, out, topics=_topics_but(a, {"/tf", "/clock"}), compression=z)),
             ("merge", size_a + size_b, lambda: plain_copy([a, b], out), rb("merge", a, b, out),
-             lambda: mcap_reference.merge_files([a, b], out)),
+             lambda: mcap_reference.merge_files([a, b], out, compression=z)),
         ]
         print(f"inputs: {size_a / 1e6:.1f} MB and {size_b / 1e6:.1f} MB ({args.bodies} bodies, {args.steps} steps, "
-              f"zstd in and out), in {args.tmp}; median of {args.runs} rounds")
+              f"zstd in, {args.compression} out), in {args.tmp}; median of {args.runs} rounds")
         print(f"{'job':<14} {'copy MB/s':>10} {'rbsim MB/s':>11} {'python MB/s':>12} {'rbsim/copy':>11} "
               f"{'rbsim/python':>13}")
         missed = 0
