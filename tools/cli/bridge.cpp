@@ -36,6 +36,9 @@ std::optional<std::uint64_t> sim_time(const msgs::TopicSpec& spec, std::span<con
 }
 
 int bridge_command(const BridgeArgs& a) {
+  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
+  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
+  install_stop_handlers();
   auto participant = node::Participant::create(a.domain, a.node);
   if (!participant) return fail("bridge", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
@@ -58,7 +61,6 @@ int bridge_command(const BridgeArgs& a) {
                                 steering.value().get(), steer.node);
   if (!started) return fail("bridge", started.error().message, foxglove_exit_status(started.error()));
   foxglove::Server& server = *started.value();
-  install_stop_handlers();
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim bridge: relaying /%s/* and /clock on %s (Ctrl-C stops)\n", a.ns.c_str(),
               participant.value().description().c_str());

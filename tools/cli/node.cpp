@@ -47,6 +47,9 @@ Status apply_ros_args(Scene& scene, std::int64_t steps, control::RunSettings& se
 }
 
 int node_command(const NodeArgs& a) {
+  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
+  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
+  install_stop_handlers();
   // The node is /<namespace> on the graph: its topics /<namespace>/<name> are its private ones.
   const Result<node::NodeName> name = node::parse_node_name(a.node.ns);
   if (!name) return fail("node", name.error().message, 2);
@@ -104,7 +107,6 @@ int node_command(const NodeArgs& a) {
     commands_channel = ids[static_cast<std::size_t>(msgs::TopicId::Commands)];
     foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);
   }
-  install_stop_handlers();
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim node: %s on %s, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
               scene.name.c_str(), participant.value().description().c_str(), a.node.ns.c_str(),
@@ -116,7 +118,10 @@ int node_command(const NodeArgs& a) {
   }
   if (a.wait_for > 0) {
     if (!a.quiet) RBSIM_LOG(Info, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
-    if (!sink.value()->wait_for_subscribers(a.wait_for, stop_requested)) return 128 + stop_signal();
+    if (!sink.value()->wait_for_subscribers(a.wait_for, stop_requested)) {
+      if (!a.quiet) RBSIM_LOG(Info, "rbsim node: stopped while waiting, nothing published\n");
+      return 0;  // as for a stop while running
+    }
   }
   const auto start = std::chrono::steady_clock::now();
   Result<Driver> created = Driver::create(scene);

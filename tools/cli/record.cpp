@@ -51,6 +51,9 @@ bool snapshot_requested() {
 }
 
 int record_command(RecordArgs a) {
+  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
+  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
+  install_stop_handlers();
   if (a.wrong_duration) {
     RBSIM_LOG(Error,
               "rbsim record: error: --duration: a recorder runs in wall-clock time: use --wall-duration "
@@ -105,7 +108,6 @@ int record_command(RecordArgs a) {
   // rosbag2's recorder services on the recorder's node (/rbsim_recorder/snapshot, ...).
   auto services = node::RecorderServices::create(participant.value(), *recorder.value());
   if (!services) return fail("record", services.error().message);
-  install_stop_handlers();
   install_snapshot_handler();
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim record: recording %s topics under /%s on %s to %s (Ctrl-C to stop)\n",

@@ -94,6 +94,9 @@ std::vector<foxglove::HostedService> player_services(const node::Replay& replay,
 }
 
 int replay_command(ReplayArgs a) {
+  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
+  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
+  install_stop_handlers();
   if (!a.ns.empty()) a.replay.ns = a.ns;
   auto participant = node::Participant::create(a.domain, a.node);
   if (!participant) return fail("replay", participant.error().message);
@@ -142,7 +145,6 @@ int replay_command(ReplayArgs a) {
       srv->publish(static_cast<foxglove::ChannelId>(output + 1), t, cdr);
     };
   }
-  install_stop_handlers();
   if (!a.quiet) {
     const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
     char rate[32] = "as fast as possible";

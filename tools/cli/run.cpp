@@ -40,6 +40,9 @@ struct RunOptions {
 };
 
 int run(const RunOptions& o) {
+  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
+  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
+  install_stop_handlers();
   control::OfflineRunDef def;
   def.scene = o.scene;
   def.steps = o.steps;
@@ -86,7 +89,6 @@ int run(const RunOptions& o) {
     offline.add(*frames);
   }
 
-  install_stop_handlers();
   Progress progress(steps, o.progress == "always"  ? Progress::Mode::Always
                            : o.progress == "never" ? Progress::Mode::Never
                                                    : Progress::Mode::Auto);
