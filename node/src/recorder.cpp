@@ -5,9 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 #include <optional>
 #include <regex>
 
+#include "rbsim/assert.hpp"
 #include "rbsim/bag.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/recorder.hpp"
@@ -294,6 +296,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
     holding_ = false;
     if (Status st = release_held(); !st) return st.error();
   }
+  RBSIM_ASSERT(holding_ || held_.empty(), "samples are held only while a latched topic is awaited");
+  RBSIM_ASSERT(latched_pending_.size() == topics_.size(), "one latched-pending flag per topic");
   return any;
 }
 
@@ -369,6 +373,10 @@ bool Recorder::scene_pending() const {
 }
 
 Status Recorder::release_held() {
+  RBSIM_ASSERT(
+      held_bytes_ == std::accumulate(held_.begin(), held_.end(), std::size_t{0},
+                                     [](std::size_t n, const Held& h) { return n + h.sample.cdr.size(); }),
+      "held_bytes_ counts the held samples' bytes");
   // Latched samples first, at the earliest held log time, so the file stays in log-time order.
   const std::uint64_t first = held_.empty() ? 0 : held_.front().log_time;
   for (const bool latched : {true, false}) {
