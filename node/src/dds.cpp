@@ -157,7 +157,7 @@ Result<Participant> Participant::create(std::uint32_t domain, const NodeName& no
   Participant participant(
       p, s.domain, s.describe() + (security->requested ? ", " + security->describe() : ""), node, s.distro);
   auto graph = Graph::create(participant, node, s.distro);
-  if (!graph) return Error{"cannot publish the node on ros_discovery_info: " + graph.error().message};
+  if (!graph) return with_context("cannot publish the node on ros_discovery_info: ", graph.error());
   participant.graph_ = std::move(graph.value());
   return participant;
 }

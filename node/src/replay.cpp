@@ -88,7 +88,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   const std::string& path = options.path;
   // Raw messages only: every channel of our types is replayed as recorded, whatever it holds.
   auto opened = log::Recording::open(path, log::raw_options());
-  if (!opened) return Error{"cannot read " + opened.error().message};
+  if (!opened) return with_context("cannot read ", opened.error());
   im.recording = std::move(opened.value());
 
   // Channels that carry one of our types as CDR (found by type), by id (file order).
@@ -187,7 +187,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     any = true;
     return false;
   });
-  if (!st) return Error{"cannot read " + st.error().message};
+  if (!st) return with_context("cannot read ", st.error());
   if (!any) return Error{path + ": the log has rbsim topics but no messages on them"};
   r->last_log_time_ = std::max(r->first_log_time_, im.recording->last_log_time().value_or(0));
 
@@ -274,7 +274,7 @@ Status Replay::Impl::send_latched(std::uint64_t start, std::set<std::uint16_t>& 
     // Past the start with one per channel: the rest of the log cannot change the choice.
     return m.log_time < start || latched.size() < latched_channels.size();
   });
-  if (!st) return Error{"cannot read " + st.error().message};
+  if (!st) return with_context("cannot read ", st.error());
   for (const auto& [ch, m] : latched) {
     if (stop()) return Ok{};
     if (Status s = publishers[route.at(ch)].publish(m.data); !s) return s.error();
@@ -295,7 +295,7 @@ Result<std::optional<std::uint64_t>> Replay::Impl::seek_position(std::uint64_t s
     found = m.log_time;
     return false;
   });
-  if (!st) return Error{"cannot read " + st.error().message};
+  if (!st) return with_context("cannot read ", st.error());
   return found;
 }
 
@@ -437,7 +437,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
       control.published(m.log_time, per_step ? sim : std::nullopt);
       return true;
     });
-    if (!st) return Error{"cannot read " + st.error().message};
+    if (!st) return with_context("cannot read ", st.error());
     if (failure) return *failure;
     if (stopped) {
       control.pass_end();

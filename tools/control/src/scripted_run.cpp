@@ -36,7 +36,7 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
   if (!recorded) return recorded.error();
   for (const msgs::CommandMessage& m : recorded.value()) {
     Result<Command> c = from_message(m);
-    if (!c) return Error{path + ": " + c.error().message};
+    if (!c) return with_context(path + ": ", c.error());
     out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq)});
   }
   return out;
