@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "rbsim/command_script.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/recording.hpp"
 
 namespace rbsim::control {
@@ -77,7 +78,7 @@ Status ScriptedRun::finish(const std::string& path) {
   }
   if (mismatches_.empty()) return Ok{};
   return Error{path + ": " + std::to_string(mismatches_.size()) +
-               (mismatches_.size() == 1 ? " command" : " commands") + " (of " +
+               plural(mismatches_.size(), " command", " commands") + " (of " +
                std::to_string(counted.commands) + ") did not apply as " +
                (is_recording_path(path) ? "recorded" : "written")};
 }
