@@ -232,7 +232,8 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   mcap::RecordEntry entry;
   if (!reader.next(entry) || !std::holds_alternative<mcap::Header>(entry.record)) {
     const Status& s = reader.status();
-    return Error{in + ": " + (s.ok() ? std::string("no Header record") : s.error().message) +
+    return Error{in + ": " +
+                 (s.ok() ? std::string("no Header record") : mcap::describe_read_error(s.error())) +
                  "; nothing to recover, nothing written"};
   }
   const mcap::Header header = std::get<mcap::Header>(entry.record);
