@@ -1,8 +1,6 @@
 // The replay: an MCAP recording republished over DDS with its recorded timing.
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstring>
 #include <map>
 #include <set>
 
@@ -25,17 +23,6 @@ bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
     if (now >= deadline_ns) return true;
     sleep_until(std::min(deadline_ns, now + kSlice));
   }
-}
-
-// rosgraph_msgs/msg/Clock in CDR: encapsulation header (CDR_LE), int32 sec, uint32 nanosec.
-std::array<std::byte, 12> clock_cdr(std::uint64_t t_ns) {
-  std::array<std::byte, 12> out{};
-  out[1] = std::byte{1};
-  const auto sec = static_cast<std::int32_t>(t_ns / 1'000'000'000);
-  const auto nsec = static_cast<std::uint32_t>(t_ns % 1'000'000'000);
-  std::memcpy(out.data() + 4, &sec, 4);
-  std::memcpy(out.data() + 8, &nsec, 4);
-  return out;
 }
 }  // namespace
 
@@ -344,8 +331,9 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     if (tap == nullptr || !tap->message) return;
     tap->message(im.output_of.at(channel), sim.value_or(last_sim.value_or(log_time)), cdr);
   };
+  msgs::Bytes cdr_of_clock;
   auto publish_clock = [&](std::uint64_t t) -> Status {
-    const auto cdr = clock_cdr(t);
+    const msgs::Bytes& cdr = msgs::encode_clock(t, cdr_of_clock);
     if (Status s = im.publishers[*im.clock_publisher].publish(cdr); !s) return s;
     if (tap != nullptr && tap->message) tap->message(outputs_.size() - 1, t, cdr);
     ++published_;
