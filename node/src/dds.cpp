@@ -11,6 +11,7 @@
 #include <cstring>
 #include <optional>
 
+#include "clock.hpp"
 #include "graph.hpp"
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
@@ -255,6 +256,15 @@ std::int32_t Publisher::matched() const {
   dds_publication_matched_status_t st{};
   if (dds_get_publication_matched_status(writer_, &st) < 0) return 0;
   return static_cast<std::int32_t>(st.current_count);
+}
+
+bool Publisher::wait_for_subscribers(std::int32_t count, bool (*stop)()) const {
+  constexpr std::int64_t kPoll = 20'000'000;
+  while (matched() < count) {
+    if (stop != nullptr && stop()) return false;
+    sleep_until(monotonic_ns() + kPoll);  // a signal ends it early: stop is looked at next
+  }
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -213,11 +213,7 @@ std::vector<Replay::PlayerService> Replay::player_services() const {
 }
 
 bool Replay::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
-  const Publisher& pub = impl_->publishers[impl_->wait_publisher];
-  while (pub.matched() < count) {
-    if (!sleep_until_or_stop(monotonic_ns() + 20'000'000, stop)) return false;
-  }
-  return true;
+  return impl_->publishers[impl_->wait_publisher].wait_for_subscribers(count, stop);
 }
 
 Status Replay::finish(double timeout_s) {
