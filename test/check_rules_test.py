@@ -99,6 +99,15 @@ class CheckModulesTest(CheckerTest):
         self.tree.write("tools/log/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
         self.assertFails("(little-endian fields read by hand (le64))")
 
+    def test_type_name_outside_msgs_fails(self):
+        self.tree.write("tools/msgs/include/rbsim/msgs.hpp",
+                        'inline constexpr const char* kTrigger = "std_srvs/srv/Trigger";\n')
+        self.tree.write("node/src/services.cpp", '#include "rbsim_msgs/msg/Command.h"\n'
+                        '// "rbsim_msgs/msg/Command" in a comment is no spelling\nconst char* t = kTrigger;\n')
+        self.assertPasses()
+        self.tree.write("node/src/services.cpp", 'const char* t = "std_srvs/srv/Trigger";\n')
+        self.assertFails("node/src/services.cpp: module node spells the type name std_srvs/srv/Trigger")
+
     def test_allowlist_ratchets(self):
         self.tree.write("tools/check/src/compare.cpp", "rbsim::mcap::IndexedReader r;\n")
         self.tree.write("test/architecture_allowlist.txt", "mcap-reader tools/check/src/compare.cpp\n")

@@ -1,8 +1,6 @@
 // The replay: an MCAP recording republished over DDS with its recorded timing.
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstring>
 #include <map>
 #include <set>
 
@@ -25,17 +23,6 @@ bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
     if (now >= deadline_ns) return true;
     sleep_until(std::min(deadline_ns, now + kSlice));
   }
-}
-
-// rosgraph_msgs/msg/Clock in CDR: encapsulation header (CDR_LE), int32 sec, uint32 nanosec.
-std::array<std::byte, 12> clock_cdr(std::uint64_t t_ns) {
-  std::array<std::byte, 12> out{};
-  out[1] = std::byte{1};
-  const auto sec = static_cast<std::int32_t>(t_ns / 1'000'000'000);
-  const auto nsec = static_cast<std::uint32_t>(t_ns % 1'000'000'000);
-  std::memcpy(out.data() + 4, &sec, 4);
-  std::memcpy(out.data() + 8, &nsec, 4);
-  return out;
 }
 }  // namespace
 
@@ -88,7 +75,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   const std::string& path = options.path;
   // Raw messages only: every channel of our types is replayed as recorded, whatever it holds.
   auto opened = log::Recording::open(path, log::raw_options());
-  if (!opened) return Error{"cannot read " + opened.error().message};
+  if (!opened) return with_context("cannot read ", opened.error());
   im.recording = std::move(opened.value());
 
   // Channels that carry one of our types as CDR (found by type), by id (file order).
@@ -187,7 +174,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
     any = true;
     return false;
   });
-  if (!st) return Error{"cannot read " + st.error().message};
+  if (!st) return with_context("cannot read ", st.error());
   if (!any) return Error{path + ": the log has rbsim topics but no messages on them"};
   r->last_log_time_ = std::max(r->first_log_time_, im.recording->last_log_time().value_or(0));
 
@@ -226,11 +213,7 @@ std::vector<Replay::PlayerService> Replay::player_services() const {
 }
 
 bool Replay::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
-  const Publisher& pub = impl_->publishers[impl_->wait_publisher];
-  while (pub.matched() < count) {
-    if (!sleep_until_or_stop(monotonic_ns() + 20'000'000, stop)) return false;
-  }
-  return true;
+  return impl_->publishers[impl_->wait_publisher].wait_for_subscribers(count, stop);
 }
 
 Status Replay::finish(double timeout_s) {
@@ -274,7 +257,7 @@ Status Replay::Impl::send_latched(std::uint64_t start, std::set<std::uint16_t>& 
     // Past the start with one per channel: the rest of the log cannot change the choice.
     return m.log_time < start || latched.size() < latched_channels.size();
   });
-  if (!st) return Error{"cannot read " + st.error().message};
+  if (!st) return with_context("cannot read ", st.error());
   for (const auto& [ch, m] : latched) {
     if (stop()) return Ok{};
     if (Status s = publishers[route.at(ch)].publish(m.data); !s) return s.error();
@@ -295,7 +278,7 @@ Result<std::optional<std::uint64_t>> Replay::Impl::seek_position(std::uint64_t s
     found = m.log_time;
     return false;
   });
-  if (!st) return Error{"cannot read " + st.error().message};
+  if (!st) return with_context("cannot read ", st.error());
   return found;
 }
 
@@ -344,8 +327,9 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
     if (tap == nullptr || !tap->message) return;
     tap->message(im.output_of.at(channel), sim.value_or(last_sim.value_or(log_time)), cdr);
   };
+  msgs::Bytes cdr_of_clock;
   auto publish_clock = [&](std::uint64_t t) -> Status {
-    const auto cdr = clock_cdr(t);
+    const msgs::Bytes& cdr = msgs::encode_clock(t, cdr_of_clock);
     if (Status s = im.publishers[*im.clock_publisher].publish(cdr); !s) return s;
     if (tap != nullptr && tap->message) tap->message(outputs_.size() - 1, t, cdr);
     ++published_;
@@ -437,7 +421,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
       control.published(m.log_time, per_step ? sim : std::nullopt);
       return true;
     });
-    if (!st) return Error{"cannot read " + st.error().message};
+    if (!st) return with_context("cannot read ", st.error());
     if (failure) return *failure;
     if (stopped) {
       control.pass_end();

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "rbsim/bag.hpp"
 #include "rbsim/cat.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_tools.hpp"
@@ -110,7 +111,7 @@ int info_command(const LogOptions& o) {
   const bool bag = files->size() != 1 || files->front() != o.file;
   if (bag) {
     std::printf("bag:         %s (rosbag2, %zu file%s)\n", o.file.c_str(), files->size(),
-                files->size() == 1 ? "" : "s");
+                plural(files->size(), "", "s"));
     for (const std::string& f : files.value()) std::printf("  %s\n", f.c_str());
   }
   for (const std::string& f : files.value()) {

@@ -11,6 +11,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/replay.hpp"
 #include "rbsim/rosout.hpp"
@@ -188,8 +189,8 @@ int replay_command(ReplayArgs a) {
   if (server) (void)server->flush(2.0);  // viewers that keep up get the end of the log
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim replay: %s after %llu complete pass%s, %llu messages published%s\n",
-              complete ? "done" : "stopped", static_cast<unsigned long long>(passes), passes == 1 ? "" : "es",
-              static_cast<unsigned long long>(replay.published()),
+              complete ? "done" : "stopped", static_cast<unsigned long long>(passes),
+              plural(passes, "", "es"), static_cast<unsigned long long>(replay.published()),
               server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;

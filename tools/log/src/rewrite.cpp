@@ -14,6 +14,7 @@
 #include <tuple>
 
 #include "rbsim/atomic_file.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/mcap_tools.hpp"
 #include "rbsim/recording.hpp"
@@ -22,15 +23,6 @@
 namespace rbsim::log {
 
 namespace {
-
-std::string count_text(std::uint64_t n) {
-  std::string digits = std::to_string(n), out;
-  for (std::size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
-}
 
 // The output file: identical schemas and channels written once, messages through one writer into
 // an AtomicFile's temporary, renamed into place by close().
@@ -203,13 +195,13 @@ std::vector<const mcap::ChunkIndex*> whole_chunks(const Recording& recording, mc
 }  // namespace
 
 std::string RewriteReport::summary(const std::string& out) const {
-  std::string s = "wrote " + out + ": " + count_text(messages) + (messages == 1 ? " message" : " messages");
-  if (latched > 0) s += " (" + count_text(latched) + " latched from before the window)";
-  s += " on " + count_text(topics.size()) + (topics.size() == 1 ? " topic, " : " topics, ");
-  s += count_text(channels) + (channels == 1 ? " channel, " : " channels, ");
-  s += count_text(schemas) + (schemas == 1 ? " schema" : " schemas");
+  std::string s = "wrote " + out + ": " + group_digits(messages) + plural(messages, " message", " messages");
+  if (latched > 0) s += " (" + group_digits(latched) + " latched from before the window)";
+  s += " on " + group_digits(topics.size()) + plural(topics.size(), " topic, ", " topics, ");
+  s += group_digits(channels) + plural(channels, " channel, ", " channels, ");
+  s += group_digits(schemas) + plural(schemas, " schema", " schemas");
   if (copied_chunks > 0)
-    s += "; " + count_text(copied_chunks) + (copied_chunks == 1 ? " chunk" : " chunks") + " copied whole";
+    s += "; " + group_digits(copied_chunks) + plural(copied_chunks, " chunk", " chunks") + " copied whole";
   s += '\n';
   return s;
 }
