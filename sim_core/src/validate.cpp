@@ -25,8 +25,10 @@ Status World::validate() const {
   }
   if (shape_.size() != n) return broken("the shape index does not hold one entry per body");
   const bool rotations = uses_rotations();
-  if (rotations && (cos_.size() != n || sin_.size() != n)) return broken("cos/sin do not hold one entry per body");
-  if (wind_moments_.size() != winds_.size() * shapes_.size()) return broken("one wind moment per wind and shape");
+  if (rotations && (cos_.size() != n || sin_.size() != n))
+    return broken("cos/sin do not hold one entry per body");
+  if (wind_moments_.size() != winds_.size() * shapes_.size())
+    return broken("one wind moment per wind and shape");
   for (const Shape& s : shapes_) {
     if (s.count < 2 || s.first < 0 || static_cast<std::size_t>(s.first) + s.count > shape_vertices_.size())
       return broken("a shape's vertices out of range");
@@ -35,9 +37,11 @@ Status World::validate() const {
     const auto body = [b](const char* what) { return broken("body " + std::to_string(b) + ": " + what); };
     if (!positive_finite(mass_[b]) || !positive_finite(inertia_[b]) || !positive_finite(radius_[b]))
       return body("mass, inertia and radius must be finite and > 0");
-    if (shape_[b] < 0 || static_cast<std::size_t>(shape_[b]) >= shapes_.size()) return body("shape index out of range");
+    if (shape_[b] < 0 || static_cast<std::size_t>(shape_[b]) >= shapes_.size())
+      return body("shape index out of range");
     // sincos gives the bits of cos() and sin() (step.cpp): equality is exact, NaN aside.
-    if (rotations && !std::isnan(theta_[b]) && (cos_[b] != std::cos(theta_[b]) || sin_[b] != std::sin(theta_[b])))
+    if (rotations && !std::isnan(theta_[b]) &&
+        (cos_[b] != std::cos(theta_[b]) || sin_[b] != std::sin(theta_[b])))
       return body("cos/sin are not those of theta (state written without sync_rotations())");
   }
   for (std::size_t s = 0; s < springs_.size(); ++s) {
