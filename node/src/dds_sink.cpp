@@ -83,11 +83,16 @@ void Pacer::rebase(const World& world) {
   start_step_ = world.step_index() + 1;
 }
 
-void Pacer::wait(const World& world) const {
+std::optional<std::int64_t> Pacer::due_ns(const World& world) const {
   const std::int64_t next = world.step_index() + 1;
-  if (rate_ <= 0.0 || next % every_ != 0) return;
+  if (rate_ <= 0.0 || next % every_ != 0) return std::nullopt;
+  // (steps since the start) * dt of simulated time take that / rate of wall time.
   const double due = static_cast<double>(next - start_step_) * world.dt() / rate_;
-  sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
+  return start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9));
+}
+
+void Pacer::wait(const World& world) const {
+  if (const std::optional<std::int64_t> due = due_ns(world)) sleep_until(*due);
 }
 
 }  // namespace rbsim::node

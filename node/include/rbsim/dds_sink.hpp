@@ -71,6 +71,9 @@ class Pacer final : public Sink {
   // Before the boundary of the step after `world`'s: waits until that step is due (when it is
   // one that is published).
   void wait(const World& world) const;
+  // When the step after `world`'s is due (monotonic clock, ns), or nothing when it goes at once
+  // (rate 0) or is not published. wait() sleeps until this time.
+  std::optional<std::int64_t> due_ns(const World& world) const;
   // A live change of pace (a control command, between steps). The Driver then calls rebase(),
   // from which the new pace counts.
   void set_pace(double rate, std::int64_t publish_every) {
