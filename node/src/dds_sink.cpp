@@ -91,7 +91,7 @@ void Pacer::wait(const World& world) const {
   const std::int64_t next = world.step_index() + 1;
   if (rate_ <= 0.0 || next % every_ != 0) return;
   const double due = static_cast<double>(next - start_step_) * world.dt() / rate_;
-  sleep_until(start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9)));
+  sleep_until(start_ns_ + seconds_to_ns_clamped(due));
 }
 
 }  // namespace rbsim::node
