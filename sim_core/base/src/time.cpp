@@ -15,7 +15,7 @@ constexpr double kPastRange = 9223372036854775808.0;  // 2^63: the first ns coun
 
 Result<std::int64_t> seconds_to_ns(double seconds) {
   const double ns = std::round(seconds * 1e9);
-  if (!(ns >= 0.0 && ns < kPastRange)) {  // NaN fails both comparisons
+  if (!(seconds >= 0.0 && ns < kPastRange)) {  // NaN fails both comparisons
     char value[32];
     std::snprintf(value, sizeof value, "%g", seconds);
     return Error{std::string(value) +
