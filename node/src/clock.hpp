@@ -1,16 +1,12 @@
-// Monotonic time for pacing (node, replay), in ns.
+// Sleeping until a monotonic time for pacing (node, replay); the clock is base's monotonic_ns().
 #pragma once
 #include <time.h>
 
 #include <cstdint>
 
-namespace rbsim::node {
+#include "rbsim/time.hpp"
 
-inline std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+namespace rbsim::node {
 
 // Sleeps until `deadline_ns` (monotonic). A signal (Ctrl-C) ends the sleep early: callers look at
 // their stop flag afterwards.

@@ -18,6 +18,7 @@
 #include "rbsim/dds.hpp"
 #include "rbsim/rosout.hpp"
 #include "rbsim/security.hpp"
+#include "rbsim/time.hpp"
 #include "rbsim/type_hash.hpp"
 #include "topics.hpp"
 
@@ -240,7 +241,7 @@ Status Publisher::publish(std::span<const std::byte> cdr, bool (*stop)()) {
 Status Publisher::flush(double timeout_s, bool (*stop)()) {
   // In slices, so a stop request (a second Ctrl-C, or the first when a subscriber died) cuts the
   // wait to kStoppingFlush.
-  const auto timeout = static_cast<dds_duration_t>(timeout_s * 1e9);
+  const auto timeout = static_cast<dds_duration_t>(seconds_to_ns_clamped(timeout_s));
   constexpr dds_duration_t kStoppingFlush = DDS_SECS(1);
   dds_return_t rc = DDS_RETCODE_TIMEOUT;
   for (dds_duration_t waited = 0; rc == DDS_RETCODE_TIMEOUT && waited < timeout; waited += kWriteSlice) {
@@ -376,13 +377,6 @@ std::int32_t Subscription::matched() const {
   dds_subscription_matched_status_t st{};
   if (dds_get_subscription_matched_status(reader_, &st) < 0) return 0;
   return static_cast<std::int32_t>(st.current_count);
-}
-
-const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns) {
-  for (const msgs::TopicSpec& spec : msgs::topics()) {
-    if (name == spec.suffix || name == msgs::topic_name(spec, ns)) return &spec;
-  }
-  return nullptr;
 }
 
 }  // namespace rbsim::node

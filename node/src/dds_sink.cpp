@@ -88,7 +88,7 @@ std::optional<std::int64_t> Pacer::due_ns(const World& world) const {
   if (rate_ <= 0.0 || next % every_ != 0) return std::nullopt;
   // (steps since the start) * dt of simulated time take that / rate of wall time.
   const double due = static_cast<double>(next - start_step_) * world.dt() / rate_;
-  return start_ns_ + static_cast<std::int64_t>(std::llround(due * 1e9));
+  return start_ns_ + seconds_to_ns_clamped(due);
 }
 
 void Pacer::wait(const World& world) const {

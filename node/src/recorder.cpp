@@ -51,50 +51,15 @@ std::uint64_t Recorder::Gaps::lost(double dt) const {
 }
 
 namespace {
-// The topics `options` choose, in msgs::topics() order (rosbag2's rule, RecorderOptions).
+// The topics `options` choose, in msgs::topics() order (rosbag2's rule, RecorderOptions), by
+// msgs::select_topics().
 Result<std::vector<const msgs::TopicSpec*>> choose_topics(const RecorderOptions& options) {
-  auto named = [&](const std::vector<std::string>& names) -> Result<std::vector<const msgs::TopicSpec*>> {
-    std::vector<const msgs::TopicSpec*> out;
-    for (const std::string& name : names) {
-      const msgs::TopicSpec* spec = find_topic(name, options.ns);
-      if (spec == nullptr) {
-        std::string known;
-        for (const msgs::TopicSpec& s : msgs::topics())
-          known += (known.empty() ? "" : ", ") + msgs::topic_name(s, options.ns);
-        return Error{"unknown topic \"" + name + "\" (rbsim topics: " + known + ")"};
-      }
-      out.push_back(spec);
-    }
-    return out;
-  };
-  auto regex = [](const std::string& text, const char* option) -> Result<std::optional<std::regex>> {
-    if (text.empty()) return std::optional<std::regex>();
-    try {
-      return std::optional<std::regex>(std::regex(text, std::regex::ECMAScript));
-    } catch (const std::regex_error& e) {
-      return Error{std::string(option) + " \"" + text + "\": not a regular expression (" + e.what() + ")",
-                   ErrorCode::InvalidArgument};
-    }
-  };
-  auto include = named(options.topics);
-  auto exclude = named(options.exclude_topics);
-  auto match = regex(options.regex, "--regex");
-  auto unmatch = regex(options.exclude_regex, "--exclude-regex");
-  if (!include) return include.error();
-  if (!exclude) return exclude.error();
-  if (!match) return match.error();
-  if (!unmatch) return unmatch.error();
-  const bool all = options.topics.empty() && options.regex.empty();
+  const std::vector<msgs::TopicCandidate> candidates = msgs::topic_candidates(options.ns, /*events=*/true);
+  Result<std::vector<std::size_t>> chosen = msgs::select_topics(
+      {options.topics, options.regex, options.exclude_topics, options.exclude_regex}, candidates);
+  if (!chosen) return chosen.error();
   std::vector<const msgs::TopicSpec*> out;
-  for (const msgs::TopicSpec& spec : msgs::topics()) {
-    const std::string name = msgs::topic_name(spec, options.ns);
-    const auto in = [&spec](const std::vector<const msgs::TopicSpec*>& v) {
-      return std::find(v.begin(), v.end(), &spec) != v.end();
-    };
-    const bool chosen = all || in(include.value()) || (*match && std::regex_match(name, **match));
-    const bool dropped = in(exclude.value()) || (*unmatch && std::regex_match(name, **unmatch));
-    if (chosen && !dropped) out.push_back(&spec);
-  }
+  for (const std::size_t i : chosen.value()) out.push_back(candidates[i].spec);
   if (out.empty()) return Error{"the topic options choose no topic to record", ErrorCode::InvalidArgument};
   return out;
 }

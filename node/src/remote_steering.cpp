@@ -7,6 +7,7 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/relay.hpp"
+#include "rbsim/time.hpp"
 #include "service_set.hpp"
 
 namespace rbsim::node {
@@ -336,9 +337,8 @@ void RemoteSteering::send(Pending pending, std::vector<InFlight>& out) {
     pending.done(failed("node " + options_.node + ": " + seq.error().message));
     return;
   }
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                             std::chrono::duration<double>(options_.call_timeout_s));
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::nanoseconds(seconds_to_ns_clamped(options_.call_timeout_s));
   out.push_back(
       {std::move(pending.command), std::move(pending.done), request->client, seq.value(), deadline});
 }

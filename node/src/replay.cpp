@@ -129,28 +129,19 @@ Result<std::vector<Replay::Impl::Candidate>> Replay::Impl::candidates(
 
 Result<std::vector<Replay::Impl::Candidate>> Replay::Impl::choose(std::vector<Candidate> candidates) const {
   const std::string& path = options.path;
-  // --topics: every name must pick at least one recorded rbsim channel.
+  // --topics: every name must pick at least one recorded rbsim channel (msgs::select_topics()).
   if (!options.topics.empty()) {
-    std::vector<Candidate> chosen;
-    for (const std::string& name : options.topics) {
-      bool found = false;
-      for (const Candidate c : candidates) {
-        if (msgs::names_topic(name, c->channel->topic) || name == c->spec->suffix) {
-          found = true;
-          if (std::none_of(chosen.begin(), chosen.end(), [&](const Candidate x) { return x == c; })) {
-            chosen.push_back(c);
-          }
-        }
-      }
-      if (!found) {
-        std::string known;
-        for (const Candidate c : candidates) known += (known.empty() ? "" : ", ") + c->channel->topic;
-        return Error{"unknown topic \"" + name + "\": " + path + " has " + known};
-      }
-    }
-    std::sort(chosen.begin(), chosen.end(),
+    std::vector<msgs::TopicCandidate> named;
+    for (const Candidate c : candidates) named.push_back({c->channel->topic, c->spec});
+    msgs::TopicFilter filter;
+    filter.topics = options.topics;
+    Result<std::vector<std::size_t>> chosen = msgs::select_topics(filter, named);
+    if (!chosen) return Error{path + ": " + chosen.error().message};
+    std::vector<Candidate> kept;
+    for (const std::size_t i : chosen.value()) kept.push_back(candidates[i]);
+    std::sort(kept.begin(), kept.end(),
               [](const Candidate a, const Candidate b) { return a->channel->id < b->channel->id; });
-    candidates = std::move(chosen);
+    candidates = std::move(kept);
   }
   if (options.clock) {
     std::erase_if(candidates, [](const Candidate c) { return c->spec->id == msgs::TopicId::Clock; });
@@ -329,15 +320,13 @@ Result<std::optional<std::uint64_t>> Replay::Impl::seek_position(std::uint64_t s
 
 namespace {
 std::uint64_t seconds_ns(double s) {
-  return static_cast<std::uint64_t>(std::llround(std::max(0.0, s) * 1e9));
+  return static_cast<std::uint64_t>(seconds_to_ns_clamped(s));
 }
 }  // namespace
 
 std::uint64_t Replay::Impl::start_of(std::uint64_t first_log_time) const {
-  const double offset_ns = std::max(0.0, options.start_offset) * 1e9;
-  return offset_ns >= static_cast<double>(mcap::kMaxTime - first_log_time)
-             ? mcap::kMaxTime
-             : first_log_time + static_cast<std::uint64_t>(std::llround(offset_ns));
+  const std::uint64_t offset_ns = seconds_ns(options.start_offset);
+  return offset_ns >= mcap::kMaxTime - first_log_time ? mcap::kMaxTime : first_log_time + offset_ns;
 }
 
 Replay::Impl::End Replay::Impl::end_of(std::uint64_t start) const {
@@ -520,9 +509,7 @@ Result<bool> Replay::play(bool (*stop)(), const Tap* tap) {
   if (tap != nullptr && tap->pass) tap->pass();
   if (!im.delayed && im.options.delay > 0.0) {
     im.delayed = true;
-    if (!sleep_until_or_stop(monotonic_ns() + static_cast<std::int64_t>(std::llround(im.options.delay * 1e9)),
-                             stop))
-      return false;
+    if (!sleep_until_or_stop(monotonic_ns() + seconds_to_ns_clamped(im.options.delay), stop)) return false;
   }
   Impl::Pass pass(*this, im, stop, tap, im.start_of(first_log_time_));
   const auto latched_sent = [&pass](std::uint16_t ch, const mcap::Message& m) { pass.latched_sent(ch, m); };

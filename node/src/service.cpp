@@ -23,6 +23,7 @@
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
 #include "rbsim/cdr.hpp"
+#include "rbsim/time.hpp"
 
 namespace rbsim::node {
 
@@ -31,7 +32,7 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 dds_duration_t to_dds(double seconds) {
-  return static_cast<dds_duration_t>(std::max(0.0, seconds) * 1e9);
+  return static_cast<dds_duration_t>(seconds_to_ns_clamped(seconds));
 }
 
 // rmw_qos_profile_services_default as rmw_cyclonedds_cpp turns it into DDS QoS: reliable, volatile,

@@ -71,7 +71,7 @@ INSTANTIATE_TEST_SUITE_P(
         // --topics: an unknown name is named, with the valid ones; checked in the chosen namespace.
         UsageCase{{"run", "scene.xml", "--record", "x.mcap", "--topics", "body_states,tfs"},
                   "rbsim run: error: --topics",
-                  "unknown topic \"tfs\" (topics: scene, markers, body_states"},
+                  "unknown topic \"tfs\" (topics: /clock, /rbsim/body_states, /rbsim/energy"},
         UsageCase{{"run", "scene.xml", "--record", "x.mcap", "--namespace", "a", "--topics", "/rbsim/energy"},
                   "rbsim run: error: --topics",
                   "unknown topic \"/rbsim/energy\""},

@@ -14,6 +14,7 @@
 #include "rbsim/outputs.hpp"
 #include "rbsim/recorder.hpp"
 #include "rbsim/rosout.hpp"
+#include "rbsim/time.hpp"
 #include "validators.hpp"
 
 namespace rbsim::cli {
@@ -34,6 +35,14 @@ struct RecordArgs {
   std::optional<double> wrong_duration;
   node::NodeName node{"/", "rbsim_recorder"};  // as rosbag2's recorder names its node
 };
+
+// --max-file-duration, --snapshot-duration in ns (0 when not given), by base's one rule.
+Result<std::uint64_t> duration_ns(const std::optional<double>& seconds, const char* option) {
+  if (!seconds) return std::uint64_t{0};
+  const Result<std::int64_t> ns = seconds_to_ns(*seconds);
+  if (!ns) return Error{std::string(option) + ": " + ns.error().message};
+  return static_cast<std::uint64_t>(ns.value());
+}
 
 // SIGUSR1 asks a recorder in snapshot mode for a snapshot.
 std::atomic<int> g_snapshot{0};
@@ -62,10 +71,11 @@ std::optional<int> choose_outputs(RecordArgs& a, std::string& bag, std::vector<O
   a.rec.compression = codec.value();
   // OUT ending in .mcap is one file; any other path a rosbag2 bag directory, holding file 0.
   outputs = {{a.rec.path, "OUT"}};
-  if (a.max_file_duration)
-    a.rec.max_file_duration_ns = static_cast<std::uint64_t>(*a.max_file_duration * 1e9);
-  if (a.snapshot_duration)
-    a.rec.snapshot_duration_ns = static_cast<std::uint64_t>(*a.snapshot_duration * 1e9);
+  const Result<std::uint64_t> file_ns = duration_ns(a.max_file_duration, "--max-file-duration");
+  const Result<std::uint64_t> snapshot_ns = duration_ns(a.snapshot_duration, "--snapshot-duration");
+  if (!file_ns || !snapshot_ns) return fail("record", (file_ns ? snapshot_ns : file_ns).error().message, 2);
+  a.rec.max_file_duration_ns = file_ns.value();
+  a.rec.snapshot_duration_ns = snapshot_ns.value();
   if (log::is_bag_output(a.rec.path)) {
     bag = a.rec.path;
     outputs = log::bag_outputs(bag, "OUT");

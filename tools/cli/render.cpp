@@ -4,6 +4,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/counts.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/render.hpp"
@@ -59,7 +60,7 @@ int plot_command(const PlotArgs& a) {
     std::fprintf(stderr, "rbsim plot: error: invalid --size \"%s\" (expected WxH)\n", a.size.c_str());
     return 1;
   }
-  if (a.duration && render::is_recording(a.input)) {  // a recording plots what it holds
+  if (a.duration && log::is_recording(a.input)) {  // a recording plots what it holds
     std::fprintf(stderr,
                  "rbsim plot: error: --duration applies to a scene, not to a recording (%s)\n"
                  "Run 'rbsim plot --help' for usage.\n",

@@ -179,7 +179,4 @@ class Subscription {
   std::vector<Writer> writers_;
 };
 
-// Looks up a TopicSpec by ROS topic suffix ("body_states") or full name ("/rbsim/body_states").
-const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns);
-
 }  // namespace rbsim::node

@@ -54,6 +54,7 @@ struct SideInfo {
 
 struct Topic {
   std::string name;
+  const msgs::TopicSpec* spec = nullptr;  // of its first channel's type, when one of ours
   bool selected = true;
   SideInfo side[2];
   bool ready = false;
@@ -178,11 +179,12 @@ class Comparer {
     return msgs::topic_for_type(schema_name) == &msgs::topic(id);
   }
 
-  static bool any_names(const std::vector<std::string>& list, const std::string& topic) {
+  // --topics and --exclude-topics by msgs::selects_topic(), the rule of msgs::select_topics().
+  static bool any_names(const std::vector<std::string>& list, const msgs::TopicCandidate& topic) {
     return std::any_of(list.begin(), list.end(),
-                       [&](const std::string& n) { return msgs::names_topic(n, topic); });
+                       [&](const std::string& n) { return msgs::selects_topic(n, topic); });
   }
-  bool selected(const std::string& topic) const {
+  bool selected(const msgs::TopicCandidate& topic) const {
     if (any_names(o_.exclude_topics, topic)) return false;
     return o_.topics.empty() || any_names(o_.topics, topic);
   }
@@ -211,9 +213,11 @@ class Comparer {
     if (s.channel_topic.count(channel.id) != 0) return Ok{};  // the summary repeats channels
     auto [it, fresh] = topic_index_.try_emplace(channel.topic, topics_.size());
     if (fresh) {
+      const auto schema = s.schemas.find(channel.schema_id);
       topics_.emplace_back();
       topics_.back().name = channel.topic;
-      topics_.back().selected = selected(channel.topic);
+      topics_.back().spec = schema == s.schemas.end() ? nullptr : msgs::topic_for_type(schema->second.name);
+      topics_.back().selected = selected({channel.topic, topics_.back().spec});
     }
     s.channel_topic[channel.id] = it->second;
     Topic& t = topics_[it->second];
@@ -530,14 +534,13 @@ class Comparer {
   }
 
   Result<CheckReport> finish() {
-    for (const std::string& name : o_.topics) {
-      if (std::none_of(topics_.begin(), topics_.end(),
-                       [&](const Topic& t) { return msgs::names_topic(name, t.name); })) {
-        std::string known;
-        for (const Topic& t : topics_) known += (known.empty() ? "" : ", ") + t.name;
-        return Error{"--topics: " + name + " is in neither log (topics: " + (known.empty() ? "none" : known) +
-                     ")"};
-      }
+    {  // every --topics name selects a topic of either log
+      std::vector<msgs::TopicCandidate> known;
+      for (const Topic& t : topics_) known.push_back({t.name, t.spec});
+      msgs::TopicFilter filter;
+      filter.topics = o_.topics;
+      if (Result<std::vector<std::size_t>> chosen = msgs::select_topics(filter, known); !chosen)
+        return chosen.error();
     }
     std::vector<std::size_t> order(topics_.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;

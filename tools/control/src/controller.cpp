@@ -7,6 +7,7 @@
 
 #include "rbsim/assert.hpp"
 #include "rbsim/control.hpp"
+#include "rbsim/time.hpp"
 
 namespace rbsim::control {
 
@@ -295,8 +296,7 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       resume_at_.reset();
       if (command.pause_seconds > 0.0) {
         resume_at_ = std::chrono::steady_clock::now() +
-                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                         std::chrono::duration<double>(command.pause_seconds));
+                     std::chrono::nanoseconds(seconds_to_ns_clamped(command.pause_seconds));
         r.message += " for " + to_string(ParameterValue::of_double(command.pause_seconds)) + " s";
       }
       if (!settings_.paused) {

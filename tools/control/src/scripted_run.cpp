@@ -3,21 +3,17 @@
 #include <string>
 #include <utility>
 
+#include "rbsim/bag.hpp"
 #include "rbsim/command_script.hpp"
 #include "rbsim/counts.hpp"
 #include "rbsim/recording.hpp"
 
 namespace rbsim::control {
 
-bool is_recording_path(const std::string& path) {
-  std::error_code ec;
-  return path.ends_with(".mcap") || std::filesystem::is_directory(path, ec);  // a file or a bag directory
-}
-
 Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,
                                                    std::int64_t steps) {
   std::vector<ScriptedCommand> out;
-  if (!is_recording_path(path)) {
+  if (!log::is_recording(path)) {
     Result<std::vector<Command>> script = load_command_script(path, scene, steps);
     if (!script) return script.error();
     for (Command& c : script.value()) {
@@ -80,7 +76,7 @@ Status ScriptedRun::finish(const std::string& path) {
   return Error{path + ": " + std::to_string(mismatches_.size()) +
                plural(mismatches_.size(), " command", " commands") + " (of " +
                std::to_string(counted.commands) + ") did not apply as " +
-               (is_recording_path(path) ? "recorded" : "written")};
+               (log::is_recording(path) ? "recorded" : "written")};
 }
 
 }  // namespace rbsim::control

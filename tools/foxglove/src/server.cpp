@@ -25,17 +25,13 @@
 #include "hosted.hpp"
 #include "parameter_requests.hpp"
 #include "rbsim/foxglove.hpp"
+#include "rbsim/time.hpp"
 #include "services.hpp"
 #include "transport.hpp"
 
 namespace rbsim::foxglove {
 
 namespace {
-std::int64_t monotonic_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 constexpr int kTickMs = 10;  // the pump also runs this often: the stall check, websocketpp's drain
 }  // namespace
 
@@ -285,7 +281,7 @@ struct Server::Impl {
     const std::size_t buffered = transport->buffered(c.connection);
     c.in_flight = buffered;
     const bool waiting = buffered > 0 || !c.queue.empty();
-    if (waiting && static_cast<double>(now - c.last_progress_ns) > options.stall_timeout_s * 1e9) {
+    if (waiting && now - c.last_progress_ns > seconds_to_ns_clamped(options.stall_timeout_s)) {
       c.dropping = true;
       ++totals.disconnected;
       transport->drop(c.connection);
@@ -659,7 +655,7 @@ std::size_t Server::client_count() const {
 
 bool Server::flush(double timeout_s) {
   Impl& im = *impl_;
-  const std::int64_t deadline = monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  const std::int64_t deadline = monotonic_ns() + seconds_to_ns_clamped(timeout_s);
   while (true) {
     bool pending = false;
     {

@@ -9,6 +9,7 @@
 
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/mcap_records.hpp"
 #include "rbsim/mcap_tools.hpp"
 
 namespace rbsim::log {
@@ -30,10 +31,24 @@ void emit_nanoseconds(YAML::Emitter& y, const char* key, const char* unit, std::
 
 }  // namespace
 
-bool is_bag_output(std::string_view path) {
+PathKind path_kind(std::string_view path) {
   std::error_code ec;
-  return !(path.size() >= 5 && path.substr(path.size() - 5) == ".mcap") &&
-         !fs::is_regular_file(fs::path(path), ec);
+  const fs::file_status status = fs::status(fs::path(path), ec);
+  if (path.ends_with(".mcap")) return PathKind::McapFile;
+  if (fs::is_directory(status)) return PathKind::BagDirectory;
+  if (!fs::exists(status)) return PathKind::Missing;
+  Result<std::unique_ptr<mcap::ByteSource>> source = mcap::open_file_source(std::string(path));
+  return source.ok() && mcap::check_magic(*source.value(), 0).ok() ? PathKind::McapFile : PathKind::OtherFile;
+}
+
+bool is_recording(std::string_view path) {
+  const PathKind kind = path_kind(path);
+  return kind == PathKind::McapFile || kind == PathKind::BagDirectory;
+}
+
+bool is_bag_output(std::string_view path) {
+  const PathKind kind = path_kind(path);
+  return kind == PathKind::BagDirectory || kind == PathKind::Missing;
 }
 
 std::string bag_file(const std::string& dir, std::size_t index) {

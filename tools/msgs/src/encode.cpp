@@ -6,6 +6,7 @@
 #include "cdr.hpp"
 #include "rbsim/assert.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/time.hpp"
 
 namespace rbsim::msgs {
 
@@ -158,8 +159,7 @@ std::vector<std::uint32_t> triangulate(std::span<const Vec2> p) {
 }
 
 std::uint64_t sim_time_ns(std::int64_t step, double dt) {
-  const double ns = std::round(static_cast<double>(step) * dt * 1e9);
-  return ns <= 0.0 ? 0 : static_cast<std::uint64_t>(ns);
+  return static_cast<std::uint64_t>(seconds_to_ns_clamped(static_cast<double>(step) * dt));
 }
 
 std::uint64_t sim_time_ns(const World& world) {

@@ -107,32 +107,22 @@ TopicSet default_topics() {
 }
 
 Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns) {
-  TopicSet set;
-  set.set(static_cast<std::size_t>(TopicId::Scene));
-  bool any = false;
+  TopicFilter filter;
   while (!list.empty()) {
     const auto comma = list.find(',');
     std::string_view name = list.substr(0, comma);
     list = comma == std::string_view::npos ? std::string_view() : list.substr(comma + 1);
     while (!name.empty() && name.front() == ' ') name.remove_prefix(1);
     while (!name.empty() && name.back() == ' ') name.remove_suffix(1);
-    if (name.empty()) continue;
-    any = true;
-    const TopicSpec* found = nullptr;
-    for (const TopicSpec& spec : kTopics) {
-      if (spec.event) continue;
-      if (names_topic(name, topic_name(spec, ns)) || name == spec.suffix) found = &spec;
-    }
-    if (found == nullptr) {
-      std::string known;
-      for (const TopicSpec& spec : kTopics) {
-        if (!spec.event) known += (known.empty() ? "" : ", ") + std::string(spec.suffix);
-      }
-      return Error{"unknown topic \"" + std::string(name) + "\" (topics: " + known + ")"};
-    }
-    set.set(static_cast<std::size_t>(found->id));
+    if (!name.empty()) filter.topics.emplace_back(name);
   }
-  if (!any) return Error{"no topic given"};
+  if (filter.topics.empty()) return Error{"no topic given"};
+  const std::vector<TopicCandidate> candidates = topic_candidates(ns, /*events=*/false);
+  Result<std::vector<std::size_t>> chosen = select_topics(filter, candidates);
+  if (!chosen) return chosen.error();
+  TopicSet set;
+  set.set(static_cast<std::size_t>(TopicId::Scene));
+  for (const std::size_t i : chosen.value()) set.set(static_cast<std::size_t>(candidates[i].spec->id));
   return set;
 }
 

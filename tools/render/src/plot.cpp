@@ -12,6 +12,7 @@
 
 #include "process.hpp"
 #include "rbsim/atomic_file.hpp"
+#include "rbsim/bag.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/render.hpp"
 #include "rbsim/run.hpp"
@@ -93,7 +94,7 @@ Result<std::vector<Sample>> samples_from_log(const std::string& path) {
 
 Status plot(const std::string& input, const PlotOptions& o) {
   Result<std::vector<Sample>> samples =
-      is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
+      log::is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
   if (!samples) return samples.error();
 
   AtomicFile png;  // gnuplot writes it

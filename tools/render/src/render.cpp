@@ -153,13 +153,6 @@ class FrameSink final : public Sink {
 
 }  // namespace
 
-bool is_recording(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return log::recording_files(path).ok();  // a rosbag2 bag
-  Result<std::unique_ptr<mcap::ByteSource>> source = mcap::open_file_source(path);
-  return source.ok() && mcap::check_magic(*source.value(), 0).ok();
-}
-
 namespace detail {
 Result<int> run_process(const std::vector<std::string>& args) {
   std::vector<char*> argv;
@@ -185,7 +178,7 @@ std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, do
 }
 
 Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
-  if (is_recording(input)) {
+  if (log::is_recording(input)) {
     FrameWriter frames(o.out_dir, o.width, o.height, o.fps, o.overwrite);
     std::vector<Pose> poses;
     log::RecordingOptions ro;

@@ -47,11 +47,11 @@ struct ScriptedCommand {
   bool expect_success = true;
   std::string origin;  // "steer.yaml:3", "live.mcap: command 4"
 };
-// The commands of `path`: a script (above), or a recording (a path ending in .mcap or a bag directory: its
+// The commands of `path`: a script (above), or a recording (log::is_recording: an MCAP file or a bag
+// directory: its
 // /<ns>/commands, rbsim/recording.hpp's read_commands, which refuses one that lost a command).
 [[nodiscard]] Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,
                                                                  std::int64_t steps);
-bool is_recording_path(const std::string& path);
 
 // An offline run steered by loaded commands (rbsim run --commands, rbsim::testing::RecordScene):
 // the Controller for the Driver (DriverOptions::control), every command submitted, each applied

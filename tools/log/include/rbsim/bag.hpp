@@ -20,7 +20,19 @@ inline constexpr std::string_view kBagMetadataFile = "metadata.yaml";
 // The rosbag2 metadata version Jazzy writes (QoS policies by name).
 inline constexpr int kBagMetadataVersion = 9;
 
-// True when an output path names a bag directory (not ending in ".mcap", not an existing file).
+// What a path names, by the one rule of every command that takes a recording, a bag or a scene
+// (render and plot's input, run --commands, run --record's and record's OUT):
+enum class PathKind {
+  McapFile,      // any path ending in ".mcap", or an existing file starting with MCAP's magic
+  BagDirectory,  // any other existing directory: a rosbag2 bag (its metadata.yaml lists its files)
+  OtherFile,     // anything else that exists: a scene, a command script
+  Missing,       // nothing there yet (as an output: a bag directory to create)
+};
+PathKind path_kind(std::string_view path);
+// An input that is a recording rather than a scene or a script: an MCAP file or a bag directory.
+bool is_recording(std::string_view path);
+// An output that is a bag directory: an existing directory, or a new path not ending in ".mcap"
+// (an existing file stays one file: a script's temporary, replaced with --overwrite).
 bool is_bag_output(std::string_view path);
 // The path of file `index` of bag `dir`: "runs/bag" -> "runs/bag/bag_0.mcap".
 std::string bag_file(const std::string& dir, std::size_t index);

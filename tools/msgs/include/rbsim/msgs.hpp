@@ -80,11 +80,46 @@ using TopicSet = std::bitset<kTopicCount>;
 // What a run publishes and records unless told otherwise: everything but the PoseArray (poses),
 // which /tf replaces for viewers.
 TopicSet default_topics();
-// A comma-separated --topics list: each name as names_topic() understands it against the topic's
-// name in namespace `ns`, or its bare suffix ("body_states", "/rbsim/body_states", "tf", "/tf",
-// "rbsim/markers"). The scene description is always included (every reader needs it).
-// Fails on an empty list or an unknown name, naming it and listing the valid ones.
+// A comma-separated --topics list of the topics a World publishes (no event topic): each name as
+// select_topics() takes it against the topics' names in namespace `ns` ("body_states",
+// "/rbsim/body_states", "tf", "/tf", "rbsim/markers"). The scene description is always included
+// (every reader needs it). Fails on an empty list ("no topic given") or an unknown name
+// (unknown_topic(), listing the valid names).
 Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns = "rbsim");
+
+// ---------------------------------------------------------------------------------------------
+// Selecting topics by name or pattern: the one rule of every command's --topics, --exclude-topics,
+// --regex and --exclude-regex (run, node, record, replay, log cat, log filter, check, Python's
+// and rbsim::testing's topic lists), as MCAP's topicFilter and rosbag2's topic_filter are one.
+
+// A topic a selection chooses from: its name, and its TopicSpec when its type is one of ours.
+struct TopicCandidate {
+  std::string name;
+  const TopicSpec* spec = nullptr;
+};
+// Our topics in namespace `ns` as candidates, in topics() order; the event topic (commands) only
+// when `events`.
+std::vector<TopicCandidate> topic_candidates(std::string_view ns, bool events);
+// Whether a name given on a command line selects `topic`: names_topic() against its name ("/rbsim/
+// body_states", "rbsim/body_states", "body_states"), or, for one of our types, the topic's suffix
+// ("body_states" selects a BodyStates channel recorded under any name).
+bool selects_topic(std::string_view requested, const TopicCandidate& topic);
+// What to select. Nothing to keep (no names, no regex) keeps every topic.
+struct TopicFilter {
+  std::vector<std::string> topics;          // keep the topics these name (selects_topic())
+  std::string regex;                        // and those whose whole name this matches (ECMAScript)
+  std::vector<std::string> exclude_topics;  // but never the topics these name
+  std::string exclude_regex;                // nor those whose whole name this matches
+};
+// The candidates `filter` selects, as indices into `candidates`, in their order. Empty names are
+// skipped. Fails on a name of `topics` or `exclude_topics` that selects no candidate
+// (unknown_topic()), or on a pattern that is not a regular expression ("--regex \"(\": not a
+// regular expression (...)", ErrorCode::InvalidArgument).
+Result<std::vector<std::size_t>> select_topics(const TopicFilter& filter,
+                                               std::span<const TopicCandidate> candidates);
+// The one wording of a name that selects no topic: unknown topic "/rbsim/nope" (topics:
+// /rbsim/a, /rbsim/b), the candidates' names sorted, each once ("(topics: none)" without any).
+Error unknown_topic(std::string_view requested, std::span<const TopicCandidate> candidates);
 // The topics of a set in topics() order.
 std::vector<TopicId> topic_ids(const TopicSet& set);
 // DDS names per ROS 2 conventions: "rt/rbsim/body_states", "rbsim_msgs::msg::dds_::BodyStates_".
@@ -131,7 +166,8 @@ struct Time {
   std::int32_t sec = 0;
   std::uint32_t nanosec = 0;
 };
-// Simulated time of the world's current step, t = step * dt, rounded to the nanosecond.
+// Simulated time of the world's current step, t = step * dt, rounded to the nanosecond (base's
+// seconds_to_ns_clamped()).
 Time sim_time(const World& world);
 std::uint64_t sim_time_ns(const World& world);
 // The same for step `step` of a world stepping `dt` (t = step * dt, as World::time()).

@@ -144,9 +144,6 @@ struct PlotOptions {
 };
 [[nodiscard]] Status plot(const std::string& input, const PlotOptions& options);
 
-// Whether `path` is a recording (an MCAP file, by its magic, or a rosbag2 bag directory) rather than a scene.
-bool is_recording(const std::string& path);
-
 // Parses "1280x720".
 bool parse_size(const std::string& text, int& width, int& height);
 
