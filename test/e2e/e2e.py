@@ -1948,33 +1948,40 @@ def case_soak(ctx):
             os.remove(path)
 
 
+# Every case, in the order of their CTest entries (an entry's --index is its place here).
 CASES = {
     "node_record": case_node_record,
     "late_recorder": case_late_recorder,
     "replay_roundtrip": case_replay_roundtrip,
     "replay_options": case_replay_options,
-    "player": case_player,
     "subscribers_come_and_go": case_subscribers_come_and_go,
     "python_subscriber": case_python_subscriber,
     "netns": case_netns,
     "netns_link_flap": case_netns_link_flap,
-    "security": case_security,
     "bad_input": case_bad_input,
+    "record_disk_full": case_record_disk_full,
+    "record_sigkill": case_record_sigkill,
+    "soak": case_soak,
     "ros_env": case_ros_env,
     "ros_graph": case_ros_graph,
-    "record_disk_full": case_record_disk_full,
-    "disk_full": case_disk_full,
     "record_bag": case_record_bag,
     "record_bag_sigkill": case_record_bag_sigkill,
     "record_snapshot": case_record_snapshot,
+    "player": case_player,
     "record_services": case_record_services,
-    "record_sigkill": case_record_sigkill,
-    "soak": case_soak,
+    "security": case_security,
+    "disk_full": case_disk_full,
 }
 
 
 def main():
+    # The one list of cases: test/e2e/CMakeLists.txt reads it at configure time (one CTest entry
+    # e2e.<case> each, --index its place in this list); --list needs no venv and no other option.
+    if sys.argv[1:] == ["--list"]:
+        print("\n".join(CASES))
+        return 0
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--list", action="store_true", help="print the case names, one a line, and exit")
     ap.add_argument("--case", required=True, choices=sorted(CASES))
     ap.add_argument("--index", type=int, required=True, help="test index (part of the DDS domain id)")
     ap.add_argument("--rbsim", required=True)
