@@ -1849,19 +1849,26 @@ def case_record_snapshot(ctx):
     # An observer (a plain recorder, small chunks) shows how far the node got: a snapshot recorder
     # writes nothing until asked. The node waits for both.
     seen = ctx.path("observer.mcap")
-    obs = ctx.rb("record-observer", *record_args(ctx, seen, "--chunk-size", 1024, "--wall-duration", 60,
-                                                            "--node-name", "rbsim_observer"))
-    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", 5, "--wait-for-subscribers", 2))
+    obs = ctx.rb("record-observer", *record_args(ctx, seen, "--chunk-size", 1024, "--wall-duration", 90,
+                                                 "--node-name", "rbsim_observer"))
+    # Long enough for both snapshots on a busy machine; stopped with SIGINT after them.
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", 60, "--wait-for-subscribers", 2))
     # Its SIGUSR1 handler is in place once it says it records (before, SIGUSR1 would kill it).
     rec.wait_for_text("rbsim record: recording", 20, stream="stderr")
     # More than the second a snapshot keeps has gone out (not a time: discovery can take seconds).
     wait_recorded(ctx, obs, seen, lambda got: recorded_span(got) >= 1.3, 60, "1.3 s of body states")
     ctx.check(not any(f.endswith(".mcap") for f in os.listdir(bag)), "snapshot mode wrote a file before a snapshot")
     for i in range(2):
+        if i > 0:  # a snapshot takes what it kept: 1.3 s more published since (seen by the observer)
+            wait_recorded(ctx, obs, seen, lambda got: max((m[1] for m in got if m[0].endswith("/body_states")),
+                                                          default=0) >= taken + 1_300_000_000,
+                          60, "1.3 s of body states after the first snapshot")
         rec.signal(signal.SIGUSR1)
-        rec.wait_for_text(f"written to {bag}/snap_{i}.mcap", 10, stream="stderr")
-        time.sleep(1.2)
-    exited_ok(ctx, node, 60)
+        rec.wait_for_text(f"written to {bag}/snap_{i}.mcap", 30, stream="stderr")
+        taken = time.time_ns()
+    ctx.require(node.alive(), f"the node ended before the snapshots were taken\n{node.output()}")
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 30)
     rec.signal(signal.SIGINT)
     exited_ok(ctx, rec, 30)
     obs.signal(signal.SIGINT)
@@ -1892,8 +1899,9 @@ def case_record_services(ctx):
     scene = ctx.scene("chain.xml")
     bag = ctx.path("bag")
     names = ("pause", "resume", "is_paused", "split_bagfile", "snapshot")
-    rec = ctx.rb("record", *record_args(ctx, bag, "--wall-duration", 60, "--chunk-size", 1024))
-    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", 4, "--wait-for-subscribers", 1))
+    rec = ctx.rb("record", *record_args(ctx, bag, "--wall-duration", 90, "--chunk-size", 1024))
+    # Long enough for every call on a busy machine; stopped with SIGINT after them.
+    node = ctx.rb("node", *node_args(ctx, scene, "--rate", 1, "--duration", 60, "--wait-for-subscribers", 1))
     client = Player(ctx.domain, "/rbsim_recorder", "file://" + ctx.loopback_xml, names=names)
     ctx.require(client.wait_matched(20), "the Python client did not match the recorder's five services in 20 s")
 
@@ -1913,7 +1921,12 @@ def case_record_services(ctx):
     ctx.check(not call("is_paused").paused, "is_paused true after resume")
     call("split_bagfile")
     ctx.check(not call("snapshot").success, "snapshot succeeded outside snapshot mode")
-    exited_ok(ctx, node, 60)
+    # Steps recorded after the split, in its new file.
+    wait_recorded(ctx, rec, os.path.join(bag, "bag_1.mcap"), lambda got: per_topic(got).get("body_states", 0) >= 100,
+                  60, "100 body states after the split")
+    ctx.require(node.alive(), f"the node ended before the calls were done\n{node.output()}")
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 30)
     rec.signal(signal.SIGINT)
     exited_ok(ctx, rec, 30)
     meta = bag_metadata(bag)
@@ -1937,7 +1950,7 @@ def case_record_services(ctx):
     rec = ctx.rb("record-snap", *record_args(ctx, snap, "--snapshot-duration", 1, "--wall-duration", 60))
     seen = ctx.path("observer.mcap")  # how far the node got: the snapshot recorder writes nothing yet
     obs = ctx.rb("record-observer", *record_args(ctx, seen, "--chunk-size", 1024, "--wall-duration", 60,
-                                                            "--node-name", "rbsim_observer"))
+                                                 "--node-name", "rbsim_observer"))
     node = ctx.rb("node-snap", *node_args(ctx, scene, "--rate", 1, "--duration", 3, "--wait-for-subscribers", 2))
     ctx.require(client.wait_matched(20), "no match with the snapshot recorder's services")
     wait_recorded(ctx, obs, seen, lambda got: recorded_span(got) >= 1.3, 60, "1.3 s of body states")
