@@ -47,6 +47,20 @@ CommandResult wait(std::future<CommandResult>& f) {
   return f.get();
 }
 
+// Waits for a paused loop that carries out a `step N` to reach step `want`, not for a time: a pause
+// is answered "already paused" at the boundary it is applied at and leaves the stepping alone, so
+// it is probed (at most 2,000 times, 1 ms apart) until the answer names a step >= `want`.
+CommandResult paused_at(Controller& controller, std::int64_t want) {
+  CommandResult r;
+  for (int i = 0; i < 2000; ++i) {
+    std::future<CommandResult> probe = controller.submit(simple(Command::kNextStep, CommandKind::Pause));
+    r = wait(probe);
+    if (r.step >= want) break;
+    std::this_thread::sleep_for(1ms);
+  }
+  return r;
+}
+
 void expect_same_runs(const std::vector<Snapshot>& a, const std::vector<Snapshot>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -214,9 +228,7 @@ TEST(ControllerPause, FromAnotherThreadStepNAdvancesExactlyNSteps) {
   const CommandResult stepped = wait(step);
   ASSERT_TRUE(stepped.successful) << stepped.message;
   EXPECT_EQ(stepped.step, 0);
-  std::this_thread::sleep_for(50ms);  // the loop idles at step 7
-  std::future<CommandResult> probe = controller.submit(simple(Command::kNextStep, CommandKind::Pause));
-  const CommandResult probed = wait(probe);
+  const CommandResult probed = paused_at(controller, 7);  // the loop idles at step 7, not beyond
   EXPECT_EQ(probed.step, 7) << probed.message;
   EXPECT_NE(probed.message.find("already paused"), std::string::npos);
   std::future<CommandResult> running_step =
@@ -334,7 +346,7 @@ TEST(ControllerCommands, ForABoundaryThatHasPassedFail) {
   AsyncRun running(scene, kSteps, controller);
   std::future<CommandResult> step = controller.submit(simple(Command::kNextStep, CommandKind::Step, 10));
   ASSERT_TRUE(wait(step).successful);
-  std::this_thread::sleep_for(20ms);
+  ASSERT_EQ(paused_at(controller, 10).step, 10);  // step 3 has passed
   std::future<CommandResult> late = controller.submit(set(3, {{"rate", V::of_double(1.0)}}));
   const CommandResult r = wait(late);
   EXPECT_FALSE(r.successful);

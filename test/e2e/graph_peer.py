@@ -104,20 +104,35 @@ def main() -> int:
         if out["entry"] and out["log"]:
             break
         time.sleep(0.05)
-    if out["entry"]:
-        # Discovery of the participant's endpoints, and any later entry (the node has created all its
-        # endpoints before it prints its start line, but samples of two topics may arrive in any order).
-        time.sleep(0.5)
-        take_entries()
-        key = out["entry"]["participant"][:32]
+
+    def read_discovery(key):
         for p in parts.read(N=256):
             if p.key.hex == key:
                 ud = p.qos[Policy.Userdata]
                 out["user_data"] = ud.data.decode("latin-1") if ud else ""
         for reader, kind in ((pubs, "writers"), (subs, "readers")):
+            out[kind] = {}
             for e in reader.read(N=1024):
                 if e.participant_key.hex == key:
                     out[kind][e.key.hex] = e.topic_name
+
+    def agree():  # what the entry lists is what discovery reports (but the entry's own writer)
+        e = out["entry"]
+        listed_w, listed_r = sorted(g[:32] for g in e["writers"]), sorted(g[:32] for g in e["readers"])
+        found_w = sorted(k for k, t in out["writers"].items() if t != "ros_discovery_info")
+        return out["user_data"] is not None and listed_w == found_w and listed_r == sorted(out["readers"])
+
+    if out["entry"]:
+        # Discovery of the participant's endpoints, and any later entry (the node has created all its
+        # endpoints before it prints its start line, but samples of two topics may arrive in any
+        # order): read until the two agree (not for a time: on a busy machine discovery can take
+        # seconds), within the same deadline; what was read last is printed either way.
+        while True:
+            take_entries()
+            read_discovery(out["entry"]["participant"][:32])
+            if agree() or time.monotonic() >= deadline:
+                break
+            time.sleep(0.05)
     print(json.dumps(out), flush=True)
     return 0 if out["entry"] and out["log"] else 2
 

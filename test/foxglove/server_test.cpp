@@ -92,6 +92,23 @@ bool eventually(P pred, std::chrono::milliseconds limit = std::chrono::milliseco
   return pred();
 }
 
+// Sends `subscribe` and returns once the server has taken it in: it handles a client's frames in
+// order, so its answer to a frame sent after (an unsubscribe of an id never given: a status) says
+// the subscription is in place. Reads at most 16 frames (serverInfo and advertise included), each
+// within the client's 5 s timeout.
+::testing::AssertionResult subscribed(WsClient& c, const std::string& subscribe) {
+  if (!c.send_text(subscribe) || !c.send_text(R"({"op":"unsubscribe","subscriptionIds":[987654321]})"))
+    return ::testing::AssertionFailure() << "cannot send";
+  for (int i = 0; i < 16; ++i) {
+    auto f = c.read();
+    if (!f) return ::testing::AssertionFailure() << "no status reply to the probe after " << subscribe;
+    if (f->opcode != 1) continue;
+    const Json j = Json::parse(f->data, nullptr, false);
+    if (j.is_object() && j.value("op", "") == "status") return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "16 frames without the probe's status reply";
+}
+
 TEST(FoxgloveServer, AnswersEitherSubprotocolWithServerInfoAndAdvertise) {
   auto server = start();
   ASSERT_TRUE(server);
@@ -265,12 +282,13 @@ TEST(FoxgloveServer, AStalledClientSlowsNeitherTheProducerNorOthersAndIsDisconne
   ASSERT_TRUE(server);
   WsClient stalled, good;
   // The staller subscribes and never reads again; its small window fills at once.
+  // Both subscriptions in place before the first publish (the staller reads only up to the
+  // answer to its probe).
   ASSERT_EQ(stalled.connect(server->port(), {"foxglove.websocket.v1"}, 4096), 101);
-  ASSERT_TRUE(stalled.send_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":2}]})"));
+  ASSERT_TRUE(subscribed(stalled, R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":2}]})"));
   handshake(good, server->port());
-  ASSERT_TRUE(good.send_text(R"({"op":"subscribe","subscriptions":[{"id":2,"channelId":2}]})"));
-  ASSERT_TRUE(eventually([&] { return server->client_count() == 2; }));
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(subscribed(good, R"({"op":"subscribe","subscriptions":[{"id":2,"channelId":2}]})"));
+  ASSERT_EQ(server->client_count(), 2u);
 
   // The good client reads on its own thread, as fast as it can.
   constexpr int kMessages = 400;
@@ -323,9 +341,8 @@ TEST(FoxgloveServer, FlushWaitsForAReaderButNotForeverForAStaller) {
   // A client that reads nothing: flush gives up at its timeout.
   WsClient staller;
   ASSERT_EQ(staller.connect(server->port(), {"foxglove.sdk.v1"}, 4096), 101);
-  ASSERT_TRUE(staller.send_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":2}]})"));
-  ASSERT_TRUE(eventually([&] { return server->client_count() == 2; }));
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(subscribed(staller, R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":2}]})"));
+  ASSERT_EQ(server->client_count(), 2u);
   for (int i = 0; i < 200; ++i) server->publish(2, static_cast<std::uint64_t>(i), payload);
   const auto t0 = Clock::now();
   EXPECT_FALSE(server->flush(0.3));

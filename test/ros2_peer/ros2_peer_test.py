@@ -191,8 +191,21 @@ def case_parameters(ctx):
         types = {m["types"]: m["type"] for m in peer_json(ctx, net, "types", "params", node_name, "types", "dt",
                                                           "bodies", "paused", "scene")}
         ctx.check(types == {"dt": 3, "bodies": 2, "paused": 1, "scene": 4}, f"get_parameter_types: {types}")
-        events = net.peer("events", "events", "forces.0.fy", "--timeout", 60)
-        time.sleep(1.0)  # the events subscription matches first
+        events = net.peer("events", "events", "forces.0.fy", "--timeout", 120)
+        # The events subscription matched before the set it is to see: another parameter
+        # (forces.0.fx, set back to 0 after) is set until its event reaches the subscriber. Not a
+        # time: on a busy machine matching can take seconds. At most 10 tries of 2 s each.
+        for k in range(10):
+            peer_json(ctx, net, f"probe-{k}", "params", node_name, "set", f"forces.0.fx={0.125 * (k + 1)}")
+            deadline = time.monotonic() + 2.0
+            while time.monotonic() < deadline and events.alive() and \
+                    not any(m.get("event") == "forces.0.fx" for m in lines(events)):
+                time.sleep(0.05)
+            if any(m.get("event") == "forces.0.fx" for m in lines(events)):
+                break
+        else:
+            ctx.require(False, f"/parameter_events: no event reached the subscriber after 10 sets\n{events.output()}")
+        peer_json(ctx, net, "probe-back", "params", node_name, "set", "forces.0.fx=0.0")
         sets = peer_json(ctx, net, "set", "params", node_name, "set", "forces.0.fy=-3.7", "rate=2")
         ctx.check([m.get("set") for m in sets] == [True, False],
                   f"set_parameters forces.0.fy=-3.7 (double) and rate=2 (integer for a double): {sets}")

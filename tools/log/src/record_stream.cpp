@@ -1,6 +1,8 @@
 // The reader thread of a streamed recording (rbsim/record_stream.hpp).
 #include "rbsim/record_stream.hpp"
 
+#include <string>
+
 #include "rbsim/bag.hpp"
 #include "rbsim/mcap_tools.hpp"
 
@@ -11,6 +13,8 @@ Status RecordStream::open(const std::string& given) {
   if (!files) return files.error();
   files_ = std::move(files.value());
   path_ = files_.front();
+  // Missing, a directory or empty: worded as Recording words it.
+  if (std::string e = mcap_tools::unreadable(path_); !e.empty()) return Error{path_ + ": " + e};
   if (const Status st = reader_.open(path_); !st.ok())
     return Error{path_ + ": " + mcap_tools::read_error(st.error())};
   thread_ = std::thread([this] { run(); });
@@ -46,7 +50,11 @@ bool RecordStream::next_file() {
   ++file_;
   std::lock_guard<std::mutex> lock(mu_);
   path_ = files_[file_];
-  if (Status st = reader_.open(path_); !st.ok()) failure_ = st;
+  if (std::string e = mcap_tools::unreadable(path_); !e.empty()) {
+    failure_ = Error{e};
+  } else if (Status st = reader_.open(path_); !st.ok()) {
+    failure_ = st;
+  }
   return failure_.ok();
 }
 
