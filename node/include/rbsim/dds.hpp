@@ -92,9 +92,8 @@ struct RawTopic {
 // What an endpoint carries besides its topic and QoS.
 struct EndpointOptions {
   // REP 2011's "RIHS01_<64 hex>" of the endpoint's type: its USER_DATA then says
-  // "typehash=<it>;" as rmw_cyclonedds_cpp writes it, except on Humble (no type hashes). Empty
-  // (today, until the hashes are computed): USER_DATA is empty, as rmw writes it for a type
-  // without a hash.
+  // "typehash=<it>;" as rmw_cyclonedds_cpp writes it, except on Humble (no type hashes). Empty:
+  // USER_DATA is empty, as rmw writes it for a type without a hash.
   std::string type_hash;
   std::int64_t lifespan_ns = 0;  // > 0: samples expire that long after they were written (/rosout)
   bool in_graph = true;          // listed in ros_discovery_info (not its own writer, as in rmw)
