@@ -6,10 +6,10 @@
 #include <cmath>
 #include <limits>
 
-#include "clock.hpp"
+#include "rbsim/clock.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
-#include "service_set.hpp"
+#include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
 

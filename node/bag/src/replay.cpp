@@ -6,11 +6,11 @@
 #include <map>
 #include <set>
 
-#include "clock.hpp"
 #include "player.hpp"
+#include "rbsim/clock.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/replay.hpp"
-#include "service_set.hpp"
+#include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "clock.hpp"
+#include "rbsim/clock.hpp"
 #include "rbsim/dds_sink.hpp"
 
 namespace rbsim::node {

@@ -7,10 +7,10 @@
 #include <future>
 #include <vector>
 
-#include "parameter_events.hpp"
 #include "rbsim/interfaces.hpp"
+#include "rbsim/parameter_events.hpp"
 #include "rbsim/service.hpp"
-#include "service_set.hpp"
+#include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
 

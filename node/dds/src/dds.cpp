@@ -11,10 +11,10 @@
 #include <cstring>
 #include <optional>
 
-#include "graph.hpp"
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/graph.hpp"
 #include "rbsim/rosout.hpp"
 #include "rbsim/security.hpp"
 #include "rbsim/type_hash.hpp"

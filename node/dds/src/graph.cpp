@@ -1,5 +1,5 @@
 // The local participant's ros_discovery_info entry (graph.hpp).
-#include "graph.hpp"
+#include "rbsim/graph.hpp"
 
 #include <algorithm>
 #include <cstring>

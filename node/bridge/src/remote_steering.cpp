@@ -2,12 +2,12 @@
 #include <chrono>
 #include <limits>
 
-#include "graph.hpp"
-#include "parameter_events.hpp"
 #include "rbsim/assert.hpp"
+#include "rbsim/graph.hpp"
 #include "rbsim/interfaces.hpp"
+#include "rbsim/parameter_events.hpp"
 #include "rbsim/relay.hpp"
-#include "service_set.hpp"
+#include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
 

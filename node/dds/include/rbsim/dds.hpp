@@ -6,7 +6,7 @@
 //
 // Each participant is one ROS 2 node on the graph (as rmw_cyclonedds_cpp makes them): its
 // USER_DATA says "enclave=/;", and it publishes ros_discovery_info listing the node with every
-// reader and writer the wrappers below create (node/src/graph.hpp), in the GID format ROS_DISTRO
+// reader and writer the wrappers below create (rbsim/graph.hpp), in the GID format ROS_DISTRO
 // selects (rbsim/ros_env.hpp).
 #pragma once
 
@@ -31,7 +31,7 @@ namespace rbsim::node {
 // Participant::create's domain argument for "ROS_DOMAIN_ID, else 0".
 inline constexpr std::uint32_t kDomainFromEnvironment = UINT32_MAX;
 
-class Graph;  // node/src/graph.hpp
+class Graph;  // rbsim/graph.hpp
 
 // A DDS participant, configured by ROS 2's environment variables (rbsim/ros_env.hpp): by default
 // (ROS_AUTOMATIC_DISCOVERY_RANGE unset or LOCALHOST, no ROS_STATIC_PEERS) the domain runs on

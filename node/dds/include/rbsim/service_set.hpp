@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "graph.hpp"
+#include "rbsim/graph.hpp"
 #include "rbsim/service.hpp"
 
 namespace rbsim::node {

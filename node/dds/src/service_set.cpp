@@ -1,5 +1,5 @@
 // Servers of one node on one serving thread (service_set.hpp).
-#include "service_set.hpp"
+#include "rbsim/service_set.hpp"
 
 #include <chrono>
 

@@ -9,7 +9,7 @@
 #include "rbsim/interfaces.hpp"
 #include "rbsim/recorder.hpp"
 #include "rbsim/rosout.hpp"
-#include "service_set.hpp"
+#include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
 
