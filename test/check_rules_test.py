@@ -99,6 +99,18 @@ class CheckModulesTest(CheckerTest):
         self.tree.write("tools/log/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
         self.assertFails("(little-endian fields read by hand (le64))")
 
+    def test_cyclone_outside_dds_fails(self):
+        self.tree.write("node/dds/src/dds.cpp", "#include <dds/dds.h>\nint p = dds_create_participant(0, 0, 0);\n")
+        self.tree.write("node/bag/src/names.cpp", "// not dds_create_waitset(\n"
+                        'std::string t = rbsim::msgs::dds_topic_name("/a"); const char* s = "dds_take(";\n')
+        self.assertPasses()
+        self.tree.write("node/bag/src/recorder.cpp", "#include <dds/dds.h>\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (#include <dds/dds.h>); only dds may")
+        self.tree.write("node/bag/src/recorder.cpp", "void f(int w) { dds_waitset_wait(w, nullptr, 0, 0); }\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (dds_waitset_wait)")
+        self.tree.write("node/bag/src/recorder.cpp", "struct ddsi_serdata* held;\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (ddsi_serdata)")
+
     def test_allowlist_ratchets(self):
         self.tree.write("tools/check/src/compare.cpp", "rbsim::mcap::IndexedReader r;\n")
         self.tree.write("test/architecture_allowlist.txt", "mcap-reader tools/check/src/compare.cpp\n")

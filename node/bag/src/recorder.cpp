@@ -1,6 +1,4 @@
 // The recorder: DDS topics to an MCAP file, byte for byte.
-#include <dds/dds.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -112,12 +110,14 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   if (options.snapshot_duration_ns == 0) {
     if (Status st = r->open_file(); !st) return st.error();
   }
-  r->waitset_ = dds_create_waitset(participant.handle());
+  auto waitset = WaitSet::create(participant);
+  if (!waitset) return waitset.error();
+  r->waitset_ = std::move(waitset.value());
   for (const msgs::TopicSpec* spec : wanted) {
     const std::string ros = msgs::topic_name(*spec, options.ns);
     auto sub = Subscription::create(participant, *spec, ros, qos_for(*spec));
     if (!sub) return sub.error();
-    dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->topics_.size()));
+    r->waitset_.attach(sub.value());
     Topic topic{std::move(sub.value()), 0, 0, {}, {}, 0, Gaps{}};
     r->topics_.push_back(std::move(topic));
     r->latched_pending_.push_back(spec->latched());
@@ -231,14 +231,10 @@ Result<std::uint64_t> Recorder::snapshot() {
   return n;
 }
 
-Recorder::~Recorder() {
-  if (waitset_ > 0) dds_delete(waitset_);
-}
+Recorder::~Recorder() = default;
 
 Result<bool> Recorder::poll(std::int64_t timeout_ns) {
-  dds_attach_t triggered[16];
-  const dds_return_t n = dds_waitset_wait(waitset_, triggered, 16, timeout_ns);
-  if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
+  if (Result<std::int32_t> n = waitset_.wait(timeout_ns); !n) return n.error();
   bool any = false;
   // A chunk compressed while no message came in reaches the file now, not at the next message.
   if (auto st = writer_.is_open() ? writer_.write_compressed_chunk() : Status(Ok{}); !st.ok())

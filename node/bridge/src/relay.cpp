@@ -1,15 +1,13 @@
 // The relay's DDS side: raw CDR samples of every rbsim topic, handed on as they come.
 #include "rbsim/relay.hpp"
 
-#include <dds/dds.h>
-
 namespace rbsim::node {
 
 Result<std::unique_ptr<Relay>> Relay::create(const Participant& participant, const std::string& ns) {
   std::unique_ptr<Relay> r(new Relay());
-  r->waitset_ = dds_create_waitset(participant.handle());
-  if (r->waitset_ < 0)
-    return Error{std::string("cannot create a DDS waitset: ") + dds_strretcode(r->waitset_)};
+  auto waitset = WaitSet::create(participant);
+  if (!waitset) return waitset.error();
+  r->waitset_ = std::move(waitset.value());
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     QosSpec qos = qos_for(spec);
     if (!qos.transient_local) {
@@ -18,20 +16,16 @@ Result<std::unique_ptr<Relay>> Relay::create(const Participant& participant, con
     }
     auto sub = Subscription::create(participant, spec, msgs::topic_name(spec, ns), qos);
     if (!sub) return sub.error();
-    dds_waitset_attach(r->waitset_, sub->reader(), static_cast<dds_attach_t>(r->subscriptions_.size()));
+    r->waitset_.attach(sub.value());
     r->subscriptions_.push_back(std::move(sub.value()));
   }
   return r;
 }
 
-Relay::~Relay() {
-  if (waitset_ > 0) dds_delete(waitset_);
-}
+Relay::~Relay() = default;
 
 Result<std::uint64_t> Relay::poll(std::int64_t timeout_ns, const OnSample& on_sample) {
-  dds_attach_t triggered[16];
-  const dds_return_t n = dds_waitset_wait(waitset_, triggered, 16, timeout_ns);
-  if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
+  if (Result<std::int32_t> n = waitset_.wait(timeout_ns); !n) return n.error();
   std::uint64_t count = 0;
   for (Subscription& s : subscriptions_) {
     while (s.take(sample_)) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <optional>
+#include <utility>
 
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
@@ -366,6 +367,40 @@ std::int32_t Subscription::matched() const {
   dds_subscription_matched_status_t st{};
   if (dds_get_subscription_matched_status(reader_, &st) < 0) return 0;
   return static_cast<std::int32_t>(st.current_count);
+}
+
+// ---------------------------------------------------------------------------------------------
+Result<WaitSet> WaitSet::create(const Participant& participant) {
+  WaitSet w;
+  w.handle_ = dds_create_waitset(participant.handle());
+  if (w.handle_ < 0) return Error{std::string("cannot create a DDS waitset: ") + dds_strretcode(w.handle_)};
+  return w;
+}
+
+WaitSet::WaitSet(WaitSet&& o) noexcept : handle_(o.handle_), attached_(o.attached_) {
+  o.handle_ = 0;
+}
+WaitSet& WaitSet::operator=(WaitSet&& o) noexcept {
+  if (this != &o) {
+    if (handle_ > 0) dds_delete(handle_);
+    handle_ = std::exchange(o.handle_, 0);
+    attached_ = o.attached_;
+  }
+  return *this;
+}
+WaitSet::~WaitSet() {
+  if (handle_ > 0) dds_delete(handle_);
+}
+
+void WaitSet::attach(const Subscription& subscription) {
+  dds_waitset_attach(handle_, subscription.reader(), static_cast<dds_attach_t>(attached_++));
+}
+
+Result<std::int32_t> WaitSet::wait(std::int64_t timeout_ns) {
+  dds_attach_t triggered[16];
+  const dds_return_t n = dds_waitset_wait(handle_, triggered, 16, timeout_ns);
+  if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
+  return static_cast<std::int32_t>(n);
 }
 
 const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns) {

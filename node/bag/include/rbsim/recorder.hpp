@@ -144,7 +144,7 @@ class Recorder {
   std::uint64_t snapshot_dropped() const { return snapshot_dropped_; }
 
  private:
-  std::int32_t waitset_ = 0;
+  WaitSet waitset_;
   std::vector<Topic> topics_;
   std::uint64_t received_ = 0;
   double dt_ = 0.0;  // from the scene description; 0 until it arrives

@@ -46,7 +46,7 @@ class Relay {
  private:
   Relay() = default;
   std::vector<Subscription> subscriptions_;
-  std::int32_t waitset_ = 0;
+  WaitSet waitset_;
   Received sample_;
   std::uint64_t received_ = 0;
 };

@@ -176,6 +176,24 @@ class Subscription {
   std::vector<Writer> writers_;
 };
 
+// Waits for samples on several subscriptions at once (a DDS waitset): the loop of the recorder
+// and of the relay, which take from every subscription once any has something.
+class WaitSet {
+ public:
+  static Result<WaitSet> create(const Participant& participant);
+  WaitSet() = default;
+  WaitSet(WaitSet&& other) noexcept;
+  WaitSet& operator=(WaitSet&& other) noexcept;
+  ~WaitSet();
+  void attach(const Subscription& subscription);
+  // Waits up to `timeout_ns` until an attached subscription has samples; returns how many have.
+  Result<std::int32_t> wait(std::int64_t timeout_ns);
+
+ private:
+  std::int32_t handle_ = 0;
+  std::int64_t attached_ = 0;
+};
+
 // Looks up a TopicSpec by ROS topic suffix ("body_states") or full name ("/rbsim/body_states").
 const msgs::TopicSpec* find_topic(std::string_view name, std::string_view ns);
 
