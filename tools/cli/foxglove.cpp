@@ -7,7 +7,7 @@
 #include <system_error>
 
 #include "commands.hpp"
-#include "rbsim/rosout.hpp"
+#include "rbsim/print.hpp"
 
 #ifndef RBSIM_FOXGLOVE_LAYOUT
 #define RBSIM_FOXGLOVE_LAYOUT "docs/foxglove-layout.json"

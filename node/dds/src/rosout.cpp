@@ -3,7 +3,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <cstdarg>
 #include <cstdio>
 
 namespace rbsim::node {
@@ -32,29 +31,16 @@ std::string_view function_name(std::string_view pretty) {
   return pretty.substr(cut);
 }
 
-void log(LogLevel level, std::string_view line, std::source_location where) {
-  std::fprintf(stderr, "%.*s\n", static_cast<int>(line.size()), line.data());
+namespace {
+// The print hook (rbsim/print.hpp): a printed line, after stderr, to the current Rosout.
+void to_current(LogLevel level, std::string_view line, const std::source_location& where) {
   std::lock_guard lock(g_current_mutex);
   if (g_current == nullptr) return;
   if (Status st = g_current->publish(level, line, where); !st) {
     std::fprintf(stderr, "rbsim: warning: /rosout: %s\n", st.error().message.c_str());
   }
 }
-
-void logf(LogLevel level, std::source_location where, const char* format, ...) {
-  std::va_list args;
-  va_start(args, format);
-  std::va_list copy;
-  va_copy(copy, args);
-  const int n = std::vsnprintf(nullptr, 0, format, copy);
-  va_end(copy);
-  std::string text(n > 0 ? static_cast<std::size_t>(n) : 0, '\0');
-  if (n > 0) std::vsnprintf(text.data(), text.size() + 1, format, args);
-  va_end(args);
-  // Lines end where log() ends them.
-  while (!text.empty() && text.back() == '\n') text.pop_back();
-  log(level, text, where);
-}
+}  // namespace
 
 Result<std::unique_ptr<Rosout>> Rosout::create(const Participant& participant, Clock clock) {
   // rcl_qos_profile_rosout_default.
@@ -70,6 +56,7 @@ Result<std::unique_ptr<Rosout>> Rosout::create(const Participant& participant, C
       new Rosout(std::move(pub.value()), participant.node().logger_name(), std::move(clock)));
   std::lock_guard lock(g_current_mutex);
   g_current = rosout.get();
+  print::set_hook(&to_current);
   return rosout;
 }
 

@@ -1,5 +1,6 @@
-// The one path of the lines a DDS command (node, record, replay, bridge) prints on stderr: each
-// goes to stderr and, while a Rosout lives, also to /rosout as rcl_interfaces/msg/Log (what rcl's
+// /rosout for the lines a DDS command (node, record, replay, bridge) prints: each goes to stderr
+// through base's print::log (rbsim/print.hpp) and, while a Rosout lives (it is the print hook),
+// also to /rosout as rcl_interfaces/msg/Log (what rcl's
 // rosout handler publishes for a node: level, the node's logger name, the text, file, function,
 // line, stamped in the node's clock), with rcl's rosout QoS (reliable, transient local, keep last
 // 1000, lifespan 10 s).
@@ -14,18 +15,16 @@
 #include <string_view>
 
 #include "rbsim/dds.hpp"
+#include "rbsim/print.hpp"
 #include "rbsim/ros_graph_msgs.hpp"
 
 namespace rbsim::node {
 
 using LogLevel = msgs::LogLevel;
 
-// Writes `line` and a newline to stderr, then publishes it on the current Rosout, if any.
-void log(LogLevel level, std::string_view line, std::source_location where = std::source_location::current());
-// printf-style log() for the call sites that format (RBSIM_LOG).
-[[gnu::format(printf, 3, 4)]] void logf(LogLevel level, std::source_location where, const char* format, ...);
-#define RBSIM_LOG(level, ...) \
-  ::rbsim::node::logf(::rbsim::node::LogLevel::level, std::source_location::current(), __VA_ARGS__)
+// stderr, then the current Rosout, if any (base's print::log, whose hook the Rosout is).
+using print::log;
+using print::logf;
 
 // A node's /rosout publisher. While it lives it is the process's current one (the last created).
 class Rosout {
