@@ -12,7 +12,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "openssl_util.hpp"
+#include "rbsim/openssl_util.hpp"
 
 namespace rbsim::node {
 

@@ -1,12 +1,12 @@
-// An SROS2 keystore and its enclaves (rbsim/security.hpp), laid out as `ros2 security` lays them
+// An SROS2 keystore and its enclaves (rbsim/sros2.hpp), laid out as `ros2 security` lays them
 // out (sros2/keystore: _keystore.py, _enclave.py; policy templates governance.xml, permissions.xsl).
 #include <filesystem>
 #include <sstream>
 
-#include "openssl_util.hpp"
 #include "rbsim/atomic_file.hpp"
 #include "rbsim/msgs.hpp"
-#include "rbsim/security.hpp"
+#include "rbsim/openssl_util.hpp"
+#include "rbsim/sros2.hpp"
 
 namespace rbsim::node {
 

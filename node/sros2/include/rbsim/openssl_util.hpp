@@ -1,5 +1,5 @@
-// The OpenSSL pieces of DDS Security (src/security.cpp, src/keystore.cpp): owned handles, reading
-// and checking PEM certificates, keys and S/MIME documents, and making them. Errors name the file.
+// The OpenSSL pieces of DDS Security (node/dds/src/security.cpp, node/sros2/src/keystore.cpp): owned handles,
+// reading and checking PEM certificates, keys and S/MIME documents, and making them. Errors name the file.
 #pragma once
 
 #include <openssl/evp.h>

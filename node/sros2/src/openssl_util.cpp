@@ -1,5 +1,5 @@
-// OpenSSL for DDS Security's files (src/openssl_util.hpp).
-#include "openssl_util.hpp"
+// OpenSSL for DDS Security's files (rbsim/openssl_util.hpp).
+#include "rbsim/openssl_util.hpp"
 
 #include <openssl/bio.h>
 #include <openssl/err.h>
