@@ -2,8 +2,9 @@
 """The module rules of docs/architecture.md, checked on the sources: each module includes only
 the public headers of the modules its row allows (its own internals stay in its src/), and every
 public header belongs to exactly one module; only the modules of READER_MODULES use the MCAP
-readers, no module but mcap frames MCAP by hand (magic, record prefix, opcodes), and no module but
-dds includes a Cyclone DDS header or calls Cyclone's C API.
+readers, no module but mcap frames MCAP by hand (magic, record prefix, opcodes), no module but msgs
+spells a message or service type name ("std_srvs/srv/Trigger": msgs's constants instead), and no
+module but dds includes a Cyclone DDS header or calls Cyclone's C API.
 
     check_modules.py ROOT [--allowlist FILE]   # exit 1 listing every break of a rule
 
@@ -100,6 +101,18 @@ def check_includes(root, name, path, text, owner, problems):
         elif target != name and target not in allowed:
             problems.append(f"{path.relative_to(root)}: module {name} includes rbsim/{header} of module "
                             f"{target} (allowed: {', '.join(sorted(allowed)) or 'none'})")
+# A ROS type name spelt in a string literal: msgs holds them (topics(), interfaces.hpp's kType and
+# kService); every other module takes its constants, so a type is renamed in one place.
+TYPE_NAME_MODULES = {"msgs"}
+TYPE_NAME = re.compile(r'"([a-z][a-z0-9_]*/(?:msg|srv|action)/[A-Z][A-Za-z0-9_]*)"')
+
+
+def type_name_use(name, text):
+    """The first message or service type name `text` spells, if module `name` may not."""
+    if name in TYPE_NAME_MODULES:
+        return None
+    m = TYPE_NAME.search(check_common.strip(text, literals=False))
+    return m and m.group(1)
 
 
 def reader_use(name, text):
@@ -165,6 +178,9 @@ def main():
             if cyclone:
                 problems.append(f"{rel}: module {name} uses Cyclone DDS ({cyclone}); only "
                                 f"{', '.join(sorted(CYCLONE_MODULES))} may (node/dds, behind the middleware seam)")
+            spelt = type_name_use(name, text)
+            if spelt:
+                problems.append(f"{rel}: module {name} spells the type name {spelt}; take msgs's constant")
             framed = framing_use(name, text)
             if framed:
                 framers.add(rel)

@@ -2,11 +2,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rbsim/assert.hpp"
 #include "rbsim/core.hpp"
 
 namespace rbsim {
 
 void World::step() {
+  RBSIM_ASSERT(validate().ok(), "the world's arrays hold their invariants at a step boundary");
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   std::fill(tau_.begin(), tau_.end(), 0.0);

@@ -46,7 +46,7 @@ struct HullKeyHash {
   std::size_t operator()(const HullKey& k) const { return std::hash<std::string>{}(k.bytes); }
 };
 
-Status validate(const WorldDef& def) {
+Status validate_definition(const WorldDef& def) {
   if (!(std::isfinite(def.dt) && def.dt > 0)) return invalid("dt must be finite and > 0");
   const auto n = static_cast<std::int32_t>(def.bodies.size());
   for (std::int32_t b = 0; b < n; ++b) {
@@ -86,7 +86,7 @@ Status validate(const WorldDef& def) {
 }  // namespace
 
 Result<World> World::create(const WorldDef& def) {
-  if (Status st = validate(def); !st) return st.error();
+  if (Status st = validate_definition(def); !st) return st.error();
   World w;
   w.integrator_ = def.integrator;
   w.dt_ = def.dt;

@@ -68,5 +68,36 @@ TEST(Subscription, TakenBytesStayValidWhileTheReceivedHoldsThem) {
   EXPECT_EQ(std::vector<std::byte>(moved.cdr.begin(), moved.cdr.end()), sent[0]);
 }
 
+// The one wait for subscribers (node's and replay's --wait-for-subscribers): it returns once
+// `count` match, and gives up when its stop flag turns true, looking at it between polls.
+int g_stop_calls = 0;
+int g_stop_after = 0;
+bool stop_after_some_calls() {
+  return ++g_stop_calls > g_stop_after;
+}
+
+TEST(Publisher, WaitForSubscribersUntilMatchedOrStopped) {
+  Result<Participant> participant = Participant::create(144);
+  ASSERT_TRUE(participant.ok()) << participant.error().message;
+  const msgs::TopicSpec& spec = msgs::topic(msgs::TopicId::Clock);
+  const std::string name = "/subscription_test_wait_" + std::to_string(::getpid()) + "/clock";
+  const QosSpec qos = qos_for(spec, 10);
+  Result<Publisher> pub = Publisher::create(participant.value(), spec, name, qos);
+  ASSERT_TRUE(pub.ok()) << pub.error().message;
+  EXPECT_TRUE(pub.value().wait_for_subscribers(0, nullptr));  // none asked for: at once
+
+  g_stop_calls = 0;
+  g_stop_after = 3;
+  EXPECT_FALSE(pub.value().wait_for_subscribers(1, stop_after_some_calls));  // nobody subscribes
+  EXPECT_EQ(g_stop_calls, 4);
+
+  Result<Subscription> sub = Subscription::create(participant.value(), spec, name, qos);
+  ASSERT_TRUE(sub.ok()) << sub.error().message;
+  g_stop_calls = 0;
+  g_stop_after = 500;  // 10 s of 20 ms polls
+  EXPECT_TRUE(pub.value().wait_for_subscribers(1, stop_after_some_calls));
+  EXPECT_GE(pub.value().matched(), 1);
+}
+
 }  // namespace
 }  // namespace rbsim::node

@@ -175,16 +175,35 @@ TEST(CheckMagic, BadTruncatedAndGoodMagic) {
   auto bad = make_buffer_source(flipped);
   const Status s = check_magic(*bad, 0);
   EXPECT_EQ(s.code(), ErrorCode::BadMagic);
-  EXPECT_NE(s.error().message.find("at offset 0"), std::string::npos) << s.error().message;
+  EXPECT_EQ(s.error().message, "the leading magic bytes are wrong");
 
   auto short_good = make_buffer_source(Bytes(file.begin(), file.begin() + 5));
   EXPECT_EQ(check_magic(*short_good, 0).code(), ErrorCode::Truncated);
+  EXPECT_EQ(check_magic(*short_good, 0).error().message, "the file ends inside the leading magic (5 bytes)");
   auto short_bad = make_buffer_source(Bytes(flipped.begin(), flipped.begin() + 5));
   EXPECT_EQ(check_magic(*short_bad, 0).code(), ErrorCode::BadMagic);
 
   // Without its trailing magic a file has no Footer to read.
   auto cut = make_buffer_source(Bytes(file.begin(), file.end() - 1));
   EXPECT_EQ(read_footer(*cut).code(), ErrorCode::Truncated);
+}
+
+// The one wording of a read error: what the file is by the code, then the reader's message.
+TEST(DescribeReadError, SaysWhatTheFileIsByTheCode) {
+  EXPECT_EQ(describe_read_error({"the leading magic bytes are wrong", ErrorCode::BadMagic}),
+            "not an MCAP file: the leading magic bytes are wrong");
+  EXPECT_EQ(describe_read_error({"no trailing magic", ErrorCode::Truncated}), "truncated: no trailing magic");
+  for (ErrorCode c : {ErrorCode::CrcMismatch, ErrorCode::DecompressionFailed, ErrorCode::Malformed})
+    EXPECT_EQ(describe_read_error({"chunk at 9", c}), "corrupted: chunk at 9");
+  EXPECT_EQ(describe_read_error({"cannot read: EIO", ErrorCode::IoError}), "cannot read: EIO");
+  EXPECT_EQ(describe_read_error({"anything"}), "anything");
+
+  // A stream reader's error on a foreign file, described, is what doctor says of it.
+  const std::string text = "name,value\n1,2\n";
+  auto foreign = make_buffer_source(Bytes(reinterpret_cast<const std::byte*>(text.data()),
+                                          reinterpret_cast<const std::byte*>(text.data()) + text.size()));
+  const Status magic = check_magic(*foreign, 0);
+  EXPECT_EQ(describe_read_error(magic.error()), "not an MCAP file: the leading magic bytes are wrong");
 }
 
 TEST(ByteSource, FileAndBufferSourcesGiveTheSameRecords) {

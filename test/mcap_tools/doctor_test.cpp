@@ -293,6 +293,10 @@ TEST_F(DoctorTest, TruncatedEmptyAndForeignFiles) {
   write_text(dir_ / "text.mcap", "name,value\n1,2\n");
   auto r = mcap_tools::doctor((dir_ / "text.mcap").string());
   EXPECT_EQ(r.first_error(), "not an MCAP file: the leading magic bytes are wrong");
+  // The readers' callers word it the same (mcap::describe_read_error, through read_error).
+  const Result<mcap_tools::LogInfo> info = mcap_tools::info((dir_ / "text.mcap").string());
+  ASSERT_FALSE(info.ok());
+  EXPECT_EQ(info.error().message, r.first_error());
   r = mcap_tools::doctor((dir_ / "missing.mcap").string());
   EXPECT_NE(r.first_error().find("cannot open"), std::string::npos) << r.first_error();
   r = mcap_tools::doctor(dir_.path().string());

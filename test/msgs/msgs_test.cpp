@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -144,6 +146,30 @@ TEST(EncoderClock, MatchesHandEncodedCdr) {
   ASSERT_EQ(out.size(), expected.size());
   for (std::size_t i = 0; i < out.size(); ++i)
     EXPECT_EQ(static_cast<int>(out[i]), expected[i]) << "byte " << i;
+}
+
+// rbsim replay's /clock for a log time, byte for byte what it wrote by hand before encode_clock
+// (CDR_LE header, int32 sec, uint32 nanosec), and reusing the buffer it is given.
+TEST(EncodeClock, IsWhatReplayWroteByHand) {
+  auto by_hand = [](std::uint64_t t_ns) {
+    std::array<std::byte, 12> out{};
+    out[1] = std::byte{1};
+    const auto sec = static_cast<std::int32_t>(t_ns / 1'000'000'000);
+    const auto nsec = static_cast<std::uint32_t>(t_ns % 1'000'000'000);
+    std::memcpy(out.data() + 4, &sec, 4);
+    std::memcpy(out.data() + 8, &nsec, 4);
+    return out;
+  };
+  rbsim::msgs::Bytes out(40, std::byte{0xAB});  // a longer message before: replaced, not appended to
+  for (std::uint64_t t :
+       {std::uint64_t{0}, std::uint64_t{1}, std::uint64_t{999'999'999}, std::uint64_t{1'500'000'000},
+        std::uint64_t{1'700'000'000'123'456'789}, std::uint64_t{2'147'483'647'999'999'999}}) {
+    const rbsim::msgs::Bytes& cdr = rbsim::msgs::encode_clock(t, out);
+    EXPECT_EQ(&cdr, &out);
+    const auto expected = by_hand(t);
+    ASSERT_EQ(out.size(), expected.size()) << t;
+    EXPECT_EQ(std::memcmp(out.data(), expected.data(), expected.size()), 0) << t;
+  }
 }
 
 TEST(EncoderBodyStates, DecodesToTheWorldState) {

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdio>
 
+#include "rbsim/counts.hpp"
 #include "rbsim/print.hpp"
 
 namespace rbsim::cli {
@@ -91,7 +92,7 @@ void Progress::finish() {
 }
 
 std::string count_of(std::int64_t n, const char* one, const char* many) {
-  return std::to_string(n) + " " + (n == 1 ? one : many);
+  return std::to_string(n) + " " + plural(n, one, many);
 }
 
 Result<mcap::Compression> compression_option(const std::string& name, int level) {

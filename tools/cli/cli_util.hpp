@@ -50,7 +50,7 @@ Result<mcap::Compression> compression_option(const std::string& name, int level 
 int fail(const char* command, const std::string& message, int exit_status = 1,
          std::source_location where = std::source_location::current());
 
-// "1 body", "2 bodies": a count with its noun in the right number.
+// "1 body", "2 bodies": a count with its noun in the right number (rbsim::plural decides).
 std::string count_of(std::int64_t n, const char* one, const char* many);
 
 }  // namespace rbsim::cli

@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "commands.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/print.hpp"
 
 #ifndef RBSIM_FOXGLOVE_LAYOUT
@@ -129,7 +130,7 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
 
 std::string foxglove_summary(const foxglove::Server& server) {
   const foxglove::ServerStats s = server.stats();
-  std::string line = "foxglove: " + std::to_string(s.clients) + (s.clients == 1 ? " client" : " clients") +
+  std::string line = "foxglove: " + std::to_string(s.clients) + plural(s.clients, " client", " clients") +
                      ", " + std::to_string(s.published) + " messages queued, " + std::to_string(s.dropped) +
                      " dropped for slow clients";
   if (s.disconnected > 0) line += ", " + std::to_string(s.disconnected) + " disconnected for not reading";
@@ -139,8 +140,7 @@ std::string foxglove_summary(const foxglove::Server& server) {
   if (s.full > 0) line += ", " + std::to_string(s.full) + " refused over --foxglove-max-clients";
   if (s.handshake_timeouts > 0)
     line += ", " + std::to_string(s.handshake_timeouts) + " closed for an unfinished handshake";
-  if (s.requests > 0)
-    line += ", " + std::to_string(s.requests) + (s.requests == 1 ? " request" : " requests");
+  if (s.requests > 0) line += ", " + std::to_string(s.requests) + plural(s.requests, " request", " requests");
   if (s.refused_requests > 0) line += ", " + std::to_string(s.refused_requests) + " requests refused";
   return line;
 }

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "rbsim/bag.hpp"
 #include "rbsim/cat.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
 #include "rbsim/mcap_tools.hpp"
@@ -110,7 +111,7 @@ int info_command(const LogOptions& o) {
   const bool bag = files->size() != 1 || files->front() != o.file;
   if (bag) {
     std::printf("bag:         %s (rosbag2, %zu file%s)\n", o.file.c_str(), files->size(),
-                files->size() == 1 ? "" : "s");
+                plural(files->size(), "", "s"));
     for (const std::string& f : files.value()) std::printf("  %s\n", f.c_str());
   }
   for (const std::string& f : files.value()) {
@@ -209,6 +210,108 @@ int cat_command(const LogOptions& o) {
   return 0;
 }
 
+struct InspectApps {
+  CLI::App *info = nullptr, *doctor = nullptr, *recover = nullptr;
+};
+
+// rbsim log info | doctor | recover: any MCAP file.
+InspectApps add_inspect_commands(CLI::App* app, const std::shared_ptr<LogOptions>& o) {
+  CLI::App* info =
+      app->add_subcommand("info",
+                          "Summarise a recording: duration, topics with types and counts, chunks, "
+                          "compression");
+  info->add_option("file", o->file, "MCAP file or rosbag2 bag directory")->required();
+  info->footer(
+      "Reads the summary section (or scans a file that has none, and says so) and checks the data section "
+      "CRC.\nExit status: 0 success, 1 error (unreadable, truncated or corrupted file), 2 usage error.");
+
+  CLI::App* doctor = app->add_subcommand(
+      "doctor",
+      "Check a recording's structure the way 'mcap doctor' does: magic, header/footer, records, chunk CRCs "
+      "and decompression, message and chunk indexes, statistics, summary offsets, data and summary CRCs");
+  doctor->add_option("file", o->file, "MCAP file or rosbag2 bag directory (each of its files)")->required();
+  doctor->add_flag("--strict-message-order", o->strict_message_order,
+                   "Messages out of log-time order are errors (by default warnings)");
+  doctor->footer(
+      "Prints 'Examining FILE', then one line per problem ('error: ...' or 'warning: ...').\n"
+      "Exit status: 0 no errors (warnings allowed), 1 any error, 2 usage error.");
+
+  CLI::App* recover = app->add_subcommand(
+      "recover",
+      "Rebuild a valid, indexed recording from a truncated or damaged one, keeping every complete message");
+  recover->add_option("in", o->file, "Damaged MCAP file")->required();
+  recover->add_option("out", o->out, "Output MCAP file (written under a temporary name, then renamed)")
+      ->required();
+  recover->add_option("--compression", o->compression, "Chunk compression of the output")
+      ->check(CLI::IsMember({"zstd", "lz4", "none"}))
+      ->default_str("zstd");
+  recover->add_flag("-q,--quiet", o->quiet, "No report on stdout");
+  recover->add_flag("--overwrite", o->overwrite, "Replace OUT if it exists (by default it is refused)");
+  recover->footer(
+      "Chunks are the unit of recovery: a chunk cut off by the end of the file (or failing its CRC) is lost "
+      "with "
+      "its messages; every complete chunk is kept, with the same schema and channel ids, profile and "
+      "library.\n"
+      "Exit status: 0 OUT written (a copy of an intact input, or every complete message of a damaged one, "
+      "with a warning on stderr saying what was lost), 1 nothing could be recovered (no complete message; "
+      "no OUT written) or an error, 2 usage error.");
+
+  return {info, doctor, recover};
+}
+
+struct ReadApps {
+  CLI::App *exp = nullptr, *cat = nullptr;
+};
+
+// rbsim log export | cat: a recording's messages as CSV or JSON.
+ReadApps add_read_commands(CLI::App* app, const std::shared_ptr<LogOptions>& o) {
+  CLI::App* exp = app->add_subcommand(
+      "export", "Write the CSV files 'rbsim run --csv / --energy-csv' write, from a recording of the run");
+  exp->add_option("file", o->file, "MCAP file recorded by rbsim run --record")->required();
+  exp->add_option("--csv", o->csv, std::string("Per-body CSV: ") + kBodyCsvColumns);
+  exp->add_option("--energy-csv", o->energy_csv, std::string("Scene-wide CSV: ") + kEnergyCsvColumns);
+  exp->add_option("--namespace", o->ns,
+                  "ROS namespace of the recording's topics (default: the only one in the file)")
+      ->check(ros_namespace());
+  exp->add_flag("-q,--quiet", o->quiet, "No closing summary line");
+  exp->add_flag("--overwrite", o->overwrite,
+                "Replace the CSV files if they exist (by default they are refused)");
+  exp->footer(
+      "Byte for byte what rbsim run wrote for the recorded steps (all of them, or every k-th with "
+      "--record-every k).\nExit status: 0 success, 1 error, 2 usage error.");
+
+  CLI::App* cat = app->add_subcommand(
+      "cat",
+      "Print every message as one line of JSON, decoded by its schema (as 'mcap cat --json'), or one topic "
+      "as CSV");
+  cat->add_option("file", o->file, "MCAP file")->required();
+  cat->add_option("--topics", o->topics,
+                  "Only these topics, comma-separated; each as recorded (/rbsim/body_states) or by its "
+                  "last name (body_states)")
+      ->delimiter(',');
+  cat->add_option("--start", o->start, "Only messages logged at or after this many seconds")
+      ->check(non_negative());
+  cat->add_option("--end", o->end, "Only messages logged before this many seconds")->check(non_negative());
+  cat->add_option("--format", o->format, "json: a JSON object per message; csv: one topic as a table")
+      ->check(CLI::IsMember({"json", "csv"}))
+      ->default_str("json");
+  cat->footer(
+      "json (the default): one JSON object per line and message, in log-time order (equal times in file "
+      "order):\n"
+      "  {\"topic\":\"/rbsim/body_states\",\"sequence\":0,\"log_time\":0,\"publish_time\":0,\"data\":{...}}\n"
+      "log_time and publish_time are integer nanoseconds as recorded. data is the message decoded from its "
+      "channel's ros2msg schema as nested JSON: an object per message type, an array per array or "
+      "sequence, field names as in the .msg definitions; floats shortest round-trip, NaN and infinities as "
+      "null (JSON has neither); data is null for a channel without a ros2msg/CDR schema.\n"
+      "csv: one topic (--topics, or the file's only one): a header log_time,publish_time,sequence,<fields> "
+      "whose fields are the first message's flattened schema fields (bodies[0].x, ..., bodies.length), then "
+      "one row per message; a message of another shape (other sequence lengths) is an error.\n"
+      "Exit status: 0 success, 1 error (unreadable or corrupt file, a message its schema cannot decode, an "
+      "unknown topic; for csv several topics or another shape), 2 usage error.");
+
+  return {exp, cat};
+}
+
 struct RewriteApps {
   CLI::App *filter = nullptr, *merge = nullptr, *compress = nullptr;
 };
@@ -296,98 +399,16 @@ Subcommand add_log_command(CLI::App& parent) {
   app->require_subcommand(1);
   app->footer("Run 'rbsim log <command> --help' for a command's options.");
 
-  CLI::App* info =
-      app->add_subcommand("info",
-                          "Summarise a recording: duration, topics with types and counts, chunks, "
-                          "compression");
-  info->add_option("file", o->file, "MCAP file or rosbag2 bag directory")->required();
-  info->footer(
-      "Reads the summary section (or scans a file that has none, and says so) and checks the data section "
-      "CRC.\nExit status: 0 success, 1 error (unreadable, truncated or corrupted file), 2 usage error.");
-
-  CLI::App* doctor = app->add_subcommand(
-      "doctor",
-      "Check a recording's structure the way 'mcap doctor' does: magic, header/footer, records, chunk CRCs "
-      "and decompression, message and chunk indexes, statistics, summary offsets, data and summary CRCs");
-  doctor->add_option("file", o->file, "MCAP file or rosbag2 bag directory (each of its files)")->required();
-  doctor->add_flag("--strict-message-order", o->strict_message_order,
-                   "Messages out of log-time order are errors (by default warnings)");
-  doctor->footer(
-      "Prints 'Examining FILE', then one line per problem ('error: ...' or 'warning: ...').\n"
-      "Exit status: 0 no errors (warnings allowed), 1 any error, 2 usage error.");
-
-  CLI::App* recover = app->add_subcommand(
-      "recover",
-      "Rebuild a valid, indexed recording from a truncated or damaged one, keeping every complete message");
-  recover->add_option("in", o->file, "Damaged MCAP file")->required();
-  recover->add_option("out", o->out, "Output MCAP file (written under a temporary name, then renamed)")
-      ->required();
-  recover->add_option("--compression", o->compression, "Chunk compression of the output")
-      ->check(CLI::IsMember({"zstd", "lz4", "none"}))
-      ->default_str("zstd");
-  recover->add_flag("-q,--quiet", o->quiet, "No report on stdout");
-  recover->add_flag("--overwrite", o->overwrite, "Replace OUT if it exists (by default it is refused)");
-  recover->footer(
-      "Chunks are the unit of recovery: a chunk cut off by the end of the file (or failing its CRC) is lost "
-      "with "
-      "its messages; every complete chunk is kept, with the same schema and channel ids, profile and "
-      "library.\n"
-      "Exit status: 0 OUT written (a copy of an intact input, or every complete message of a damaged one, "
-      "with a warning on stderr saying what was lost), 1 nothing could be recovered (no complete message; "
-      "no OUT written) or an error, 2 usage error.");
-
-  CLI::App* exp = app->add_subcommand(
-      "export", "Write the CSV files 'rbsim run --csv / --energy-csv' write, from a recording of the run");
-  exp->add_option("file", o->file, "MCAP file recorded by rbsim run --record")->required();
-  exp->add_option("--csv", o->csv, std::string("Per-body CSV: ") + kBodyCsvColumns);
-  exp->add_option("--energy-csv", o->energy_csv, std::string("Scene-wide CSV: ") + kEnergyCsvColumns);
-  exp->add_option("--namespace", o->ns,
-                  "ROS namespace of the recording's topics (default: the only one in the file)")
-      ->check(ros_namespace());
-  exp->add_flag("-q,--quiet", o->quiet, "No closing summary line");
-  exp->add_flag("--overwrite", o->overwrite,
-                "Replace the CSV files if they exist (by default they are refused)");
-  exp->footer(
-      "Byte for byte what rbsim run wrote for the recorded steps (all of them, or every k-th with "
-      "--record-every k).\nExit status: 0 success, 1 error, 2 usage error.");
-
-  CLI::App* cat = app->add_subcommand(
-      "cat",
-      "Print every message as one line of JSON, decoded by its schema (as 'mcap cat --json'), or one topic "
-      "as CSV");
-  cat->add_option("file", o->file, "MCAP file")->required();
-  cat->add_option("--topics", o->topics,
-                  "Only these topics, comma-separated; each as recorded (/rbsim/body_states) or by its "
-                  "last name (body_states)")
-      ->delimiter(',');
-  cat->add_option("--start", o->start, "Only messages logged at or after this many seconds")
-      ->check(non_negative());
-  cat->add_option("--end", o->end, "Only messages logged before this many seconds")->check(non_negative());
-  cat->add_option("--format", o->format, "json: a JSON object per message; csv: one topic as a table")
-      ->check(CLI::IsMember({"json", "csv"}))
-      ->default_str("json");
-  cat->footer(
-      "json (the default): one JSON object per line and message, in log-time order (equal times in file "
-      "order):\n"
-      "  {\"topic\":\"/rbsim/body_states\",\"sequence\":0,\"log_time\":0,\"publish_time\":0,\"data\":{...}}\n"
-      "log_time and publish_time are integer nanoseconds as recorded. data is the message decoded from its "
-      "channel's ros2msg schema as nested JSON: an object per message type, an array per array or "
-      "sequence, field names as in the .msg definitions; floats shortest round-trip, NaN and infinities as "
-      "null (JSON has neither); data is null for a channel without a ros2msg/CDR schema.\n"
-      "csv: one topic (--topics, or the file's only one): a header log_time,publish_time,sequence,<fields> "
-      "whose fields are the first message's flattened schema fields (bodies[0].x, ..., bodies.length), then "
-      "one row per message; a message of another shape (other sequence lengths) is an error.\n"
-      "Exit status: 0 success, 1 error (unreadable or corrupt file, a message its schema cannot decode, an "
-      "unknown topic; for csv several topics or another shape), 2 usage error.");
-
+  const InspectApps inspect = add_inspect_commands(app, o);
+  const ReadApps read = add_read_commands(app, o);
   const RewriteApps rewrite = add_rewrite_commands(app, o);
 
-  return {app, [o, info, doctor, recover, exp, cat, rewrite]() -> int {
-            if (info->parsed()) return info_command(*o);
-            if (doctor->parsed()) return doctor_command(*o);
-            if (recover->parsed()) return recover_command(*o);
-            if (exp->parsed()) return export_command(*o);
-            if (cat->parsed()) return cat_command(*o);
+  return {app, [o, inspect, read, rewrite]() -> int {
+            if (inspect.info->parsed()) return info_command(*o);
+            if (inspect.doctor->parsed()) return doctor_command(*o);
+            if (inspect.recover->parsed()) return recover_command(*o);
+            if (read.exp->parsed()) return export_command(*o);
+            if (read.cat->parsed()) return cat_command(*o);
             if (rewrite.filter->parsed()) return filter_command(*o);
             if (rewrite.merge->parsed()) return merge_command(*o);
             if (rewrite.compress->parsed()) return compress_command(*o);

@@ -46,6 +46,122 @@ Status apply_ros_args(Scene& scene, std::int64_t steps, control::RunSettings& se
   return Ok{};
 }
 
+// The DDS sink's options: the run's settings after --ros-args, and the step messages it shares.
+node::NodeOptions sink_options(const NodeArgs& a, const control::RunSettings& settings, const Scene& scene) {
+  // Each step is encoded once for DDS and the Foxglove server alike.
+  node::NodeOptions node_options = a.node;
+  node_options.stop = stop_requested;
+  node_options.rate = settings.rate;
+  node_options.publish_every = settings.publish_every;
+  node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
+  return node_options;
+}
+
+// --foxglove: the server, the sink feeding it and the channel of /<ns>/commands. The sink goes
+// before the server (members are destroyed in reverse).
+struct NodeFoxglove {
+  std::unique_ptr<foxglove::Server> server;
+  std::unique_ptr<foxglove::FoxgloveSink> sink;
+  foxglove::ChannelId commands_channel = 0;  // /<ns>/commands to viewers, as on DDS
+};
+
+// Starts the Foxglove server (which prints its listening line) on the node's topics and
+// /<ns>/commands; the exit status when it cannot.
+std::optional<int> serve_foxglove(const NodeArgs& a, const control::RunSettings& settings,
+                                  const node::NodeOptions& node_options, control::Controller& controller,
+                                  const node::NodeName& name, NodeFoxglove& out) {
+  foxglove::SinkOptions fo;
+  fo.publish_every = settings.publish_every;
+  fo.topics = a.node.topics;
+  fo.ns = a.node.ns;
+  fo.messages = node_options.messages;
+  std::vector<foxglove::ChannelId> ids;
+  msgs::TopicSet served = fo.topics;
+  served.set(static_cast<std::size_t>(msgs::TopicId::Commands));
+  auto channels = foxglove::ros2_channels(served, a.node.ns, &ids);
+  if (!channels) return fail("node", channels.error().message);
+  auto started = start_foxglove("rbsim node", a.foxglove, std::move(channels.value()), &controller,
+                                name.fully_qualified());
+  if (!started) return fail("node", started.error().message, foxglove_exit_status(started.error()));
+  out.server = std::move(started.value());
+  out.commands_channel = ids[static_cast<std::size_t>(msgs::TopicId::Commands)];
+  out.sink = std::make_unique<foxglove::FoxgloveSink>(*out.server, std::move(ids), fo);
+  return std::nullopt;
+}
+
+// --wait-for-subscribers: false when a stop came first (nothing published).
+bool wait_for_subscribers(const NodeArgs& a, node::DdsSink& sink) {
+  if (!a.quiet) RBSIM_LOG(Info, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
+  if (!sink.wait_for_subscribers(a.wait_for, stop_requested)) {
+    if (!a.quiet) RBSIM_LOG(Info, "rbsim node: stopped while waiting, nothing published\n");
+    return false;
+  }
+  return true;
+}
+
+// Rate and publish_every changes reach the pacer and the publishers at a step boundary.
+void follow_settings(control::Controller& controller, node::Pacer& pacer, node::DdsSink& sink,
+                     foxglove::FoxgloveSink* foxglove_sink) {
+  controller.on_settings([&pacer, &sink, foxglove_sink](const control::RunSettings& s) {
+    pacer.set_pace(s.rate, s.publish_every);
+    sink.set_publish_every(s.publish_every);
+    if (foxglove_sink) foxglove_sink->set_publish_every(s.publish_every);
+  });
+}
+
+// Every applied command goes out on /<ns>/commands over DDS (the node's services) and to viewers.
+void publish_commands(control::Controller& controller, node::NodeServices& services, const NodeFoxglove& fox,
+                      double dt) {
+  controller.on_command([&applied = services, &server = fox.server, commands_channel = fox.commands_channel,
+                         dt](const control::Command& c, const control::CommandResult& r) {
+    applied.command_applied(c, r);
+    if (server && commands_channel != 0) {
+      server->publish(commands_channel, msgs::sim_time_ns(r.step >= 0 ? r.step : 0, dt),
+                      applied.last_command());
+    }
+  });
+}
+
+// One begin()/run() pass, or one per loop with --loop until a stop; the exit status of a pass
+// that failed or diverged.
+std::optional<int> run_passes(const NodeArgs& a, Driver& driver, const DriverOptions& options) {
+  do {
+    if (Status st = driver.begin(); !st) return fail("node", st.error().message);
+    const Result<PassEnd> end = driver.run(options);
+    if (!end) return fail("node", end.error().message);
+    if (end.value() == PassEnd::Diverged) {
+      // Subscribers still get every step before it (bounded wait for their acknowledgements).
+      const Status flushed = driver.finish();
+      return fail("node", describe_divergence(driver.divergence()) + ". Published steps up to " +
+                              std::to_string(driver.world().step_index() - 1) +
+                              (flushed ? "" : " (" + flushed.error().message + ")") +
+                              " (--allow-nonfinite keeps going).");
+    }
+  } while (a.loop && !stop_requested());
+  return std::nullopt;
+}
+
+// The end line: steps, speed, messages, service calls, parameter changes, the viewers'.
+void print_end_line(const Driver& driver, std::chrono::steady_clock::time_point start,
+                    const control::Controller& controller, const node::NodeServices& services,
+                    const node::DdsSink& sink, const foxglove::Server* server) {
+  const std::int64_t total_steps = driver.steps_done();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const control::ControlCounters counted = controller.counters();
+  const node::NodeServiceCounters served = services.counters();
+  const std::string dropped = served.dropped > 0 ? " (" + std::to_string(served.dropped) + " dropped)" : "";
+  RBSIM_LOG(
+      Info, "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s%s, %s%s\n",
+      stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
+      format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
+      static_cast<unsigned long long>(sink.published()),
+      count_of(static_cast<std::int64_t>(served.received), "service call", "service calls").c_str(),
+      dropped.c_str(),
+      count_of(static_cast<std::int64_t>(counted.parameter_changes), "parameter change", "parameter changes")
+          .c_str(),
+      server ? ("; " + foxglove_summary(*server)).c_str() : "");
+}
+
 int node_command(const NodeArgs& a) {
   // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
   // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
@@ -72,12 +188,7 @@ int node_command(const NodeArgs& a) {
                  st.error().message.c_str());
     return 2;
   }
-  // Each step is encoded once for DDS and the Foxglove server alike.
-  node::NodeOptions node_options = a.node;
-  node_options.stop = stop_requested;
-  node_options.rate = settings.rate;
-  node_options.publish_every = settings.publish_every;
-  node_options.messages = std::make_shared<msgs::StepMessages>(scene, a.node.ns);
+  const node::NodeOptions node_options = sink_options(a, settings, scene);
   auto sink = node::DdsSink::create(participant.value(), node_options);
   if (!sink) return fail("node", sink.error().message);
   // Commands (parameters, pause, step, reset, impulses) apply at step boundaries. The controller
@@ -86,26 +197,11 @@ int node_command(const NodeArgs& a) {
   // The Foxglove server serves beside DDS, steered through the controller. The pacer releases
   // each step when it is due; the Foxglove sink's hand-off to the server's thread (a copy and a
   // wake-up) goes first, so viewers do not wait for the DDS writes.
-  std::unique_ptr<foxglove::Server> server;
-  std::unique_ptr<foxglove::FoxgloveSink> foxglove_sink;
-  foxglove::ChannelId commands_channel = 0;  // /<ns>/commands to viewers, as on DDS
+  NodeFoxglove foxglove;
   if (a.foxglove.address) {
-    foxglove::SinkOptions fo;
-    fo.publish_every = settings.publish_every;
-    fo.topics = a.node.topics;
-    fo.ns = a.node.ns;
-    fo.messages = node_options.messages;
-    std::vector<foxglove::ChannelId> ids;
-    msgs::TopicSet served = fo.topics;
-    served.set(static_cast<std::size_t>(msgs::TopicId::Commands));
-    auto channels = foxglove::ros2_channels(served, a.node.ns, &ids);
-    if (!channels) return fail("node", channels.error().message);
-    auto started = start_foxglove("rbsim node", a.foxglove, std::move(channels.value()), &controller,
-                                  name->fully_qualified());
-    if (!started) return fail("node", started.error().message, foxglove_exit_status(started.error()));
-    server = std::move(started.value());
-    commands_channel = ids[static_cast<std::size_t>(msgs::TopicId::Commands)];
-    foxglove_sink = std::make_unique<foxglove::FoxgloveSink>(*server, std::move(ids), fo);
+    if (std::optional<int> exit =
+            serve_foxglove(a, settings, node_options, controller, name.value(), foxglove))
+      return *exit;
   }
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim node: %s on %s, topics under /%s (and /tf, /clock), rate %s, %lld steps%s\n",
@@ -116,13 +212,7 @@ int node_command(const NodeArgs& a) {
               : settings.paused ? ", paused"
                                 : "");
   }
-  if (a.wait_for > 0) {
-    if (!a.quiet) RBSIM_LOG(Info, "rbsim node: waiting for %d subscriber(s)...\n", a.wait_for);
-    if (!sink.value()->wait_for_subscribers(a.wait_for, stop_requested)) {
-      if (!a.quiet) RBSIM_LOG(Info, "rbsim node: stopped while waiting, nothing published\n");
-      return 0;  // as for a stop while running
-    }
-  }
+  if (a.wait_for > 0 && !wait_for_subscribers(a, *sink.value())) return 0;  // as for a stop while running
   const auto start = std::chrono::steady_clock::now();
   Result<Driver> created = Driver::create(scene);
   if (!created) return fail("node", created.error().message);
@@ -134,67 +224,27 @@ int node_command(const NodeArgs& a) {
   } forget_world{clock_world};
   node::Pacer pacer(settings.rate, settings.publish_every);
   driver.add(pacer);
-  if (foxglove_sink) driver.add(*foxglove_sink);
+  if (foxglove.sink) driver.add(*foxglove.sink);
   driver.add(*sink.value());
-  // Rate and publish_every changes reach the pacer and the publishers at a step boundary.
-  controller.on_settings([&](const control::RunSettings& s) {
-    pacer.set_pace(s.rate, s.publish_every);
-    sink.value()->set_publish_every(s.publish_every);
-    if (foxglove_sink) foxglove_sink->set_publish_every(s.publish_every);
-  });
+  follow_settings(controller, pacer, *sink.value(), foxglove.sink.get());
   // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse)
   // answer through the controller; every parameter change also goes out on /parameter_events
   // (an observer beside the Foxglove server's parameter updates).
   auto services =
       node::NodeServices::create(participant.value(), controller, {name->fully_qualified(), scene.world.dt});
   if (!services) return fail("node", services.error().message);
-  controller.on_command([&applied = *services.value(), &server, commands_channel, dt = scene.world.dt](
-                            const control::Command& c, const control::CommandResult& r) {
-    applied.command_applied(c, r);
-    if (server && commands_channel != 0) {
-      server->publish(commands_channel, msgs::sim_time_ns(r.step >= 0 ? r.step : 0, dt),
-                      applied.last_command());
-    }
-  });
+  publish_commands(controller, *services.value(), foxglove, scene.world.dt);
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;
   options.stop = stop_requested;
   options.control = &controller;
   options.pace = [&pacer](const World& world) { pacer.wait(world); };
-  do {
-    if (Status st = driver.begin(); !st) return fail("node", st.error().message);
-    const Result<PassEnd> end = driver.run(options);
-    if (!end) return fail("node", end.error().message);
-    if (end.value() == PassEnd::Diverged) {
-      // Subscribers still get every step before it (bounded wait for their acknowledgements).
-      const Status flushed = driver.finish();
-      return fail("node", describe_divergence(driver.divergence()) + ". Published steps up to " +
-                              std::to_string(driver.world().step_index() - 1) +
-                              (flushed ? "" : " (" + flushed.error().message + ")") +
-                              " (--allow-nonfinite keeps going).");
-    }
-  } while (a.loop && !stop_requested());
+  if (std::optional<int> exit = run_passes(a, driver, options)) return *exit;
   controller.close("the node stopped");
   if (Status st = driver.finish(); !st) return fail("node", st.error().message);
-  if (!a.quiet) {
-    const std::int64_t total_steps = driver.steps_done();
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const control::ControlCounters counted = controller.counters();
-    const node::NodeServiceCounters served = services.value()->counters();
-    const std::string dropped = served.dropped > 0 ? " (" + std::to_string(served.dropped) + " dropped)" : "";
-    RBSIM_LOG(Info,
-              "rbsim node: %s after %lld steps in %s (%.4g steps/s), %llu messages published, %s%s, %s%s\n",
-              stop_requested() ? "stopped" : "done", static_cast<long long>(total_steps),
-              format_seconds(wall).c_str(), wall > 0 ? static_cast<double>(total_steps) / wall : 0.0,
-              static_cast<unsigned long long>(sink.value()->published()),
-              count_of(static_cast<std::int64_t>(served.received), "service call", "service calls").c_str(),
-              dropped.c_str(),
-              count_of(static_cast<std::int64_t>(counted.parameter_changes), "parameter change",
-                       "parameter changes")
-                  .c_str(),
-              server ? ("; " + foxglove_summary(*server)).c_str() : "");
-  }
+  if (!a.quiet)
+    print_end_line(driver, start, controller, *services.value(), *sink.value(), foxglove.server.get());
   return 0;
 }
 }  // namespace

@@ -50,16 +50,9 @@ bool snapshot_requested() {
   return g_snapshot.exchange(0, std::memory_order_relaxed) != 0;
 }
 
-int record_command(RecordArgs a) {
-  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
-  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
-  install_stop_handlers();
-  if (a.wrong_duration) {
-    RBSIM_LOG(Error,
-              "rbsim record: error: --duration: a recorder runs in wall-clock time: use --wall-duration "
-              "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.");
-    return 2;
-  }
+// The codec, and the outputs OUT names: one .mcap file, or a rosbag2 bag directory (`bag`)
+// holding file 0; the exit status of a choice of options that cannot go together.
+std::optional<int> choose_outputs(RecordArgs& a, std::string& bag, std::vector<OutputPath>& outputs) {
   // A live recorder must keep up with what arrives: zstd at a fast negative level by default, which
   // costs much less CPU than level 1 for somewhat larger files (scripts/bench-record-live measures
   // both). `rbsim run --record` writes offline and keeps level 1.
@@ -68,8 +61,7 @@ int record_command(RecordArgs a) {
   if (!codec) return fail("record", codec.error().message);
   a.rec.compression = codec.value();
   // OUT ending in .mcap is one file; any other path a rosbag2 bag directory, holding file 0.
-  std::string bag;
-  std::vector<OutputPath> outputs{{a.rec.path, "OUT"}};
+  outputs = {{a.rec.path, "OUT"}};
   if (a.max_file_duration)
     a.rec.max_file_duration_ns = static_cast<std::uint64_t>(*a.max_file_duration * 1e9);
   if (a.snapshot_duration)
@@ -88,6 +80,65 @@ int record_command(RecordArgs a) {
     return fail("record", "--snapshot-duration writes one file per snapshot: it takes no --max-file-* option",
                 2);
   }
+  return std::nullopt;
+}
+
+// Records until a stop, --wall-duration or --max-messages; what failed, if anything did.
+std::optional<std::string> record_until_stopped(const RecordArgs& a, node::Recorder& recorder,
+                                                node::RecorderServices& services) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto deadline = a.duration ? start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                 std::chrono::duration<double>(*a.duration))
+                                   : std::chrono::steady_clock::time_point::max();
+  std::optional<std::string> failure;
+  while (!stop_requested() && std::chrono::steady_clock::now() < deadline) {
+    auto polled = recorder.poll(100'000'000);  // 100 ms: Ctrl-C and --wall-duration are seen promptly
+    if (!polled) {
+      failure = polled.error().message;
+      break;
+    }
+    if (a.rec.max_messages > 0 && recorder.received() >= a.rec.max_messages) break;
+    if (Status st = services.carry_out(a.quiet, snapshot_requested()); !st) {
+      failure = st.error().message;
+      break;
+    }
+  }
+  return failure;
+}
+
+// The end lines: per topic what arrived and what was lost, then the totals.
+void print_counts(const node::Recorder& recorder, const std::string& path) {
+  std::uint64_t lost = 0, duplicates = 0;
+  for (const auto& c : recorder.counts()) {
+    RBSIM_LOG(Info, "  %-28s received %8llu  lost %llu%s\n", c.topic.c_str(),
+              static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.lost),
+              c.duplicates > 0 ? ("  delivered twice " + std::to_string(c.duplicates)).c_str() : "");
+    lost += c.lost;
+    duplicates += c.duplicates;
+  }
+  if (duplicates > 0) {
+    RBSIM_LOG(Info,
+              "rbsim record: %llu samples DDS delivered again (after a reconnection) were recorded once\n",
+              static_cast<unsigned long long>(duplicates));
+  }
+  RBSIM_LOG(Info, "rbsim record: %llu messages received, %llu lost, written to %s\n",
+            static_cast<unsigned long long>(recorder.received()), static_cast<unsigned long long>(lost),
+            path.c_str());
+}
+
+int record_command(RecordArgs a) {
+  // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
+  // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
+  install_stop_handlers();
+  if (a.wrong_duration) {
+    RBSIM_LOG(Error,
+              "rbsim record: error: --duration: a recorder runs in wall-clock time: use --wall-duration "
+              "SECONDS (--duration is simulated time elsewhere)\nRun 'rbsim record --help' for usage.");
+    return 2;
+  }
+  std::string bag;
+  std::vector<OutputPath> outputs;
+  if (std::optional<int> exit = choose_outputs(a, bag, outputs)) return *exit;
 
   if (Status st = check_outputs(outputs, {}, a.overwrite); !st) return fail("record", st.error().message);
   std::error_code ec;
@@ -114,45 +165,11 @@ int record_command(RecordArgs a) {
               a.rec.topics.empty() ? "all rbsim" : "the chosen", a.rec.ns.c_str(),
               participant.value().description().c_str(), a.rec.path.c_str());
   }
-  const auto start = std::chrono::steady_clock::now();
-  const auto deadline = a.duration ? start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                 std::chrono::duration<double>(*a.duration))
-                                   : std::chrono::steady_clock::time_point::max();
-  std::optional<std::string> failure;
-  while (!stop_requested() && std::chrono::steady_clock::now() < deadline) {
-    auto polled =
-        recorder.value()->poll(100'000'000);  // 100 ms: Ctrl-C and --wall-duration are seen promptly
-    if (!polled) {
-      failure = polled.error().message;
-      break;
-    }
-    if (a.rec.max_messages > 0 && recorder.value()->received() >= a.rec.max_messages) break;
-    if (Status st = services.value()->carry_out(a.quiet, snapshot_requested()); !st) {
-      failure = st.error().message;
-      break;
-    }
-  }
+  const std::optional<std::string> failure = record_until_stopped(a, *recorder.value(), *services.value());
   // Whatever stopped us, finish a valid indexed file.
   if (Status st = recorder.value()->close(); !st)
     return fail("record", st.error().message + " (the file can be repaired with rbsim log recover)");
-  if (!a.quiet || failure) {
-    std::uint64_t lost = 0, duplicates = 0;
-    for (const auto& c : recorder.value()->counts()) {
-      RBSIM_LOG(Info, "  %-28s received %8llu  lost %llu%s\n", c.topic.c_str(),
-                static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.lost),
-                c.duplicates > 0 ? ("  delivered twice " + std::to_string(c.duplicates)).c_str() : "");
-      lost += c.lost;
-      duplicates += c.duplicates;
-    }
-    if (duplicates > 0) {
-      RBSIM_LOG(Info,
-                "rbsim record: %llu samples DDS delivered again (after a reconnection) were recorded once\n",
-                static_cast<unsigned long long>(duplicates));
-    }
-    RBSIM_LOG(Info, "rbsim record: %llu messages received, %llu lost, written to %s\n",
-              static_cast<unsigned long long>(recorder.value()->received()),
-              static_cast<unsigned long long>(lost), a.rec.path.c_str());
-  }
+  if (!a.quiet || failure) print_counts(*recorder.value(), a.rec.path);
   if (failure) return fail("record", *failure + " (the file was finished up to that point)");
   if (recorder.value()->received() == 0) {  // an empty file is no recording: leave nothing behind
     for (const std::string& f : recorder.value()->files()) std::remove(f.c_str());

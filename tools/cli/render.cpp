@@ -4,6 +4,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/render.hpp"
 #include "validators.hpp"
@@ -34,7 +35,7 @@ int render_command(const RenderArgs& a) {
   Result<std::int64_t> frames = render::render(a.input, o);
   if (!frames) return fail("render", frames.error().message);
   std::fprintf(stderr, "rbsim render: %lld %s (%dx%d at %g fps) in %s\n",
-               static_cast<long long>(frames.value()), frames.value() == 1 ? "frame" : "frames", o.width,
+               static_cast<long long>(frames.value()), plural(frames.value(), "frame", "frames"), o.width,
                o.height, o.fps, a.out.c_str());
   if (!a.mp4.empty()) {
     if (Status st = render::make_movie(a.out, a.fps, frames.value(), a.mp4); !st)

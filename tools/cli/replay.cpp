@@ -11,6 +11,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/replay.hpp"
 #include "rbsim/rosout.hpp"
@@ -93,6 +94,40 @@ std::vector<foxglove::HostedService> player_services(const node::Replay& replay,
   return hosted;
 }
 
+// One Foxglove channel per replayed output, with the recording's own schema.
+std::vector<foxglove::ChannelSpec> foxglove_channels(const node::Replay& replay) {
+  std::vector<foxglove::ChannelSpec> channels;
+  for (const auto& o : replay.outputs()) {
+    foxglove::ChannelSpec c;
+    c.topic = o.topic;
+    c.schema_name = o.type;
+    c.schema = o.schema;
+    c.latched = o.latched;
+    channels.push_back(std::move(c));
+  }
+  return channels;
+}
+
+// The start lines: the file, its span, the rate, then each output with its message count.
+void print_start(const ReplayArgs& a, const node::Replay& replay, const node::Participant& participant) {
+  const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
+  char rate[32] = "as fast as possible";
+  if (a.replay.rate > 0) std::snprintf(rate, sizeof rate, "%gx", a.replay.rate);
+  RBSIM_LOG(Info, "rbsim replay: %s (%s of log time) on %s, rate %s%s:\n", a.replay.path.c_str(),
+            format_seconds(span).c_str(), participant.description().c_str(), rate, a.loop ? ", looping" : "");
+  for (const auto& o : replay.outputs()) {
+    if (o.recorded.empty()) {
+      RBSIM_LOG(Info, "  %-28s (log time of each message)\n", o.topic.c_str());
+    } else if (o.recorded == o.topic) {
+      RBSIM_LOG(Info, "  %-28s %llu messages\n", o.topic.c_str(),
+                static_cast<unsigned long long>(o.messages));
+    } else {
+      RBSIM_LOG(Info, "  %-28s %llu messages, as %s\n", o.recorded.c_str(),
+                static_cast<unsigned long long>(o.messages), o.topic.c_str());
+    }
+  }
+}
+
 int replay_command(ReplayArgs a) {
   // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
   // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
@@ -118,16 +153,7 @@ int replay_command(ReplayArgs a) {
   node::Replay::Tap tap;
   std::uint64_t last_time = 0;
   if (a.foxglove.address) {
-    std::vector<foxglove::ChannelSpec> channels;
-    for (const auto& o : replay.outputs()) {
-      foxglove::ChannelSpec c;
-      c.topic = o.topic;
-      c.schema_name = o.type;
-      c.schema = o.schema;
-      c.latched = o.latched;
-      channels.push_back(std::move(c));
-    }
-    auto started = start_foxglove("rbsim replay", a.foxglove, std::move(channels), nullptr,
+    auto started = start_foxglove("rbsim replay", a.foxglove, foxglove_channels(replay), nullptr,
                                   participant.value().node().fully_qualified(),
                                   player_services(replay, participant.value().node().fully_qualified()));
     if (!started) return fail("replay", started.error().message, foxglove_exit_status(started.error()));
@@ -145,25 +171,7 @@ int replay_command(ReplayArgs a) {
       srv->publish(static_cast<foxglove::ChannelId>(output + 1), t, cdr);
     };
   }
-  if (!a.quiet) {
-    const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
-    char rate[32] = "as fast as possible";
-    if (a.replay.rate > 0) std::snprintf(rate, sizeof rate, "%gx", a.replay.rate);
-    RBSIM_LOG(Info, "rbsim replay: %s (%s of log time) on %s, rate %s%s:\n", a.replay.path.c_str(),
-              format_seconds(span).c_str(), participant.value().description().c_str(), rate,
-              a.loop ? ", looping" : "");
-    for (const auto& o : replay.outputs()) {
-      if (o.recorded.empty()) {
-        RBSIM_LOG(Info, "  %-28s (log time of each message)\n", o.topic.c_str());
-      } else if (o.recorded == o.topic) {
-        RBSIM_LOG(Info, "  %-28s %llu messages\n", o.topic.c_str(),
-                  static_cast<unsigned long long>(o.messages));
-      } else {
-        RBSIM_LOG(Info, "  %-28s %llu messages, as %s\n", o.recorded.c_str(),
-                  static_cast<unsigned long long>(o.messages), o.topic.c_str());
-      }
-    }
-  }
+  if (!a.quiet) print_start(a, replay, participant.value());
   if (a.wait_for > 0) {
     if (!a.quiet) RBSIM_LOG(Info, "rbsim replay: waiting for %d subscriber(s)...\n", a.wait_for);
     if (!replay.wait_for_subscribers(a.wait_for, stop_requested)) {
@@ -188,8 +196,8 @@ int replay_command(ReplayArgs a) {
   if (server) (void)server->flush(2.0);  // viewers that keep up get the end of the log
   if (!a.quiet) {
     RBSIM_LOG(Info, "rbsim replay: %s after %llu complete pass%s, %llu messages published%s\n",
-              complete ? "done" : "stopped", static_cast<unsigned long long>(passes), passes == 1 ? "" : "es",
-              static_cast<unsigned long long>(replay.published()),
+              complete ? "done" : "stopped", static_cast<unsigned long long>(passes),
+              plural(passes, "", "es"), static_cast<unsigned long long>(replay.published()),
               server ? ("; " + foxglove_summary(*server)).c_str() : "");
   }
   return 0;

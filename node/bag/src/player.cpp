@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rbsim/assert.hpp"
 #include "rbsim/clock.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
@@ -114,9 +115,17 @@ PlayerStatus PlayerControl::status() const {
   return s;
 }
 
+void PlayerControl::check_locked() const {
+  RBSIM_ASSERT(rate_ >= 0.0, "the player's rate is 0 (as fast as possible) or positive");
+  RBSIM_ASSERT(seek_answered_ <= seek_serial_, "no seek is answered before it is asked");
+  RBSIM_ASSERT(burst_active_ || burst_left_ == 0, "messages are wanted only by an active burst");
+  RBSIM_ASSERT(!closed_ || (!burst_active_ && !seek_request_), "a closed player holds no request");
+}
+
 PlayerControl::Next PlayerControl::wait_due(std::uint64_t log_time, bool (*stop)()) {
   std::unique_lock lock(mutex_);
   while (true) {
+    check_locked();
     if (stop()) return Next::Stop;
     if (seek_request_) return Next::Seek;
     if (paused_) {
@@ -134,6 +143,7 @@ PlayerControl::Next PlayerControl::wait_due(std::uint64_t log_time, bool (*stop)
 
 void PlayerControl::published(std::uint64_t log_time, std::optional<std::uint64_t> sim_ns) {
   const std::lock_guard lock(mutex_);
+  check_locked();
   if (sim_ns) sim_ns_ = sim_ns;
   if (paused_ && burst_active_ && burst_left_ > 0) {
     anchor_log_ = std::max(anchor_log_, log_time);  // the paused clock stands at what was stepped to
@@ -163,6 +173,7 @@ void PlayerControl::seek_done(bool moved, std::uint64_t log_time) {
   }
   seek_answered_ = seek_serial_;
   seek_answer_ = moved;
+  check_locked();
   answer_.notify_all();
 }
 

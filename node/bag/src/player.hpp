@@ -57,6 +57,8 @@ class PlayerControl {
 
  private:
   std::int64_t due_wall_locked(std::uint64_t log_time) const;
+  // The control's invariants (asserted where the loop acts on it; mutex_ held).
+  void check_locked() const;
   std::uint64_t now_log_locked() const;
   mutable std::mutex mutex_;
   std::condition_variable loop_wake_, answer_;

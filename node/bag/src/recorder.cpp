@@ -3,9 +3,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 #include <optional>
 #include <regex>
 
+#include "rbsim/assert.hpp"
 #include "rbsim/bag.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/recorder.hpp"
@@ -132,7 +134,7 @@ Status Recorder::open_file() {
   if (auto st = writer_.open(
           path, log::writer_options(options_.compression, options_.chunk_size, options_.compression_level));
       !st.ok()) {
-    return Error{path + ": " + st.error().message};
+    return with_context(path + ": ", st.error());
   }
   options_.path = path;  // what errors name
   files_.push_back(path);
@@ -143,7 +145,7 @@ Status Recorder::open_file() {
 
 // Closes the open file of the bag and lists it in metadata.yaml (each file's summary read once).
 Status Recorder::close_bag_file() {
-  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
+  if (auto st = writer_.close(); !st.ok()) return with_context(options_.path + ": ", st.error());
   if (Status st = bag_metadata_.add(options_.path); !st) return st;
   return bag_metadata_.write(options_.bag);
 }
@@ -159,7 +161,7 @@ Status Recorder::split(std::uint64_t log_time) {
     Topic& t = topics_[i];
     if (!t.subscription.spec().latched() || t.last.empty()) continue;
     if (auto st = writer_.write_message(t.channel, t.received - 1, log_time, t.last_source, t.last); !st.ok())
-      return Error{options_.path + ": " + st.error().message};
+      return with_context(options_.path + ": ", st.error());
   }
   return Ok{};
 }
@@ -169,7 +171,7 @@ Status Recorder::add_channels() {
   for (const std::size_t i : channel_order_) {
     Topic& t = topics_[i];
     auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, t.offered);
-    if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
+    if (!channel.ok()) return with_context(options_.path + ": ", channel.error());
     if (channel.value() != t.channel) {
       return Error{options_.path + ": channel of " + t.subscription.ros_topic() + " got id " +
                    std::to_string(channel.value()) + ", not " + std::to_string(t.channel)};
@@ -216,13 +218,13 @@ Result<std::uint64_t> Recorder::snapshot() {
     Topic& t = topics_[i];
     if (!t.subscription.spec().latched() || t.last.empty()) continue;
     if (auto st = writer_.write_message(t.channel, t.received - 1, first, t.last_source, t.last); !st.ok())
-      return Error{options_.path + ": " + st.error().message};
+      return with_context(options_.path + ": ", st.error());
     ++n;
   }
   for (const Kept& k : kept_) {
     if (auto st = writer_.write_message(topics_[k.topic].channel, k.sequence, k.log_time, k.source, k.cdr);
         !st.ok())
-      return Error{options_.path + ": " + st.error().message};
+      return with_context(options_.path + ": ", st.error());
     ++n;
   }
   kept_.clear();
@@ -238,7 +240,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   bool any = false;
   // A chunk compressed while no message came in reaches the file now, not at the next message.
   if (auto st = writer_.is_open() ? writer_.write_compressed_chunk() : Status(Ok{}); !st.ok())
-    return Error{options_.path + ": " + st.error().message};
+    return with_context(options_.path + ": ", st.error());
   Received sample;
   for (Topic& t : topics_) {
     while (t.subscription.take(sample)) {
@@ -290,6 +292,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
     holding_ = false;
     if (Status st = release_held(); !st) return st.error();
   }
+  RBSIM_ASSERT(holding_ || held_.empty(), "samples are held only while a latched topic is awaited");
+  RBSIM_ASSERT(latched_pending_.size() == topics_.size(), "one latched-pending flag per topic");
   return any;
 }
 
@@ -314,7 +318,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
       t.channel = static_cast<std::uint16_t>(channel_order_.size());
     } else {
       auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
-      if (!channel.ok()) return Error{options_.path + ": " + channel.error().message};
+      if (!channel.ok()) return with_context(options_.path + ": ", channel.error());
       t.channel = channel.value();
     }
   }
@@ -327,7 +331,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
   if (snapshots) {
     if (!latched) keep(t, sample, log_time, source);
   } else if (auto st = writer_.write_message(t.channel, t.received, log_time, source, sample.cdr); !st.ok()) {
-    return Error{options_.path + ": " + st.error().message};
+    return with_context(options_.path + ": ", st.error());
   }
   ++t.received;
   const msgs::TopicId id = t.subscription.spec().id;
@@ -365,6 +369,10 @@ bool Recorder::scene_pending() const {
 }
 
 Status Recorder::release_held() {
+  RBSIM_ASSERT(
+      held_bytes_ == std::accumulate(held_.begin(), held_.end(), std::size_t{0},
+                                     [](std::size_t n, const Held& h) { return n + h.sample.cdr.size(); }),
+      "held_bytes_ counts the held samples' bytes");
   // Latched samples first, at the earliest held log time, so the file stays in log-time order.
   const std::uint64_t first = held_.empty() ? 0 : held_.front().log_time;
   for (const bool latched : {true, false}) {
@@ -393,7 +401,7 @@ Status Recorder::close() {
   if (options_.snapshot_duration_ns > 0)
     return Ok{};  // what a snapshot did not take is dropped, as rosbag2's
   if (!options_.bag.empty() && received_ > 0) return close_bag_file();
-  if (auto st = writer_.close(); !st.ok()) return Error{options_.path + ": " + st.error().message};
+  if (auto st = writer_.close(); !st.ok()) return with_context(options_.path + ": ", st.error());
   return Ok{};
 }
 

@@ -103,8 +103,9 @@ template <class Res>
 Result<Res> decode_reply(std::span<const std::byte> reply, const RemoteSteeringOptions& o) {
   Res res;
   if (Status st = msgs::decode(reply, res); !st) {
-    return Error{"node " + o.node + " replied with a malformed " + std::string(Res::kService) +
-                 " response: " + st.error().message};
+    return with_context(
+        "node " + o.node + " replied with a malformed " + std::string(Res::kService) + " response: ",
+        st.error());
   }
   return res;
 }
@@ -116,7 +117,7 @@ Result<Res> call(ServiceClient& client, const Req& request, const RemoteSteering
   Bytes body;
   msgs::encode(request, body);
   Result<Bytes> reply = client.call(body, o.call_timeout_s);
-  if (!reply) return Error{"node " + o.node + ": " + reply.error().message};
+  if (!reply) return with_context("node " + o.node + ": ", reply.error());
   return decode_reply<Res>(reply.value(), o);
 }
 

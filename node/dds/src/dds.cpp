@@ -14,6 +14,7 @@
 
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
+#include "rbsim/clock.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/graph.hpp"
 #include "rbsim/rosout.hpp"
@@ -158,7 +159,7 @@ Result<Participant> Participant::create(std::uint32_t domain, const NodeName& no
   Participant participant(
       p, s.domain, s.describe() + (security->requested ? ", " + security->describe() : ""), node, s.distro);
   auto graph = Graph::create(participant, node, s.distro);
-  if (!graph) return Error{"cannot publish the node on ros_discovery_info: " + graph.error().message};
+  if (!graph) return with_context("cannot publish the node on ros_discovery_info: ", graph.error());
   participant.graph_ = std::move(graph.value());
   return participant;
 }
@@ -256,6 +257,15 @@ std::int32_t Publisher::matched() const {
   dds_publication_matched_status_t st{};
   if (dds_get_publication_matched_status(writer_, &st) < 0) return 0;
   return static_cast<std::int32_t>(st.current_count);
+}
+
+bool Publisher::wait_for_subscribers(std::int32_t count, bool (*stop)()) const {
+  constexpr std::int64_t kPoll = 20'000'000;
+  while (matched() < count) {
+    if (stop != nullptr && stop()) return false;
+    sleep_until(monotonic_ns() + kPoll);  // a signal ends it early: stop is looked at next
+  }
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -208,27 +208,25 @@ Result<std::optional<std::uint32_t>> domain_from_environment(const RosEnvironmen
   return std::optional<std::uint32_t>(id.value());
 }
 
-Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
-                                         std::optional<std::uint32_t> explicit_domain, std::int64_t pid) {
-  DdsSettings s;
-  DistroChoice distro = resolve_ros_distro(env);
-  s.distro = distro.distro;
-  if (distro.warning) s.warnings.push_back(*distro.warning);
-  // The domain: --domain, else ROS_DOMAIN_ID, else 0 (rcl_get_default_domain_id).
+namespace {
+// The domain: --domain, else ROS_DOMAIN_ID, else 0 (rcl_get_default_domain_id).
+Result<std::uint32_t> resolve_domain(const RosEnvironment& env,
+                                     std::optional<std::uint32_t> explicit_domain) {
   if (explicit_domain) {
     if (*explicit_domain > kMaxDomainId) {
       return Error{"domain id " + std::to_string(*explicit_domain) + " out of range [0, " +
                    std::to_string(kMaxDomainId) + "]"};
     }
-    s.domain = *explicit_domain;
-  } else {
-    auto from_env = domain_from_environment(env);
-    if (!from_env) return from_env.error();
-    s.domain = from_env.value().value_or(0);
+    return *explicit_domain;
   }
+  auto from_env = domain_from_environment(env);
+  if (!from_env) return from_env.error();
+  return from_env.value().value_or(0);
+}
 
-  // ROS_LOCALHOST_ONLY (rcl_get_localhost_only): "1" enables it; rcl takes any other non-empty
-  // value for "disabled", rbsim only "0" and refuses the rest (a "true" meant to enable it).
+// ROS_LOCALHOST_ONLY (rcl_get_localhost_only): "1" enables it; rcl takes any other non-empty
+// value for "disabled", rbsim only "0" and refuses the rest (a "true" meant to enable it).
+Result<bool> localhost_only_from(const RosEnvironment& env) {
   bool localhost_only = false;
   if (!empty(env.ros_localhost_only)) {
     if (*env.ros_localhost_only == "1") {
@@ -238,9 +236,12 @@ Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
                    " is neither 1 nor 0 (deprecated: use ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)"};
     }
   }
+  return localhost_only;
+}
 
-  // ROS_AUTOMATIC_DISCOVERY_RANGE (rcl_get_automatic_discovery_range): exact names, empty or
-  // unset means LOCALHOST; rcl warns about an unknown value and assumes LOCALHOST, rbsim refuses it.
+// ROS_AUTOMATIC_DISCOVERY_RANGE (rcl_get_automatic_discovery_range): exact names, empty or
+// unset means LOCALHOST; rcl warns about an unknown value and assumes LOCALHOST, rbsim refuses it.
+Result<DiscoveryRange> discovery_range_from(const RosEnvironment& env) {
   DiscoveryRange range = DiscoveryRange::Localhost;
   if (!empty(env.ros_automatic_discovery_range)) {
     const std::string& v = *env.ros_automatic_discovery_range;
@@ -257,6 +258,74 @@ Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
                    " is not a discovery range: LOCALHOST, SUBNET, OFF or SYSTEM_DEFAULT"};
     }
   }
+  return range;
+}
+
+// check_create_domain in rmw_cyclonedds_cpp: which range adds which Cyclone settings.
+void configure_discovery(DdsSettings& s, DiscoveryRange range, const std::vector<std::string>& peers,
+                         std::int64_t pid) {
+  switch (range) {
+    case DiscoveryRange::Localhost: {
+      // rbsim's loopback configuration, byte for byte, unless there are static peers: they are
+      // added after 127.0.0.1 (as rmw adds them after localhost); a peer on another host needs
+      // Cyclone's own choice of network interface instead of the loopback one. No multicast.
+      if (peers.empty()) {
+        s.config = std::string(kLoopbackConfig);
+        break;
+      }
+      bool all_local = true;
+      for (const std::string& p : peers) all_local = all_local && is_loopback_peer(p);
+      std::vector<std::string> with_local{"127.0.0.1"};
+      with_local.insert(with_local.end(), peers.begin(), peers.end());
+      s.static_peers = peers;
+      s.config = std::string(kHead) + "<General>" + (all_local ? std::string(kLoopbackInterface) : "") +
+                 "<AllowMulticast>false</AllowMulticast></General><Discovery>" + std::string(kIndexAndLease) +
+                 peers_xml(with_local) + "</Discovery>" + std::string(kTail);
+      break;
+    }
+    case DiscoveryRange::Subnet:
+      // Cyclone's interface selection and multicast; unicast discovery to the static peers too.
+      s.static_peers = peers;
+      s.config = std::string(kHead) + "<Discovery>" + std::string(kIndexAndLease) +
+                 (peers.empty() ? "" : peers_xml(peers)) + "</Discovery>" + std::string(kTail);
+      break;
+    case DiscoveryRange::Off:
+      // No discovery beyond this process: no multicast, no peers, no participant index, and a
+      // discovery tag no other process has (rmw's "ros_discovery_off_<pid>"). rbsim also keeps
+      // to the loopback interface: nothing needs to leave the host.
+      if (!peers.empty()) {
+        s.warnings.emplace_back("ROS_AUTOMATIC_DISCOVERY_RANGE=OFF: ROS_STATIC_PEERS is ignored");
+      }
+      s.config = std::string(kHead) + "<General>" + std::string(kLoopbackInterface) +
+                 "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>none</"
+                 "ParticipantIndex><Tag>ros_discovery_off_" +
+                 std::to_string(pid) + "</Tag></Discovery>" + std::string(kTail);
+      break;
+    case DiscoveryRange::SystemDefault:
+      // Cyclone's defaults untouched.
+      if (!peers.empty()) {
+        s.warnings.emplace_back("ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT: ROS_STATIC_PEERS is ignored");
+      }
+      break;
+  }
+}
+}  // namespace
+
+Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
+                                         std::optional<std::uint32_t> explicit_domain, std::int64_t pid) {
+  DdsSettings s;
+  DistroChoice distro = resolve_ros_distro(env);
+  s.distro = distro.distro;
+  if (distro.warning) s.warnings.push_back(*distro.warning);
+  auto domain = resolve_domain(env, explicit_domain);
+  if (!domain) return domain.error();
+  s.domain = domain.value();
+  auto localhost_only_set = localhost_only_from(env);
+  if (!localhost_only_set) return localhost_only_set.error();
+  const bool localhost_only = localhost_only_set.value();
+  auto range_set = discovery_range_from(env);
+  if (!range_set) return range_set.error();
+  DiscoveryRange range = range_set.value();
   auto peers = parse_peers(env.ros_static_peers.value_or(""));
   if (!peers) return peers.error();
 
@@ -283,53 +352,7 @@ Result<DdsSettings> resolve_dds_settings(const RosEnvironment& env,
     }
     return s;
   }
-
-  // check_create_domain in rmw_cyclonedds_cpp: which range adds which Cyclone settings.
-  switch (range) {
-    case DiscoveryRange::Localhost: {
-      // rbsim's loopback configuration, byte for byte, unless there are static peers: they are
-      // added after 127.0.0.1 (as rmw adds them after localhost); a peer on another host needs
-      // Cyclone's own choice of network interface instead of the loopback one. No multicast.
-      if (peers.value().empty()) {
-        s.config = std::string(kLoopbackConfig);
-        break;
-      }
-      bool all_local = true;
-      for (const std::string& p : peers.value()) all_local = all_local && is_loopback_peer(p);
-      std::vector<std::string> with_local{"127.0.0.1"};
-      with_local.insert(with_local.end(), peers.value().begin(), peers.value().end());
-      s.static_peers = peers.value();
-      s.config = std::string(kHead) + "<General>" + (all_local ? std::string(kLoopbackInterface) : "") +
-                 "<AllowMulticast>false</AllowMulticast></General><Discovery>" + std::string(kIndexAndLease) +
-                 peers_xml(with_local) + "</Discovery>" + std::string(kTail);
-      break;
-    }
-    case DiscoveryRange::Subnet:
-      // Cyclone's interface selection and multicast; unicast discovery to the static peers too.
-      s.static_peers = peers.value();
-      s.config = std::string(kHead) + "<Discovery>" + std::string(kIndexAndLease) +
-                 (peers.value().empty() ? "" : peers_xml(peers.value())) + "</Discovery>" +
-                 std::string(kTail);
-      break;
-    case DiscoveryRange::Off:
-      // No discovery beyond this process: no multicast, no peers, no participant index, and a
-      // discovery tag no other process has (rmw's "ros_discovery_off_<pid>"). rbsim also keeps
-      // to the loopback interface: nothing needs to leave the host.
-      if (!peers.value().empty()) {
-        s.warnings.emplace_back("ROS_AUTOMATIC_DISCOVERY_RANGE=OFF: ROS_STATIC_PEERS is ignored");
-      }
-      s.config = std::string(kHead) + "<General>" + std::string(kLoopbackInterface) +
-                 "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>none</"
-                 "ParticipantIndex><Tag>ros_discovery_off_" +
-                 std::to_string(pid) + "</Tag></Discovery>" + std::string(kTail);
-      break;
-    case DiscoveryRange::SystemDefault:
-      // Cyclone's defaults untouched.
-      if (!peers.value().empty()) {
-        s.warnings.emplace_back("ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT: ROS_STATIC_PEERS is ignored");
-      }
-      break;
-  }
+  configure_discovery(s, range, peers.value(), pid);
   return s;
 }
 

@@ -425,7 +425,7 @@ Result<ServiceServer> ServiceServer::create(const Participant& participant, std:
       user_data + options.reply_user_data, service_request_topic(service), service_request_type(srv_type),
       user_data + options.request_user_data, std::max(depth, 10), DDS_MSECS(10), listener, impl->dds);
   dds_delete_listener(listener);
-  if (!st) return Error{"service " + std::string(service) + ": " + st.error().message};
+  if (!st) return with_context("service " + std::string(service) + ": ", st.error());
   return ServiceServer(std::move(impl));
 }
 
@@ -496,7 +496,7 @@ Result<ServiceClient> ServiceClient::create(const Participant& participant, std:
                              service_request_type(srv_type), user_data + options.request_user_data,
                              service_reply_topic(service), service_response_type(srv_type),
                              user_data + options.reply_user_data, 10, DDS_SECS(1), nullptr, impl->dds);
-  if (!st) return Error{"client of " + std::string(service) + ": " + st.error().message};
+  if (!st) return with_context("client of " + std::string(service) + ": ", st.error());
   impl->id = endpoint_id(impl->dds.writer).instance_handle;
   impl->condition = dds_create_readcondition(impl->dds.reader, DDS_ANY_STATE);
   impl->waitset = dds_create_waitset(participant.handle());

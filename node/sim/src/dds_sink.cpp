@@ -68,11 +68,7 @@ bool DdsSink::wait_for_subscribers(std::int32_t count, bool (*stop)()) {
       std::find_if(ids_.begin(), ids_.end(), [](msgs::TopicId id) { return msgs::topic(id).per_step; });
   const auto& watched =
       publishers_[static_cast<std::size_t>(per_step != ids_.end() ? *per_step : ids_.front())];
-  while (watched->matched() < count) {
-    if (stop()) return false;
-    sleep_until(monotonic_ns() + 20'000'000);
-  }
-  return true;
+  return watched->wait_for_subscribers(count, stop);
 }
 
 Status Pacer::begin(const Scene&, const World& world) {

@@ -98,13 +98,13 @@ struct NodeServices::Impl {
   // reply (these responses have no field to say so).
   void add_parameters(std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>>& out) {
     using namespace msgs;
-    out.emplace_back("list_parameters", "rcl_interfaces/srv/ListParameters",
+    out.emplace_back("list_parameters", std::string(ListParametersRequest::kService),
                      typed_handler<ListParametersRequest, ListParametersResponse>(
                          [this](const RequestHeader&, const ListParametersRequest& req) {
                            return ListParametersResponse{controller.list(req.prefixes, req.depth)};
                          },
                          [](const Error&) { return std::optional<ListParametersResponse>(); }));
-    out.emplace_back("get_parameters", "rcl_interfaces/srv/GetParameters",
+    out.emplace_back("get_parameters", std::string(GetParametersRequest::kService),
                      typed_handler<GetParametersRequest, GetParametersResponse>(
                          [this](const RequestHeader&, const GetParametersRequest& req) {
                            GetParametersResponse res;
@@ -115,7 +115,7 @@ struct NodeServices::Impl {
                            return res;
                          },
                          [](const Error&) { return std::optional<GetParametersResponse>(); }));
-    out.emplace_back("describe_parameters", "rcl_interfaces/srv/DescribeParameters",
+    out.emplace_back("describe_parameters", std::string(DescribeParametersRequest::kService),
                      typed_handler<DescribeParametersRequest, DescribeParametersResponse>(
                          [this](const RequestHeader&, const DescribeParametersRequest& req) {
                            DescribeParametersResponse res;
@@ -126,7 +126,7 @@ struct NodeServices::Impl {
                            return res;
                          },
                          [](const Error&) { return std::optional<DescribeParametersResponse>(); }));
-    out.emplace_back("get_parameter_types", "rcl_interfaces/srv/GetParameterTypes",
+    out.emplace_back("get_parameter_types", std::string(GetParameterTypesRequest::kService),
                      typed_handler<GetParameterTypesRequest, GetParameterTypesResponse>(
                          [this](const RequestHeader&, const GetParameterTypesRequest& req) {
                            GetParameterTypesResponse res;
@@ -135,7 +135,7 @@ struct NodeServices::Impl {
                            return res;
                          },
                          [](const Error&) { return std::optional<GetParameterTypesResponse>(); }));
-    out.emplace_back("set_parameters", "rcl_interfaces/srv/SetParameters",
+    out.emplace_back("set_parameters", std::string(SetParametersRequest::kService),
                      typed_handler<SetParametersRequest, SetParametersResponse>(
                          [this](const RequestHeader&, const SetParametersRequest& req) {
                            Command c;
@@ -149,7 +149,7 @@ struct NodeServices::Impl {
                            return SetParametersResponse{std::move(r.results)};
                          },
                          [](const Error&) { return std::optional<SetParametersResponse>(); }));
-    out.emplace_back("set_parameters_atomically", "rcl_interfaces/srv/SetParametersAtomically",
+    out.emplace_back("set_parameters_atomically", std::string(SetParametersAtomicallyRequest::kService),
                      typed_handler<SetParametersAtomicallyRequest, SetParametersAtomicallyResponse>(
                          [this](const RequestHeader&, const SetParametersAtomicallyRequest& req) {
                            Command c;

@@ -238,6 +238,14 @@ class World {
   // vectorised.
   bool velocities_within(double limit) const;
 
+  // The invariants of the arrays at a step boundary: one entry per body in every per-body array,
+  // positive finite masses, inertias and radii, every shape, spring end and wind moment index in
+  // range, cos/sin equal to those of theta wherever springs or wind read them (a writer of
+  // state_columns() that forgot sync_rotations() breaks this one), dt > 0, step >= 0. Returns the
+  // first one broken. step() asserts it (RBSIM_ASSERT: Debug builds and the sanitizer stage); it
+  // costs a pass over the arrays.
+  [[nodiscard]] Status validate() const;
+
   // Heap bytes held by the world (capacity of every array), for the per-body memory budget.
   std::size_t memory_bytes() const;
   std::int32_t shape_count() const { return static_cast<std::int32_t>(shapes_.size()); }

@@ -364,7 +364,7 @@ std::string stem_of(const std::string& path) {
 
 Result<Scene> parse_scene(std::string_view text, const std::string& path) {
   Result<std::string> renamed = rename_repeated_attributes(text);
-  if (!renamed) return Error{path + ":" + renamed.error().message};
+  if (!renamed) return with_context(path + ":", renamed.error());
   const std::string& rewritten = renamed.value();
   tinyxml2::XMLDocument doc;
   doc.Parse(rewritten.data(), rewritten.size());
@@ -389,7 +389,7 @@ Result<Scene> parse_scene(std::string_view text, const std::string& path) {
   scene.path = path;
   scene.name = stem_of(path);
   // Backstop: anything the loader let through must also satisfy the core's own validation.
-  if (Result<World> w = World::create(scene.world); !w) return Error{path + ": " + w.error().message};
+  if (Result<World> w = World::create(scene.world); !w) return with_context(path + ": ", w.error());
   return scene;
 }
 

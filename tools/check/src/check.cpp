@@ -143,7 +143,7 @@ class Comparer {
     // The summary first: a clear error for a truncated or non-MCAP file before any comparing, and
     // the file's whole topic list (so messages of a topic the other file lacks are not queued).
     auto recording = log::Recording::open(s.path, log::raw_options());  // any file, whatever it carries
-    if (!recording) return Error{s.role + " log " + recording.error().message};
+    if (!recording) return with_context(s.role + " log ", recording.error());
     const log::Recording& r = *recording.value();
     s.header = r.header();
     for (const log::RecordedChannel& c : r.channels()) s.summary_topics.insert(c.channel->topic);
@@ -151,7 +151,7 @@ class Comparer {
     // only channels it lists (rbsim writes indexes and repeats channels; other writers may not).
     s.summary_known = r.lists_every_channel();
     if (Status st = read_dt(s, *recording.value()); !st) return st;
-    if (Status st = s.pump.open(s.path); !st) return Error{s.role + " log " + st.error().message};
+    if (Status st = s.pump.open(s.path); !st) return with_context(s.role + " log ", st.error());
     return Ok{};
   }
 
@@ -170,7 +170,7 @@ class Comparer {
       if (scene) s.scene = std::move(scene.value());
       return false;
     });
-    if (!st) return Error{s.role + " log " + st.error().message};
+    if (!st) return with_context(s.role + " log ", st.error());
     return Ok{};
   }
 
@@ -191,7 +191,7 @@ class Comparer {
     Side& s = side_[si];
     mcap::Record* next = s.pump.next();
     if (next == nullptr) {
-      if (Status st = s.pump.status(); !st) return Error{s.role + " log " + st.error().message};
+      if (Status st = s.pump.status(); !st) return with_context(s.role + " log ", st.error());
       s.done = true;
       return Ok{};
     }
@@ -260,14 +260,14 @@ class Comparer {
                                     info.schema_data.size());
         auto decoder = msgs::MessageDecoder::create(info.schema_name, text);
         if (!decoder) {
-          return Error{with_path(
-              side_[si], "schema " + info.schema_name + " of " + t.name + ": " + decoder.error().message)};
+          return with_context(with_path(side_[si], "schema " + info.schema_name + " of " + t.name + ": "),
+                              decoder.error());
         }
         t.decoder[si] = std::move(decoder.value());
         auto layout = Layout::create(info.schema_name, text);
         if (!layout) {
-          return Error{with_path(
-              side_[si], "schema " + info.schema_name + " of " + t.name + ": " + layout.error().message)};
+          return with_context(with_path(side_[si], "schema " + info.schema_name + " of " + t.name + ": "),
+                              layout.error());
         }
         if (si == kRun) {
           t.layout = std::move(layout.value());
@@ -461,8 +461,8 @@ class Comparer {
 
   Status decode(Topic& t, int si, const Pending& p, std::vector<Scalar>& out) {
     if (Status st = t.decoder[si]->decode(p.data, out); !st) {
-      return Error{
-          with_path(side_[si], t.name + " message " + std::to_string(p.index) + ": " + st.error().message)};
+      return with_context(with_path(side_[si], t.name + " message " + std::to_string(p.index) + ": "),
+                          st.error());
     }
     return Ok{};
   }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rbsim/check.hpp"
+#include "rbsim/counts.hpp"
 #include "sentences.hpp"
 
 namespace rbsim::check {
@@ -68,7 +69,7 @@ void append_table(std::string& out, const CheckReport& r, bool all_fields) {
   }
   if (identical > 0) {
     append(out, "  %s%zu field%s identical%s\n", rows.empty() ? "all " : "", identical,
-           identical == 1 ? "" : "s", all_fields || rows.empty() ? "" : " (--all-fields lists them)");
+           plural(identical, "", "s"), all_fields || rows.empty() ? "" : " (--all-fields lists them)");
   }
 }
 
@@ -76,15 +77,6 @@ void append_table(std::string& out, const CheckReport& r, bool all_fields) {
 
 // ---------------------------------------------------------------------------------------------
 // The sentences (sentences.hpp).
-
-std::string grouped(std::uint64_t n) {
-  std::string digits = std::to_string(n), out;
-  for (std::size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
-}
 
 std::string ordinal(std::uint64_t n) {
   const std::uint64_t tens = n % 100, ones = n % 10;
@@ -154,8 +146,8 @@ std::string step_runs_text(const StepRuns& runs) {
 
 std::string only_summary(const StepRuns& runs, bool golden_only, const StepTrack& r, const StepTrack& g) {
   std::string out = std::string(golden_only ? "run lacks steps " : "run has extra steps ") +
-                    step_runs_text(runs) + " (" + grouped(runs.count) +
-                    (runs.count == 1 ? " message" : " messages");
+                    step_runs_text(runs) + " (" + group_digits(runs.count) +
+                    plural(runs.count, " message", " messages");
   std::vector<std::string> hints;
   if (r.stride != 0 && g.stride != 0 && r.stride != g.stride) {
     hints.push_back("golden recorded " +
@@ -339,8 +331,8 @@ std::string format_report(const std::string& run, const std::string& golden, con
   append_table(out, r, format.all_fields);
   const double mb = static_cast<double>(r.run_bytes + r.golden_bytes) / 1e6;
   append(out, "%zu topic%s, %llu message pair%s, %s MB of message data", r.topics.size(),
-         r.topics.size() == 1 ? "" : "s", static_cast<unsigned long long>(r.messages),
-         r.messages == 1 ? "" : "s", g(mb).c_str());
+         plural(r.topics.size(), "", "s"), static_cast<unsigned long long>(r.messages),
+         plural(r.messages, "", "s"), g(mb).c_str());
   if (format.wall_seconds) {
     const double wall = *format.wall_seconds;
     append(out, " in %s s (%s MB/s)", g(wall).c_str(), g(wall > 0 ? mb / wall : 0.0).c_str());

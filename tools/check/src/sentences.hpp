@@ -12,7 +12,6 @@
 namespace rbsim::check {
 
 // Numbers and values.
-std::string grouped(std::uint64_t n);           // "1,000"
 std::string ordinal(std::uint64_t n);           // "2nd", "10th"
 std::string fmt_short(double v);                // "%.6g"
 std::string value_text(const msgs::Scalar& s);  // floats in shortest round-trip form

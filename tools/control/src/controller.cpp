@@ -179,6 +179,12 @@ void Controller::take_incoming() {
     };
     schedule_.insert(std::upper_bound(schedule_.begin(), schedule_.end(), p, later), std::move(p));
   }
+  RBSIM_ASSERT(std::is_sorted(schedule_.begin(), schedule_.end(),
+                              [](const Pending& a, const Pending& b) {
+                                return a.command.step != b.command.step ? a.command.step < b.command.step
+                                                                        : a.sequence < b.sequence;
+                              }),
+               "the schedule is in (step, arrival) order");
 }
 
 bool Controller::due(std::int64_t step) const {
@@ -240,6 +246,7 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     idled = true;
   }
   if (settings_.paused) --step_budget_;  // one step of a `step N`
+  RBSIM_ASSERT(step_budget_ >= 0, "a step N never steps more than N");
   // Wall time went on while the loop idled: pacers start afresh from here.
   if (idled) b.timeline_changed = true;
   return b;

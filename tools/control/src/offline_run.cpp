@@ -64,7 +64,7 @@ Result<std::unique_ptr<OfflineRun>> OfflineRun::prepare(const OfflineRunDef& def
     commands = std::move(read.value());
   }
   Result<Driver> driver = Driver::create(run->scene_);
-  if (!driver) return Error{run->scene_.path + ": " + driver.error().message};
+  if (!driver) return with_context(run->scene_.path + ": ", driver.error());
   run->driver_.emplace(std::move(driver.value()));
   if (!def.commands.empty()) run->script_.emplace(run->scene_, run->steps_, std::move(commands));
   run->commands_ = def.commands;

@@ -54,9 +54,9 @@ struct FileParser {
       }
       Result<ParameterValue> value = yaml_value(kv.second);
       if (!value) {
-        return Error{yaml_line(path, kv.second.IsNull() ? kv.first : kv.second) + ": parameter '" + name +
-                         "': " + value.error().message,
-                     ErrorCode::InvalidArgument};
+        return with_context(
+            yaml_line(path, kv.second.IsNull() ? kv.first : kv.second) + ": parameter '" + name + "': ",
+            value.error(), ErrorCode::InvalidArgument);
       }
       out.push_back({{name, std::move(value.value())}, yaml_line(path, kv.second), wildcard});
     }
@@ -178,8 +178,8 @@ Result<std::vector<ParameterOverride>> parse_ros_args(const std::vector<std::str
     const std::string name = arg.substr(0, assign);
     Result<ParameterValue> value = parse_parameter_value(std::string_view(arg).substr(assign + 2));
     if (!value) {
-      return Error{t + " " + arg + ": parameter '" + name + "': " + value.error().message,
-                   ErrorCode::InvalidArgument};
+      return with_context(t + " " + arg + ": parameter '" + name + "': ", value.error(),
+                          ErrorCode::InvalidArgument);
     }
     out.push_back({{name, std::move(value.value())}, t + " " + arg, false});
   }

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "rbsim/command_script.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/recording.hpp"
 
 namespace rbsim::control {
@@ -36,7 +37,7 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
   if (!recorded) return recorded.error();
   for (const msgs::CommandMessage& m : recorded.value()) {
     Result<Command> c = from_message(m);
-    if (!c) return Error{path + ": " + c.error().message};
+    if (!c) return with_context(path + ": ", c.error());
     out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq)});
   }
   return out;
@@ -77,7 +78,7 @@ Status ScriptedRun::finish(const std::string& path) {
   }
   if (mismatches_.empty()) return Ok{};
   return Error{path + ": " + std::to_string(mismatches_.size()) +
-               (mismatches_.size() == 1 ? " command" : " commands") + " (of " +
+               plural(mismatches_.size(), " command", " commands") + " (of " +
                std::to_string(counted.commands) + ") did not apply as " +
                (is_recording_path(path) ? "recorded" : "written")};
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "parameter_requests.hpp"
 #include "protocol_util.hpp"
 
 namespace rbsim::foxglove {
@@ -238,6 +239,35 @@ void parameter_op(const std::string& op, const nlohmann::json& j, ClientProtocol
     r.untyped_integer.push_back(untyped);
   }
   if (!r.values.empty() || list->empty()) out.parameters = std::move(r);
+}
+
+void keep_known_names(ParameterRequest& r, const std::unordered_map<std::string, std::size_t>& index,
+                      std::vector<std::string>& problems) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    if (index.count(r.values[k].name) == 0) {
+      problems.push_back("no parameter '" + r.values[k].name.substr(0, 200) + "'");
+      continue;
+    }
+    if (kept != k) {
+      r.values[kept] = std::move(r.values[k]);
+      r.untyped_integer[kept] = r.untyped_integer[k];
+    }
+    ++kept;
+  }
+  r.values.resize(kept);
+  r.untyped_integer.resize(kept);
+  for (const msgs::Parameter& p : r.values) r.names.push_back(p.name);
+}
+
+void type_untyped_integers(ParameterRequest& r, const std::vector<msgs::ParameterType>& types) {
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    msgs::ParameterValue& v = r.values[k].value;
+    if (r.untyped_integer[k] && types[k] == msgs::ParameterType::Double &&
+        v.integer_value >= -(std::int64_t{1} << 53) && v.integer_value <= (std::int64_t{1} << 53)) {
+      v = msgs::ParameterValue::of_double(static_cast<double>(v.integer_value));
+    }
+  }
 }
 
 }  // namespace detail

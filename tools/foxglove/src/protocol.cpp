@@ -172,6 +172,100 @@ std::uint32_t read_u32(std::string_view b, std::size_t at) {
   for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(b[at + static_cast<std::size_t>(i)]);
   return v;
 }
+// A text frame as a JSON object with an "op" string; nullopt (and the status error in `out`) when
+// it is not one.
+std::optional<nlohmann::json> parse_request(std::string_view frame, ClientProtocol::Outcome& out) {
+  auto error = [&](const std::string& m) { out.replies.push_back(status_json(StatusLevel::Error, m)); };
+  if (frame.size() > kMaxClientFrame) {
+    error("message of " + std::to_string(frame.size()) + " bytes refused: the limit is " +
+          std::to_string(kMaxClientFrame));
+    return std::nullopt;
+  }
+  if (too_deep(frame)) {
+    error("malformed message: JSON nested deeper than " + std::to_string(kMaxDepth));
+    return std::nullopt;
+  }
+  nlohmann::json j = nlohmann::json::parse(frame.begin(), frame.end(), nullptr, false);
+  if (j.is_discarded()) {
+    error("malformed message: not valid JSON");
+    return std::nullopt;
+  }
+  if (!j.is_object()) {
+    error("malformed message: not a JSON object");
+    return std::nullopt;
+  }
+  const auto op_it = j.find("op");
+  if (op_it == j.end() || !op_it->is_string()) {
+    error("malformed message: no \"op\" string");
+    return std::nullopt;
+  }
+  return j;
+}
+
+// subscribe: each valid entry takes effect, each invalid one is a problem. A request that is no
+// array is one status error (before any problem, so the caller's flush adds nothing).
+void subscribe(const nlohmann::json& j, std::vector<std::optional<SubscriptionId>>& by_channel,
+               std::size_t& count, ClientProtocol::Outcome& out, Problems& problems) {
+  const auto subs = j.find("subscriptions");
+  if (subs == j.end() || !subs->is_array()) {
+    out.replies.push_back(status_json(StatusLevel::Error, "subscribe: \"subscriptions\" must be an array"));
+    return;
+  }
+  for (const nlohmann::json& s : *subs) {
+    if (!s.is_object()) {
+      problems.add("subscribe: entry " + shown(s) + " is not an object");
+      continue;
+    }
+    std::uint32_t id = 0, ch = 0;
+    if (!member_id(s, "id", id) || !member_id(s, "channelId", ch)) {
+      problems.add("subscribe: entry " + shown(s) + " needs integer \"id\" and \"channelId\" in [0, 2^32)");
+      continue;
+    }
+    if (ch == 0 || ch > by_channel.size()) {
+      problems.add("subscribe: unknown channel " + std::to_string(ch));
+      continue;
+    }
+    if (by_channel[ch - 1]) {
+      problems.add("subscribe: already subscribed to channel " + std::to_string(ch) + " (subscription " +
+                   std::to_string(*by_channel[ch - 1]) + ")");
+      continue;
+    }
+    if (std::find(by_channel.begin(), by_channel.end(), std::optional<SubscriptionId>(id)) !=
+        by_channel.end()) {
+      problems.add("subscribe: subscription id " + std::to_string(id) + " is already in use");
+      continue;
+    }
+    by_channel[ch - 1] = id;
+    ++count;
+    out.subscribed.push_back({id, ch});
+  }
+}
+
+// unsubscribe: as subscribe, each known id ended, each other one a problem.
+void unsubscribe(const nlohmann::json& j, std::vector<std::optional<SubscriptionId>>& by_channel,
+                 std::size_t& count, ClientProtocol::Outcome& out, Problems& problems) {
+  const auto ids = j.find("subscriptionIds");
+  if (ids == j.end() || !ids->is_array()) {
+    out.replies.push_back(
+        status_json(StatusLevel::Error, "unsubscribe: \"subscriptionIds\" must be an array"));
+    return;
+  }
+  for (const nlohmann::json& v : *ids) {
+    std::uint32_t id = 0;
+    if (!as_id(v, id)) {
+      problems.add("unsubscribe: " + shown(v) + " is not a subscription id");
+      continue;
+    }
+    const auto it = std::find(by_channel.begin(), by_channel.end(), std::optional<SubscriptionId>(id));
+    if (it == by_channel.end()) {
+      problems.add("unsubscribe: unknown subscription " + std::to_string(id));
+      continue;
+    }
+    it->reset();
+    --count;
+    out.unsubscribed.push_back({id, static_cast<ChannelId>(it - by_channel.begin() + 1)});
+  }
+}
 }  // namespace
 
 ClientProtocol::ClientProtocol(std::uint32_t channel_count, bool parameters, std::uint32_t service_count)
@@ -233,86 +327,16 @@ void ClientProtocol::handle_binary(std::string_view frame, Outcome& out) {
 void ClientProtocol::handle_text(std::string_view frame, Outcome& out) {
   out.clear();
   auto error = [&](const std::string& m) { out.replies.push_back(status_json(StatusLevel::Error, m)); };
-  if (frame.size() > kMaxClientFrame) {
-    error("message of " + std::to_string(frame.size()) + " bytes refused: the limit is " +
-          std::to_string(kMaxClientFrame));
-    return;
-  }
-  if (too_deep(frame)) {
-    error("malformed message: JSON nested deeper than " + std::to_string(kMaxDepth));
-    return;
-  }
-  const nlohmann::json j = nlohmann::json::parse(frame.begin(), frame.end(), nullptr, false);
-  if (j.is_discarded()) {
-    error("malformed message: not valid JSON");
-    return;
-  }
-  if (!j.is_object()) {
-    error("malformed message: not a JSON object");
-    return;
-  }
+  const std::optional<nlohmann::json> request = parse_request(frame, out);
+  if (!request) return;
+  const nlohmann::json& j = *request;
   const auto op_it = j.find("op");
-  if (op_it == j.end() || !op_it->is_string()) {
-    error("malformed message: no \"op\" string");
-    return;
-  }
   const auto& op = op_it->get_ref<const std::string&>();
   Problems problems;
   if (op == "subscribe") {
-    const auto subs = j.find("subscriptions");
-    if (subs == j.end() || !subs->is_array()) {
-      error("subscribe: \"subscriptions\" must be an array");
-      return;
-    }
-    for (const nlohmann::json& s : *subs) {
-      if (!s.is_object()) {
-        problems.add("subscribe: entry " + shown(s) + " is not an object");
-        continue;
-      }
-      std::uint32_t id = 0, ch = 0;
-      if (!member_id(s, "id", id) || !member_id(s, "channelId", ch)) {
-        problems.add("subscribe: entry " + shown(s) + " needs integer \"id\" and \"channelId\" in [0, 2^32)");
-        continue;
-      }
-      if (ch == 0 || ch > by_channel_.size()) {
-        problems.add("subscribe: unknown channel " + std::to_string(ch));
-        continue;
-      }
-      if (by_channel_[ch - 1]) {
-        problems.add("subscribe: already subscribed to channel " + std::to_string(ch) + " (subscription " +
-                     std::to_string(*by_channel_[ch - 1]) + ")");
-        continue;
-      }
-      if (std::find(by_channel_.begin(), by_channel_.end(), std::optional<SubscriptionId>(id)) !=
-          by_channel_.end()) {
-        problems.add("subscribe: subscription id " + std::to_string(id) + " is already in use");
-        continue;
-      }
-      by_channel_[ch - 1] = id;
-      ++count_;
-      out.subscribed.push_back({id, ch});
-    }
+    subscribe(j, by_channel_, count_, out, problems);
   } else if (op == "unsubscribe") {
-    const auto ids = j.find("subscriptionIds");
-    if (ids == j.end() || !ids->is_array()) {
-      error("unsubscribe: \"subscriptionIds\" must be an array");
-      return;
-    }
-    for (const nlohmann::json& v : *ids) {
-      std::uint32_t id = 0;
-      if (!as_id(v, id)) {
-        problems.add("unsubscribe: " + shown(v) + " is not a subscription id");
-        continue;
-      }
-      const auto it = std::find(by_channel_.begin(), by_channel_.end(), std::optional<SubscriptionId>(id));
-      if (it == by_channel_.end()) {
-        problems.add("unsubscribe: unknown subscription " + std::to_string(id));
-        continue;
-      }
-      it->reset();
-      --count_;
-      out.unsubscribed.push_back({id, static_cast<ChannelId>(it - by_channel_.begin() + 1)});
-    }
+    unsubscribe(j, by_channel_, count_, out, problems);
   } else if ((op == "advertise" || op == "unadvertise") && !publish_topic_.empty()) {
     if (op == "advertise") {
       PublishOps::advertise(*this, j, problems);

@@ -23,6 +23,7 @@
 
 #include "access.hpp"
 #include "hosted.hpp"
+#include "parameter_requests.hpp"
 #include "rbsim/foxglove.hpp"
 #include "services.hpp"
 #include "transport.hpp"
@@ -348,6 +349,43 @@ void ReplyLink::changed(const std::vector<msgs::Parameter>& parameters) {
   if (queued) server->transport->wake();
 }
 
+namespace {
+// A set's values to the steering as one command, answered through the link once applied: the
+// values now, and each refusal (those found before, in `problems`, then the steering's).
+void submit_set(control::Steering& steering, const std::shared_ptr<ReplyLink>& reply_link,
+                detail::ConnectionId id, ParameterRequest r, std::vector<msgs::Parameter> known,
+                std::vector<std::string> problems) {
+  control::Command command;
+  command.kind = control::CommandKind::SetParameters;
+  command.atomic = false;  // each its own result, as set_parameters
+  command.parameters = r.values;
+  command.source = "foxglove";
+  steering.submit(std::move(command),
+                  [link = reply_link, id, answer = r.id, values = r.values, known = std::move(known),
+                   refused = std::move(problems)](const control::CommandResult& result) mutable {
+                    std::vector<Reply> out;
+                    if (result.results.size() != values.size()) {
+                      refused.push_back(result.message);  // never applied (the run ended)
+                    } else {
+                      for (std::size_t k = 0; k < values.size(); ++k) {
+                        if (!result.results[k].successful) refused.push_back(result.results[k].reason);
+                      }
+                    }
+                    if (answer) {
+                      for (msgs::Parameter& p : known) {
+                        for (const msgs::Parameter& c : result.changed) {
+                          if (c.name == p.name) p.value = c.value;
+                        }
+                      }
+                      out.push_back({parameter_values_json(known, answer), false});
+                    }
+                    if (std::string m = problems_status_json("setParameters", refused); !m.empty())
+                      out.push_back({std::move(m), false});
+                    link->deliver(id, out, true);
+                  });
+}
+}  // namespace
+
 void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r) {
   using Op = ParameterRequest::Op;
   control::Steering& steering = *options.steering;
@@ -372,21 +410,7 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
             true);
       return;
     }
-    std::size_t kept = 0;
-    for (std::size_t k = 0; k < r.values.size(); ++k) {
-      if (parameter_index.count(r.values[k].name) == 0) {
-        problems.push_back("no parameter '" + r.values[k].name.substr(0, 200) + "'");
-        continue;
-      }
-      if (kept != k) {
-        r.values[kept] = std::move(r.values[k]);
-        r.untyped_integer[kept] = r.untyped_integer[k];
-      }
-      ++kept;
-    }
-    r.values.resize(kept);
-    r.untyped_integer.resize(kept);
-    for (const msgs::Parameter& p : r.values) r.names.push_back(p.name);
+    detail::keep_known_names(r, parameter_index, problems);
   } else if (r.names.empty()) {
     r.names = parameter_names;  // every parameter
   }
@@ -420,43 +444,8 @@ void Server::Impl::serve_parameters(detail::ConnectionId id, ParameterRequest r)
     reply(id, replies, false);
     return;
   }
-  // A JSON integer for a double parameter is that double (JSON cannot tell 2 from 2.0), if exact.
-  const std::vector<msgs::ParameterType> types = steering.types(r.names);
-  for (std::size_t k = 0; k < r.values.size(); ++k) {
-    msgs::ParameterValue& v = r.values[k].value;
-    if (r.untyped_integer[k] && types[k] == msgs::ParameterType::Double &&
-        v.integer_value >= -(std::int64_t{1} << 53) && v.integer_value <= (std::int64_t{1} << 53)) {
-      v = msgs::ParameterValue::of_double(static_cast<double>(v.integer_value));
-    }
-  }
-  control::Command command;
-  command.kind = control::CommandKind::SetParameters;
-  command.atomic = false;  // each its own result, as set_parameters
-  command.parameters = r.values;
-  command.source = "foxglove";
-  steering.submit(std::move(command),
-                  [link = link, id, answer = r.id, values = r.values, known = std::move(known),
-                   refused = std::move(problems)](const control::CommandResult& result) mutable {
-                    std::vector<Reply> out;
-                    if (result.results.size() != values.size()) {
-                      refused.push_back(result.message);  // never applied (the run ended)
-                    } else {
-                      for (std::size_t k = 0; k < values.size(); ++k) {
-                        if (!result.results[k].successful) refused.push_back(result.results[k].reason);
-                      }
-                    }
-                    if (answer) {
-                      for (msgs::Parameter& p : known) {
-                        for (const msgs::Parameter& c : result.changed) {
-                          if (c.name == p.name) p.value = c.value;
-                        }
-                      }
-                      out.push_back({parameter_values_json(known, answer), false});
-                    }
-                    if (std::string m = problems_status_json("setParameters", refused); !m.empty())
-                      out.push_back({std::move(m), false});
-                    link->deliver(id, out, true);
-                  });
+  detail::type_untyped_integers(r, steering.types(r.names));
+  submit_set(steering, link, id, std::move(r), std::move(known), std::move(problems));
 }
 
 void Server::Impl::serve_call(detail::ConnectionId id, ServiceCall call) {

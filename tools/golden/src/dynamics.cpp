@@ -102,7 +102,7 @@ Status verify_reference(const StageContext& c, const FosssimMatch& match, const 
   Result<std::vector<std::byte>> bytes = read_file(match.reference);
   if (!bytes) return bytes.error();
   Result<FosssimLog> reference = parse_fosssim(bytes.value(), static_cast<std::int32_t>(c.model.mass.size()));
-  if (!reference) return Error{match.reference + ": " + reference.error().message};
+  if (!reference) return with_context(match.reference + ": ", reference.error());
   Result<GradeReport> graded = grade(c.scene, reference.value());
   if (!graded) return graded.error();
   const GradeReport& gr = graded.value();

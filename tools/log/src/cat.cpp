@@ -133,7 +133,7 @@ Status cat(const std::string& path, const CatOptions& options,
         rm.channel->channel->message_encoding == "cdr") {
       auto decoder = msgs::MessageDecoder::create(schema->name, rm.channel->schema_text());
       if (!decoder) {
-        failure = Error{path + ": schema " + schema->name + ": " + decoder.error().message};
+        failure = with_context(path + ": schema " + schema->name + ": ", decoder.error());
         return false;
       }
       it->second.decoder = std::move(decoder.value());
@@ -146,14 +146,14 @@ Status cat(const std::string& path, const CatOptions& options,
         failure =
             Error{at() + "no ros2msg schema with CDR encoding: no columns to print (use --format json)"};
       } else if (Status st = table.row(*it->second.decoder, rm, line, on_line); !st) {
-        failure = Error{at() + st.error().message};
+        failure = with_context(at(), st.error());
       }
       return static_cast<bool>(failure);
     }
     append_json_head(line, rm);
     if (it->second.decoder) {
       if (Status st = it->second.decoder->to_json(rm.cdr(), line); !st) {
-        failure = Error{at() + st.error().message};
+        failure = with_context(at(), st.error());
         return false;
       }
     } else {

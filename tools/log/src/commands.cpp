@@ -17,9 +17,9 @@ Result<std::vector<msgs::CommandMessage>> read_commands(Recording& recording) {
   Status st = recording.read_messages(filter, [&](const RecordedMessage& m) {
     msgs::CommandMessage c;
     if (Status d = msgs::decode(m.cdr(), c); !d) {
-      decoded = Error{recording.path() + ": " + topic + " message at log time " +
-                          std::to_string(m.message->log_time) + ": " + d.error().message,
-                      ErrorCode::Malformed};
+      decoded = with_context(recording.path() + ": " + topic + " message at log time " +
+                                 std::to_string(m.message->log_time) + ": ",
+                             d.error(), ErrorCode::Malformed);
       return false;
     }
     out.push_back(std::move(c));

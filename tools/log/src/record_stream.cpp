@@ -32,7 +32,7 @@ bool RecordStream::keep(const mcap::Record& record) {
     bool repeat = false;
     if (Status st = join_.channel(file_, *c, repeat); !st) {
       joined_ = true;
-      failure_ = Error{files_[file_] + ": " + st.error().message, ErrorCode::Malformed};
+      failure_ = with_context(files_[file_] + ": ", st.error(), ErrorCode::Malformed);
       return false;
     }
     return !repeat;

@@ -236,7 +236,11 @@ struct Recording::Impl {
     s->step = step;
     s->has = {};
     s->log_time = {};
-    return **pending.insert(pending.begin() + static_cast<std::ptrdiff_t>(pos), std::move(s));
+    Slot& slot = **pending.insert(pending.begin() + static_cast<std::ptrdiff_t>(pos), std::move(s));
+    RBSIM_ASSERT((pos == 0 || pending[pos - 1]->step < step) &&
+                     (pos + 1 == pending.size() || pending[pos + 1]->step > step),
+                 "the steps waiting to be joined are distinct and in order");
+    return slot;
   }
 
   Status message(const mcap::MessageEntry& e, std::size_t i) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <future>
 #include <map>
 #include <mutex>
@@ -14,6 +15,7 @@
 #include <tuple>
 
 #include "rbsim/atomic_file.hpp"
+#include "rbsim/counts.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/mcap_tools.hpp"
 #include "rbsim/recording.hpp"
@@ -22,15 +24,6 @@
 namespace rbsim::log {
 
 namespace {
-
-std::string count_text(std::uint64_t n) {
-  std::string digits = std::to_string(n), out;
-  for (std::size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
-}
 
 // The output file: identical schemas and channels written once, messages through one writer into
 // an AtomicFile's temporary, renamed into place by close().
@@ -203,18 +196,65 @@ std::vector<const mcap::ChunkIndex*> whole_chunks(const Recording& recording, mc
 }  // namespace
 
 std::string RewriteReport::summary(const std::string& out) const {
-  std::string s = "wrote " + out + ": " + count_text(messages) + (messages == 1 ? " message" : " messages");
-  if (latched > 0) s += " (" + count_text(latched) + " latched from before the window)";
-  s += " on " + count_text(topics.size()) + (topics.size() == 1 ? " topic, " : " topics, ");
-  s += count_text(channels) + (channels == 1 ? " channel, " : " channels, ");
-  s += count_text(schemas) + (schemas == 1 ? " schema" : " schemas");
+  std::string s = "wrote " + out + ": " + group_digits(messages) + plural(messages, " message", " messages");
+  if (latched > 0) s += " (" + group_digits(latched) + " latched from before the window)";
+  s += " on " + group_digits(topics.size()) + plural(topics.size(), " topic, ", " topics, ");
+  s += group_digits(channels) + plural(channels, " channel, ", " channels, ");
+  s += group_digits(schemas) + plural(schemas, " schema", " schemas");
   if (copied_chunks > 0)
-    s += "; " + count_text(copied_chunks) + (copied_chunks == 1 ? " chunk" : " chunks") + " copied whole";
+    s += "; " + group_digits(copied_chunks) + plural(copied_chunks, " chunk", " chunks") + " copied whole";
   s += '\n';
   return s;
 }
 
 namespace {
+
+// Copies the chunks `whole` as stored, and through `copy_messages` (from, to) the messages before
+// each of them; `cursor` moves past each one copied.
+Status copy_whole_chunks(const std::string& in, Recording& recording, Output& output,
+                         const std::vector<const mcap::ChunkIndex*>& whole,
+                         const std::function<Status(mcap::Timestamp, mcap::Timestamp)>& copy_messages,
+                         mcap::Timestamp& cursor) {
+  // Each copied chunk's CRC is checked (the chunk decompressed) while the copying goes on: every
+  // other chunk on a second thread, the rest on this one after its copy, so two cores share the
+  // checks; the output is committed only once every check passed.
+  struct Lane {
+    mcap::ChunkDecompressor decompressor;
+    Bytes records;
+  };
+  Lane here, there;
+  const auto check = [&in](Lane& lane, const mcap::Chunk& chunk, std::uint64_t offset) -> Status {
+    if (Status st = lane.decompressor.decompress(chunk, lane.records, true); !st.ok())
+      return Error{in + ": chunk at offset " + std::to_string(offset) + ": " +
+                   mcap_tools::read_error(st.error())};
+    return Ok{};
+  };
+  std::future<Status> checked;
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    const mcap::ChunkIndex& ci = *whole[i];
+    if (Status st = copy_messages(cursor, ci.message_start_time + 1); !st) return st.error();
+    auto raw = recording.read_chunk(ci, false);
+    if (!raw) return raw.error();
+    if (Status st = output.copy(raw.value()); !st) return st.error();
+    cursor = ci.message_end_time;
+    if (i % 2 == 1) {
+      if (Status st = check(here, raw.value().chunk, ci.chunk_start_offset); !st) return st.error();
+      continue;
+    }
+    if (checked.valid()) {
+      if (Status st = checked.get(); !st) return st.error();
+    }
+    checked = std::async(
+        std::launch::async,
+        [&check, &there, offset = ci.chunk_start_offset, chunk = std::move(raw.value().chunk)]() -> Status {
+          return check(there, chunk, offset);
+        });
+  }
+  if (checked.valid()) {
+    if (Status st = checked.get(); !st) return st.error();
+  }
+  return Ok{};
+}
 
 // filter() and compress(): with copy_chunks, whole chunks inside the window are copied as stored.
 Result<RewriteReport> filter_file(const std::string& in, const std::string& out, const FilterOptions& options,
@@ -284,44 +324,8 @@ Result<RewriteReport> filter_file(const std::string& in, const std::string& out,
   if (copy_chunks) {
     const auto whole = whole_chunks(recording, start, end, kept_ids, options.output.compression);
     for (const mcap::ChunkIndex* ci : whole) selection.skip_chunks.push_back(ci->chunk_start_offset);
-    // Each copied chunk's CRC is checked (the chunk decompressed) while the copying goes on: every
-    // other chunk on a second thread, the rest on this one after its copy, so two cores share the
-    // checks; the output is committed only once every check passed.
-    struct Lane {
-      mcap::ChunkDecompressor decompressor;
-      Bytes records;
-    };
-    Lane here, there;
-    const auto check = [&in](Lane& lane, const mcap::Chunk& chunk, std::uint64_t offset) -> Status {
-      if (Status st = lane.decompressor.decompress(chunk, lane.records, true); !st.ok())
-        return Error{in + ": chunk at offset " + std::to_string(offset) + ": " +
-                     mcap_tools::read_error(st.error())};
-      return Ok{};
-    };
-    std::future<Status> checked;
-    for (std::size_t i = 0; i < whole.size(); ++i) {
-      const mcap::ChunkIndex& ci = *whole[i];
-      if (Status st = copy_messages(cursor, ci.message_start_time + 1); !st) return st.error();
-      auto raw = recording.read_chunk(ci, false);
-      if (!raw) return raw.error();
-      if (Status st = output.copy(raw.value()); !st) return st.error();
-      cursor = ci.message_end_time;
-      if (i % 2 == 1) {
-        if (Status st = check(here, raw.value().chunk, ci.chunk_start_offset); !st) return st.error();
-        continue;
-      }
-      if (checked.valid()) {
-        if (Status st = checked.get(); !st) return st.error();
-      }
-      checked = std::async(
-          std::launch::async,
-          [&check, &there, offset = ci.chunk_start_offset, chunk = std::move(raw.value().chunk)]() -> Status {
-            return check(there, chunk, offset);
-          });
-    }
-    if (checked.valid()) {
-      if (Status st = checked.get(); !st) return st.error();
-    }
+    if (Status st = copy_whole_chunks(in, recording, output, whole, copy_messages, cursor); !st)
+      return st.error();
   }
   if (Status st = copy_messages(cursor, end); !st) return st.error();
   return output.close();

@@ -78,11 +78,8 @@ struct IndexedReader::Impl {
 
   Status read_header() {
     if (source->size() == 0) return Error{"empty file", ErrorCode::Truncated};
-    // A file shorter than the magic whose bytes match is cut off: the Header read below says so.
-    if (Status st = check_magic(*source, 0); !st.ok() && st.code() != ErrorCode::Truncated) {
-      if (st.code() == ErrorCode::BadMagic) return Error{"not an MCAP file (bad magic)", ErrorCode::BadMagic};
-      return st;
-    }
+    // Not MCAP, or cut off inside the magic: check_magic says which (describe_read_error words it).
+    if (Status st = check_magic(*source, 0); !st.ok()) return st;
     RecordView rec;
     if (Status st = read_record(*source, sizeof kMagic, rec); !st.ok()) return st;
     auto parsed = parse_record(rec.opcode, rec.content);

@@ -1,5 +1,6 @@
 // Record framing (spec: Records): the one place that reads opcodes, length prefixes and magic.
 #include <cstring>
+#include <string>
 
 #include "rbsim/mcap_records.hpp"
 #include "wire.hpp"
@@ -15,11 +16,33 @@ Status check_magic(ByteSource& source, std::uint64_t offset) {
   if (n > 0) {
     if (Status s = source.read(offset, n, view); !s.ok()) return s;
     if (std::memcmp(view.data(), kMagic, view.size()) != 0) {
+      if (offset == 0) return Error{"the leading magic bytes are wrong", ErrorCode::BadMagic};
       return Error{"bad magic" + at(offset), ErrorCode::BadMagic};
     }
   }
-  if (n < sizeof kMagic) return Error{"file ends inside the magic" + at(offset), ErrorCode::Truncated};
+  if (n < sizeof kMagic) {
+    if (offset == 0) {
+      return Error{"the file ends inside the leading magic (" + std::to_string(size) + " bytes)",
+                   ErrorCode::Truncated};
+    }
+    return Error{"file ends inside the magic" + at(offset), ErrorCode::Truncated};
+  }
   return Ok{};
+}
+
+std::string describe_read_error(const Error& error) {
+  switch (error.code) {
+    case ErrorCode::BadMagic:
+      return "not an MCAP file: " + error.message;
+    case ErrorCode::Truncated:
+      return "truncated: " + error.message;
+    case ErrorCode::CrcMismatch:
+    case ErrorCode::DecompressionFailed:
+    case ErrorCode::Malformed:
+      return "corrupted: " + error.message;
+    default:
+      return error.message;
+  }
 }
 
 void RecordReader::reset(std::uint64_t begin, std::uint64_t end) {

@@ -85,15 +85,7 @@ void Streamer::update_crcs(const RecordView& record) {
 // The leading magic; the records follow it.
 bool Streamer::start() {
   if (source_.size() == 0) return fail(Error{"empty file", ErrorCode::Truncated});
-  if (Status s = check_magic(source_, 0); !s.ok()) {
-    if (s.code() == ErrorCode::BadMagic) {
-      return fail(Error{"not an MCAP file (bad magic)", ErrorCode::BadMagic});
-    }
-    if (s.code() == ErrorCode::Truncated) {
-      return fail(Error{"file ends inside the magic", ErrorCode::Truncated});
-    }
-    return fail(s);
-  }
+  if (Status s = check_magic(source_, 0); !s.ok()) return fail(s);  // worded by describe_read_error
   if (options_.verify_crcs) data_crc_ = crc32(ByteView(kMagic, sizeof kMagic));
   position_ = sizeof kMagic;
   records_.reset(position_);

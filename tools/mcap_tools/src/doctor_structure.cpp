@@ -33,12 +33,8 @@ bool Doctor::walk(mcap::ByteSource& source) {
 
 bool Doctor::check_leading_magic(mcap::ByteSource& source) {
   const Status magic = mcap::check_magic(source, 0);
-  if (magic.code() == ErrorCode::BadMagic) {
-    error("not an MCAP file: the leading magic bytes are wrong");
-    return false;
-  }
-  if (magic.code() == ErrorCode::Truncated) {
-    error(cat("truncated: the file ends inside the leading magic (", size_, " bytes)"));
+  if (magic.code() == ErrorCode::BadMagic || magic.code() == ErrorCode::Truncated) {
+    error(mcap::describe_read_error(magic.error()));
     return false;
   }
   // The data section CRC covers the leading magic too.

@@ -216,7 +216,7 @@ std::string RecoverReport::summary() const {
 Result<RecoverReport> recover(const std::string& in, const std::string& out, const RecoverOptions& options) {
   RecoverReport report;
   auto input = detail::open_input(in);
-  if (!input) return Error{in + ": " + input.error().message};
+  if (!input) return with_context(in + ": ", input.error());
   mcap::ByteSource& file = *input.value();
   report.input_size = file.size();
   if (report.input_size == 0) return Error{in + ": empty file (0 bytes): not an MCAP file; nothing written"};
@@ -232,7 +232,8 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   mcap::RecordEntry entry;
   if (!reader.next(entry) || !std::holds_alternative<mcap::Header>(entry.record)) {
     const Status& s = reader.status();
-    return Error{in + ": " + (s.ok() ? std::string("no Header record") : s.error().message) +
+    return Error{in + ": " +
+                 (s.ok() ? std::string("no Header record") : mcap::describe_read_error(s.error())) +
                  "; nothing to recover, nothing written"};
   }
   const mcap::Header header = std::get<mcap::Header>(entry.record);
@@ -251,7 +252,7 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
   wo.profile = header.profile;
   wo.library = header.library;
   if (Status s = rec.writer().open(output.writer_path(), wo); !s.ok())
-    return Error{out + ": " + s.error().message};
+    return with_context(out + ": ", s.error());
   auto abandon = [&](const std::string& why) -> Result<RecoverReport> {
     (void)rec.writer().close();
     return Error{out + ": " + why};  // output's destructor removes the temporary
@@ -308,7 +309,7 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out, con
     return abandon("nothing to recover from " + in + " (" + report.problem +
                    "): it holds no complete message; nothing written");
   }
-  if (Status s = rec.writer().close(); !s.ok()) return Error{out + ": " + s.error().message};
+  if (Status s = rec.writer().close(); !s.ok()) return with_context(out + ": ", s.error());
   if (Status st = output.commit(); !st) return st.error();
   return report;
 }

@@ -45,16 +45,16 @@ std::string unreadable(const std::string& path) {
 }
 
 std::string read_error(const Error& error) {
+  const std::string words = mcap::describe_read_error(error);
   switch (error.code) {
     case ErrorCode::Truncated:
-      return "truncated: " + error.message +
-             " (rbsim log recover rebuilds a valid file from its complete chunks)";
+      return words + " (rbsim log recover rebuilds a valid file from its complete chunks)";
     case ErrorCode::CrcMismatch:
     case ErrorCode::DecompressionFailed:
     case ErrorCode::Malformed:
-      return "corrupted: " + error.message + " (rbsim log doctor lists the problems)";
+      return words + " (rbsim log doctor lists the problems)";
     default:
-      return error.message;
+      return words;
   }
 }
 

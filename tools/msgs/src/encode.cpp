@@ -166,9 +166,14 @@ std::uint64_t sim_time_ns(const World& world) {
   return sim_time_ns(world.step_index(), world.dt());
 }
 
-Time sim_time(std::int64_t step, double dt) {
-  const std::uint64_t ns = sim_time_ns(step, dt);
+namespace {
+Time time_of(std::uint64_t ns) {
   return Time{static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
+}
+}  // namespace
+
+Time sim_time(std::int64_t step, double dt) {
+  return time_of(sim_time_ns(step, dt));
 }
 
 Time sim_time(const World& world) {
@@ -408,9 +413,16 @@ void Encoder::markers(const World& world, Bytes& out) const {
   }
 }
 
+const Bytes& encode_clock(std::uint64_t t_ns, Bytes& out) {
+  {
+    CdrWriter w(out);
+    w.time(time_of(t_ns));
+  }  // finished: padded
+  return out;
+}
+
 void Encoder::clock(const World& world, Bytes& out) const {
-  CdrWriter w(out);
-  w.time(sim_time(world));
+  encode_clock(sim_time_ns(world), out);
 }
 
 void Encoder::encode(TopicId id, const World& world, Bytes& out) const {

@@ -129,7 +129,7 @@ Status plot(const std::string& input, const PlotOptions& o) {
       std::ferror(script.get()) != 0)
     return Error{o.out_png + ": cannot write gnuplot's scratch files: " + std::strerror(errno)};
   Result<int> code = detail::run_process({"gnuplot", open_file_path(::fileno(script.get()))});
-  if (!code) return Error{"gnuplot: " + code.error().message};
+  if (!code) return with_context("gnuplot: ", code.error());
   if (code.value() != 0) return Error{"gnuplot failed drawing " + o.out_png};
   return png.commit();
 }

@@ -243,7 +243,7 @@ Status make_movie(const std::string& frames_dir, double fps, std::int64_t frames
                            "-c:v",   "libx264",   "-pix_fmt",   "yuv420p",   "-crf",
                            "20",     "-movflags", "+faststart", "-f",        "mp4",
                            output});
-  if (!code) return Error{"ffmpeg: " + code.error().message};
+  if (!code) return with_context("ffmpeg: ", code.error());
   if (code.value() != 0) {
     return Error{"ffmpeg failed (exit " + std::to_string(code.value()) + ") making " + mp4};
   }

@@ -115,6 +115,9 @@ class Publisher {
   // true meanwhile, gives up on this sample with ErrorCode::Cancelled.
   [[nodiscard]] Status publish(std::span<const std::byte> cdr, bool (*stop)() = nullptr);
   std::int32_t matched() const;  // subscriptions currently matched
+  // The one wait for subscribers (rbsim node's and rbsim replay's --wait-for-subscribers): until
+  // `count` subscriptions match, polling every 20 ms; false when `stop` (if any) turned true.
+  bool wait_for_subscribers(std::int32_t count, bool (*stop)()) const;
   // Waits until every matched reliable reader acknowledged everything written (bounded; about a
   // second once `stop` is true).
   [[nodiscard]] Status flush(double timeout_s, bool (*stop)() = nullptr);

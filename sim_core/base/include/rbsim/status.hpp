@@ -67,4 +67,13 @@ class [[nodiscard]] Result {
 
 using Status = Result<Ok>;
 
+// The one way to say where an error happened: `context` put before its message, its code kept
+// (`with_context(path + ": ", st.error())`), so an outer layer adds words, never loses what a
+// caller acts on. `code` replaces the code only where a caller's answer must stay another one.
+[[nodiscard]] inline Error with_context(std::string context, const Error& error,
+                                        std::optional<ErrorCode> code = std::nullopt) {
+  context += error.message;
+  return Error{std::move(context), code.value_or(error.code)};
+}
+
 }  // namespace rbsim

@@ -147,7 +147,7 @@ struct ParameterRequest {
 // fields by name), at most kMaxClientChannels at a time; each message it sends on one is a command
 // (src/command_in.cpp decodes it) applied at the next step boundary.
 inline constexpr std::string_view kCommandInSuffix = "command_in";
-inline constexpr std::string_view kCommandInSchema = "rbsim_msgs/msg/Command";
+inline constexpr std::string_view kCommandInSchema = msgs::CommandMessage::kType;
 inline constexpr std::string_view kClientPublishEncodings[] = {"cdr", "json"};
 inline constexpr std::size_t kMaxClientChannels = 16;
 // A client's messageData (opcode 0x01): opcode, channel id (uint32), payload.

@@ -45,8 +45,16 @@ class ViewSource final : public ByteSource {
 
 // Checks the 8 magic bytes at `offset` (0: leading, after the Footer: trailing). BadMagic when
 // the bytes there differ from kMagic, Truncated when the source ends before all 8 (the ones
-// present being right), IoError when the read fails.
+// present being right), IoError when the read fails. At offset 0 the message is what
+// describe_read_error words ("the leading magic bytes are wrong", "the file ends inside the
+// leading magic (5 bytes)").
 Status check_magic(ByteSource& source, std::uint64_t offset);
+// A read error in words, the one place they are chosen (the readers' callers through
+// mcap_tools::read_error, which adds the tool that helps, and doctor): what the file is by the
+// error's code, then what was found. BadMagic: "not an MCAP file: MESSAGE"; Truncated:
+// "truncated: MESSAGE"; CrcMismatch, DecompressionFailed, Malformed: "corrupted: MESSAGE"; any
+// other code: the message alone.
+std::string describe_read_error(const Error& error);
 // The magic's length: where a file's first record starts, and what follows its Footer.
 inline constexpr std::uint64_t kMagicSize = sizeof kMagic;
 

@@ -98,7 +98,8 @@ Result<RecoverReport> recover(const std::string& in, const std::string& out,
 std::string unreadable(const std::string& path);
 // "1.500000000" seconds for a nanosecond timestamp.
 std::string seconds(std::uint64_t ns);
-// A read error with a hint of which tool helps ("... (rbsim log recover can save ...)").
+// A read error in mcap::describe_read_error's words, with a hint of which tool helps
+// ("truncated: ... (rbsim log recover rebuilds ...)").
 std::string read_error(const Error& error);
 
 }  // namespace rbsim::mcap_tools

@@ -172,7 +172,7 @@ class Encoder {
   // visualization_msgs/msg/MarkerArray, latched: the body shapes in their frames (they move with
   // /tf) and the fixed spring anchors in "world".
   void markers(const World& world, Bytes& out) const;
-  void clock(const World& world, Bytes& out) const;  // rosgraph_msgs/msg/Clock
+  void clock(const World& world, Bytes& out) const;  // rosgraph_msgs/msg/Clock: encode_clock
   void encode(TopicId id, const World& world, Bytes& out) const;
 
  private:
@@ -181,6 +181,10 @@ class Encoder {
   // Every spring's colour when they all share one: the springs marker then carries it once.
   std::optional<Color> spring_color_;
 };
+
+// The one /clock message (rosgraph_msgs/msg/Clock) at `t_ns` nanoseconds into `out`, returned:
+// the simulator's for a world's time (Encoder::clock), rbsim replay's for a recording's log time.
+const Bytes& encode_clock(std::uint64_t t_ns, Bytes& out);
 
 // The messages of the world's current step, each encoded once however many sinks send it (the
 // node's DDS and Foxglove sinks share one): get() encodes a topic at its first request in a step.
