@@ -2,8 +2,9 @@
 """The module rules of docs/architecture.md, checked on the sources: each module includes only
 the public headers of the modules its row allows (its own internals stay in its src/), and every
 public header belongs to exactly one module; only the modules of READER_MODULES use the MCAP
-readers, no module but mcap frames MCAP by hand (magic, record prefix, opcodes), and no module but
-msgs spells a message or service type name ("std_srvs/srv/Trigger": msgs's constants instead).
+readers, no module but mcap frames MCAP by hand (magic, record prefix, opcodes), no module but msgs
+spells a message or service type name ("std_srvs/srv/Trigger": msgs's constants instead), and no
+module but dds includes a Cyclone DDS header or calls Cyclone's C API.
 
     check_modules.py ROOT [--allowlist FILE]   # exit 1 listing every break of a rule
 
@@ -34,12 +35,24 @@ MODULES = {
     "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
     "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
     "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
-    "node": ("node", {"core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
+    "sros2": ("node/sros2", {"msgs"}),
+    "dds": ("node/dds", {"sros2", "core", "msgs"}),
+    "sim_node": ("node/sim", {"dds", "core", "scene", "io", "control", "msgs"}),
+    "bag": ("node/bag", {"dds", "core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
+    "bridge": ("node/bridge", {"dds", "core", "scene", "io", "control", "msgs"}),
     "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden", "control"}),
     "foxglove": ("tools/foxglove", {"core", "scene", "io", "control", "msgs"}),
     "python": ("python", {"core", "scene", "io", "control", "msgs", "mcap", "log", "check"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }
+# Cyclone DDS lives in node/dds alone (the middleware under the node's other modules, as
+# rmw_cyclonedds_cpp is under rcl): no other module includes its headers or uses its C API (dds_*
+# calls, dds_*_t / ddsi_* / ddsrt_* types, DDS_* constants). msgs's own dds_topic_name and
+# dds_type_name (the ROS 2 naming rule, no Cyclone) are not Cyclone's.
+CYCLONE_MODULES = {"dds"}
+CYCLONE_INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]((?:dds|ddsc|ddsi|ddsrt)/[^>"]*)', re.M)
+CYCLONE_API = re.compile(r"(?<![\w:.>])(dds_(?!topic_name\b|type_name\b)\w+\s*\(|dds_\w+_t\b|ddsi_\w+|ddsrt_\w+|"
+                         r"DDS_[A-Z][A-Z0-9_]*\b)")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"rbsim/([A-Za-z0-9_]+\.hpp)"', re.M)
 SOURCE_SUFFIXES = (".cpp", ".hpp", ".h", ".in")
 
@@ -118,6 +131,17 @@ def framing_use(name, text):
     return next((what for pattern, what in FRAMING if pattern.search(code)), None)
 
 
+def cyclone_use(name, text):
+    """The first Cyclone DDS header or API name `text` uses, if module `name` may not."""
+    if name in CYCLONE_MODULES:
+        return None
+    m = CYCLONE_INCLUDE.search(text)
+    if m:
+        return f"#include <{m.group(1)}>"
+    m = CYCLONE_API.search(check_common.strip(text))
+    return m and m.group(1).rstrip("( \t")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("root", type=pathlib.Path)
@@ -150,6 +174,10 @@ def main():
                 if rel not in listed["mcap-reader"]:
                     problems.append(f"{rel}: module {name} uses the MCAP readers ({used}); only "
                                     f"{', '.join(sorted(READER_MODULES))} may")
+            cyclone = cyclone_use(name, text)
+            if cyclone:
+                problems.append(f"{rel}: module {name} uses Cyclone DDS ({cyclone}); only "
+                                f"{', '.join(sorted(CYCLONE_MODULES))} may (node/dds, behind the middleware seam)")
             spelt = type_name_use(name, text)
             if spelt:
                 problems.append(f"{rel}: module {name} spells the type name {spelt}; take msgs's constant")

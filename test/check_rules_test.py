@@ -99,14 +99,26 @@ class CheckModulesTest(CheckerTest):
         self.tree.write("tools/log/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
         self.assertFails("(little-endian fields read by hand (le64))")
 
+    def test_cyclone_outside_dds_fails(self):
+        self.tree.write("node/dds/src/dds.cpp", "#include <dds/dds.h>\nint p = dds_create_participant(0, 0, 0);\n")
+        self.tree.write("node/bag/src/names.cpp", "// not dds_create_waitset(\n"
+                        'std::string t = rbsim::msgs::dds_topic_name("/a"); const char* s = "dds_take(";\n')
+        self.assertPasses()
+        self.tree.write("node/bag/src/recorder.cpp", "#include <dds/dds.h>\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (#include <dds/dds.h>); only dds may")
+        self.tree.write("node/bag/src/recorder.cpp", "void f(int w) { dds_waitset_wait(w, nullptr, 0, 0); }\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (dds_waitset_wait)")
+        self.tree.write("node/bag/src/recorder.cpp", "struct ddsi_serdata* held;\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (ddsi_serdata)")
+
     def test_type_name_outside_msgs_fails(self):
         self.tree.write("tools/msgs/include/rbsim/msgs.hpp",
                         'inline constexpr const char* kTrigger = "std_srvs/srv/Trigger";\n')
-        self.tree.write("node/src/services.cpp", '#include "rbsim_msgs/msg/Command.h"\n'
+        self.tree.write("node/sim/src/services.cpp", '#include "rbsim_msgs/msg/Command.h"\n'
                         '// "rbsim_msgs/msg/Command" in a comment is no spelling\nconst char* t = kTrigger;\n')
         self.assertPasses()
-        self.tree.write("node/src/services.cpp", 'const char* t = "std_srvs/srv/Trigger";\n')
-        self.assertFails("node/src/services.cpp: module node spells the type name std_srvs/srv/Trigger")
+        self.tree.write("node/sim/src/services.cpp", 'const char* t = "std_srvs/srv/Trigger";\n')
+        self.assertFails("node/sim/src/services.cpp: module sim_node spells the type name std_srvs/srv/Trigger")
 
     def test_allowlist_ratchets(self):
         self.tree.write("tools/check/src/compare.cpp", "rbsim::mcap::IndexedReader r;\n")

@@ -462,7 +462,7 @@ std::string hex(std::span<const std::byte> b, std::size_t from, std::size_t to) 
          << "\n  Cyclone: ..." << hex(cyclone, from, at + 8);
 }
 
-// Raw CDR is handed to dds_writecdr through the node's raw-bytes serdata (node/src/raw_serdata.cpp).
+// Raw CDR is handed to dds_writecdr through the node's raw-bytes serdata (node/dds/src/raw_serdata.cpp).
 
 // ---------------------------------------------------------------------------------------------
 // DDS plumbing: one participant per test on a private domain, a topic of the type under test,

@@ -1,4 +1,4 @@
-// The replay's player state (node/src/player.hpp) without DDS: the pacing clock under pause, resume
+// The replay's player state (node/bag/src/player.hpp) without DDS: the pacing clock under pause, resume
 // and rate changes; rates <= 0 refused; play_next/burst only while paused, counted as the loop
 // publishes; a seek answered by the loop, withdrawn when no loop takes it, refused once closed.
 #include <gtest/gtest.h>

@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "rbsim/counts.hpp"
-#include "rbsim/rosout.hpp"
+#include "rbsim/print.hpp"
 
 namespace rbsim::cli {
 
@@ -104,7 +104,7 @@ Result<mcap::Compression> compression_option(const std::string& name, int level)
 }
 
 int fail(const char* command, const std::string& message, int exit_status, std::source_location where) {
-  node::log(node::LogLevel::Error, "rbsim " + std::string(command) + ": error: " + message, where);
+  print::log(print::Level::Error, "rbsim " + std::string(command) + ": error: " + message, where);
   return exit_status;
 }
 

@@ -46,7 +46,7 @@ std::string format_seconds(double seconds);
 Result<mcap::Compression> compression_option(const std::string& name, int level = 0);
 
 // Prints "rbsim COMMAND: error: MESSAGE" on stderr (and, in a DDS command, on /rosout: the one
-// logging path, rbsim/rosout.hpp); returns the exit status to end with.
+// printing path, rbsim/print.hpp, whose hook is the node's Rosout); returns the exit status to end with.
 int fail(const char* command, const std::string& message, int exit_status = 1,
          std::source_location where = std::source_location::current());
 

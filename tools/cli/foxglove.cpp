@@ -8,7 +8,7 @@
 
 #include "commands.hpp"
 #include "rbsim/counts.hpp"
-#include "rbsim/rosout.hpp"
+#include "rbsim/print.hpp"
 
 #ifndef RBSIM_FOXGLOVE_LAYOUT
 #define RBSIM_FOXGLOVE_LAYOUT "docs/foxglove-layout.json"

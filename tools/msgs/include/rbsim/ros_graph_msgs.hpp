@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rbsim/msgs.hpp"
+#include "rbsim/print.hpp"
 
 namespace rbsim::msgs {
 
@@ -35,7 +36,7 @@ struct ParticipantEntities {
 void encode_participant_entities(const ParticipantEntities& info, std::size_t gid_size, Bytes& out);
 
 // rcl_interfaces/msg/Log's levels (its constants DEBUG .. FATAL).
-enum class LogLevel : std::uint8_t { Debug = 10, Info = 20, Warn = 30, Error = 40, Fatal = 50 };
+using LogLevel = print::Level;  // rcl_interfaces/msg/Log's levels (rbsim/print.hpp)
 struct LogMessage {
   Time stamp;
   LogLevel level = LogLevel::Info;

@@ -1,0 +1,234 @@
+// The node's parameter and control services (rbsim/node_services.hpp).
+#include "rbsim/node_services.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <future>
+#include <vector>
+
+#include "rbsim/interfaces.hpp"
+#include "rbsim/parameter_events.hpp"
+#include "rbsim/service.hpp"
+#include "rbsim/service_set.hpp"
+
+namespace rbsim::node {
+
+namespace {
+
+using control::Command;
+using control::CommandKind;
+using control::CommandResult;
+
+constexpr std::size_t kBudgetPerServer = 8;  // requests one server handles before the next one's turn
+
+// /<ns>/commands: every command reaches a late joiner (a recorder started after the first
+// command), reliable, transient local, keep all.
+QosSpec commands_qos() {
+  QosSpec q;
+  q.transient_local = true;
+  q.keep_all = true;
+  return q;
+}
+
+}  // namespace
+
+struct NodeServices::Impl {
+  control::Controller& controller;
+  NodeServicesOptions options;
+  std::optional<Publisher> events;
+  std::optional<Publisher> commands;  // /<ns>/commands
+  Bytes command_cdr;                  // the run loop's thread only
+  std::uint64_t next_sequence = 0;    // the run loop's thread only
+  Bytes event_cdr;
+  std::atomic<std::uint64_t> event_count{0};
+  std::atomic<std::uint64_t> command_count{0};
+  ServiceSet services;  // last: stopped first, before the members its handlers use go
+
+  Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
+
+  // Submits `command` and waits (bounded) for the boundary that applies it.
+  CommandResult apply(Command command) {
+    command.source = "ros2 service";
+    std::future<CommandResult> done = controller.submit(std::move(command));
+    if (done.wait_for(std::chrono::duration<double>(options.apply_timeout_s)) != std::future_status::ready) {
+      CommandResult r;
+      r.message = "not applied within " + std::to_string(options.apply_timeout_s) + " s";
+      return r;
+    }
+    return done.get();
+  }
+
+  // The control services through the control module's one mapping (control::control_services()).
+  void add_controls(std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>>& out) {
+    using namespace msgs;
+    for (const control::ControlService& s : control::control_services()) {
+      ServiceServer::Handler h;
+      if (s.kind == CommandKind::Step) {
+        h = typed_handler<StepRequest, StepResponse>(
+            [this](const RequestHeader&, const StepRequest& req) {
+              return control::step_response(apply(control::command_for(req)));
+            },
+            [](const Error& e) {
+              return std::optional<StepResponse>(StepResponse{false, e.message, 0});
+            });
+      } else if (s.kind == CommandKind::Impulse) {
+        h = typed_handler<ApplyImpulseRequest, ApplyImpulseResponse>(
+            [this](const RequestHeader&, const ApplyImpulseRequest& req) {
+              return control::impulse_response(apply(control::command_for(req)));
+            },
+            [](const Error& e) {
+              return std::optional<ApplyImpulseResponse>(ApplyImpulseResponse{false, e.message, 0});
+            });
+      } else {
+        h = typed_handler<TriggerRequest, TriggerResponse>(
+            [this, kind = s.kind](const RequestHeader&, const TriggerRequest& req) {
+              return control::trigger_response(apply(control::command_for(kind, req)));
+            },
+            [](const Error& e) {
+              return std::optional<TriggerResponse>(TriggerResponse{false, e.message});
+            });
+      }
+      out.emplace_back(std::string(s.name), std::string(s.type), std::move(h));
+    }
+  }
+
+  // rclcpp's parameter services: reads answer from the table as of the last boundary; a read
+  // naming an unknown parameter answers an empty list, as rclcpp's do; a malformed request gets no
+  // reply (these responses have no field to say so).
+  void add_parameters(std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>>& out) {
+    using namespace msgs;
+    out.emplace_back("list_parameters", std::string(ListParametersRequest::kService),
+                     typed_handler<ListParametersRequest, ListParametersResponse>(
+                         [this](const RequestHeader&, const ListParametersRequest& req) {
+                           return ListParametersResponse{controller.list(req.prefixes, req.depth)};
+                         },
+                         [](const Error&) { return std::optional<ListParametersResponse>(); }));
+    out.emplace_back("get_parameters", std::string(GetParametersRequest::kService),
+                     typed_handler<GetParametersRequest, GetParametersResponse>(
+                         [this](const RequestHeader&, const GetParametersRequest& req) {
+                           GetParametersResponse res;
+                           for (auto& v : controller.get(req.names)) {
+                             if (!v) return GetParametersResponse{};
+                             res.values.push_back(std::move(*v));
+                           }
+                           return res;
+                         },
+                         [](const Error&) { return std::optional<GetParametersResponse>(); }));
+    out.emplace_back("describe_parameters", std::string(DescribeParametersRequest::kService),
+                     typed_handler<DescribeParametersRequest, DescribeParametersResponse>(
+                         [this](const RequestHeader&, const DescribeParametersRequest& req) {
+                           DescribeParametersResponse res;
+                           for (auto& d : controller.describe(req.names)) {
+                             if (!d) return DescribeParametersResponse{};
+                             res.descriptors.push_back(std::move(*d));
+                           }
+                           return res;
+                         },
+                         [](const Error&) { return std::optional<DescribeParametersResponse>(); }));
+    out.emplace_back("get_parameter_types", std::string(GetParameterTypesRequest::kService),
+                     typed_handler<GetParameterTypesRequest, GetParameterTypesResponse>(
+                         [this](const RequestHeader&, const GetParameterTypesRequest& req) {
+                           GetParameterTypesResponse res;
+                           for (ParameterType t : controller.types(req.names))
+                             res.types.push_back(static_cast<std::uint8_t>(t));
+                           return res;
+                         },
+                         [](const Error&) { return std::optional<GetParameterTypesResponse>(); }));
+    out.emplace_back("set_parameters", std::string(SetParametersRequest::kService),
+                     typed_handler<SetParametersRequest, SetParametersResponse>(
+                         [this](const RequestHeader&, const SetParametersRequest& req) {
+                           Command c;
+                           c.kind = CommandKind::SetParameters;
+                           c.atomic = false;
+                           c.parameters = req.parameters;
+                           CommandResult r = apply(std::move(c));
+                           if (r.results.size() != req.parameters.size()) {  // never applied
+                             r.results.assign(req.parameters.size(), SetParametersResult{false, r.message});
+                           }
+                           return SetParametersResponse{std::move(r.results)};
+                         },
+                         [](const Error&) { return std::optional<SetParametersResponse>(); }));
+    out.emplace_back("set_parameters_atomically", std::string(SetParametersAtomicallyRequest::kService),
+                     typed_handler<SetParametersAtomicallyRequest, SetParametersAtomicallyResponse>(
+                         [this](const RequestHeader&, const SetParametersAtomicallyRequest& req) {
+                           Command c;
+                           c.kind = CommandKind::SetParameters;
+                           c.atomic = true;
+                           c.parameters = req.parameters;
+                           const CommandResult r = apply(std::move(c));
+                           SetParametersResult result{r.successful, r.successful ? std::string{} : r.message};
+                           if (!r.results.empty() && !r.results.front().successful)
+                             result = r.results.front();
+                           return SetParametersAtomicallyResponse{result};
+                         },
+                         [](const Error&) { return std::optional<SetParametersAtomicallyResponse>(); }));
+  }
+};
+
+NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+NodeServices::~NodeServices() {
+  impl_->services.stop();
+}
+
+Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& participant,
+                                                           control::Controller& controller,
+                                                           const NodeServicesOptions& options) {
+  auto impl = std::make_unique<Impl>(controller, options);
+  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services;
+  impl->add_controls(services);
+  impl->add_parameters(services);
+  for (auto& [name, type, handler] : services) {
+    if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
+      return st.error();
+  }
+  auto events = Publisher::create(participant, parameter_events_topic(), parameter_events_qos());
+  if (!events) return events.error();
+  impl->events.emplace(std::move(events.value()));
+  const std::string commands_topic = options.node + "/" + std::string(msgs::CommandMessage::kSuffix);
+  auto commands = Publisher::create(
+      participant,
+      RawTopic{msgs::dds_topic_name(commands_topic), msgs::dds_type_name(msgs::CommandMessage::kType),
+               std::string(msgs::CommandMessage::kType)},
+      commands_qos());
+  if (!commands) return commands.error();
+  impl->commands.emplace(std::move(commands.value()));
+  impl->services.start(kBudgetPerServer);
+  return std::unique_ptr<NodeServices>(new NodeServices(std::move(impl)));
+}
+
+void NodeServices::command_applied(const Command& command, const CommandResult& result) {
+  // Every command, applied or refused, as data on /<ns>/commands, numbered without gaps.
+  impl_->command_cdr.clear();
+  msgs::encode(control::to_message(command, result, impl_->next_sequence++, impl_->options.dt),
+               impl_->command_cdr);
+  if (impl_->commands->publish(impl_->command_cdr)) ++impl_->command_count;
+  if (result.changed.empty() || result.step < 0) return;
+  msgs::ParameterEvent event;
+  event.node = impl_->options.node;
+  event.stamp = msgs::sim_time(result.step, impl_->options.dt);
+  event.changed_parameters = result.changed;
+  impl_->event_cdr.clear();
+  msgs::encode(event, impl_->event_cdr);
+  if (impl_->events->publish(impl_->event_cdr)) ++impl_->event_count;
+}
+
+std::span<const std::byte> NodeServices::last_command() const {
+  return impl_->command_cdr;
+}
+
+NodeServiceCounters NodeServices::counters() const {
+  NodeServiceCounters c;
+  for (const ServiceStats& st : impl_->services.stats()) {
+    c.received += st.received;
+    c.calls += st.answered;
+    c.dropped += st.dropped_full + st.dropped_large + st.malformed + st.client_gone + st.client_unmatched +
+                 st.unanswered + st.write_failed;
+  }
+  c.events = impl_->event_count.load();
+  c.commands = impl_->command_count.load();
+  return c;
+}
+
+}  // namespace rbsim::node
