@@ -34,7 +34,8 @@ TEST(DdsSink, PublishEveryBelowOneIsRefusedAtCreate) {
 // and each wait against the due time it reports, so a loaded machine (a thread descheduled at any
 // point) cannot make the test fail.
 std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -48,7 +49,8 @@ TEST(Pacer, RebaseAndSetPaceCountTheNextStepFromNow) {
   Pacer pacer(1.0, 1);
   // The step after `step` is due `after_ns` past a moment in [before, after]; wait() returns no
   // earlier than that.
-  const auto expect_due = [&](std::int64_t step, std::int64_t before, std::int64_t after, std::int64_t after_ns) {
+  const auto expect_due = [&](std::int64_t step, std::int64_t before, std::int64_t after,
+                              std::int64_t after_ns) {
     w.set_step_index(step);
     const std::optional<std::int64_t> due = pacer.due_ns(w);
     ASSERT_TRUE(due.has_value()) << "step " << step;
