@@ -2083,7 +2083,12 @@ def main():
                     help="rbsim is built with AddressSanitizer: its resident size says nothing about leaks")
     args = ap.parse_args()
     ensure_venv(args.venv, args.requirements)
+    return run_case(args, CASES[args.case])
 
+
+def run_case(args, case):
+    """Runs one case (a function of a Ctx) to its verdict: prints PASSED, FAILED with every
+    problem, or SKIPPED, and returns the exit status. Also the driver of startup_stops.py."""
     ctx = Ctx(args)
     # ctest's timeout and Ctrl-C: end the case through the finally block (children killed,
     # namespaces deleted).
@@ -2093,7 +2098,7 @@ def main():
     signal.signal(signal.SIGINT, on_signal)
     status = 1
     try:
-        status = CASES[args.case](ctx) or 0
+        status = case(ctx) or 0
     except Failure as e:
         ctx.failures.append(str(e))
         ctx.log(f"FAIL: {e}")

@@ -20,7 +20,6 @@ import random
 import signal
 import sys
 import time
-import traceback
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import e2e  # noqa: E402  (the process, domain and MCAP helpers of the end-to-end suite)
@@ -171,28 +170,7 @@ def main():
     args = ap.parse_args()
     args.case = "startup_stops"
     e2e.ensure_venv(args.venv, args.requirements)
-    ctx = e2e.Ctx(args)
-
-    def on_signal(sig, _frame):
-        raise Failure(f"interrupted by {signal.Signals(sig).name}")
-    signal.signal(signal.SIGTERM, on_signal)
-    signal.signal(signal.SIGINT, on_signal)
-    try:
-        case_startup_stops(ctx)
-    except Failure as e:
-        ctx.failures.append(str(e))
-    except Exception:  # noqa: BLE001
-        ctx.failures.append(traceback.format_exc())
-    finally:
-        ctx.cleanup()
-    elapsed = time.monotonic() - ctx.t0
-    if ctx.failures:
-        print(f"e2e.startup_stops: FAILED ({len(ctx.failures)} problems, {elapsed:.1f} s)")
-        for f in ctx.failures:
-            print(f"  - {f}")
-        return 1
-    print(f"e2e.startup_stops: PASSED ({elapsed:.1f} s)")
-    return 0
+    return e2e.run_case(args, case_startup_stops)
 
 
 if __name__ == "__main__":
