@@ -502,8 +502,10 @@ async function caseTls(check) {
   const node = new Proc("node", [A.rbsim, ...nodeArgs(scene("airplane.xml"), "--rate", 1, "--duration", 30),
     "--foxglove", "127.0.0.1:0", "--foxglove-tls", cert, key].map(String), { logDir: workdir });
   const url = (await node.waitFor(/foxglove: listening on (wss:\/\/127\.0\.0\.1:\d+)/, 20000))[1];
-  check(/foxglove: open https:\/\/app\.foxglove\.dev\/\?ds=foxglove-websocket&ds\.url=wss%3A%2F%2F127\.0\.0\.1/
-    .test(node.err), "the printed link is not wss://");
+  // The link is the line after the listening one: wait for it (its own line), then check it.
+  const link = (await node.waitFor(/foxglove: open (\S+)\n/, 20000))[1];
+  check(/^https:\/\/app\.foxglove\.dev\/\?ds=foxglove-websocket&ds\.url=wss%3A%2F%2F127\.0\.0\.1/.test(link),
+    `the printed link is not wss://: ${link}`);
   const c = await new Client(need, url, { name: "trusting", wsOptions: { ca: fs.readFileSync(cert) } }).ready();
   check(c.serverInfo.capabilities.includes("parameters"), `serverInfo capabilities ${c.serverInfo.capabilities}`);
   await until("messages over wss://", 10000, () => c.messages.length >= 20);
