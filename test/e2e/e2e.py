@@ -2063,6 +2063,16 @@ CASES = {
 }
 
 
+def add_case_arguments(ap):
+    """The arguments every case's driver takes (this one's and startup_stops.py's)."""
+    ap.add_argument("--index", type=int, required=True, help="test index (part of the DDS domain id)")
+    ap.add_argument("--rbsim", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--workdir", required=True)
+    ap.add_argument("--venv", required=True)
+    ap.add_argument("--requirements", required=True)
+
+
 def main():
     # The one list of cases: test/e2e/CMakeLists.txt reads it at configure time (one CTest entry
     # e2e.<case> each, --index its place in this list); --list needs no venv and no other option.
@@ -2072,12 +2082,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--list", action="store_true", help="print the case names, one a line, and exit")
     ap.add_argument("--case", required=True, choices=sorted(CASES))
-    ap.add_argument("--index", type=int, required=True, help="test index (part of the DDS domain id)")
-    ap.add_argument("--rbsim", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--workdir", required=True)
-    ap.add_argument("--venv", required=True)
-    ap.add_argument("--requirements", required=True)
+    add_case_arguments(ap)
     ap.add_argument("--soak-seconds", type=float, default=20.0, help="length of the soak case (scripts/soak: 120)")
     ap.add_argument("--sanitized", action="store_true",
                     help="rbsim is built with AddressSanitizer: its resident size says nothing about leaks")

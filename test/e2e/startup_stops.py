@@ -161,12 +161,7 @@ def case_startup_stops(ctx):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--index", type=int, required=True, help="test index (part of the DDS domain id)")
-    ap.add_argument("--rbsim", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--workdir", required=True)
-    ap.add_argument("--venv", required=True)
-    ap.add_argument("--requirements", required=True)
+    e2e.add_case_arguments(ap)
     args = ap.parse_args()
     args.case = "startup_stops"
     e2e.ensure_venv(args.venv, args.requirements)
