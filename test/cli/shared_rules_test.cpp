@@ -1,8 +1,8 @@
 // One rule per shared decision, seen from the command line: the commands that take the same input
 // decide the same about it (issue 36, point 2). Which topics a name selects and how an unknown one
-// is worded (msgs::select_topics); whether a path is a recording or a scene (log::path_kind);
-// seconds to nanoseconds (rbsim::seconds_to_ns). DDS commands on rbsim's loopback configuration,
-// on a domain no other test uses.
+// is worded (msgs::select_topics, also for an enclave's permissions); whether a path is a recording or a
+// scene (log::path_kind); seconds to nanoseconds (rbsim::seconds_to_ns). DDS commands on rbsim's loopback
+// configuration, on a domain no other test uses.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -73,6 +73,18 @@ TEST(SharedRules, AnUnknownTopicIsWordedAlikeByEveryCommand) {
   EXPECT_NE(rec.err.find("unknown topic \"nope\" (topics: /clock, /rbsim/body_states, /rbsim/commands, "),
             std::string::npos)
       << rec;
+  // The enclave's permissions name topics the same way: the same words, and no keystore file
+  // touched for a name that selects nothing.
+  const fs::path ks = dir / "keystore";
+  const test::Outcome keystore = rbsim({"security", "create-keystore", ks.string()});
+  ASSERT_EQ(keystore.exit_code, 0) << keystore;
+  const test::Outcome enclave =
+      rbsim({"security", "create-enclave", ks.string(), "/rbsim", "--topics", "scene,nope"});
+  EXPECT_EQ(enclave.exit_code, 1) << enclave;
+  EXPECT_NE(enclave.err.find("unknown topic \"nope\" (topics: /clock, /rbsim/body_states, /rbsim/commands, "),
+            std::string::npos)
+      << enclave;
+  EXPECT_FALSE(fs::exists(ks / "enclaves/rbsim")) << "an enclave was made for a bad --topics";
 }
 
 TEST(SharedRules, LogCatAndCheckSelectTheSameTopics) {

@@ -160,6 +160,26 @@ TEST_F(Security, CreateKeystoreAndEnclaveLayOutSros2sFiles) {
   const std::string restricted = test::read_text(ks() / "enclaves/restricted/permissions.xml");
   EXPECT_NE(restricted.find("<topic>rt/sec_node/scene</topic>"), std::string::npos);
   EXPECT_EQ(restricted.find("rt/sec_node/*"), std::string::npos);
+  // Names as every command takes them: a full name, and /tf (at the root) listed once.
+  ASSERT_TRUE(
+      create_enclave(ks().string(), "/named", {.ns = "sec_node", .topics = {"/sec_node/energy", "tf"}}));
+  const std::string named = test::read_text(ks() / "enclaves/named/permissions.xml");
+  EXPECT_NE(named.find("<topic>rt/sec_node/energy</topic>"), std::string::npos) << named;
+  // Each allowed topic appears once in the publish rule and once in the subscribe rule.
+  const auto count = [&named](const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = named.find(what); at != std::string::npos; at = named.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("<topic>rt/tf</topic>"), 2u) << named;
+  EXPECT_EQ(count("<topic>rt/sec_node/energy</topic>"), 2u) << named;
+  EXPECT_EQ(named.find("rt/sec_node/tf"), std::string::npos) << named;
+  // A name that selects no topic is refused before anything is made.
+  const Status unknown = create_enclave(ks().string(), "/unknown", {.ns = "sec_node", .topics = {"nope"}});
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().message.find("--topics: unknown topic \"nope\""), std::string::npos)
+      << unknown.error().message;
+  EXPECT_FALSE(std::filesystem::exists(ks() / "enclaves/unknown"));
 }
 
 // Cyclone's own plugins load the files and create the participant (its handshake is the e2e

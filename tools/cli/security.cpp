@@ -53,8 +53,8 @@ Subcommand add_security_command(CLI::App& parent) {
       ->default_str("rbsim");
   a->enclave_app
       ->add_option("--topics", a->enclave_options.topics,
-                   "Only these rbsim topics of the namespace (comma-separated suffixes: "
-                   "scene,body_states); default: all of them")
+                   "Only these rbsim topics of the namespace (comma-separated, named as --topics "
+                   "of every command: scene,body_states or /rbsim/body_states); default: all of them")
       ->delimiter(',');
   app->footer(
       "A process uses enclave <keystore>/enclaves/<node name> (ROS_SECURITY_ENCLAVE_OVERRIDE names another) "

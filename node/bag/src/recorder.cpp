@@ -86,8 +86,8 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
     if (!sub) return sub.error();
     r->waitset_.attach(sub.value());
     Topic topic{std::move(sub.value()), 0, 0, {}, {}, 0, Gaps{}};
+    topic.latched_pending = spec->latched();
     r->topics_.push_back(std::move(topic));
-    r->latched_pending_.push_back(spec->latched());
     if (spec->latched()) r->holding_ = true;
   }
   return r;
@@ -234,13 +234,13 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       if (holding_ && (!latched || (t.subscription.spec().id != msgs::TopicId::Scene && scene_pending()))) {
         held_bytes_ += sample.cdr.size();
         held_.push_back({index, std::move(sample), now});
-        if (latched) latched_pending_[index] = false;  // it came: only its writing waits
+        if (latched) t.latched_pending = false;  // it came: only its writing waits
         ++received_;
       } else {
         const std::uint64_t log_time = held_.empty() ? now : std::min(now, held_.front().log_time);
         if (Status st = write(t, sample, log_time); !st) return st.error();
         ++received_;
-        latched_pending_[index] = false;
+        t.latched_pending = false;
         if (holding_ && !latched_outstanding()) {
           holding_ = false;
           if (Status st = release_held(); !st) return st.error();
@@ -258,7 +258,6 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
     if (Status st = release_held(); !st) return st.error();
   }
   RBSIM_ASSERT(holding_ || held_.empty(), "samples are held only while a latched topic is awaited");
-  RBSIM_ASSERT(latched_pending_.size() == topics_.size(), "one latched-pending flag per topic");
   return any;
 }
 
@@ -311,26 +310,21 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
 }
 
 bool Recorder::latched_outstanding() const {
-  bool scene_seen = true;
-  for (std::size_t i = 0; i < topics_.size(); ++i) {
-    if (latched_pending_[i] && topics_[i].subscription.spec().id == msgs::TopicId::Scene) scene_seen = false;
-  }
-  for (std::size_t i = 0; i < topics_.size(); ++i) {
-    if (!latched_pending_[i]) continue;
+  const bool scene_seen = !scene_pending();
+  for (const Topic& t : topics_) {
+    if (!t.latched_pending) continue;
     // The scene description is always waited for; other latched topics while a node offers them
     // (or until the scene description came, discovery of their writer having had that long).
-    if (topics_[i].subscription.spec().id == msgs::TopicId::Scene || !scene_seen ||
-        topics_[i].subscription.matched() > 0)
+    if (t.subscription.spec().id == msgs::TopicId::Scene || !scene_seen || t.subscription.matched() > 0)
       return true;
   }
   return false;
 }
 
 bool Recorder::scene_pending() const {
-  for (std::size_t i = 0; i < topics_.size(); ++i) {
-    if (latched_pending_[i] && topics_[i].subscription.spec().id == msgs::TopicId::Scene) return true;
-  }
-  return false;
+  return std::any_of(topics_.begin(), topics_.end(), [](const Topic& t) {
+    return t.latched_pending && t.subscription.spec().id == msgs::TopicId::Scene;
+  });
 }
 
 Status Recorder::release_held() {

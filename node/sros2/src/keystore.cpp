@@ -1,5 +1,6 @@
 // An SROS2 keystore and its enclaves (rbsim/sros2.hpp), laid out as `ros2 security` lays them
 // out (sros2/keystore: _keystore.py, _enclave.py; policy templates governance.xml, permissions.xsl).
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -60,18 +61,25 @@ std::string iso_date(int years_from_now) {
 }
 
 // The DDS topic names an enclave may use (rmw_cyclonedds_cpp's prefixes: rt/ topics, rq/ and rr/
-// service requests and replies).
-std::vector<std::string> allowed_topics(const EnclaveOptions& o) {
+// service requests and replies). --topics names rbsim topics as every other command does
+// (msgs::select_topics: "body_states", "/rbsim/body_states", "tf" for the root /tf); an unknown one
+// is an error, not a permission for a topic that does not exist.
+Result<std::vector<std::string>> allowed_topics(const EnclaveOptions& o) {
   std::string ns = o.ns;
   while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
   std::vector<std::string> t;
   if (o.topics.empty()) {
     t.push_back("rt/" + ns + "/*");
   } else {
-    for (const std::string& suffix : o.topics) t.push_back("rt/" + ns + "/" + suffix);
+    const std::vector<msgs::TopicCandidate> candidates = msgs::topic_candidates(ns, /*events=*/true);
+    msgs::TopicFilter filter;
+    filter.topics = o.topics;
+    Result<std::vector<std::size_t>> chosen = msgs::select_topics(filter, candidates);
+    if (!chosen) return with_context("--topics: ", chosen.error());
+    for (const std::size_t i : chosen.value()) t.push_back(msgs::dds_topic_name(candidates[i].name));
   }
   for (const char* root : {"rt/clock", "rt/tf", "rt/rosout", "rt/parameter_events", "ros_discovery_info"})
-    t.emplace_back(root);
+    if (std::find(t.begin(), t.end(), root) == t.end()) t.emplace_back(root);
   t.push_back("rq/" + ns + "/*");
   t.push_back("rr/" + ns + "/*");
   t.push_back("rq/rbsim_recorder/*");
@@ -81,9 +89,9 @@ std::vector<std::string> allowed_topics(const EnclaveOptions& o) {
   return t;
 }
 
-std::string permissions_xml(const std::string& enclave, const EnclaveOptions& o) {
+std::string permissions_xml(const std::string& enclave, const std::vector<std::string>& allowed) {
   std::ostringstream topics;
-  for (const std::string& t : allowed_topics(o)) topics << "              <topic>" << t << "</topic>\n";
+  for (const std::string& t : allowed) topics << "              <topic>" << t << "</topic>\n";
   std::ostringstream x;
   x << R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
@@ -212,6 +220,8 @@ Status create_enclave(const std::string& keystore, const std::string& enclave,
   if (const std::string problem = msgs::ros_namespace_problem(options.ns); !problem.empty())
     return Error{"--namespace \"" + options.ns + "\" is not a ROS 2 namespace: it " + problem,
                  ErrorCode::InvalidArgument};
+  Result<std::vector<std::string>> allowed = allowed_topics(options);  // before any file is made
+  if (!allowed) return allowed.error();
   const fs::path root(keystore);
   Result<Ca> ca = read_ca(root);
   if (!ca) return ca.error();
@@ -233,7 +243,7 @@ Status create_enclave(const std::string& keystore, const std::string& enclave,
           write_file(dir / "cert.pem", ssl::certificate_pem(*cert.value(), (dir / "cert.pem").string()));
       !st)
     return st;
-  const std::string permissions = permissions_xml(enclave, options);
+  const std::string permissions = permissions_xml(enclave, allowed.value());
   if (Status st = write_file(dir / "permissions.xml", permissions); !st) return st;
   const fs::path signed_permissions = dir / "permissions.p7s";
   return write_file(signed_permissions,

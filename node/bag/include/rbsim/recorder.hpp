@@ -113,6 +113,7 @@ class Recorder {
     // a link came back after the lease expired), and a log must hold each message once.
     std::vector<std::pair<std::array<std::uint8_t, 16>, std::int64_t>> newest{};
     std::uint64_t duplicates = 0;
+    bool latched_pending = false;  // latched, and nothing came on it yet
   };
   RecorderOptions options_;
   mcap::Writer writer_;
@@ -164,8 +165,7 @@ class Recorder {
     Received sample;
     std::uint64_t log_time;
   };
-  bool holding_ = false;               // a latched topic is recorded and has not delivered yet
-  std::vector<bool> latched_pending_;  // per topics_ entry: latched, nothing came on it yet
+  bool holding_ = false;  // a latched topic is recorded and has not delivered yet
   [[nodiscard]] bool latched_outstanding() const;
   [[nodiscard]] bool scene_pending() const;
   std::vector<Held> held_;

@@ -27,8 +27,9 @@ inline constexpr const char* kEnclaveFiles[] = {
 
 struct EnclaveOptions {
   std::string ns = "rbsim";  // the namespace whose topics and services the enclave may use
-  // rbsim topics (suffixes, "body_states") the enclave may publish and subscribe to; empty: all
-  // (rt/<ns>/*). Services of <ns>, /clock, /tf, /rosout, /parameter_events and
+  // rbsim topics the enclave may publish and subscribe to, named as every command names them
+  // (msgs::select_topics: "body_states", "/rbsim/body_states"; an unknown one is an error); empty:
+  // all (rt/<ns>/*). Services of <ns>, /clock, /tf, /rosout, /parameter_events and
   // ros_discovery_info are always allowed.
   std::vector<std::string> topics{};
 };
