@@ -105,9 +105,11 @@ class DdsParticipant final : public ParticipantImpl {
   Result<std::unique_ptr<SubscriptionImpl>> create_subscription(const TopicRef& topic, const QosSpec& qos,
                                                                 const EndpointOptions& options) override;
   Result<std::unique_ptr<WaitSetImpl>> create_waitset() override;
-  Result<std::unique_ptr<ServiceServerImpl>> create_server(std::string_view service, std::string_view srv_type,
+  Result<std::unique_ptr<ServiceServerImpl>> create_server(std::string_view service,
+                                                           std::string_view srv_type,
                                                            const ServiceOptions& options) override;
-  Result<std::unique_ptr<ServiceClientImpl>> create_client(std::string_view service, std::string_view srv_type,
+  Result<std::unique_ptr<ServiceClientImpl>> create_client(std::string_view service,
+                                                           std::string_view srv_type,
                                                            const ClientOptions& options) override;
 
   DdsContext& context() { return context_; }
@@ -122,15 +124,20 @@ class DdsParticipant final : public ParticipantImpl {
 };
 
 // The services (service.cpp).
-Result<std::unique_ptr<ServiceServerImpl>> make_dds_server(const DdsContext& context, std::string_view service,
-                                                           std::string_view srv_type, const ServiceOptions& options,
+Result<std::unique_ptr<ServiceServerImpl>> make_dds_server(const DdsContext& context,
+                                                           std::string_view service,
+                                                           std::string_view srv_type,
+                                                           const ServiceOptions& options,
                                                            const DdsServiceUserData& user_data);
-Result<std::unique_ptr<ServiceClientImpl>> make_dds_client(const DdsContext& context, std::string_view service,
-                                                           std::string_view srv_type, const ClientOptions& options,
+Result<std::unique_ptr<ServiceClientImpl>> make_dds_client(const DdsContext& context,
+                                                           std::string_view service,
+                                                           std::string_view srv_type,
+                                                           const ClientOptions& options,
                                                            const DdsServiceUserData& user_data);
 
 // Lists a new endpoint in its participant's graph entry; returns where it is listed.
-std::weak_ptr<Graph> list_endpoint(const DdsContext& context, Graph::Kind kind, dds_entity_t entity, bool in_graph);
+std::weak_ptr<Graph> list_endpoint(const DdsContext& context, Graph::Kind kind, dds_entity_t entity,
+                                   bool in_graph);
 // Unlists it (nothing when the graph went first).
 void unlist_endpoint(const std::weak_ptr<Graph>& where, dds_entity_t entity);
 

@@ -40,7 +40,8 @@ Result<Publisher> Publisher::create(const Participant& participant, const msgs::
 
 Result<Publisher> Publisher::create(const Participant& participant, const RawTopic& raw, const QosSpec& qos,
                                     const EndpointOptions& options) {
-  auto impl = participant.impl().create_publisher(TopicRef{raw.ros_name, raw.ros_type, nullptr}, qos, options);
+  auto impl =
+      participant.impl().create_publisher(TopicRef{raw.ros_name, raw.ros_type, nullptr}, qos, options);
   if (!impl) return impl.error();
   return Publisher(std::move(impl.value()), raw.ros_name);
 }

@@ -164,7 +164,7 @@ class Subscription {
   std::uint64_t lost() const;    // samples the middleware reports lost or rejected
   std::int32_t matched() const;  // publications currently matched
   const std::string& ros_topic() const { return ros_topic_; }
-  const msgs::TopicSpec& spec() const;  // only for one created with a TopicSpec
+  const msgs::TopicSpec& spec() const;               // only for one created with a TopicSpec
   SubscriptionImpl& impl() const { return *impl_; }  // for backends
 
  private:

@@ -142,7 +142,7 @@ class ServiceClient {
   bool wait_reply(double timeout_s);
   // send() and waits up to `timeout_s` for the reply to that request (others are dropped).
   Result<Bytes> call(std::span<const std::byte> request, double timeout_s);
-  std::uint64_t id() const;  // the guid of its request headers
+  std::uint64_t id() const;                           // the guid of its request headers
   ServiceClientImpl& impl() const { return *impl_; }  // for backends
 
  private:
