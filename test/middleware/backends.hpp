@@ -27,7 +27,8 @@ class Backends : public ::testing::TestWithParam<std::string> {
   bool memory() const { return GetParam() == "memory"; }
   Participant participant(const std::string& name = "seam_test") {
     const NodeName node{"/", name};
-    Result<Participant> p = memory() ? create_memory_participant(network_, node) : create_dds_participant(kDomain, node);
+    Result<Participant> p =
+        memory() ? create_memory_participant(network_, node) : create_dds_participant(kDomain, node);
     EXPECT_TRUE(p.ok()) << p.error().message;
     return std::move(p.value());
   }
@@ -67,7 +68,8 @@ inline std::vector<std::byte> clock_cdr(std::uint8_t sec) {
 inline bool take_within(WaitSet& waitset, Subscription& sub, Received& out, double seconds = kPatience) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!sub.take(out)) {
-    const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(end - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(end - std::chrono::steady_clock::now());
     if (left.count() <= 0) return false;
     if (!waitset.wait(left.count())) return false;
   }

@@ -51,12 +51,12 @@ TEST_F(MemoryBackend, GraphListsNodesAndTheirEndpoints) {
     EXPECT_EQ(graph[1].name.fully_qualified(), "/ns/b");
     const std::string clock_type(clock_spec().type);
     const std::string step_type(msgs::StepRequest::kService);
-    EXPECT_EQ(graph[0].endpoints, (std::vector<MemoryNetwork::Endpoint>{
-                                      {Kind::Publisher, "/clock", clock_type},
-                                      {Kind::ServiceClient, "/ns/b/step", step_type}}));
-    EXPECT_EQ(graph[1].endpoints, (std::vector<MemoryNetwork::Endpoint>{
-                                      {Kind::Subscription, "/clock", clock_type},
-                                      {Kind::ServiceServer, "/ns/b/step", step_type}}));
+    EXPECT_EQ(graph[0].endpoints,
+              (std::vector<MemoryNetwork::Endpoint>{{Kind::Publisher, "/clock", clock_type},
+                                                    {Kind::ServiceClient, "/ns/b/step", step_type}}));
+    EXPECT_EQ(graph[1].endpoints,
+              (std::vector<MemoryNetwork::Endpoint>{{Kind::Subscription, "/clock", clock_type},
+                                                    {Kind::ServiceServer, "/ns/b/step", step_type}}));
   }
   const std::vector<MemoryNetwork::Node> graph = network->graph();
   ASSERT_EQ(graph.size(), 1u);
@@ -86,8 +86,8 @@ TEST_F(MemoryBackend, KeepLastQueueDropsTheOldestAndCountsThem) {
 TEST_F(MemoryBackend, MatchesByNameTypeAndDurability) {
   Participant p = participant("p");
   auto pub = Publisher::create(p, clock_spec(), "/t", QosSpec{false, false, 10});
-  auto other_type =
-      Subscription::create(p, RawTopic{"/t", std::string(msgs::ParameterEvent::kType)}, QosSpec{false, false, 10});
+  auto other_type = Subscription::create(p, RawTopic{"/t", std::string(msgs::ParameterEvent::kType)},
+                                         QosSpec{false, false, 10});
   auto wants_durability = Subscription::create(p, clock_spec(), "/t", QosSpec{true, false, 10});
   ASSERT_TRUE(pub.ok() && other_type.ok() && wants_durability.ok());
   EXPECT_EQ(pub->matched(), 0);

@@ -146,9 +146,8 @@ TEST_P(ServiceServerSeam, CountsDropsAndUnansweredAndCallsOnArrival) {
   EXPECT_EQ(s.queued, 2u);
   EXPECT_EQ(arrivals.load(), 2);
   EXPECT_TRUE(server->wait(0.0));
-  const std::size_t handled = server->serve([](const RequestHeader&, std::span<const std::byte>, Bytes&) {
-    return false;
-  });
+  const std::size_t handled =
+      server->serve([](const RequestHeader&, std::span<const std::byte>, Bytes&) { return false; });
   EXPECT_EQ(handled, 2u);
   s = server->stats();
   EXPECT_EQ(s.unanswered, 2u);
@@ -167,8 +166,12 @@ TEST_P(ServiceServerSeam, TypedHandlerAnswersAndRepliesToMalformedRequests) {
   ASSERT_TRUE(server.ok() && client.ok());
   ASSERT_TRUE(client->wait_for_server(kPatience).ok());
   const auto handler = typed_handler<msgs::StepRequest, msgs::StepResponse>(
-      [](const RequestHeader&, const msgs::StepRequest& req) { return msgs::StepResponse{true, "ok", req.steps + 1u}; },
-      [](const Error&) { return std::optional<msgs::StepResponse>(msgs::StepResponse{false, "malformed", 0}); });
+      [](const RequestHeader&, const msgs::StepRequest& req) {
+        return msgs::StepResponse{true, "ok", req.steps + 1u};
+      },
+      [](const Error&) {
+        return std::optional<msgs::StepResponse>(msgs::StepResponse{false, "malformed", 0});
+      });
   Bytes truncated = step_request(1);
   truncated.resize(6);
   ASSERT_TRUE(client->send(step_request(41)).ok());

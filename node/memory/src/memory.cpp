@@ -75,16 +75,19 @@ class MemParticipant final : public ParticipantImpl {
   }
   Result<std::unique_ptr<SubscriptionImpl>> create_subscription(const TopicRef& topic, const QosSpec& qos,
                                                                 const EndpointOptions& options) override {
-    return std::unique_ptr<SubscriptionImpl>(new MemSubscription(network_, id_, topic, qos, options.in_graph));
+    return std::unique_ptr<SubscriptionImpl>(
+        new MemSubscription(network_, id_, topic, qos, options.in_graph));
   }
   Result<std::unique_ptr<WaitSetImpl>> create_waitset() override {
     return std::unique_ptr<WaitSetImpl>(new MemWaitSet(network_));
   }
-  Result<std::unique_ptr<ServiceServerImpl>> create_server(std::string_view service, std::string_view srv_type,
+  Result<std::unique_ptr<ServiceServerImpl>> create_server(std::string_view service,
+                                                           std::string_view srv_type,
                                                            const ServiceOptions& options) override {
     return make_server(network_, id_, service, srv_type, options);
   }
-  Result<std::unique_ptr<ServiceClientImpl>> create_client(std::string_view service, std::string_view srv_type,
+  Result<std::unique_ptr<ServiceClientImpl>> create_client(std::string_view service,
+                                                           std::string_view srv_type,
                                                            const ClientOptions& options) override {
     return make_client(network_, id_, service, srv_type, options);
   }
@@ -152,12 +155,13 @@ std::int32_t MemPublisher::matched() const {
 bool MemPublisher::wait_for_subscribers(std::int32_t count, bool (*stop)()) const {
   MemoryNetwork::State& s = network_->state();
   std::unique_lock lock(s.mutex);
-  return wait_until_stopped(lock, s.matched, [&] { return matched_locked() >= count; }, stop);
+  return wait_until_stopped(
+      lock, s.matched, [&] { return matched_locked() >= count; }, stop);
 }
 
 // ---------------------------------------------------------------------------------------------
-MemSubscription::MemSubscription(Network network, std::uint64_t node, const TopicRef& topic, const QosSpec& qos,
-                                 bool in_graph)
+MemSubscription::MemSubscription(Network network, std::uint64_t node, const TopicRef& topic,
+                                 const QosSpec& qos, bool in_graph)
     : network_(std::move(network)), name_(topic.ros_name), type_(topic.ros_type), qos_(qos) {
   MemoryNetwork::State& s = network_->state();
   const std::lock_guard lock(s.mutex);
@@ -234,8 +238,8 @@ void MemWaitSet::attach(SubscriptionImpl& subscription) {
 }
 
 std::int32_t MemWaitSet::ready_locked() const {
-  return static_cast<std::int32_t>(
-      std::count_if(attached_.begin(), attached_.end(), [](const MemSubscription* s) { return s->has_samples(); }));
+  return static_cast<std::int32_t>(std::count_if(attached_.begin(), attached_.end(),
+                                                 [](const MemSubscription* s) { return s->has_samples(); }));
 }
 
 Result<std::int32_t> MemWaitSet::wait(std::int64_t timeout_ns) {
@@ -248,7 +252,8 @@ Result<std::int32_t> MemWaitSet::wait(std::int64_t timeout_ns) {
 }  // namespace memory
 
 // ---------------------------------------------------------------------------------------------
-std::uint64_t MemoryNetwork::State::add_endpoint(std::uint64_t node, bool in_graph, MemoryNetwork::Endpoint endpoint) {
+std::uint64_t MemoryNetwork::State::add_endpoint(std::uint64_t node, bool in_graph,
+                                                 MemoryNetwork::Endpoint endpoint) {
   const std::uint64_t id = ++next_id;
   if (!in_graph) return id;
   for (memory::ListedNode& n : nodes) {

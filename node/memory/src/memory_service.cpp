@@ -89,7 +89,8 @@ MemServer::MemServer(Network network, std::uint64_t node, std::string_view servi
   options_.queue_limit = std::max<std::size_t>(options.queue_limit, 1);
   MemoryNetwork::State& s = network_->state();
   const std::lock_guard lock(s.mutex);
-  id_ = s.add_endpoint(node, options.in_graph, {MemoryNetwork::Endpoint::Kind::ServiceServer, service_, type_});
+  id_ =
+      s.add_endpoint(node, options.in_graph, {MemoryNetwork::Endpoint::Kind::ServiceServer, service_, type_});
   s.servers.push_back(this);
   s.matched.notify_all();
 }
@@ -245,7 +246,8 @@ Result<std::unique_ptr<ServiceServerImpl>> make_server(const Network& network, s
 Result<std::unique_ptr<ServiceClientImpl>> make_client(const Network& network, std::uint64_t node,
                                                        std::string_view service, std::string_view srv_type,
                                                        const ClientOptions& options) {
-  return std::unique_ptr<ServiceClientImpl>(new MemClient(network, node, service, srv_type, options.in_graph));
+  return std::unique_ptr<ServiceClientImpl>(
+      new MemClient(network, node, service, srv_type, options.in_graph));
 }
 
 }  // namespace rbsim::node::memory

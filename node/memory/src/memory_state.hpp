@@ -124,7 +124,8 @@ class MemPublisher final : public PublisherImpl {
 
 class MemSubscription final : public SubscriptionImpl {
  public:
-  MemSubscription(Network network, std::uint64_t node, const TopicRef& topic, const QosSpec& qos, bool in_graph);
+  MemSubscription(Network network, std::uint64_t node, const TopicRef& topic, const QosSpec& qos,
+                  bool in_graph);
   ~MemSubscription() override;
   bool take(Received& out) override;
   std::uint64_t lost() const override;

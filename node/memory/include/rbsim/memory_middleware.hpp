@@ -63,6 +63,7 @@ class MemoryNetwork {
 };
 
 // A participant (one node) on `network`.
-Result<Participant> create_memory_participant(std::shared_ptr<MemoryNetwork> network, const NodeName& node = {});
+Result<Participant> create_memory_participant(std::shared_ptr<MemoryNetwork> network,
+                                              const NodeName& node = {});
 
 }  // namespace rbsim::node
