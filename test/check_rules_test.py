@@ -99,6 +99,15 @@ class CheckModulesTest(CheckerTest):
         self.tree.write("tools/log/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
         self.assertFails("(little-endian fields read by hand (le64))")
 
+    def test_dds_header_outside_the_backends_fails(self):
+        # The node's upper modules reach the network through the seam (node/middleware) alone.
+        self.tree.write("node/dds/include/rbsim/dds.hpp", "#pragma once\n")
+        self.tree.write("node/middleware/include/rbsim/middleware.hpp", "#pragma once\n")
+        self.tree.write("node/bag/src/player.cpp", '#include "rbsim/middleware.hpp"\n')
+        self.assertPasses()
+        self.tree.write("node/bag/src/player.cpp", '#include "rbsim/dds.hpp"\n')
+        self.assertFails("node/bag/src/player.cpp: module bag includes rbsim/dds.hpp of module dds")
+
     def test_cyclone_outside_dds_fails(self):
         self.tree.write("node/dds/src/dds.cpp", "#include <dds/dds.h>\nint p = dds_create_participant(0, 0, 0);\n")
         self.tree.write("node/bag/src/names.cpp", "// not dds_create_waitset(\n"

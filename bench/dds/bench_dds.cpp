@@ -57,13 +57,13 @@ std::int64_t monotonic_ns() {  // steady_clock is CLOCK_MONOTONIC in libstdc++
 }
 
 int listen(std::uint32_t domain, const std::string& topic, double seconds) {
-  auto participant = rbsim::node::Participant::create(domain);
+  auto participant = rbsim::node::create_dds_participant(domain);
   if (!participant) return std::fprintf(stderr, "%s\n", participant.error().message.c_str()), 1;
   const auto& spec = rbsim::msgs::topic(rbsim::msgs::TopicId::BodyStates);
   auto sub = rbsim::node::Subscription::create(participant.value(), spec, topic, rbsim::node::qos_for(spec));
   if (!sub) return std::fprintf(stderr, "%s\n", sub.error().message.c_str()), 1;
-  const dds_entity_t waitset = dds_create_waitset(participant->handle());
-  dds_waitset_attach(waitset, dds_create_readcondition(sub->reader(), DDS_ANY_STATE), 0);
+  const dds_entity_t waitset = dds_create_waitset(dds_entity(*participant));
+  dds_waitset_attach(waitset, dds_create_readcondition(dds_entity(*sub), DDS_ANY_STATE), 0);
   std::printf("READY\n");
   std::fflush(stdout);
   std::vector<std::array<std::int64_t, 4>> rows;
@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
       count = std::stoi(argv[i]);
     }
   }
-  auto participant = rbsim::node::Participant::create(domain);
+  auto participant = rbsim::node::create_dds_participant(domain);
   if (!participant) return std::fprintf(stderr, "%s\n", participant.error().message.c_str()), 1;
   const auto& spec = rbsim::msgs::topic(rbsim::msgs::TopicId::BodyStates);
   rbsim::node::QosSpec qos;
@@ -122,8 +122,8 @@ int main(int argc, char** argv) {
   auto sub =
       rbsim::node::Subscription::create(participant.value(), spec, ping ? "/bench/pong" : "/bench/ping", qos);
   if (!pub || !sub) return std::fprintf(stderr, "cannot create endpoints\n"), 1;
-  const dds_entity_t waitset = dds_create_waitset(participant->handle());
-  const dds_entity_t cond = dds_create_readcondition(sub->reader(), DDS_ANY_STATE);
+  const dds_entity_t waitset = dds_create_waitset(dds_entity(*participant));
+  const dds_entity_t cond = dds_create_readcondition(dds_entity(*sub), DDS_ANY_STATE);
   dds_waitset_attach(waitset, cond, 0);
   rbsim::node::Received got;
   if (!ping) {
@@ -132,9 +132,9 @@ int main(int argc, char** argv) {
     while (Clock::now() - idle_since < std::chrono::seconds(10)) {
       ddsi_serdata* d = nullptr;
       dds_sample_info_t info{};
-      if (dds_takecdr(sub->reader(), &d, 1, &info, DDS_ANY_STATE) == 1) {
+      if (dds_takecdr(dds_entity(*sub), &d, 1, &info, DDS_ANY_STATE) == 1) {
         if (info.valid_data) {
-          dds_writecdr(pub->writer(), d);  // takes the reference
+          dds_writecdr(dds_entity(*pub), d);  // takes the reference
         } else {
           ddsi_serdata_unref(d);
         }

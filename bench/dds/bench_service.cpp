@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "raw_serdata.hpp"
+#include "rbsim/dds.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
 
@@ -144,7 +145,7 @@ int serve_rbsim(const node::Participant& p, const std::string& ns) {
 }
 
 int serve_pubsub(const node::Participant& p, const std::string& ns) {
-  PubSub echo(p.handle(), "rt" + ns + "/pong", "rt" + ns + "/ping");
+  PubSub echo(dds_entity(p), "rt" + ns + "/pong", "rt" + ns + "/ping");
   Bytes reply, body;
   while (!stop) {
     if (!echo.take(0.1)) continue;
@@ -173,7 +174,7 @@ Caller rbsim_caller(const node::Participant& p, const std::string& ns) {
 }
 
 Caller pubsub_caller(const node::Participant& p, const std::string& ns) {
-  auto ps = std::make_shared<PubSub>(p.handle(), "rt" + ns + "/ping", "rt" + ns + "/pong");
+  auto ps = std::make_shared<PubSub>(dds_entity(p), "rt" + ns + "/ping", "rt" + ns + "/pong");
   auto sample = std::make_shared<Bytes>();
   auto seq = std::make_shared<std::int64_t>(0);
   return {[ps](double t) {
@@ -235,7 +236,7 @@ int run_peer(const Peer& peer, std::uint32_t domain, int calls, int warmup, Row&
   if (posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, argv, environ) != 0) return 1;
   int rc = 1;
   {
-    auto participant = node::Participant::create(domain);
+    auto participant = node::create_dds_participant(domain);
     if (participant) {
       Caller c = peer.caller(participant.value(), ns);
       if (c.ready && c.ready(10.0)) {
@@ -269,7 +270,7 @@ int main(int argc, char** argv) {
     const Peer* peer = find_peer(argv[2]);
     if (peer == nullptr) return 2;
     signal(SIGTERM, [](int) { stop = 1; });
-    auto participant = node::Participant::create(static_cast<std::uint32_t>(std::atoi(argv[3])));
+    auto participant = node::create_dds_participant(static_cast<std::uint32_t>(std::atoi(argv[3])));
     if (!participant) return 1;
     return peer->serve(participant.value(), argv[4]);
   }

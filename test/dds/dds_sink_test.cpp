@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "rbsim/dds.hpp"
 #include "rbsim/dds_sink.hpp"
 
 namespace rbsim::node {
@@ -12,7 +13,7 @@ namespace {
 
 // Publishing every 0th (or -2nd) step is an error from create(), not a silent every 1.
 TEST(DdsSink, PublishEveryBelowOneIsRefusedAtCreate) {
-  Result<Participant> participant = Participant::create(143);
+  Result<Participant> participant = create_dds_participant(143);
   ASSERT_TRUE(participant.ok()) << participant.error().message;
   for (const std::int64_t every : {std::int64_t{0}, std::int64_t{-2}}) {
     NodeOptions options;

@@ -234,7 +234,7 @@ constexpr const char* kInfoType = "rmw_dds_common::msg::dds_::ParticipantEntitie
 void check_entry_matches_discovery(std::uint32_t domain, std::size_t gid_size) {
   Observer observer(domain);
   const dds_entity_t info_reader = observer.reader("ros_discovery_info", kInfoType);
-  auto participant = Participant::create(domain, NodeName{"/graph/test", "sim"});
+  auto participant = create_dds_participant(domain, NodeName{"/graph/test", "sim"});
   ASSERT_TRUE(participant.ok()) << participant.error().message;
   NodeOptions options;
   options.domain = domain;
@@ -338,7 +338,7 @@ TEST(Graph, ParticipantThatGoesUnlistsItsNodeFirst) {
   const dds_entity_t reader = observer.reader("ros_discovery_info", kInfoType);
   std::vector<std::uint8_t> participant_gid;
   {
-    auto participant = Participant::create(kDomain, NodeName{"/", "short_lived"});
+    auto participant = create_dds_participant(kDomain, NodeName{"/", "short_lived"});
     ASSERT_TRUE(participant.ok()) << participant.error().message;
     auto info = wait_for_entry(reader, 16, "short_lived", 0, 0);
     ASSERT_TRUE(info.has_value());
@@ -358,10 +358,10 @@ TEST(Graph, ParticipantThatGoesUnlistsItsNodeFirst) {
 TEST(Graph, ParticipantUserDataCarriesTheEnclave) {
   constexpr std::uint32_t kDomain = 147;
   Observer observer(kDomain);
-  auto participant = Participant::create(kDomain, NodeName{"/", "enclave_test"});
+  auto participant = create_dds_participant(kDomain, NodeName{"/", "enclave_test"});
   ASSERT_TRUE(participant.ok()) << participant.error().message;
   dds_guid_t key{};
-  ASSERT_EQ(dds_get_guid(participant.value().handle(), &key), DDS_RETCODE_OK);
+  ASSERT_EQ(dds_get_guid(dds_entity(participant.value()), &key), DDS_RETCODE_OK);
   std::optional<std::string> user_data;
   eventually(10, [&] {
     const dds_entity_t r =
@@ -391,7 +391,7 @@ TEST(Rosout, LogPublishesTheLineWithLevelNameAndSite) {
   constexpr std::uint32_t kDomain = 148;
   Observer observer(kDomain);
   const dds_entity_t reader = observer.reader("rt/rosout", "rcl_interfaces::msg::dds_::Log_");
-  auto participant = Participant::create(kDomain, NodeName{"/a/b", "sim"});
+  auto participant = create_dds_participant(kDomain, NodeName{"/a/b", "sim"});
   ASSERT_TRUE(participant.ok()) << participant.error().message;
   auto rosout = Rosout::create(participant.value(), [] { return std::int64_t{12'500'000'001}; });
   ASSERT_TRUE(rosout.ok()) << rosout.error().message;

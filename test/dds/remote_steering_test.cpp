@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "control_test_util.hpp"
+#include "rbsim/dds.hpp"
 #include "rbsim/node_services.hpp"
 #include "rbsim/relay.hpp"
 
@@ -42,7 +43,7 @@ Command kind(CommandKind k, std::int64_t steps = 0) {
 }
 
 Participant participant(const std::string& name) {
-  auto p = Participant::create(kDomain, NodeName{"/", name});
+  auto p = create_dds_participant(kDomain, NodeName{"/", name});
   if (!p) throw std::runtime_error(p.error().message);
   return std::move(p.value());
 }

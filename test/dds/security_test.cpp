@@ -188,7 +188,7 @@ TEST_F(Security, ParticipantCreateIsSecuredByCyclonesPlugins) {
   ::setenv("ROS_SECURITY_ENABLE", "true", 1);
   ::setenv("ROS_SECURITY_STRATEGY", "Enforce", 1);
   ::setenv("ROS_SECURITY_KEYSTORE", ks().c_str(), 1);
-  Result<Participant> p = Participant::create(57, kNode);
+  Result<Participant> p = create_dds_participant(57, kNode);
   ::unsetenv("ROS_SECURITY_ENABLE");
   ASSERT_TRUE(p) << p.error().message;
   EXPECT_NE(p->description().find("secured as enclave /sec_node (Enforce)"), std::string::npos)

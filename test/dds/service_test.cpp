@@ -2,6 +2,7 @@
 // process: names and sample layout, our client against our server, two clients, a client that
 // vanishes, a client whose reply reader never matches, hostile samples from a raw writer, a flood.
 #include "rbsim/service.hpp"
+#include "rbsim/dds.hpp"
 #include "step_handler.hpp"
 
 #include <dds/dds.h>
@@ -58,7 +59,7 @@ bool serve_until(ServiceServer& server, Done done, double seconds = 5.0) {
 
 struct Loopback : ::testing::Test {
   void SetUp() override {
-    auto p = Participant::create(kDomain);
+    auto p = create_dds_participant(kDomain);
     ASSERT_TRUE(p.ok()) << p.error().message;
     participant.emplace(std::move(p.value()));
   }
@@ -169,23 +170,23 @@ TEST_F(Loopback, ServiceServerAnswersServiceClientWithItsHeaderBack) {
 // clientid/serviceid.
 TEST_F(Loopback, EndpointsReportIdsAndCarryUserData) {
   const std::string name = unique_service("ids");
-  ServiceOptions so;
-  so.request_user_data = "typehash=REQ;";
-  ServiceServer server = make_server(name, so);
-  ClientOptions co;
-  co.request_user_data = "typehash=CLIENTREQ;";
-  ServiceClient client = make_client(name, co);
+  auto made_server = create_dds_server(*participant, name, kStep, {}, {"typehash=REQ;", ""});
+  ASSERT_TRUE(made_server.ok()) << made_server.error().message;
+  ServiceServer server = std::move(made_server.value());
+  auto made_client = create_dds_client(*participant, name, kStep, {}, {"typehash=CLIENTREQ;", ""});
+  ASSERT_TRUE(made_client.ok()) << made_client.error().message;
+  ServiceClient client = std::move(made_client.value());
   ASSERT_TRUE(client.wait_for_server(5.0).ok());
-  const EndpointId ids[] = {server.request_reader(), server.reply_writer(), client.request_writer(),
-                            client.reply_reader()};
+  const EndpointId ids[] = {dds_request_reader(server), dds_reply_writer(server), dds_request_writer(client),
+                            dds_reply_reader(client)};
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_NE(ids[i].instance_handle, 0u);
     for (std::size_t j = 0; j < i; ++j) EXPECT_NE(ids[i].guid, ids[j].guid);
   }
-  EXPECT_EQ(client.id(), client.request_writer().instance_handle);
+  EXPECT_EQ(client.id(), dds_request_writer(client).instance_handle);
   // What the server's reader sees of the client's writer (discovery data): USER_DATA.
   dds_entity_t topic_reader =
-      dds_create_reader(participant->handle(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+      dds_create_reader(dds_entity(*participant), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
   std::string user_data;
   for (int i = 0; i < 200 && user_data.empty(); ++i) {
     void* samples[16] = {};
@@ -313,7 +314,7 @@ TEST_F(Loopback, ReplyToAClientWithoutItsReplyReaderIsDroppedAfterTheMatchTimeou
   ServiceOptions so;
   so.client_match_timeout_s = 0.2;
   ServiceServer server = make_server(name, so);
-  RawWriter raw(participant->handle(), service_request_topic(name), service_request_type(kStep),
+  RawWriter raw(dds_entity(*participant), service_request_topic(name), service_request_type(kStep),
                 "clientid=nobody;");
   for (int i = 0; i < 500 && !raw.matched(); ++i) std::this_thread::sleep_for(10ms);
   ASSERT_TRUE(raw.matched());
@@ -374,7 +375,7 @@ TEST_F(Loopback, HostileRequestsAreCountedOrRefused) {
   ServiceOptions so;
   so.max_request_bytes = 1024;
   ServiceServer server = make_server(name, so);
-  RawWriter raw(participant->handle(), service_request_topic(name), service_request_type(kStep), "");
+  RawWriter raw(dds_entity(*participant), service_request_topic(name), service_request_type(kStep), "");
   ServiceClient witness = make_client(name);  // so the reply writer has a reader to match
   for (int i = 0; i < 500 && !raw.matched(); ++i) std::this_thread::sleep_for(10ms);
   ASSERT_TRUE(raw.matched());

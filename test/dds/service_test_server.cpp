@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "rbsim/dds.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/service.hpp"
 #include "step_handler.hpp"
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: service_test_server DOMAIN NAMESPACE\n");
     return 2;
   }
-  auto participant = node::Participant::create(static_cast<std::uint32_t>(std::atoi(argv[1])));
+  auto participant = node::create_dds_participant(static_cast<std::uint32_t>(std::atoi(argv[1])));
   if (!participant) {
     std::fprintf(stderr, "%s\n", participant.error().message.c_str());
     return 1;

@@ -39,7 +39,7 @@ int bridge_command(const BridgeArgs& a) {
   // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
   // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
   install_stop_handlers();
-  auto participant = node::Participant::create(a.domain, a.node);
+  auto participant = node::create_dds_participant(a.domain, a.node);
   if (!participant) return fail("bridge", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
   if (!rosout) return fail("bridge", rosout.error().message);

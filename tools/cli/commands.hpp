@@ -35,7 +35,7 @@ Subcommand add_security_command(CLI::App& parent);   // security.cpp: SROS2 keys
 
 // The DDS commands' --domain (record.cpp): bound to `domain`, which starts as ROS_DOMAIN_ID (or 0),
 // so the command line wins; an invalid ROS_DOMAIN_ID leaves node::kDomainFromEnvironment for
-// Participant::create to report. Also puts the help on ROS 2's DDS environment variables before
+// node::create_dds_participant to report. Also puts the help on ROS 2's DDS environment variables before
 // the command's own footer.
 CLI::Option* add_domain_option(CLI::App* app, std::uint32_t& domain);
 

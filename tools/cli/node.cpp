@@ -6,6 +6,7 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/control.hpp"
+#include "rbsim/dds.hpp"
 #include "rbsim/dds_sink.hpp"
 #include "rbsim/node_services.hpp"
 #include "rbsim/ros_args.hpp"
@@ -169,7 +170,7 @@ int node_command(const NodeArgs& a) {
   // The node is /<namespace> on the graph: its topics /<namespace>/<name> are its private ones.
   const Result<node::NodeName> name = node::parse_node_name(a.node.ns);
   if (!name) return fail("node", name.error().message, 2);
-  auto participant = node::Participant::create(a.node.domain, name.value());
+  auto participant = node::create_dds_participant(a.node.domain, name.value());
   if (!participant) return fail("node", participant.error().message);
   // The node's clock is the simulation's (it publishes /clock): 0 until there is a world.
   const World* clock_world = nullptr;

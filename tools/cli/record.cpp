@@ -156,7 +156,7 @@ int record_command(RecordArgs a) {
   if (!bag.empty()) {
     if (Status st = log::make_bag_directory(bag); !st) return fail("record", st.error().message);
   }
-  auto participant = node::Participant::create(a.domain, a.node);
+  auto participant = node::create_dds_participant(a.domain, a.node);
   if (!participant) return fail("record", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
   if (!rosout) return fail("record", rosout.error().message);

@@ -133,7 +133,7 @@ int replay_command(ReplayArgs a) {
   // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
   install_stop_handlers();
   if (!a.ns.empty()) a.replay.ns = a.ns;
-  auto participant = node::Participant::create(a.domain, a.node);
+  auto participant = node::create_dds_participant(a.domain, a.node);
   if (!participant) return fail("replay", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
   if (!rosout) return fail("replay", rosout.error().message);

@@ -3,7 +3,6 @@
 #include <limits>
 
 #include "rbsim/assert.hpp"
-#include "rbsim/graph.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/parameter_events.hpp"
 #include "rbsim/relay.hpp"
@@ -190,15 +189,10 @@ Result<std::unique_ptr<RemoteSteering>> RemoteSteering::create(const Participant
   s->options_ = options;
   auto add = [&](std::string_view name, std::string_view type) -> Status {
     ClientOptions co;
-    if (Status st = type_hash_user_data(participant, type, co.request_user_data, co.reply_user_data); !st)
-      return st;
+    co.in_graph = true;  // ros2 node info lists the bridge's clients
     Result<ServiceClient> c =
         ServiceClient::create(participant, options.node + "/" + std::string(name), type, co);
     if (!c) return c.error();
-    if (Graph* graph = participant.graph()) {  // ros2 node info lists the bridge's clients
-      if (Status st = graph->add(Graph::Kind::Writer, c->request_writer().guid); !st) return st;
-      if (Status st = graph->add(Graph::Kind::Reader, c->reply_reader().guid); !st) return st;
-    }
     s->clients_.push_back(std::move(c.value()));
     return Ok{};
   };

@@ -1,4 +1,5 @@
-// Cyclone DDS plumbing: participants, raw-CDR publishers and subscriptions.
+// The seam on Cyclone DDS (dds_backend.hpp): participants, raw-CDR publishers and subscriptions,
+// wait sets.
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 #include <dds/ddsi/ddsi_sertype.h>
@@ -12,6 +13,7 @@
 #include <optional>
 #include <utility>
 
+#include "dds_backend.hpp"
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
 #include "rbsim/clock.hpp"
@@ -77,36 +79,37 @@ void offered_by(const dds_qos_t* qos, msgs::OfferedQos& out) {
   }
 }
 
-Result<dds_entity_t> make_topic(dds_entity_t participant, const RawTopic& raw,
-                                const ddsi_sertype** sertype = nullptr) {
-  return make_raw_topic(participant, raw.dds_name, raw.dds_type, sertype);
-}
-
-RawTopic raw_topic(const msgs::TopicSpec& spec, std::string_view ros_topic) {
-  return {msgs::dds_topic_name(ros_topic), descriptor(spec.id)->m_typename, std::string(spec.type)};
+// A topic of the seam by its DDS names: "rt" before the ROS name, the type's DDS name (idlc's, for
+// one of msgs::topics()).
+DdsTopic dds_topic(const TopicRef& ref) {
+  if (ref.spec != nullptr) {
+    return {msgs::dds_topic_name(ref.ros_name), descriptor(ref.spec->id)->m_typename, ref.ros_type,
+            ref.ros_name};
+  }
+  const std::string name = msgs::dds_topic_name(ref.ros_name);
+  return {name, msgs::dds_type_name(ref.ros_type), ref.ros_type, name};
 }
 
 // The endpoint's options with the type hash of its topic's type filled in (every shipped type
 // hashes: a failure is a bug in the definitions, caught by msgs's tests).
-EndpointOptions with_type_hash(const EndpointOptions& options, const RawTopic& raw) {
+EndpointOptions with_type_hash(const EndpointOptions& options, const DdsTopic& topic) {
   EndpointOptions o = options;
-  if (o.type_hash.empty() && !raw.ros_type.empty()) {
-    Result<std::string> hash = msgs::type_hash(raw.ros_type);
+  if (o.type_hash.empty() && !topic.ros_type.empty()) {
+    Result<std::string> hash = msgs::type_hash(topic.ros_type);
     RBSIM_ASSERT(hash, "a shipped type hashes");
     if (hash) o.type_hash = hash.value();
   }
   return o;
 }
+}  // namespace
 
-// Lists a new endpoint in its participant's graph entry; returns where it is listed.
-std::weak_ptr<Graph> list_endpoint(const Participant& participant, Graph::Kind kind, dds_entity_t entity,
-                                   const EndpointOptions& options) {
-  const std::shared_ptr<Graph> graph = participant.shared_graph();
-  if (!options.in_graph || !graph) return {};
-  if (Status st = graph->add(kind, Graph::guid_of(entity)); !st) {
+std::weak_ptr<Graph> list_endpoint(const DdsContext& context, Graph::Kind kind, dds_entity_t entity,
+                                   bool in_graph) {
+  if (!in_graph || !context.graph) return {};
+  if (Status st = context.graph->add(kind, Graph::guid_of(entity)); !st) {
     log(LogLevel::Warn, "rbsim: warning: ros_discovery_info not updated: " + st.error().message);
   }
-  return graph;
+  return context.graph;
 }
 void unlist_endpoint(const std::weak_ptr<Graph>& where, dds_entity_t entity) {
   const std::shared_ptr<Graph> graph = where.lock();
@@ -114,13 +117,12 @@ void unlist_endpoint(const std::weak_ptr<Graph>& where, dds_entity_t entity) {
   // A failure here has no one left to report to (a destructor); the next change republishes.
   static_cast<void>(graph->remove(Graph::guid_of(entity)));
 }
-}  // namespace
 
 std::string_view loopback_config() {
   return kLoopbackConfig;
 }
 
-Result<Participant> Participant::create(std::uint32_t domain, const NodeName& node) {
+Result<Participant> create_dds_participant(std::uint32_t domain, const NodeName& node) {
   const RosEnvironment env = RosEnvironment::from_process();
   auto settings = resolve_dds_settings(
       env, domain == kDomainFromEnvironment ? std::nullopt : std::optional<std::uint32_t>(domain), getpid());
@@ -157,73 +159,76 @@ Result<Participant> Participant::create(std::uint32_t domain, const NodeName& no
         p);
   }
   // Security asked for: every command's start line says whether it runs secured.
-  Participant participant(
-      p, s.domain, s.describe() + (security->requested ? ", " + security->describe() : ""), node, s.distro);
-  auto graph = Graph::create(participant, node, s.distro);
+  auto impl = std::make_unique<DdsParticipant>(
+      DdsContext{p, s.distro, nullptr}, s.domain,
+      s.describe() + (security->requested ? ", " + security->describe() : ""), node);
+  auto graph = Graph::create(p, node, s.distro);
   if (!graph) return with_context("cannot publish the node on ros_discovery_info: ", graph.error());
-  participant.graph_ = std::move(graph.value());
-  return participant;
+  impl->context().graph = std::move(graph.value());
+  return Participant(std::move(impl));
 }
 
-Participant::Participant(Participant&& o) noexcept
-    : handle_(o.handle_),
-      domain_(o.domain_),
-      description_(std::move(o.description_)),
-      node_(std::move(o.node_)),
-      distro_(o.distro_),
-      graph_(std::move(o.graph_)) {
-  o.handle_ = 0;
+DdsParticipant::~DdsParticipant() {
+  context_.graph.reset();  // its writer before the participant (endpoints still alive find it gone)
+  if (context_.participant > 0) dds_delete(context_.participant);
 }
-Participant::~Participant() {
-  graph_.reset();  // its writer before the participant (Publishers still alive find it gone)
-  if (handle_ > 0) dds_delete(handle_);
+
+Result<std::unique_ptr<PublisherImpl>> DdsParticipant::create_publisher(const TopicRef& topic,
+                                                                        const QosSpec& qos,
+                                                                        const EndpointOptions& options) {
+  auto p = DdsPublisher::create(context_, dds_topic(topic), qos, options);
+  if (!p) return p.error();
+  return std::unique_ptr<PublisherImpl>(std::move(p.value()));
+}
+
+Result<std::unique_ptr<SubscriptionImpl>> DdsParticipant::create_subscription(
+    const TopicRef& topic, const QosSpec& qos, const EndpointOptions& options) {
+  auto s = DdsSubscription::create(context_, dds_topic(topic), topic.spec, qos, options);
+  if (!s) return s.error();
+  return std::unique_ptr<SubscriptionImpl>(std::move(s.value()));
+}
+
+Result<std::unique_ptr<ServiceServerImpl>> DdsParticipant::create_server(std::string_view service,
+                                                                         std::string_view srv_type,
+                                                                         const ServiceOptions& options) {
+  return make_dds_server(context_, service, srv_type, options, {});
+}
+
+Result<std::unique_ptr<ServiceClientImpl>> DdsParticipant::create_client(std::string_view service,
+                                                                         std::string_view srv_type,
+                                                                         const ClientOptions& options) {
+  return make_dds_client(context_, service, srv_type, options, {});
 }
 
 // ---------------------------------------------------------------------------------------------
-Result<Publisher> Publisher::create(const Participant& participant, const msgs::TopicSpec& spec,
-                                    std::string_view ros_topic, const QosSpec& q,
-                                    const EndpointOptions& options) {
-  auto p = create(participant, raw_topic(spec, ros_topic), q, options);
-  if (p) p.value().ros_topic_ = std::string(ros_topic);
-  return p;
-}
-
-Result<Publisher> Publisher::create(const Participant& participant, const RawTopic& raw, const QosSpec& q,
-                                    const EndpointOptions& options) {
+Result<std::unique_ptr<DdsPublisher>> DdsPublisher::create(const DdsContext& context, const DdsTopic& raw,
+                                                           const QosSpec& q, const EndpointOptions& options) {
   const ddsi_sertype* sertype = nullptr;
-  auto topic = make_topic(participant.handle(), raw, &sertype);
+  auto topic = make_raw_topic(context.participant, raw.dds_name, raw.dds_type, &sertype);
   if (!topic) return topic.error();
-  dds_qos_t* qos = make_qos(q, false, with_type_hash(options, raw), participant.distro());
-  const dds_entity_t writer = dds_create_writer(participant.handle(), topic.value(), qos, nullptr);
+  dds_qos_t* qos = make_qos(q, false, with_type_hash(options, raw), context.distro);
+  const dds_entity_t writer = dds_create_writer(context.participant, topic.value(), qos, nullptr);
   dds_delete_qos(qos);
   if (writer < 0) {
     dds_delete(topic.value());
     return dds_error("cannot create DDS writer for " + raw.dds_name, writer);
   }
-  Publisher p;
-  p.writer_ = writer;
-  p.topic_ = topic.value();
-  p.sertype_ = sertype;
-  p.ros_topic_ = raw.dds_name;
-  p.graph_ = list_endpoint(participant, Graph::Kind::Writer, writer, options);
+  std::unique_ptr<DdsPublisher> p(new DdsPublisher());
+  p->writer_ = writer;
+  p->topic_ = topic.value();
+  p->sertype_ = sertype;
+  p->label_ = raw.label;
+  p->graph_ = list_endpoint(context, Graph::Kind::Writer, writer, options.in_graph);
   return p;
 }
 
-Publisher::Publisher(Publisher&& o) noexcept
-    : writer_(o.writer_),
-      topic_(o.topic_),
-      sertype_(o.sertype_),
-      ros_topic_(std::move(o.ros_topic_)),
-      graph_(std::move(o.graph_)) {
-  o.writer_ = o.topic_ = 0;
-}
-Publisher::~Publisher() {
+DdsPublisher::~DdsPublisher() {
   if (writer_ > 0) unlist_endpoint(graph_, writer_);
   if (writer_ > 0) dds_delete(writer_);
   if (topic_ > 0) dds_delete(topic_);
 }
 
-Status Publisher::publish(std::span<const std::byte> cdr, bool (*stop)()) {
+Status DdsPublisher::publish(std::span<const std::byte> cdr, bool (*stop)()) {
   ddsi_serdata* d = make_raw_serdata(sertype_, cdr);
   dds_return_t rc = DDS_RETCODE_TIMEOUT;
   for (dds_duration_t blocked = 0; rc == DDS_RETCODE_TIMEOUT && blocked < kMaxBlocked;
@@ -233,13 +238,13 @@ Status Publisher::publish(std::span<const std::byte> cdr, bool (*stop)()) {
   }
   ddsi_serdata_unref(d);
   if (rc == DDS_RETCODE_TIMEOUT && stop != nullptr && stop()) {
-    return Error{"stopped while subscribers of " + ros_topic_ + " were not keeping up", ErrorCode::Cancelled};
+    return Error{"stopped while subscribers of " + label_ + " were not keeping up", ErrorCode::Cancelled};
   }
-  if (rc < 0) return dds_error("publishing on " + ros_topic_ + " failed", rc);
+  if (rc < 0) return dds_error("publishing on " + label_ + " failed", rc);
   return Ok{};
 }
 
-Status Publisher::flush(double timeout_s, bool (*stop)()) {
+Status DdsPublisher::flush(double timeout_s, bool (*stop)()) {
   // In slices, so a stop request (a second Ctrl-C, or the first when a subscriber died) cuts the
   // wait to kStoppingFlush.
   const auto timeout = static_cast<dds_duration_t>(seconds_to_ns_clamped(timeout_s));
@@ -249,18 +254,17 @@ Status Publisher::flush(double timeout_s, bool (*stop)()) {
     if (stop != nullptr && stop() && waited >= kStoppingFlush) break;
     rc = dds_wait_for_acks(writer_, std::min(kWriteSlice, timeout - waited));
   }
-  if (rc < 0)
-    return dds_error("subscribers of " + ros_topic_ + " did not acknowledge everything in time", rc);
+  if (rc < 0) return dds_error("subscribers of " + label_ + " did not acknowledge everything in time", rc);
   return Ok{};
 }
 
-std::int32_t Publisher::matched() const {
+std::int32_t DdsPublisher::matched() const {
   dds_publication_matched_status_t st{};
   if (dds_get_publication_matched_status(writer_, &st) < 0) return 0;
   return static_cast<std::int32_t>(st.current_count);
 }
 
-bool Publisher::wait_for_subscribers(std::int32_t count, bool (*stop)()) const {
+bool DdsPublisher::wait_for_subscribers(std::int32_t count, bool (*stop)()) const {
   constexpr std::int64_t kPoll = 20'000'000;
   while (matched() < count) {
     if (stop != nullptr && stop()) return false;
@@ -270,23 +274,15 @@ bool Publisher::wait_for_subscribers(std::int32_t count, bool (*stop)()) const {
 }
 
 // ---------------------------------------------------------------------------------------------
-Result<Subscription> Subscription::create(const Participant& participant, const msgs::TopicSpec& spec,
-                                          std::string_view ros_topic, const QosSpec& q,
-                                          const EndpointOptions& options) {
-  auto s = create(participant, raw_topic(spec, ros_topic), q, options);
-  if (s) {
-    s.value().ros_topic_ = std::string(ros_topic);
-    s.value().spec_ = &spec;
-  }
-  return s;
-}
-
-Result<Subscription> Subscription::create(const Participant& participant, const RawTopic& raw,
-                                          const QosSpec& q, const EndpointOptions& options) {
-  auto topic = make_topic(participant.handle(), raw);
+Result<std::unique_ptr<DdsSubscription>> DdsSubscription::create(const DdsContext& context,
+                                                                 const DdsTopic& raw,
+                                                                 const msgs::TopicSpec* spec,
+                                                                 const QosSpec& q,
+                                                                 const EndpointOptions& options) {
+  auto topic = make_raw_topic(context.participant, raw.dds_name, raw.dds_type);
   if (!topic) return topic.error();
-  dds_qos_t* qos = make_qos(q, true, with_type_hash(options, raw), participant.distro());
-  const dds_entity_t reader = dds_create_reader(participant.handle(), topic.value(), qos, nullptr);
+  dds_qos_t* qos = make_qos(q, true, with_type_hash(options, raw), context.distro);
+  const dds_entity_t reader = dds_create_reader(context.participant, topic.value(), qos, nullptr);
   dds_delete_qos(qos);
   if (reader < 0) {
     dds_delete(topic.value());
@@ -294,35 +290,28 @@ Result<Subscription> Subscription::create(const Participant& participant, const 
   }
   dds_set_status_mask(reader,
                       DDS_DATA_AVAILABLE_STATUS | DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS);
-  Subscription s;
-  s.reader_ = reader;
-  s.topic_ = topic.value();
-  s.ros_topic_ = raw.dds_name;
-  s.q_ = q;
-  s.graph_ = list_endpoint(participant, Graph::Kind::Reader, reader, options);
+  std::unique_ptr<DdsSubscription> s(new DdsSubscription());
+  s->reader_ = reader;
+  s->topic_ = topic.value();
+  s->spec_ = spec;
+  s->q_ = q;
+  s->graph_ = list_endpoint(context, Graph::Kind::Reader, reader, options.in_graph);
   return s;
 }
 
-Subscription::Subscription(Subscription&& o) noexcept
-    : reader_(o.reader_),
-      topic_(o.topic_),
-      ros_topic_(std::move(o.ros_topic_)),
-      spec_(o.spec_),
-      q_(o.q_),
-      graph_(std::move(o.graph_)) {
-  o.reader_ = o.topic_ = 0;
-}
-Subscription::~Subscription() {
+DdsSubscription::~DdsSubscription() {
   if (reader_ > 0) unlist_endpoint(graph_, reader_);
   if (reader_ > 0) dds_delete(reader_);
   if (topic_ > 0) dds_delete(topic_);
 }
 
-void SerdataUnref::operator()(ddsi_serdata* d) const {
-  ddsi_serdata_unref(d);
+namespace {
+void release_serdata(void* d) {
+  ddsi_serdata_unref(static_cast<ddsi_serdata*>(d));
 }
+}  // namespace
 
-bool Subscription::take(Received& out) {
+bool DdsSubscription::take(Received& out) {
   while (true) {
     ddsi_serdata* d = nullptr;
     dds_sample_info_t info{};
@@ -336,7 +325,7 @@ bool Subscription::take(Received& out) {
     // bytes (rbsim's raw CDR type keeps them in one buffer).
     const std::uint32_t size = ddsi_serdata_size(d);
     ddsrt_iovec_t bytes{};
-    out.held.reset(ddsi_serdata_to_ser_ref(d, 0, size, &bytes));
+    out.held = Loan(ddsi_serdata_to_ser_ref(d, 0, size, &bytes), &release_serdata);
     ddsi_serdata_unref(d);
     out.cdr = {static_cast<const std::byte*>(bytes.iov_base), bytes.iov_len};
     out.source_time_ns = info.source_timestamp;
@@ -361,12 +350,7 @@ bool Subscription::take(Received& out) {
   }
 }
 
-const msgs::TopicSpec& Subscription::spec() const {
-  RBSIM_ASSERT(spec_ != nullptr, "spec() of a Subscription created from a RawTopic");
-  return *spec_;
-}
-
-std::uint64_t Subscription::lost() const {
+std::uint64_t DdsSubscription::lost() const {
   dds_sample_lost_status_t lost{};
   dds_sample_rejected_status_t rejected{};
   dds_get_sample_lost_status(reader_, &lost);
@@ -374,44 +358,61 @@ std::uint64_t Subscription::lost() const {
   return static_cast<std::uint64_t>(lost.total_count) + static_cast<std::uint64_t>(rejected.total_count);
 }
 
-std::int32_t Subscription::matched() const {
+std::int32_t DdsSubscription::matched() const {
   dds_subscription_matched_status_t st{};
   if (dds_get_subscription_matched_status(reader_, &st) < 0) return 0;
   return static_cast<std::int32_t>(st.current_count);
 }
 
 // ---------------------------------------------------------------------------------------------
-Result<WaitSet> WaitSet::create(const Participant& participant) {
-  WaitSet w;
-  w.handle_ = dds_create_waitset(participant.handle());
-  if (w.handle_ < 0) return Error{std::string("cannot create a DDS waitset: ") + dds_strretcode(w.handle_)};
-  return w;
+Result<std::unique_ptr<WaitSetImpl>> DdsParticipant::create_waitset() {
+  const dds_entity_t handle = dds_create_waitset(context_.participant);
+  if (handle < 0) return Error{std::string("cannot create a DDS waitset: ") + dds_strretcode(handle)};
+  return std::unique_ptr<WaitSetImpl>(new DdsWaitSet(handle));
 }
 
-WaitSet::WaitSet(WaitSet&& o) noexcept : handle_(o.handle_), attached_(o.attached_) {
-  o.handle_ = 0;
-}
-WaitSet& WaitSet::operator=(WaitSet&& o) noexcept {
-  if (this != &o) {
-    if (handle_ > 0) dds_delete(handle_);
-    handle_ = std::exchange(o.handle_, 0);
-    attached_ = o.attached_;
-  }
-  return *this;
-}
-WaitSet::~WaitSet() {
+DdsWaitSet::~DdsWaitSet() {
   if (handle_ > 0) dds_delete(handle_);
 }
 
-void WaitSet::attach(const Subscription& subscription) {
-  dds_waitset_attach(handle_, subscription.reader(), static_cast<dds_attach_t>(attached_++));
+void DdsWaitSet::attach(SubscriptionImpl& subscription) {
+  dds_waitset_attach(handle_, static_cast<DdsSubscription&>(subscription).reader(),
+                     static_cast<dds_attach_t>(attached_++));
 }
 
-Result<std::int32_t> WaitSet::wait(std::int64_t timeout_ns) {
+Result<std::int32_t> DdsWaitSet::wait(std::int64_t timeout_ns) {
   dds_attach_t triggered[16];
   const dds_return_t n = dds_waitset_wait(handle_, triggered, 16, timeout_ns);
   if (n < 0) return Error{std::string("DDS wait failed: ") + dds_strretcode(n)};
   return static_cast<std::int32_t>(n);
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+const DdsParticipant* dds_of(const Participant& p) {
+  return dynamic_cast<const DdsParticipant*>(&p.impl());
+}
+}  // namespace
+
+std::int32_t dds_entity(const Participant& participant) {
+  const DdsParticipant* p = dds_of(participant);
+  return p != nullptr ? p->context().participant : 0;
+}
+std::int32_t dds_entity(const Publisher& publisher) {
+  const auto* p = dynamic_cast<const DdsPublisher*>(&publisher.impl());
+  return p != nullptr ? p->writer() : 0;
+}
+std::int32_t dds_entity(const Subscription& subscription) {
+  const auto* s = dynamic_cast<const DdsSubscription*>(&subscription.impl());
+  return s != nullptr ? s->reader() : 0;
+}
+std::uint32_t dds_domain(const Participant& participant) {
+  const DdsParticipant* p = dds_of(participant);
+  return p != nullptr ? p->domain() : 0;
+}
+RosDistro dds_distro(const Participant& participant) {
+  const DdsParticipant* p = dds_of(participant);
+  return p != nullptr ? p->context().distro : RosDistro::Jazzy;
 }
 
 }  // namespace rbsim::node

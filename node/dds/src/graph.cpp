@@ -1,6 +1,8 @@
 // The local participant's ros_discovery_info entry (graph.hpp).
 #include "rbsim/graph.hpp"
 
+#include "dds_backend.hpp"
+
 #include <algorithm>
 #include <cstring>
 
@@ -13,20 +15,22 @@ msgs::Guid Graph::guid_of(dds_entity_t entity) {
   return out;
 }
 
-Result<std::unique_ptr<Graph>> Graph::create(const Participant& participant, const NodeName& node,
+Result<std::unique_ptr<Graph>> Graph::create(dds_entity_t participant, const NodeName& node,
                                              RosDistro distro) {
   // rmw_cyclonedds_cpp's discovery publisher: reliable, transient local, keep last 1, and no
   // ROS topic prefix (the DDS topic is "ros_discovery_info").
-  const RawTopic topic{"ros_discovery_info", msgs::dds_type_name(msgs::kParticipantEntitiesInfoType),
-                       std::string(msgs::kParticipantEntitiesInfoType)};
+  const DdsTopic topic{"ros_discovery_info", msgs::dds_type_name(msgs::kParticipantEntitiesInfoType),
+                       std::string(msgs::kParticipantEntitiesInfoType), "ros_discovery_info"};
   EndpointOptions options;
   options.in_graph = false;
-  auto writer = Publisher::create(participant, topic, QosSpec{true, false, 1}, options);
+  auto writer =
+      DdsPublisher::create(DdsContext{participant, distro, nullptr}, topic, QosSpec{true, false, 1}, options);
   if (!writer) return writer.error();
   msgs::ParticipantEntities info;
-  info.participant = guid_of(participant.handle());
+  info.participant = guid_of(participant);
   info.nodes.push_back({node.ns, node.name, {}, {}});
-  std::unique_ptr<Graph> graph(new Graph(std::move(writer.value()), std::move(info), distro));
+  std::unique_ptr<Graph> graph(
+      new Graph(Publisher(std::move(writer.value()), "ros_discovery_info"), std::move(info), distro));
   std::lock_guard lock(graph->mutex_);
   if (Status st = graph->publish_locked(); !st) return st.error();
   return graph;

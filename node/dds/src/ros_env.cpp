@@ -178,18 +178,6 @@ Result<NodeName> parse_node_name(std::string_view path) {
   return out;
 }
 
-std::string NodeName::fully_qualified() const {
-  return (ns == "/" ? "" : ns) + "/" + name;
-}
-
-// rcl_create_node_logger_name: the namespace without its leading '/', '/' -> '.', then the name.
-std::string NodeName::logger_name() const {
-  if (ns == "/") return name;
-  std::string s = ns.substr(1);
-  for (char& c : s) c = c == '/' ? '.' : c;
-  return s + "." + name;
-}
-
 std::string DdsSettings::describe() const {
   std::string s = "domain " + std::to_string(domain) + " (";
   if (from_cyclonedds_uri) return s + "CYCLONEDDS_URI)";

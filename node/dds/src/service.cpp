@@ -1,4 +1,4 @@
-// ROS 2 services on Cyclone DDS, rmw_cyclonedds_cpp's way (rbsim/service.hpp): the raw-CDR sertype
+// ROS 2 services on Cyclone DDS, rmw_cyclonedds_cpp's way (rbsim/dds.hpp): the raw-CDR sertype
 // under the service's request and response type names, the request header spliced before the body.
 #include "rbsim/service.hpp"
 
@@ -20,10 +20,12 @@
 #include <utility>
 #include <vector>
 
+#include "dds_backend.hpp"
 #include "raw_serdata.hpp"
 #include "rbsim/assert.hpp"
 #include "rbsim/cdr.hpp"
 #include "rbsim/time.hpp"
+#include "rbsim/type_hash.hpp"
 
 namespace rbsim::node {
 
@@ -221,11 +223,12 @@ Result<RequestHeader> unwrap_service_sample(std::span<const std::byte> sample, B
 // ---------------------------------------------------------------------------------------------
 // Server
 
-struct ServiceServer::Impl {
+struct DdsServer final : ServiceServerImpl {
   std::string service;
   ServiceOptions options;
   dds_entity_t participant = 0;
-  Endpoints dds;  // writer: replies, reader: requests
+  Endpoints dds;               // writer: replies, reader: requests
+  std::weak_ptr<Graph> graph;  // where its endpoints are listed
 
   // Filled by the listener on Cyclone's receive thread, emptied by serve(): a ring of slots whose
   // buffers are reused, so a steady stream of requests does not allocate.
@@ -238,7 +241,7 @@ struct ServiceServer::Impl {
   std::condition_variable arrived;
   std::vector<Slot> ring;
   std::size_t head = 0, count = 0;
-  ServiceStats stats;  // stats.pending: pending.size() as serve() left it
+  ServiceStats stats_;  // stats_.pending: pending.size() as serve() left it
 
   // The caller's thread only (serve()).
   struct Pending {
@@ -256,9 +259,17 @@ struct ServiceServer::Impl {
   std::unordered_set<std::string> reader_ids;
   MatchState writers_at, readers_at;
 
-  ~Impl() { dds.remove(); }
+  ~DdsServer() override {
+    if (dds.reader > 0) unlist_endpoint(graph, dds.reader);
+    if (dds.writer > 0) unlist_endpoint(graph, dds.writer);
+    dds.remove();
+  }
 
-  static void on_data(dds_entity_t reader, void* arg) { static_cast<Impl*>(arg)->take_all(reader); }
+  std::size_t serve(const ServiceHandler& handler, std::size_t budget) override;
+  bool wait(double timeout_s) override;
+  ServiceStats stats() const override;
+
+  static void on_data(dds_entity_t reader, void* arg) { static_cast<DdsServer*>(arg)->take_all(reader); }
 
   void take_all(dds_entity_t reader) {
     while (true) {
@@ -272,20 +283,20 @@ struct ServiceServer::Impl {
 
   void queue(ddsi_serdata* d, std::uint64_t publication) {
     std::lock_guard lock(mu);
-    ++stats.received;
+    ++stats_.received;
     if (ddsi_serdata_size(d) > options.max_request_bytes) {
-      ++stats.dropped_large;  // never copied
+      ++stats_.dropped_large;  // never copied
       return;
     }
     if (count == ring.size()) {
-      ++stats.dropped_full;
+      ++stats_.dropped_full;
       return;
     }
     sample_bytes(d, taken);
     Slot& slot = ring[(head + count) % ring.size()];
     auto header = unwrap_service_sample(taken, slot.body);
     if (!header) {
-      ++stats.malformed;
+      ++stats_.malformed;
       return;
     }
     slot.header = header.value();
@@ -336,7 +347,7 @@ struct ServiceServer::Impl {
 
   void count_one(std::uint64_t ServiceStats::*field) {
     std::lock_guard lock(mu);
-    ++(stats.*field);
+    ++(stats_.*field);
   }
 
   void write(const RequestHeader& header, std::span<const std::byte> body) {
@@ -403,116 +414,146 @@ struct ServiceServer::Impl {
   }
 };
 
-ServiceServer::ServiceServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-ServiceServer::ServiceServer(ServiceServer&&) noexcept = default;
-ServiceServer::~ServiceServer() = default;
+namespace {
+// The USER_DATA "typehash=RIHS01_...;" of a node's service endpoints (a server's or a client's), as
+// rmw_cyclonedds_cpp writes it; empty under Humble, which has no type hashes.
+Status type_hash_user_data(const DdsContext& context, std::string_view srv_type, bool in_graph,
+                           std::string& request, std::string& reply) {
+  if (!in_graph || !has_type_hashes(context.distro)) return Ok{};
+  Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
+  if (!h) return h.error();
+  request = msgs::typehash_user_data(h->request);
+  reply = msgs::typehash_user_data(h->reply);
+  return Ok{};
+}
+}  // namespace
 
-Result<ServiceServer> ServiceServer::create(const Participant& participant, std::string_view service,
-                                            std::string_view srv_type, const ServiceOptions& options) {
-  auto impl = std::make_unique<Impl>();
+Result<std::unique_ptr<ServiceServerImpl>> make_dds_server(const DdsContext& context,
+                                                           std::string_view service,
+                                                           std::string_view srv_type,
+                                                           const ServiceOptions& options,
+                                                           const DdsServiceUserData& extra) {
+  std::string request_hash, reply_hash;
+  if (Status st = type_hash_user_data(context, srv_type, options.in_graph, request_hash, reply_hash); !st)
+    return st.error();
+  auto impl = std::make_unique<DdsServer>();
   impl->service = std::string(service);
   impl->options = options;
   impl->options.queue_limit = std::max<std::size_t>(options.queue_limit, 1);
   impl->ring.resize(impl->options.queue_limit);
-  impl->participant = participant.handle();
-  const std::string user_data = "serviceid=" + endpoint_pair_id(participant.handle()) + ";";
+  impl->participant = context.participant;
+  const std::string user_data = "serviceid=" + endpoint_pair_id(context.participant) + ";";
   dds_listener_t* listener = dds_create_listener(impl.get());
-  dds_lset_data_available(listener, &Impl::on_data);
+  dds_lset_data_available(listener, &DdsServer::on_data);
   // The reader keeps as many requests as the queue: the listener drains it as they arrive, so the
   // queue, where drops are counted, is where a flood is cut.
   const auto depth = static_cast<std::int32_t>(std::min<std::size_t>(impl->options.queue_limit, INT32_MAX));
   Status st = make_endpoints(
-      participant.handle(), service_reply_topic(service), service_response_type(srv_type),
-      user_data + options.reply_user_data, service_request_topic(service), service_request_type(srv_type),
-      user_data + options.request_user_data, std::max(depth, 10), DDS_MSECS(10), listener, impl->dds);
+      context.participant, service_reply_topic(service), service_response_type(srv_type),
+      user_data + reply_hash + extra.reply, service_request_topic(service), service_request_type(srv_type),
+      user_data + request_hash + extra.request, std::max(depth, 10), DDS_MSECS(10), listener, impl->dds);
   dds_delete_listener(listener);
   if (!st) return with_context("service " + std::string(service) + ": ", st.error());
-  return ServiceServer(std::move(impl));
+  if (options.in_graph && context.graph) {  // ros2 node info lists the node's services
+    if (Status g = context.graph->add(Graph::Kind::Reader, Graph::guid_of(impl->dds.reader)); !g)
+      return g.error();
+    if (Status g = context.graph->add(Graph::Kind::Writer, Graph::guid_of(impl->dds.writer)); !g)
+      return g.error();
+    impl->graph = context.graph;
+  }
+  return std::unique_ptr<ServiceServerImpl>(std::move(impl));
 }
 
-std::size_t ServiceServer::serve(const Handler& handler, std::size_t budget) {
-  Impl& s = *impl_;
-  if (!s.pending.empty()) s.retry_pending();
+std::size_t DdsServer::serve(const ServiceHandler& handler, std::size_t budget) {
+  if (!pending.empty()) retry_pending();
   std::size_t handled = 0;
-  while (handled < budget && s.pop()) {
+  while (handled < budget && pop()) {
     ++handled;
-    s.reply.clear();
-    if (!handler(s.current.header, s.current.body, s.reply)) {
-      s.count_one(&ServiceStats::unanswered);
+    reply.clear();
+    if (!handler(current.header, current.body, reply)) {
+      count_one(&ServiceStats::unanswered);
       continue;
     }
-    s.deliver(s.current.header, s.current.publication, s.reply);
+    deliver(current.header, current.publication, reply);
   }
-  std::lock_guard lock(s.mu);
-  s.stats.pending = s.pending.size();  // for stats() from any thread
+  std::lock_guard lock(mu);
+  stats_.pending = pending.size();  // for stats() from any thread
   return handled;
 }
 
-bool ServiceServer::wait(double timeout_s) {
-  std::unique_lock lock(impl_->mu);
-  return impl_->arrived.wait_for(lock, std::chrono::duration<double>(std::max(0.0, timeout_s)),
-                                 [&] { return impl_->count > 0; });
+bool DdsServer::wait(double timeout_s) {
+  std::unique_lock lock(mu);
+  return arrived.wait_for(lock, std::chrono::duration<double>(std::max(0.0, timeout_s)),
+                          [&] { return count > 0; });
 }
 
-ServiceStats ServiceServer::stats() const {
-  std::lock_guard lock(impl_->mu);
-  ServiceStats s = impl_->stats;
-  s.queued = impl_->count;
+ServiceStats DdsServer::stats() const {
+  std::lock_guard lock(mu);
+  ServiceStats s = stats_;
+  s.queued = count;
   return s;
-}
-EndpointId ServiceServer::request_reader() const {
-  return endpoint_id(impl_->dds.reader);
-}
-EndpointId ServiceServer::reply_writer() const {
-  return endpoint_id(impl_->dds.writer);
-}
-const std::string& ServiceServer::service() const {
-  return impl_->service;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Client
 
-struct ServiceClient::Impl {
+struct DdsClient final : ServiceClientImpl {
   Endpoints dds;  // writer: requests, reader: replies
   dds_entity_t waitset = 0, condition = 0;
-  std::uint64_t id = 0;
+  std::uint64_t client_id = 0;
   std::int64_t next_seq = 0;
   Bytes sample, taken;
-  ~Impl() {
+  std::weak_ptr<Graph> graph;  // where its endpoints are listed
+  ~DdsClient() override {
+    if (dds.writer > 0) unlist_endpoint(graph, dds.writer);
+    if (dds.reader > 0) unlist_endpoint(graph, dds.reader);
     if (waitset > 0) dds_delete(waitset);
     dds.remove();  // the read condition goes with its reader
   }
+  bool server_ready() const override;
+  Status wait_for_server(double timeout_s) override;
+  Result<std::int64_t> send(std::span<const std::byte> request) override;
+  bool take_reply(RequestHeader& header, Bytes& reply) override;
+  bool wait_reply(double timeout_s) override;
+  std::uint64_t id() const override { return client_id; }
 };
 
-ServiceClient::ServiceClient(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-ServiceClient::ServiceClient(ServiceClient&&) noexcept = default;
-ServiceClient::~ServiceClient() = default;
-
-Result<ServiceClient> ServiceClient::create(const Participant& participant, std::string_view service,
-                                            std::string_view srv_type, const ClientOptions& options) {
-  auto impl = std::make_unique<Impl>();
-  const std::string user_data = "clientid=" + endpoint_pair_id(participant.handle()) + ";";
-  Status st = make_endpoints(participant.handle(), service_request_topic(service),
-                             service_request_type(srv_type), user_data + options.request_user_data,
+Result<std::unique_ptr<ServiceClientImpl>> make_dds_client(const DdsContext& context,
+                                                           std::string_view service,
+                                                           std::string_view srv_type,
+                                                           const ClientOptions& options,
+                                                           const DdsServiceUserData& extra) {
+  std::string request_hash, reply_hash;
+  if (Status st = type_hash_user_data(context, srv_type, options.in_graph, request_hash, reply_hash); !st)
+    return st.error();
+  auto impl = std::make_unique<DdsClient>();
+  const std::string user_data = "clientid=" + endpoint_pair_id(context.participant) + ";";
+  Status st = make_endpoints(context.participant, service_request_topic(service),
+                             service_request_type(srv_type), user_data + request_hash + extra.request,
                              service_reply_topic(service), service_response_type(srv_type),
-                             user_data + options.reply_user_data, 10, DDS_SECS(1), nullptr, impl->dds);
+                             user_data + reply_hash + extra.reply, 10, DDS_SECS(1), nullptr, impl->dds);
   if (!st) return with_context("client of " + std::string(service) + ": ", st.error());
-  impl->id = endpoint_id(impl->dds.writer).instance_handle;
+  impl->client_id = endpoint_id(impl->dds.writer).instance_handle;
   impl->condition = dds_create_readcondition(impl->dds.reader, DDS_ANY_STATE);
-  impl->waitset = dds_create_waitset(participant.handle());
+  impl->waitset = dds_create_waitset(context.participant);
   if (impl->condition < 0 || impl->waitset < 0 || dds_waitset_attach(impl->waitset, impl->condition, 0) < 0) {
     return Error{"client of " + std::string(service) + ": cannot create its DDS wait set"};
   }
-  return ServiceClient(std::move(impl));
+  if (options.in_graph && context.graph) {  // ros2 node info lists the node's clients
+    if (Status g = context.graph->add(Graph::Kind::Writer, Graph::guid_of(impl->dds.writer)); !g)
+      return g.error();
+    if (Status g = context.graph->add(Graph::Kind::Reader, Graph::guid_of(impl->dds.reader)); !g)
+      return g.error();
+    impl->graph = context.graph;
+  }
+  return std::unique_ptr<ServiceClientImpl>(std::move(impl));
 }
 
-bool ServiceClient::server_ready() const {
-  return publication_state(impl_->dds.writer).current > 0 &&
-         subscription_state(impl_->dds.reader).current > 0;
+bool DdsClient::server_ready() const {
+  return publication_state(dds.writer).current > 0 && subscription_state(dds.reader).current > 0;
 }
 
-Status ServiceClient::wait_for_server(double timeout_s) {
+Status DdsClient::wait_for_server(double timeout_s) {
   const auto end =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
   while (!server_ready()) {
@@ -522,61 +563,74 @@ Status ServiceClient::wait_for_server(double timeout_s) {
   return Ok{};
 }
 
-Result<std::int64_t> ServiceClient::send(std::span<const std::byte> request) {
+Result<std::int64_t> DdsClient::send(std::span<const std::byte> request) {
   if (request.size() < msgs::CdrCursor::kHeader)
     return Error{"a request must be a CDR message", ErrorCode::InvalidArgument};
-  const RequestHeader header{impl_->id, ++impl_->next_seq};
-  wrap_service_sample(header, request, impl_->sample);
-  ddsi_serdata* d = make_raw_serdata(impl_->dds.writer_type, impl_->sample);
-  const dds_return_t rc = dds_writecdr(impl_->dds.writer, d);
+  const RequestHeader header{client_id, ++next_seq};
+  wrap_service_sample(header, request, sample);
+  ddsi_serdata* d = make_raw_serdata(dds.writer_type, sample);
+  const dds_return_t rc = dds_writecdr(dds.writer, d);
   if (rc < 0) return dds_error("sending a request failed", rc);
   return header.seq;
 }
 
-bool ServiceClient::take_reply(RequestHeader& header, Bytes& reply) {
+bool DdsClient::take_reply(RequestHeader& header, Bytes& reply) {
   while (true) {
     ddsi_serdata* d = nullptr;
     dds_sample_info_t info{};
-    if (dds_takecdr(impl_->dds.reader, &d, 1, &info, DDS_ANY_STATE) <= 0) return false;
-    if (info.valid_data) sample_bytes(d, impl_->taken);
+    if (dds_takecdr(dds.reader, &d, 1, &info, DDS_ANY_STATE) <= 0) return false;
+    if (info.valid_data) sample_bytes(d, taken);
     ddsi_serdata_unref(d);
     if (!info.valid_data) continue;
-    auto h = unwrap_service_sample(impl_->taken, reply);
-    if (!h || h.value().guid != impl_->id) continue;  // malformed, or another client's
+    auto h = unwrap_service_sample(taken, reply);
+    if (!h || h.value().guid != client_id) continue;  // malformed, or another client's
     header = h.value();
     return true;
   }
 }
 
-bool ServiceClient::wait_reply(double timeout_s) {
-  return dds_waitset_wait(impl_->waitset, nullptr, 0, to_dds(timeout_s)) > 0;
+bool DdsClient::wait_reply(double timeout_s) {
+  return dds_waitset_wait(waitset, nullptr, 0, to_dds(timeout_s)) > 0;
 }
 
-Result<Bytes> ServiceClient::call(std::span<const std::byte> request, double timeout_s) {
-  auto seq = send(request);
-  if (!seq) return seq.error();
-  const auto end =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-  Bytes reply;
-  RequestHeader header;
-  while (true) {
-    while (take_reply(header, reply)) {
-      if (header.seq == seq.value()) return reply;
-    }
-    const auto left = std::chrono::duration<double>(end - Clock::now()).count();
-    if (left <= 0) return Error{"no reply within " + std::to_string(timeout_s) + " s"};
-    wait_reply(left);
-  }
+// ---------------------------------------------------------------------------------------------
+// The DDS side of the service handles
+
+Result<ServiceServer> create_dds_server(const Participant& participant, std::string_view service,
+                                        std::string_view srv_type, const ServiceOptions& options,
+                                        const DdsServiceUserData& user_data) {
+  const auto* p = dynamic_cast<const DdsParticipant*>(&participant.impl());
+  if (p == nullptr) return Error{"create_dds_server: not a DDS participant", ErrorCode::InvalidArgument};
+  auto impl = make_dds_server(p->context(), service, srv_type, options, user_data);
+  if (!impl) return impl.error();
+  return ServiceServer(std::move(impl.value()), std::string(service));
 }
 
-std::uint64_t ServiceClient::id() const {
-  return impl_->id;
+Result<ServiceClient> create_dds_client(const Participant& participant, std::string_view service,
+                                        std::string_view srv_type, const ClientOptions& options,
+                                        const DdsServiceUserData& user_data) {
+  const auto* p = dynamic_cast<const DdsParticipant*>(&participant.impl());
+  if (p == nullptr) return Error{"create_dds_client: not a DDS participant", ErrorCode::InvalidArgument};
+  auto impl = make_dds_client(p->context(), service, srv_type, options, user_data);
+  if (!impl) return impl.error();
+  return ServiceClient(std::move(impl.value()));
 }
-EndpointId ServiceClient::request_writer() const {
-  return endpoint_id(impl_->dds.writer);
+
+EndpointId dds_request_reader(const ServiceServer& server) {
+  const auto* s = dynamic_cast<const DdsServer*>(&server.impl());
+  return s != nullptr ? endpoint_id(s->dds.reader) : EndpointId{};
 }
-EndpointId ServiceClient::reply_reader() const {
-  return endpoint_id(impl_->dds.reader);
+EndpointId dds_reply_writer(const ServiceServer& server) {
+  const auto* s = dynamic_cast<const DdsServer*>(&server.impl());
+  return s != nullptr ? endpoint_id(s->dds.writer) : EndpointId{};
+}
+EndpointId dds_request_writer(const ServiceClient& client) {
+  const auto* c = dynamic_cast<const DdsClient*>(&client.impl());
+  return c != nullptr ? endpoint_id(c->dds.writer) : EndpointId{};
+}
+EndpointId dds_reply_reader(const ServiceClient& client) {
+  const auto* c = dynamic_cast<const DdsClient*>(&client.impl());
+  return c != nullptr ? endpoint_id(c->dds.reader) : EndpointId{};
 }
 
 }  // namespace rbsim::node

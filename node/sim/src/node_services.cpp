@@ -188,10 +188,7 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
   impl->events.emplace(std::move(events.value()));
   const std::string commands_topic = options.node + "/" + std::string(msgs::CommandMessage::kSuffix);
   auto commands = Publisher::create(
-      participant,
-      RawTopic{msgs::dds_topic_name(commands_topic), msgs::dds_type_name(msgs::CommandMessage::kType),
-               std::string(msgs::CommandMessage::kType)},
-      commands_qos());
+      participant, RawTopic{commands_topic, std::string(msgs::CommandMessage::kType)}, commands_qos());
   if (!commands) return commands.error();
   impl->commands.emplace(std::move(commands.value()));
   impl->services.start(kBudgetPerServer);

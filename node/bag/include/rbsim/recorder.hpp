@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "rbsim/bag.hpp"
-#include "rbsim/dds.hpp"
 #include "rbsim/mcap.hpp"
+#include "rbsim/middleware.hpp"
 
 namespace rbsim::node {
 

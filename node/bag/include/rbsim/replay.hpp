@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "rbsim/dds.hpp"
+#include "rbsim/middleware.hpp"
 
 namespace rbsim::node {
 

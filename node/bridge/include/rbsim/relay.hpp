@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "rbsim/control.hpp"
-#include "rbsim/dds.hpp"
+#include "rbsim/middleware.hpp"
 #include "rbsim/service.hpp"
 
 namespace rbsim::node {

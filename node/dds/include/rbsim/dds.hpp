@@ -1,199 +1,106 @@
-// DDS with ROS 2 conventions on Eclipse Cyclone DDS: participants, and publishers and
-// subscriptions of raw CDR on rbsim's topics (topics "rt/<namespace>/<name>", types
-// "pkg::msg::dds_::Name_", CDR with the 4-byte encapsulation header), so a ROS 2 system using
-// rmw_cyclonedds_cpp sees them. Payloads are the exact bytes rbsim_msgs encodes: the same bytes
-// go to DDS, to MCAP and back.
+// The middleware seam's backend on Eclipse Cyclone DDS, with ROS 2 conventions as
+// rmw_cyclonedds_cpp has them, so a ROS 2 system using it sees rbsim's nodes: topics
+// "rt/<namespace>/<name>" of types "pkg::msg::dds_::Name_" carrying raw CDR (the exact bytes
+// rbsim_msgs encodes, 4-byte encapsulation header included), services on rmw_cyclonedds_cpp's
+// wire format (below), and each participant one ROS 2 node on the graph: its USER_DATA says
+// "enclave=/;", and it publishes ros_discovery_info listing the node with every endpoint created
+// in the graph (rbsim/graph.hpp), in the GID format ROS_DISTRO selects (rbsim/ros_env.hpp).
 //
-// Each participant is one ROS 2 node on the graph (as rmw_cyclonedds_cpp makes them): its
-// USER_DATA says "enclave=/;", and it publishes ros_discovery_info listing the node with every
-// reader and writer the wrappers below create (rbsim/graph.hpp), in the GID format ROS_DISTRO
-// selects (rbsim/ros_env.hpp).
+// Services, as rmw_cyclonedds_cpp puts them on the wire:
+//   - service "/rbsim/pause" is two topics, requests on "rq/rbsim/pauseRequest" and replies on
+//     "rr/rbsim/pauseReply", of types "pkg::srv::dds_::Name_Request_" / "Name_Response_";
+//   - every request and reply is CDR with rmw_cyclonedds's request header (cdds_request_header_t:
+//     u64 client id, i64 sequence number) first, then the message's fields, aligned as if the header
+//     were not there (it is 16 bytes, a multiple of every alignment); a reply carries its request's
+//     header back unchanged, and a client keeps the replies whose id is its own (its request
+//     writer's instance handle);
+//   - the QoS is rmw_qos_profile_services_default (reliable, volatile, keep last 10), and each
+//     endpoint's USER_DATA says "clientid=<id>;" or "serviceid=<id>;" (one id for an endpoint pair),
+//     then a node's endpoint's type hashes, so a server can tell whether a client's reply reader is
+//     matched before it answers.
+// A server takes requests on Cyclone's receive thread (a DDS listener) into its bounded queue. A
+// reply to a client whose reply reader is not matched yet is kept (bounded) and retried at later
+// serve() calls for a short while, instead of waiting as rmw_cyclonedds does (up to 100 ms inside
+// rmw_send_response); a client that is gone gets none.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
-#include <utility>
-#include <vector>
 
-#include "rbsim/core.hpp"
-#include "rbsim/msgs.hpp"
+#include "rbsim/bytes.hpp"
+#include "rbsim/middleware.hpp"
 #include "rbsim/ros_env.hpp"
-
-struct ddsi_sertype;  // Cyclone DDS
-struct ddsi_serdata;
+#include "rbsim/service.hpp"
+#include "rbsim/status.hpp"
 
 namespace rbsim::node {
-
-// Participant::create's domain argument for "ROS_DOMAIN_ID, else 0".
-inline constexpr std::uint32_t kDomainFromEnvironment = UINT32_MAX;
-
-class Graph;  // rbsim/graph.hpp
 
 // A DDS participant, configured by ROS 2's environment variables (rbsim/ros_env.hpp): by default
 // (ROS_AUTOMATIC_DISCOVERY_RANGE unset or LOCALHOST, no ROS_STATIC_PEERS) the domain runs on
 // rbsim's loopback configuration (127.0.0.1 only, no multicast, ParticipantIndex auto); with
 // CYCLONEDDS_URI set, on whatever that configuration says. Warnings about variables that are
-// ignored go to stderr.
-class Participant {
- public:
-  // `domain`: the explicit id (--domain), or kDomainFromEnvironment; `node`: the node it is.
-  static Result<Participant> create(std::uint32_t domain = kDomainFromEnvironment, const NodeName& node = {});
-  Participant(Participant&& other) noexcept;
-  Participant& operator=(Participant&&) = delete;
-  ~Participant();
-  std::int32_t handle() const { return handle_; }
-  std::uint32_t domain() const { return domain_; }
-  // How it was configured, e.g. "domain 7 (LOCALHOST)" (DdsSettings::describe).
-  const std::string& description() const { return description_; }
-  const NodeName& node() const { return node_; }
-  RosDistro distro() const { return distro_; }
-  // The node's graph entry: endpoints created outside Publisher and Subscription (a service's
-  // request reader and reply writer) register there. Null only while the participant is created.
-  Graph* graph() const { return graph_.get(); }
-  std::shared_ptr<Graph> shared_graph() const { return graph_; }
-
- private:
-  Participant(std::int32_t handle, std::uint32_t domain, std::string description, NodeName node,
-              RosDistro distro)
-      : handle_(handle),
-        domain_(domain),
-        description_(std::move(description)),
-        node_(std::move(node)),
-        distro_(distro) {}
-  std::int32_t handle_ = 0;
-  std::uint32_t domain_ = 0;
-  std::string description_;
-  NodeName node_;
-  RosDistro distro_ = RosDistro::Jazzy;
-  std::shared_ptr<Graph> graph_;
-};
+// ignored go to stderr. `domain`: the explicit id (--domain), or kDomainFromEnvironment; `node`:
+// the node it is.
+Result<Participant> create_dds_participant(std::uint32_t domain = kDomainFromEnvironment,
+                                           const NodeName& node = {});
 
 // The loopback configuration compiled into rbsim (node/config/cyclonedds-loopback.xml).
 std::string_view loopback_config();
 
-using QosSpec = msgs::OfferedQos;
-// The QoS rbsim's writers use (msgs::offered_qos: what recordings say they offered).
-inline QosSpec qos_for(const msgs::TopicSpec& spec, std::int32_t keep_last = 0) {
-  return msgs::offered_qos(spec, keep_last);
-}
+// ---------------------------------------------------------------------------------------------
+// DDS's side of the handles, for tests, benchmarks and diagnostics: 0 (or empty) for a handle of
+// another middleware.
+std::int32_t dds_entity(const Participant& participant);
+std::int32_t dds_entity(const Publisher& publisher);        // its writer
+std::int32_t dds_entity(const Subscription& subscription);  // its reader
+std::uint32_t dds_domain(const Participant& participant);
+RosDistro dds_distro(const Participant& participant);
 
-// A topic by its DDS names, for topics outside msgs::topics() (ros_discovery_info, /rosout).
-struct RawTopic {
-  std::string dds_name;  // "ros_discovery_info", "rt/rosout"
-  std::string dds_type;  // "rcl_interfaces::msg::dds_::Log_"
-  // "rcl_interfaces/msg/Log": the endpoints' USER_DATA carries its REP 2011 type hash
-  // (msgs::type_hash) unless EndpointOptions::type_hash says otherwise; empty: no hash.
-  std::string ros_type;
-};
-// What an endpoint carries besides its topic and QoS.
-struct EndpointOptions {
-  // REP 2011's "RIHS01_<64 hex>" of the endpoint's type: its USER_DATA then says
-  // "typehash=<it>;" as rmw_cyclonedds_cpp writes it, except on Humble (no type hashes). Empty:
-  // USER_DATA is empty, as rmw writes it for a type without a hash.
-  std::string type_hash;
-  std::int64_t lifespan_ns = 0;  // > 0: samples expire that long after they were written (/rosout)
-  bool in_graph = true;          // listed in ros_discovery_info (not its own writer, as in rmw)
-};
+// ---------------------------------------------------------------------------------------------
+// Services on the wire
 
-// Publishes pre-encoded CDR messages on one topic.
-class Publisher {
- public:
-  static Result<Publisher> create(const Participant& participant, const msgs::TopicSpec& spec,
-                                  std::string_view ros_topic, const QosSpec& qos,
-                                  const EndpointOptions& options = {});
-  static Result<Publisher> create(const Participant& participant, const RawTopic& topic, const QosSpec& qos,
-                                  const EndpointOptions& options = {});
-  Publisher(Publisher&&) noexcept;
-  Publisher& operator=(Publisher&&) = delete;
-  ~Publisher();
-  // Blocks while a reliable subscriber's window is full, up to 30 s in all; when `stop` turns
-  // true meanwhile, gives up on this sample with ErrorCode::Cancelled.
-  [[nodiscard]] Status publish(std::span<const std::byte> cdr, bool (*stop)() = nullptr);
-  std::int32_t matched() const;  // subscriptions currently matched
-  // The one wait for subscribers (rbsim node's and rbsim replay's --wait-for-subscribers): until
-  // `count` subscriptions match, polling every 20 ms; false when `stop` (if any) turned true.
-  bool wait_for_subscribers(std::int32_t count, bool (*stop)()) const;
-  // Waits until every matched reliable reader acknowledged everything written (bounded; about a
-  // second once `stop` is true).
-  [[nodiscard]] Status flush(double timeout_s, bool (*stop)() = nullptr);
-  std::int32_t writer() const { return writer_; }
-  const std::string& ros_topic() const { return ros_topic_; }
+inline constexpr std::size_t kRequestHeaderBytes = 16;
 
- private:
-  Publisher() = default;
-  std::int32_t writer_ = 0, topic_ = 0;
-  const ddsi_sertype* sertype_ = nullptr;  // the writer's (raw CDR) type, owned by the topic
-  std::string ros_topic_;
-  std::weak_ptr<Graph> graph_;  // where it is listed (gone with the participant: nothing to unlist)
-};
+// "/rbsim/pause" -> "rq/rbsim/pauseRequest" and "rr/rbsim/pauseReply".
+std::string service_request_topic(std::string_view service);
+std::string service_reply_topic(std::string_view service);
+// "std_srvs/srv/Trigger" -> "std_srvs::srv::dds_::Trigger_Request_" and "..._Response_".
+std::string service_request_type(std::string_view srv_type);
+std::string service_response_type(std::string_view srv_type);
 
-// Takes raw CDR samples from one topic.
-struct SerdataUnref {
-  void operator()(ddsi_serdata* d) const;
-};
-struct Received {
-  // The sample's CDR bytes, borrowed from DDS without a copy: valid while `held` keeps them (a
-  // move keeps them valid; the next take into this Received replaces them).
-  std::span<const std::byte> cdr;
-  std::unique_ptr<ddsi_serdata, SerdataUnref> held;
-  std::int64_t source_time_ns = 0;
-  std::array<std::uint8_t, 16> writer{};  // the sending writer's GUID (stable when it is rediscovered)
-  msgs::OfferedQos offered;               // what that writer offers (history, depth, durability)
-};
-class Subscription {
- public:
-  static Result<Subscription> create(const Participant& participant, const msgs::TopicSpec& spec,
-                                     std::string_view ros_topic, const QosSpec& qos,
-                                     const EndpointOptions& options = {});
-  // A topic outside msgs::topics() (a service's requests): spec() is not available.
-  static Result<Subscription> create(const Participant& participant, const RawTopic& topic,
-                                     const QosSpec& qos, const EndpointOptions& options = {});
-  Subscription(Subscription&&) noexcept;
-  Subscription& operator=(Subscription&&) = delete;
-  ~Subscription();
-  // Takes one sample if there is one.
-  bool take(Received& out);
-  std::int32_t reader() const { return reader_; }
-  std::uint64_t lost() const;    // samples DDS reports lost or rejected
-  std::int32_t matched() const;  // publications currently matched
-  const std::string& ros_topic() const { return ros_topic_; }
-  const msgs::TopicSpec& spec() const;  // only for one created with a TopicSpec
+// A service sample: `header` then the fields of `body` (a CDR message with its encapsulation
+// header, as msgs' encoders write it) into `out` (replaced).
+void wrap_service_sample(const RequestHeader& header, std::span<const std::byte> body, Bytes& out);
+// The header of a service sample, and its fields as a CDR message of their own (encapsulation
+// header included) in `body` (replaced). Fails when the sample is not plain little-endian CDR or is
+// too short to hold the header.
+Result<RequestHeader> unwrap_service_sample(std::span<const std::byte> sample, Bytes& body);
 
- private:
-  Subscription() = default;
-  std::int32_t reader_ = 0, topic_ = 0;
-  std::string ros_topic_;
-  const msgs::TopicSpec* spec_ = nullptr;
-  QosSpec q_;  // what it asked for: a writer's offer when discovery no longer knows it (no spec)
-  std::weak_ptr<Graph> graph_;
-  struct Writer {
-    std::uint64_t handle = 0;  // DDS instance handle of the matched publication
-    std::array<std::uint8_t, 16> guid{};
-    msgs::OfferedQos offered;
-  };
-  std::vector<Writer> writers_;
+// How another participant knows one of our endpoints: its DDS GUID (prefix and entity id, the
+// Jazzy GID; Humble pads it to 24 bytes) and, inside this process, its instance handle.
+struct EndpointId {
+  std::array<std::uint8_t, 16> guid{};
+  std::uint64_t instance_handle = 0;
 };
+EndpointId dds_request_reader(const ServiceServer& server);
+EndpointId dds_reply_writer(const ServiceServer& server);
+EndpointId dds_request_writer(const ServiceClient& client);
+EndpointId dds_reply_reader(const ServiceClient& client);
 
-// Waits for samples on several subscriptions at once (a DDS waitset): the loop of the recorder
-// and of the relay, which take from every subscription once any has something.
-class WaitSet {
- public:
-  static Result<WaitSet> create(const Participant& participant);
-  WaitSet() = default;
-  WaitSet(WaitSet&& other) noexcept;
-  WaitSet& operator=(WaitSet&& other) noexcept;
-  ~WaitSet();
-  void attach(const Subscription& subscription);
-  // Waits up to `timeout_ns` until an attached subscription has samples; returns how many have.
-  Result<std::int32_t> wait(std::int64_t timeout_ns);
-
- private:
-  std::int32_t handle_ = 0;
-  std::int64_t attached_ = 0;
+// What a service's endpoints add to their USER_DATA after "serviceid=<id>;" / "clientid=<id>;"
+// and, for a node's endpoint (in_graph), its "typehash=RIHS01_...;".
+struct DdsServiceUserData {
+  std::string request, reply;
 };
+Result<ServiceServer> create_dds_server(const Participant& participant, std::string_view service,
+                                        std::string_view srv_type, const ServiceOptions& options,
+                                        const DdsServiceUserData& user_data);
+Result<ServiceClient> create_dds_client(const Participant& participant, std::string_view service,
+                                        std::string_view srv_type, const ClientOptions& options,
+                                        const DdsServiceUserData& user_data);
 
 }  // namespace rbsim::node

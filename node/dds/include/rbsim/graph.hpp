@@ -1,12 +1,11 @@
 // A process's entry on the ROS 2 graph: what rmw_dds_common's graph cache holds about the local
 // participant, published on "ros_discovery_info" (rmw_dds_common/msg/ParticipantEntitiesInfo) as
 // rmw_cyclonedds_cpp does, so `ros2 node list` and every ROS 2 client library see rbsim's node
-// with its readers and writers. The DDS wrappers (Publisher, Subscription) register their
-// endpoints here when they are created and unregister them when they go; every change republishes
-// the whole entry (keep last 1, transient local: a late joiner gets the current one).
-//
-// Other endpoints (a service's request reader and reply writer) use the same calls:
-//   graph.add(Graph::Kind::Reader, Graph::guid_of(reader));  ...  graph.remove(guid);
+// with its readers and writers. The DDS backend's endpoints (publishers, subscriptions, a service's
+// request reader and reply writer, when they are the node's: EndpointOptions::in_graph,
+// ServiceOptions::in_graph) register here when they are created and unregister when they go; every
+// change republishes the whole entry (keep last 1, transient local: a late joiner gets the
+// current one).
 #pragma once
 
 #include <dds/dds.h>
@@ -15,6 +14,7 @@
 #include <mutex>
 
 #include "rbsim/dds.hpp"
+#include "rbsim/middleware.hpp"
 #include "rbsim/ros_graph_msgs.hpp"
 
 namespace rbsim::node {
@@ -24,7 +24,7 @@ class Graph {
   enum class Kind : std::uint8_t { Reader, Writer };
   // The ros_discovery_info writer on `participant` (not listed itself, as rmw lists neither its
   // discovery writer nor its reader), publishing the node with no endpoints yet.
-  static Result<std::unique_ptr<Graph>> create(const Participant& participant, const NodeName& node,
+  static Result<std::unique_ptr<Graph>> create(dds_entity_t participant, const NodeName& node,
                                                RosDistro distro);
   // The DDS GUID of a participant, reader or writer: what rmw_cyclonedds_cpp makes its GID of.
   static msgs::Guid guid_of(dds_entity_t entity);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rbsim/core.hpp"
+#include "rbsim/middleware.hpp"  // NodeName
 
 namespace rbsim::node {
 
@@ -51,14 +52,6 @@ struct DistroChoice {
 // Unset or empty: Jazzy, silently.
 DistroChoice resolve_ros_distro(const RosEnvironment& env);
 
-// A node's name as rcl splits a fully qualified name: "/a/b/sim" is node "sim" in namespace
-// "/a/b"; "/rbsim" is node "rbsim" in the root namespace "/".
-struct NodeName {
-  std::string ns = "/";
-  std::string name = "rbsim";
-  std::string fully_qualified() const;  // "/a/b/sim"
-  std::string logger_name() const;      // "a.b.sim", as rcl names the node's logger (rosout's name field)
-};
 // "a/b/sim" or "/a/b/sim": ROS 2 name tokens (letters, digits, '_', not starting with a digit)
 // separated by single '/'; the last one is the node name. Fails naming what is wrong.
 Result<NodeName> parse_node_name(std::string_view path);

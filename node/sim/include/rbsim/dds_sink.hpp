@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "rbsim/dds.hpp"
+#include "rbsim/middleware.hpp"
 #include "rbsim/sink.hpp"
 
 namespace rbsim::node {
 
 struct NodeOptions {
-  std::uint32_t domain = kDomainFromEnvironment;  // ROS_DOMAIN_ID, else 0 (Participant::create)
+  std::uint32_t domain = kDomainFromEnvironment;  // ROS_DOMAIN_ID, else 0 (create_dds_participant)
   std::string ns = "rbsim";
   double rate = 1.0;               // real-time factor (Pacer); 0: as fast as possible
   std::int64_t publish_every = 1;  // publish every k-th step; create() refuses < 1

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "rbsim/control.hpp"
-#include "rbsim/dds.hpp"
+#include "rbsim/middleware.hpp"
 
 namespace rbsim::node {
 

@@ -3,7 +3,7 @@
 // ApplyImpulse services, and rosbag2_interfaces' player services. Field order and types follow the .msg/.srv
 // definitions (ros2/rcl_interfaces, ros2/common_interfaces, tools/msgs/definitions); the bytes are those of
 // msgs.hpp's CDR (XCDR1, little endian, 4-byte encapsulation header), the body of a service sample without
-// the request header rmw_cyclonedds_cpp puts before it (node/dds/include/rbsim/service.hpp adds and strips
+// the request header rmw_cyclonedds_cpp puts before it (node/dds/include/rbsim/dds.hpp adds and strips
 // that).
 //
 // decode() reads untrusted bytes: a truncated message, a length that runs past the data or a wrong

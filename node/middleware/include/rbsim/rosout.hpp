@@ -1,4 +1,4 @@
-// /rosout for the lines a DDS command (node, record, replay, bridge) prints: each goes to stderr
+// /rosout for the lines a ROS 2 command (node, record, replay, bridge) prints: each goes to stderr
 // through base's print::log (rbsim/print.hpp) and, while a Rosout lives (it is the print hook),
 // also to /rosout as rcl_interfaces/msg/Log (what rcl's
 // rosout handler publishes for a node: level, the node's logger name, the text, file, function,
@@ -14,7 +14,7 @@
 #include <string>
 #include <string_view>
 
-#include "rbsim/dds.hpp"
+#include "rbsim/middleware.hpp"
 #include "rbsim/print.hpp"
 #include "rbsim/ros_graph_msgs.hpp"
 

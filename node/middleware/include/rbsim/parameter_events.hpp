@@ -4,14 +4,13 @@
 
 #include <string>
 
-#include "rbsim/dds.hpp"
 #include "rbsim/interfaces.hpp"
+#include "rbsim/middleware.hpp"
 
 namespace rbsim::node {
 
 inline RawTopic parameter_events_topic() {
-  return RawTopic{msgs::dds_topic_name("/parameter_events"), msgs::dds_type_name(msgs::ParameterEvent::kType),
-                  std::string(msgs::ParameterEvent::kType)};
+  return RawTopic{"/parameter_events", std::string(msgs::ParameterEvent::kType)};
 }
 
 inline QosSpec parameter_events_qos() {

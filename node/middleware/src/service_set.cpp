@@ -3,20 +3,7 @@
 
 #include <chrono>
 
-#include "rbsim/ros_env.hpp"
-#include "rbsim/type_hash.hpp"
-
 namespace rbsim::node {
-
-Status type_hash_user_data(const Participant& participant, std::string_view srv_type, std::string& request,
-                           std::string& reply) {
-  if (!has_type_hashes(participant.distro())) return Ok{};
-  Result<msgs::ServiceEndpointHashes> h = msgs::service_endpoint_type_hashes(srv_type);
-  if (!h) return h.error();
-  request = msgs::typehash_user_data(h->request);
-  reply = msgs::typehash_user_data(h->reply);
-  return Ok{};
-}
 
 ServiceSet::~ServiceSet() {
   stop();
@@ -25,8 +12,7 @@ ServiceSet::~ServiceSet() {
 Status ServiceSet::add(const Participant& participant, const std::string& node, std::string_view name,
                        std::string_view srv_type, ServiceServer::Handler handler) {
   ServiceOptions so;
-  if (Status st = type_hash_user_data(participant, srv_type, so.request_user_data, so.reply_user_data); !st)
-    return st;
+  so.in_graph = true;
   so.on_arrival = [this] {
     {
       const std::lock_guard lock(mutex_);
@@ -36,11 +22,6 @@ Status ServiceSet::add(const Participant& participant, const std::string& node, 
   };
   Result<ServiceServer> s = ServiceServer::create(participant, node + "/" + std::string(name), srv_type, so);
   if (!s) return s.error();
-  if (!graph_) graph_ = participant.shared_graph();
-  if (graph_) {
-    if (Status st = graph_->add(Graph::Kind::Reader, s->request_reader().guid); !st) return st;
-    if (Status st = graph_->add(Graph::Kind::Writer, s->reply_writer().guid); !st) return st;
-  }
   servers_.push_back(std::move(s.value()));
   handlers_.push_back(std::move(handler));
   return Ok{};

@@ -47,10 +47,7 @@ Result<std::unique_ptr<Rosout>> Rosout::create(const Participant& participant, C
   constexpr QosSpec kQos{true, false, 1000};
   EndpointOptions options;
   options.lifespan_ns = 10'000'000'000;
-  auto pub = Publisher::create(participant,
-                               RawTopic{msgs::dds_topic_name("/rosout"), msgs::dds_type_name(msgs::kLogType),
-                                        std::string(msgs::kLogType)},
-                               kQos, options);
+  auto pub = Publisher::create(participant, RawTopic{"/rosout", std::string(msgs::kLogType)}, kQos, options);
   if (!pub) return pub.error();
   std::unique_ptr<Rosout> rosout(
       new Rosout(std::move(pub.value()), participant.node().logger_name(), std::move(clock)));

@@ -1,6 +1,6 @@
 // Servers of one node served together on one thread (the node's parameter and control services,
-// the player's): each created with its type hashes in USER_DATA (none under Humble) and its
-// request reader and reply writer on the node's graph entry; the thread wakes on any server's
+// the player's): each created as the node's endpoint (ServiceOptions::in_graph: on the graph, with
+// its type hashes where the middleware announces them); the thread wakes on any server's
 // arrival, or every 20 ms to retry replies waiting for their client's reader, so whatever the
 // caller's loop is doing (a paused run, a paused replay) requests are answered.
 #pragma once
@@ -13,15 +13,9 @@
 #include <thread>
 #include <vector>
 
-#include "rbsim/graph.hpp"
 #include "rbsim/service.hpp"
 
 namespace rbsim::node {
-
-// The USER_DATA "typehash=RIHS01_...;" of a service's request and reply endpoints (a server's or a
-// client's), as rmw_cyclonedds_cpp writes it; left empty under Humble, which has no type hashes.
-[[nodiscard]] Status type_hash_user_data(const Participant& participant, std::string_view srv_type,
-                                         std::string& request, std::string& reply);
 
 class ServiceSet {
  public:
@@ -47,7 +41,6 @@ class ServiceSet {
   std::condition_variable wake_;
   bool arrived_ = false, stopping_ = false;
   std::thread thread_;
-  std::shared_ptr<Graph> graph_;
   std::vector<ServiceServer::Handler> handlers_;
   std::vector<ServiceServer> servers_;  // last: gone (their listeners with them) before the mutex
 };
