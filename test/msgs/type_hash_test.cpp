@@ -47,6 +47,34 @@ DefinitionSource texts(std::map<std::string, std::string, std::less<>> defs) {
   };
 }
 
+// `defs` first, then the shipped definitions.
+DefinitionSource over_shipped(std::map<std::string, std::string, std::less<>> defs) {
+  auto own = texts(std::move(defs));
+  return [own](std::string_view type) -> std::optional<std::string_view> {
+    if (auto text = own(type)) return text;
+    return rbsim::msgs::shipped_definition(type);
+  };
+}
+
+// Every type rbsim ships and every type rosidl derives from them: each service's three messages,
+// each action's twelve types (rbsim/type_hash.hpp).
+std::vector<std::string> every_shipped_type() {
+  std::vector<std::string> types;
+  for (std::string_view t : rbsim::msgs::definition_types()) types.emplace_back(t);
+  for (std::string_view s : rbsim::msgs::service_types()) {
+    for (const char* suffix : {"", "_Request", "_Response", "_Event"})
+      types.push_back(std::string(s) + suffix);
+  }
+  for (std::string_view a : rbsim::msgs::action_types()) {
+    for (const char* suffix : {"", "_Goal", "_Result", "_Feedback", "_SendGoal", "_SendGoal_Request",
+                               "_SendGoal_Response", "_SendGoal_Event", "_GetResult", "_GetResult_Request",
+                               "_GetResult_Response", "_GetResult_Event", "_FeedbackMessage"}) {
+      types.push_back(std::string(a) + suffix);
+    }
+  }
+  return types;
+}
+
 // --- Published values ---------------------------------------------------------------------------
 
 // The three of issue 22 (also in RosLibRust/roslibrust roslibrust_codegen/assets/String.json, a
@@ -123,6 +151,54 @@ TEST(TypeHash, EmptyMessagesArraysAndSmallServicesMatchRoslibrust) {
             "RIHS01_5888399dedec5ccc85ea6451949fd2c9f97bfdf963f9a588821639fcd31b5d19");
 }
 
+// An action: rosidl_generator_type_description's output for robot_interfaces/action/NavigateToGoal
+// (addinedu-ros-9th/ros-repo-4,
+// install/robot_interfaces/share/robot_interfaces/action/NavigateToGoal.json, "type_hashes"): the
+// action, the twelve types rosidl derives from it and the types they use (UUID, PoseStamped, Pose,
+// ServiceEventInfo shipped). The .action text below is the fields of that file's
+// type_description_msg, in order.
+TEST(TypeHash, ActionAndItsDerivedTypesMatchRosidlOutput) {
+  const DefinitionSource source = over_shipped(
+      {{"robot_interfaces/action/NavigateToGoal",
+        "int32 robot_id\ngeometry_msgs/PoseStamped target_pose\n---\nbool success\nstring message\n---\n"
+        "geometry_msgs/PoseStamped current_pose\nstring current_status\n"}});
+  const std::pair<const char*, const char*> published[] = {
+      {"", "2eb7694618e36a43a93246acd54c7ffe2139e450666d199d3d1310f4efb7fada"},
+      {"_Goal", "5041aaeb758a7265890c524170ff1cd7a27c2834263ce4d15f596a180fd0ef82"},
+      {"_Result", "23ac9e803d1e96bf6b8be5e2781b2c6cb716478e9b81b646eedd6d92762cfba0"},
+      {"_Feedback", "e2737d9d672216201de3f47806853c986927328690412d426251cf23dfa88345"},
+      {"_FeedbackMessage", "604ebc5f2d6cdd380c610583db280686d7189a3f1aece06a34a569865195c524"},
+      {"_SendGoal", "9bcc1d4c51059d0dabe099d2817c45e6e665f11c66fd14c5b3d21f1c794ea765"},
+      {"_SendGoal_Request", "ed020abdab45ea31b1855fa5718e973fb01fcd836bc6194e3b4432dd7ac040e8"},
+      {"_SendGoal_Response", "4c91df3d63ef0ca98b08a13cc9fe3953b74ac69a17bcf5a47bb0b31e913fe349"},
+      {"_SendGoal_Event", "2b0d44152cd3b16458eea608caec4e35bcaea8979c4aada6e0a2c8e0bca76918"},
+      {"_GetResult", "916442c7a15ce3904f0d0a236aa2c0d95fce3ec90d5383cfc5bf2fdb5d2cad11"},
+      {"_GetResult_Request", "dc73121c18c39082c9aef18e46065ac3767f4bdb1f735e833130f36fceb3157e"},
+      {"_GetResult_Response", "21fff52bf79b4a059d01c7af6ead4bf1749871057261c8422c067ed693159089"},
+      {"_GetResult_Event", "79d2954ec184772ea17a47e88d6eaac4343b13e677a4dd3cdb440b0f9af70f3b"},
+  };
+  for (const auto& [suffix, hash] : published) {
+    const std::string type = std::string("robot_interfaces/action/NavigateToGoal") + suffix;
+    SCOPED_TRACE(type);
+    auto h = rbsim::msgs::type_hash(type, source);
+    ASSERT_TRUE(h.ok()) << h.error().message;
+    EXPECT_EQ(h.value(), std::string("RIHS01_") + hash);
+  }
+  // The same file's hashes of the shipped types the action uses.
+  EXPECT_EQ(rbsim::msgs::type_hash("unique_identifier_msgs/msg/UUID").value(),
+            "RIHS01_1b8e8aca958cbea28fe6ef60bf6c19b683c97a9ef60bb34752067d0f2f7ab437");
+  EXPECT_EQ(rbsim::msgs::type_hash("geometry_msgs/msg/PoseStamped").value(),
+            "RIHS01_10f3786d7d40fd2b54367835614bff85d4ad3b5dab62bf8bca0cc232d73b4cd8");
+  EXPECT_EQ(rbsim::msgs::type_hash("geometry_msgs/msg/Pose").value(),
+            "RIHS01_d501954e9476cea2996984e812054b68026ae0bfae789d9a10b23daf35cc90fa");
+  EXPECT_EQ(rbsim::msgs::type_hash("geometry_msgs/msg/Quaternion").value(),
+            "RIHS01_8a765f66778c8ff7c8ab94afcc590a2ed5325a1d9a076ffff38fbce36f458684");
+  EXPECT_EQ(rbsim::msgs::type_hash("geometry_msgs/msg/Point").value(),
+            "RIHS01_6963084842a9b04494d6b2941d11444708d892da2f4b09843b9c43f42a7f6881");
+  EXPECT_EQ(rbsim::msgs::type_hash("service_msgs/msg/ServiceEventInfo").value(),
+            "RIHS01_41bcbbe07a75c9b52bc96bfd5c24d7f0fc0a08c0cb7921b3373c5732345a6f45");
+}
+
 // The hashed text itself, in the form rosidl_generator_type_description's calculate_type_hash
 // writes (json.dumps, separators ", " and ": ", default_value removed).
 TEST(TypeDescriptionJson, IsRosidlsHashedForm) {
@@ -147,14 +223,43 @@ TEST(TypeDescriptionJson, ShippedGidIsJazzys16ByteArray) {
       << json.value();
 }
 
-TEST(TypeHash, EveryShippedTypeAndServiceHashes) {
-  std::vector<std::string> types;
-  for (std::string_view t : rbsim::msgs::definition_types()) types.emplace_back(t);
-  for (std::string_view s : rbsim::msgs::service_types()) {
-    for (const char* suffix : {"", "_Request", "_Response", "_Event"})
-      types.push_back(std::string(s) + suffix);
+// Every shipped type against rosbags, an implementation that is not ours: the table
+// test/msgs/data/rihs01_rosbags.txt holds rosbags' hash of each (char as uint8, as rosidl), and
+// test/python/check_type_hashes.py (CTest python.msgs.type_hashes_rosbags) checks on every run that
+// rosbags still computes exactly that table from tools/msgs/definitions.
+TEST(TypeHash, EveryShippedTypeMatchesRosbags) {
+  std::ifstream in(std::filesystem::path(RBSIM_TEST_MSG_DATA) / "rihs01_rosbags.txt");
+  ASSERT_TRUE(in) << "test/msgs/data/rihs01_rosbags.txt";
+  std::map<std::string, std::string> table;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string type, hash;
+    words >> type >> hash;
+    table[type] = hash;
   }
+  const std::vector<std::string> types = every_shipped_type();
+  EXPECT_EQ(table.size(), types.size());
+  for (const std::string& t : types) {
+    SCOPED_TRACE(t);
+    const auto it = table.find(t);
+    ASSERT_NE(it, table.end()) << "not in rihs01_rosbags.txt (regenerate: check_type_hashes.py --write)";
+    auto h = rbsim::msgs::type_hash(t);
+    ASSERT_TRUE(h.ok()) << h.error().message;
+    EXPECT_EQ(h.value(), it->second);
+  }
+  // simulation_interfaces 2.1.0: 15 messages, 22 services, SimulateSteps.
+  std::size_t simulation_interfaces = 0;
+  for (const std::string& t : types) simulation_interfaces += t.starts_with("simulation_interfaces/") ? 1 : 0;
+  EXPECT_EQ(simulation_interfaces, 15u + 22u * 4u + 13u);
+}
+
+TEST(TypeHash, EveryShippedTypeAndServiceHashes) {
+  const std::vector<std::string> types = every_shipped_type();
   EXPECT_GE(rbsim::msgs::service_types().size(), 9u);  // rcl_interfaces' six, Trigger, Step, ApplyImpulse
+  EXPECT_EQ(rbsim::msgs::action_types(),
+            std::vector<std::string_view>{"simulation_interfaces/action/SimulateSteps"});
   for (const std::string& t : types) {
     SCOPED_TRACE(t);
     auto cached = rbsim::msgs::type_hash(t);
@@ -215,6 +320,19 @@ TEST(TypeHash, MissingDependencyNamesItAndWhoNeedsIt) {
   auto event = rbsim::msgs::type_hash("a_msgs/srv/S_Event", texts({{"a_msgs/srv/S", "---\n"}}));
   ASSERT_FALSE(event.ok());
   EXPECT_NE(event.error().message.find("service_msgs/msg/ServiceEventInfo"), std::string::npos);
+  // An action's goal_id is unique_identifier_msgs/UUID; a type no action derives is unknown.
+  auto goal =
+      rbsim::msgs::type_hash("a_msgs/action/A_SendGoal_Request", texts({{"a_msgs/action/A", "---\n---\n"}}));
+  ASSERT_FALSE(goal.ok());
+  EXPECT_NE(goal.error().message.find("unique_identifier_msgs/msg/UUID"), std::string::npos)
+      << goal.error().message;
+  for (const char* type :
+       {"a_msgs/action/A_Request", "a_msgs/action/B_Goal", "a_msgs/action/A_SendGoal_Reply"}) {
+    auto unknown = rbsim::msgs::type_hash(type, texts({{"a_msgs/action/A", "---\n---\n"}}));
+    ASSERT_FALSE(unknown.ok()) << type;
+    EXPECT_NE(unknown.error().message.find("no definition for"), std::string::npos)
+        << unknown.error().message;
+  }
 }
 
 TEST(TypeHash, MalformedDefinitionsAreErrors) {
@@ -228,11 +346,14 @@ TEST(TypeHash, MalformedDefinitionsAreErrors) {
       {"a_msgs/msg/Field", "int32 x-y\n"},
       {"a_msgs/srv/NoSep", "int32 a\n"},
       {"a_msgs/srv/TwoSeps", "int32 a\n---\n---\n"},
+      {"a_msgs/action/OneSep", "int32 a\n---\n"},
+      {"a_msgs/action/ThreeSeps", "---\n---\n---\n"},
   };
   for (const auto& [type, text] : bad) {
     SCOPED_TRACE(type);
     std::string name = type;
     if (name.find("/srv/") != std::string::npos) name += "_Request";
+    if (name.find("/action/") != std::string::npos) name += "_Feedback";
     auto h = rbsim::msgs::type_hash(name, texts(bad));
     ASSERT_FALSE(h.ok());
     EXPECT_NE(h.error().message.find(type), std::string::npos) << h.error().message;

@@ -5,7 +5,7 @@
 namespace rbsim::msgs::detail {
 struct Definition {
   std::string_view type;  // "rbsim_msgs/msg/BodyStates", "std_srvs/srv/Trigger"
-  std::string_view text;  // the .msg or .srv file
+  std::string_view text;  // the .msg, .srv or .action file
 };
 const std::vector<Definition>& definitions();  // sorted by type
 }  // namespace rbsim::msgs::detail

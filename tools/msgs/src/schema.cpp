@@ -223,6 +223,14 @@ std::vector<std::string_view> service_types() {
   return out;
 }
 
+std::vector<std::string_view> action_types() {
+  std::vector<std::string_view> out;
+  for (const detail::Definition& d : detail::definitions()) {
+    if (d.type.find("/action/") != std::string_view::npos) out.push_back(d.type);
+  }
+  return out;
+}
+
 namespace {
 // The rosbag2 schema of `root` whose own text is `root_text` (its dependencies from definitions).
 Result<std::string> schema_of(std::string_view root, std::string_view root_text) {

@@ -1,4 +1,4 @@
-// REP 2011 type descriptions and hashes (RIHS01) from the shipped .msg/.srv definitions. The
+// REP 2011 type descriptions and hashes (RIHS01) from the shipped .msg/.srv/.action definitions. The
 // description and its JSON follow rosidl_generator_type_description (Jazzy): field type ids of
 // type_description_interfaces/msg/FieldType, capacities, string capacities, nested type names; the
 // referenced types sorted by name; json.dumps with separators (", ", ": ") and no default values.
@@ -25,12 +25,23 @@ constexpr std::string_view kRequest = "_Request";
 constexpr std::string_view kResponse = "_Response";
 constexpr std::string_view kEvent = "_Event";
 constexpr std::string_view kEventInfo = "service_msgs/msg/ServiceEventInfo";
+// What rosidl_parser's Action makes of pkg/action/Name (definition.py: ACTION_*_SUFFIX).
+constexpr std::string_view kGoal = "_Goal";
+constexpr std::string_view kResult = "_Result";
+constexpr std::string_view kFeedback = "_Feedback";
+constexpr std::string_view kSendGoal = "_SendGoal";
+constexpr std::string_view kGetResult = "_GetResult";
+constexpr std::string_view kFeedbackMessage = "_FeedbackMessage";
+constexpr std::string_view kUuid = "unique_identifier_msgs/msg/UUID";
+constexpr std::string_view kTime = "builtin_interfaces/msg/Time";
 // A hostile or broken definition source cannot make a description grow without end.
 constexpr std::size_t kMaxTypes = 4096;
 
 // type_description_interfaces/msg/FieldType: the value type ids, and the offsets rosidl adds for
 // a fixed array, a bounded and an unbounded sequence of them.
 constexpr std::uint8_t kNestedType = 1;
+constexpr std::uint8_t kInt8 = 2;
+constexpr std::uint8_t kBool = 15;
 constexpr std::uint8_t kBoundedString = 21;
 constexpr std::uint8_t kArrayOffset = 48;
 constexpr std::uint8_t kBoundedSequenceOffset = 96;
@@ -81,14 +92,15 @@ bool is_identifier(std::string_view s) {
 struct TypeName {
   std::string_view package, kind, name;
 };
-// "pkg/msg/Name" or "pkg/srv/Name", each part an identifier.
+// "pkg/msg/Name", "pkg/srv/Name" or "pkg/action/Name", each part an identifier.
 std::optional<TypeName> split_type(std::string_view full) {
   const auto a = full.find('/');
   if (a == std::string_view::npos) return std::nullopt;
   const auto b = full.find('/', a + 1);
   if (b == std::string_view::npos) return std::nullopt;
   TypeName n{full.substr(0, a), full.substr(a + 1, b - a - 1), full.substr(b + 1)};
-  if (!is_identifier(n.package) || (n.kind != "msg" && n.kind != "srv") || !is_identifier(n.name)) {
+  if (!is_identifier(n.package) || (n.kind != "msg" && n.kind != "srv" && n.kind != "action") ||
+      !is_identifier(n.name)) {
     return std::nullopt;
   }
   return n;
@@ -141,10 +153,10 @@ Result<IndividualDescription> describe_msg_text(std::string_view type, std::stri
   return d;
 }
 
-// The request (part 0) or response (part 1) of a .srv text: the lines before and after its one
-// "---" line (rosidl wants exactly one).
-Result<std::string> service_part(std::string_view service, std::string_view text, int part) {
-  std::string parts[2];
+// Part `part` of a .srv text (request, response: split by exactly one "---" line) or of an .action
+// text (goal, result, feedback: exactly two), as rosidl_adapter splits them.
+Result<std::string> definition_part(std::string_view type, std::string_view text, int part, int parts) {
+  std::string texts[3];
   int separators = 0;
   while (!text.empty()) {
     const auto nl = text.find('\n');
@@ -157,13 +169,117 @@ Result<std::string> service_part(std::string_view service, std::string_view text
       ++separators;
       continue;
     }
-    if (separators < 2) parts[separators] += std::string(line) + "\n";
+    if (separators < 3) texts[separators] += std::string(line) + "\n";
   }
-  if (separators != 1) {
-    return Error{std::string(service) + ": a service definition needs exactly one \"---\" line (found " +
-                 std::to_string(separators) + ")"};
+  if (separators != parts - 1) {
+    const char* what = parts == 2 ? "a service definition needs exactly one \"---\" line"
+                                  : "an action definition needs exactly two \"---\" lines";
+    return Error{std::string(type) + ": " + what + " (found " + std::to_string(separators) + ")"};
   }
-  return std::move(parts[part]);
+  return std::move(texts[part]);
+}
+
+// `name` without `suffix`, when it ends with it and something comes before.
+std::optional<std::string_view> strip_suffix(std::string_view name, std::string_view suffix) {
+  if (!name.ends_with(suffix) || name.size() == suffix.size()) return std::nullopt;
+  return name.substr(0, name.size() - suffix.size());
+}
+
+// A service type: "pkg/srv/Name" with a .srv text, or an action's "pkg/action/Name_SendGoal" or
+// "pkg/action/Name_GetResult" (rosidl_parser's Action.send_goal_service and get_result_service).
+// Returns the action ("pkg/action/Name") for the latter, the service itself for the former.
+std::optional<std::string> service_origin(const TypeName& n, const DefinitionSource& source) {
+  const std::string full = std::string(n.package) + "/" + std::string(n.kind) + "/" + std::string(n.name);
+  if (n.kind == "srv") return source(full) ? std::optional(full) : std::nullopt;
+  if (n.kind != "action") return std::nullopt;
+  for (const std::string_view suffix : {kSendGoal, kGetResult}) {
+    const auto action = strip_suffix(n.name, suffix);
+    if (!action) continue;
+    const std::string origin = std::string(n.package) + "/action/" + std::string(*action);
+    if (source(origin)) return origin;
+  }
+  return std::nullopt;
+}
+
+// The request or response of an action's generated service, as rosidl_parser's Action builds them:
+// _SendGoal_Request {UUID goal_id, _Goal goal}, _SendGoal_Response {bool accepted, Time stamp},
+// _GetResult_Request {UUID goal_id}, _GetResult_Response {int8 status, _Result result}.
+IndividualDescription action_service_message(const std::string& type, const std::string& service,
+                                             const std::string& action, bool request) {
+  const std::string uuid(kUuid);
+  if (service.ends_with(kSendGoal)) {
+    if (request) {
+      return {type,
+              {nested_field("goal_id", uuid, kNestedType, 0),
+               nested_field("goal", action + std::string(kGoal), kNestedType, 0)}};
+    }
+    return {type,
+            {FieldDescription{"accepted", kBool, 0, 0, ""},
+             nested_field("stamp", std::string(kTime), kNestedType, 0)}};
+  }
+  if (request) return {type, {nested_field("goal_id", uuid, kNestedType, 0)}};
+  return {type,
+          {FieldDescription{"status", kInt8, 0, 0, ""},
+           nested_field("result", action + std::string(kResult), kNestedType, 0)}};
+}
+
+// A service's _Request, _Response or _Event message (`suffix`); `service` is a service_origin().
+Result<IndividualDescription> describe_service_message(std::string_view type, const std::string& service,
+                                                       const std::string& origin, std::string_view suffix,
+                                                       const DefinitionSource& source) {
+  if (suffix == kEvent) {
+    // rosidl_parser's Service.event_message: info, then the request and the response each as a
+    // sequence of at most one.
+    return IndividualDescription{
+        std::string(type),
+        {nested_field("info", std::string(kEventInfo), kNestedType, 0),
+         nested_field("request", service + std::string(kRequest), kNestedType + kBoundedSequenceOffset, 1),
+         nested_field("response", service + std::string(kResponse), kNestedType + kBoundedSequenceOffset,
+                      1)}};
+  }
+  if (origin != service)
+    return action_service_message(std::string(type), service, origin, suffix == kRequest);
+  const auto text = source(service);
+  if (!text) return Error{"no definition for " + service + " (for " + std::string(type) + ")"};
+  auto part = definition_part(service, *text, suffix == kRequest ? 0 : 1, 2);
+  if (!part) return part.error();
+  return describe_msg_text(type, part.value());
+}
+
+// A type rosidl derives from an action (`action` has a definition): the action itself, its goal,
+// result and feedback (the three parts of the .action text) or the feedback message.
+Result<IndividualDescription> describe_action_type(std::string_view type, const std::string& action,
+                                                   std::string_view suffix, std::string_view text) {
+  if (suffix.empty()) {
+    // rosidl_generator_type_description's add_action: the six types rosidl makes of it.
+    return IndividualDescription{
+        action,
+        {nested_field("goal", action + std::string(kGoal), kNestedType, 0),
+         nested_field("result", action + std::string(kResult), kNestedType, 0),
+         nested_field("feedback", action + std::string(kFeedback), kNestedType, 0),
+         nested_field("send_goal_service", action + std::string(kSendGoal), kNestedType, 0),
+         nested_field("get_result_service", action + std::string(kGetResult), kNestedType, 0),
+         nested_field("feedback_message", action + std::string(kFeedbackMessage), kNestedType, 0)}};
+  }
+  if (suffix == kFeedbackMessage) {
+    return IndividualDescription{std::string(type),
+                                 {nested_field("goal_id", std::string(kUuid), kNestedType, 0),
+                                  nested_field("feedback", action + std::string(kFeedback), kNestedType, 0)}};
+  }
+  const int part = suffix == kGoal ? 0 : suffix == kResult ? 1 : 2;
+  auto part_text = definition_part(action, text, part, 3);
+  if (!part_text) return part_text.error();
+  return describe_msg_text(type, part_text.value());
+}
+
+// The service (`type` is a service_origin()) as rosidl_generator_type_description's add_srv
+// describes it: its three messages.
+IndividualDescription service_description(const std::string& service) {
+  return IndividualDescription{
+      service,
+      {nested_field("request_message", service + std::string(kRequest), kNestedType, 0),
+       nested_field("response_message", service + std::string(kResponse), kNestedType, 0),
+       nested_field("event_message", service + std::string(kEvent), kNestedType, 0)}};
 }
 
 // The description of one type, without the types it refers to.
@@ -171,40 +287,33 @@ Result<IndividualDescription> describe_type(std::string_view type, const Definit
   const auto name = split_type(type);
   if (!name)
     return Error{"\"" + std::string(type) +
-                 "\" is not an interface type name (pkg/msg/Name or pkg/srv/Name)"};
+                 "\" is not an interface type name (pkg/msg/Name, pkg/srv/Name or pkg/action/Name)"};
   if (name->kind == "msg") {
     const auto text = source(type);
     if (!text) return Error{"no definition for " + std::string(type)};
     return describe_msg_text(type, *text);
   }
-  const std::string prefix = std::string(name->package) + "/srv/";
-  if (source(type)) {
-    // The service itself: its three messages (rosidl_generator_type_description's add_srv).
-    const std::string base = std::string(type);
-    return IndividualDescription{
-        base,
-        {nested_field("request_message", base + std::string(kRequest), kNestedType, 0),
-         nested_field("response_message", base + std::string(kResponse), kNestedType, 0),
-         nested_field("event_message", base + std::string(kEvent), kNestedType, 0)}};
-  }
+  if (service_origin(*name, source)) return service_description(std::string(type));
+  const std::string prefix = std::string(name->package) + "/" + std::string(name->kind) + "/";
   for (const std::string_view suffix : {kRequest, kResponse, kEvent}) {
-    if (!name->name.ends_with(suffix) || name->name.size() == suffix.size()) continue;
-    const std::string service = prefix + std::string(name->name.substr(0, name->name.size() - suffix.size()));
-    const auto text = source(service);
-    if (!text) return Error{"no definition for " + service + " (for " + std::string(type) + ")"};
-    if (suffix == kEvent) {
-      // rosidl_parser's Service.event_message: info, then the request and the response each as a
-      // sequence of at most one.
-      return IndividualDescription{
-          std::string(type),
-          {nested_field("info", std::string(kEventInfo), kNestedType, 0),
-           nested_field("request", service + std::string(kRequest), kNestedType + kBoundedSequenceOffset, 1),
-           nested_field("response", service + std::string(kResponse), kNestedType + kBoundedSequenceOffset,
-                        1)}};
+    const auto base = strip_suffix(name->name, suffix);
+    if (!base) continue;
+    const std::string service = prefix + std::string(*base);
+    const auto service_name = split_type(service);
+    const auto origin = service_name ? service_origin(*service_name, source) : std::nullopt;
+    if (!origin) {
+      if (name->kind == "action") continue;
+      return Error{"no definition for " + service + " (for " + std::string(type) + ")"};
     }
-    auto part = service_part(service, *text, suffix == kRequest ? 0 : 1);
-    if (!part) return part.error();
-    return describe_msg_text(type, part.value());
+    return describe_service_message(type, service, *origin, suffix, source);
+  }
+  if (name->kind == "action") {
+    for (const std::string_view suffix : {std::string_view(), kGoal, kResult, kFeedback, kFeedbackMessage}) {
+      const auto base = suffix.empty() ? std::optional(name->name) : strip_suffix(name->name, suffix);
+      if (!base) continue;
+      const std::string action = prefix + std::string(*base);
+      if (const auto text = source(action)) return describe_action_type(type, action, suffix, *text);
+    }
   }
   return Error{"no definition for " + std::string(type)};
 }

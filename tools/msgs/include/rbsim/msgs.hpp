@@ -142,13 +142,18 @@ std::string offered_qos_yaml(const OfferedQos& qos);
 // Definitions and schemas
 
 // The .msg text of a type ("rbsim_msgs/msg/BodyStates" or "rbsim_msgs/BodyStates"), or the .srv
-// text of a service ("std_srvs/srv/Trigger": request, a "---" line, response); empty when unknown.
+// text of a service ("std_srvs/srv/Trigger": request, a "---" line, response) or the .action text
+// of an action ("simulation_interfaces/action/SimulateSteps": goal, result, feedback); empty when
+// unknown.
 std::string_view definition(std::string_view type);
 // Every message type name we carry, "pkg/msg/Name", sorted (services are not messages: their
 // request and response are, under rosidl's names, in rbsim/type_hash.hpp).
 std::vector<std::string_view> definition_types();
 // Every service type we carry, "pkg/srv/Name", sorted.
 std::vector<std::string_view> service_types();
+// Every action type we carry, "pkg/action/Name", sorted (the messages and services rosidl derives
+// from each are in rbsim/type_hash.hpp).
+std::vector<std::string_view> action_types();
 // The schema rosbag2 writes for a type with encoding "ros2msg": its .msg text followed by each
 // dependency, depth first, once, as "\n" + 80 '=' + "\nMSG: pkg/Name\n" + text.
 Result<std::string> ros2msg_schema(std::string_view type);

@@ -1,5 +1,5 @@
-// REP 2011 type hashes ("RIHS01_<64 hex>") of ROS 2 interface types, computed from the .msg and
-// .srv definitions (never written down by hand): what rmw_cyclonedds_cpp on Jazzy puts in every
+// REP 2011 type hashes ("RIHS01_<64 hex>") of ROS 2 interface types, computed from the .msg, .srv
+// and .action definitions (never written down by hand): what rmw_cyclonedds_cpp on Jazzy puts in every
 // endpoint's USER_DATA ("typehash=RIHS01_...;") and rosbag2 records per topic.
 //
 // The hash is rosidl's (rosidl_generator_type_description; rcl computes the same at run time): the
@@ -12,6 +12,16 @@
 // of the messages rosidl makes of a service: "std_srvs/srv/Trigger_Request", "..._Response" and
 // "..._Event" (service_msgs/msg/ServiceEventInfo info, the request and the response each as a
 // sequence of at most one).
+//
+// An action "pkg/action/Name" is what rosidl_parser's Action makes of the .action text (goal,
+// result and feedback split by two "---" lines): "pkg/action/Name_Goal", "..._Result" and
+// "..._Feedback" (the three parts), the services "..._SendGoal" (request: UUID goal_id, _Goal goal;
+// response: bool accepted, builtin_interfaces/Time stamp) and "..._GetResult" (request: goal_id;
+// response: int8 status, _Result result), each with its _Request, _Response and _Event, and
+// "..._FeedbackMessage" (goal_id, _Feedback feedback); the action type itself refers to those six
+// (goal, result, feedback, send_goal_service, get_result_service, feedback_message), as
+// rosidl_generator_type_description's add_action describes it. goal_id is
+// unique_identifier_msgs/msg/UUID.
 #pragma once
 
 #include <functional>
@@ -23,14 +33,16 @@
 
 namespace rbsim::msgs {
 
-// Where definitions come from: the .msg text of "pkg/msg/Name" or the .srv text of "pkg/srv/Name";
+// Where definitions come from: the .msg text of "pkg/msg/Name", the .srv text of "pkg/srv/Name" or
+// the .action text of "pkg/action/Name";
 // nullopt when unknown (an empty text is a message without fields, as std_msgs/msg/Empty).
 using DefinitionSource = std::function<std::optional<std::string_view>(std::string_view type)>;
 // The definitions rbsim ships (msgs::definition(), none of them empty).
 std::optional<std::string_view> shipped_definition(std::string_view type);
 
 // The JSON the hash is taken over (default values left out). Fails, naming the type, on an unknown
-// type, a missing dependency, a malformed definition or a service without exactly one "---".
+// type, a missing dependency, a malformed definition, a service without exactly one "---" or an
+// action without exactly two.
 Result<std::string> type_description_json(std::string_view type, const DefinitionSource& source);
 // "RIHS01_" + the SHA-256 of type_description_json(type, source) in lower-case hex.
 Result<std::string> type_hash(std::string_view type, const DefinitionSource& source);
