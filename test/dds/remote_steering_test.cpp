@@ -1,6 +1,7 @@
 // RemoteSteering (rbsim/relay.hpp), what rbsim bridge steers a node with: a node of this process
 // (a Controller and its NodeServices, run by the control tests' loop on another thread) steered
-// over the loopback DDS configuration through its ROS 2 services, and what it refuses.
+// through its ROS 2 services, over the loopback DDS configuration and over the in-memory
+// middleware (the same seam), and what it refuses.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 
 #include "control_test_util.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
 #include "rbsim/relay.hpp"
 
@@ -42,13 +44,20 @@ Command kind(CommandKind k, std::int64_t steps = 0) {
   return c;
 }
 
-Participant participant(const std::string& name) {
-  auto p = create_dds_participant(kDomain, NodeName{"/", name});
-  if (!p) throw std::runtime_error(p.error().message);
-  return std::move(p.value());
-}
+// Runs on both middlewares behind the seam: over DDS (the loopback configuration) and in memory.
+class RemoteSteeringSeam : public ::testing::TestWithParam<std::string> {
+ protected:
+  Participant participant(const std::string& name) {
+    const NodeName node{"/", name};
+    auto p = GetParam() == "memory" ? create_memory_participant(network_, node)
+                                    : create_dds_participant(kDomain, node);
+    if (!p) throw std::runtime_error(p.error().message);
+    return std::move(p.value());
+  }
+  std::shared_ptr<MemoryNetwork> network_ = std::make_shared<MemoryNetwork>();
+};
 
-TEST(RemoteSteering, RelaysParametersAndControlsToTheNodesServices) {
+TEST_P(RemoteSteeringSeam, RelaysParametersAndControlsToTheNodesServices) {
   const Scene scene = test::control_scene();
   control::Controller controller(scene, 120, control::RunSettings{0.0, 1, true});  // paused at step 0
   const std::string node = "remote_steering_" + std::to_string(::getpid());
@@ -124,7 +133,7 @@ TEST(RemoteSteering, RelaysParametersAndControlsToTheNodesServices) {
   EXPECT_EQ(remote.calls(), 5u);
 }
 
-TEST(RemoteSteering, RefusesWhatAServiceCannotSayAndANodeThatIsNotThere) {
+TEST_P(RemoteSteeringSeam, RefusesWhatAServiceCannotSayAndANodeThatIsNotThere) {
   Participant bridge = participant("remote_steering_alone");
   RemoteSteeringOptions o;
   o.node = "/nobody_" + std::to_string(::getpid());
@@ -150,6 +159,9 @@ TEST(RemoteSteering, RefusesWhatAServiceCannotSayAndANodeThatIsNotThere) {
   EXPECT_NE(table.error().message.find(o.node), std::string::npos) << table.error().message;
   EXPECT_TRUE(remote.names().empty());
 }
+
+INSTANTIATE_TEST_SUITE_P(Middleware, RemoteSteeringSeam, ::testing::Values("dds", "memory"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace
 }  // namespace rbsim::node
