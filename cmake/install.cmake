@@ -12,11 +12,11 @@ set(RBSIM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/rbsim)
 # rbsim::core is the physics and the scene loader together: what a user means by "the simulator".
 add_library(rbsim_core_package INTERFACE)
 target_link_libraries(rbsim_core_package INTERFACE rbsim_core rbsim_scene)
-set(RBSIM_EXPORTED rbsim_core_package rbsim_base rbsim_core rbsim_scene rbsim_mcap rbsim_io rbsim_msgs rbsim_mcap_tools
-                   rbsim_log rbsim_check rbsim_golden rbsim_control)
+set(RBSIM_EXPORTED rbsim_core_package rbsim_base rbsim_core rbsim_scene rbsim_mcap rbsim_run rbsim_msgs rbsim_mcap_tools
+                   rbsim_recordings rbsim_check rbsim_golden rbsim_control)
 set_target_properties(rbsim_core_package PROPERTIES EXPORT_NAME core)
 set_target_properties(rbsim_core PROPERTIES EXPORT_NAME physics)
-foreach(target rbsim_base rbsim_scene rbsim_mcap rbsim_io rbsim_msgs rbsim_mcap_tools rbsim_log rbsim_check rbsim_golden
+foreach(target rbsim_base rbsim_scene rbsim_mcap rbsim_run rbsim_msgs rbsim_mcap_tools rbsim_recordings rbsim_check rbsim_golden
                rbsim_control)
   string(REPLACE "rbsim_" "" name ${target})
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
@@ -33,8 +33,8 @@ install(TARGETS ${RBSIM_EXPORTED} EXPORT rbsimTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # The public headers of the exported libraries, and only those (module internals stay in src/).
-foreach(dir sim_core/base/include sim_core/include sim_core/scene/include tools/io/include tools/msgs/include tools/mcap/include
-            tools/mcap_tools/include tools/log/include tools/check/include tools/golden/include tools/control/include)
+foreach(dir sim_core/base/include sim_core/include sim_core/scene/include tools/run/include tools/msgs/include tools/mcap/include
+            tools/mcap_tools/include tools/recordings/include tools/check/include tools/golden/include tools/control/include)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/rbsim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endforeach()
 if(RBSIM_INSTALL_TESTING)

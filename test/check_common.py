@@ -118,7 +118,7 @@ def line_count(text):
 ALLOWLIST_KINDS = {
     "file": ("lines", "path"),  # check_sizes.py: a source file over the line limit
     "function": ("lines", "path", "name"),  # check_sizes.py: a function over the line limit
-    "mcap-reader": ("path",),  # check_modules.py: the MCAP reader API outside mcap, mcap_tools, log
+    "mcap-reader": ("path",),  # check_modules.py: the MCAP reader API outside mcap, mcap_tools, recordings
     "mcap-framing": ("path",),  # check_modules.py: MCAP framing outside tools/mcap
 }
 

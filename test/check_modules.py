@@ -26,25 +26,25 @@ MODULES = {
     "base": ("sim_core/base", set()),
     "core": ("sim_core", set()),
     "scene": ("sim_core/scene", {"core"}),
-    "io": ("tools/io", {"core", "scene"}),
-    "control": ("tools/control", {"core", "scene", "io", "msgs", "log"}),
+    "run": ("tools/run", {"core", "scene"}),
+    "control": ("tools/control", {"core", "scene", "run", "msgs", "recordings"}),
     "msgs": ("tools/msgs", {"core", "scene"}),
     "mcap": ("tools/mcap", set()),
     "mcap_tools": ("tools/mcap_tools", {"mcap"}),
-    "log": ("tools/log", {"io", "msgs", "mcap", "mcap_tools", "core", "scene"}),
-    "check": ("tools/check", {"core", "scene", "io", "msgs", "mcap", "log"}),
-    "golden": ("tools/golden", {"core", "scene", "io", "msgs", "mcap", "mcap_tools", "log"}),
-    "render": ("tools/render", {"core", "scene", "io", "msgs", "mcap", "log"}),
+    "recordings": ("tools/recordings", {"run", "msgs", "mcap", "mcap_tools", "core", "scene"}),
+    "check": ("tools/check", {"core", "scene", "run", "msgs", "mcap", "recordings"}),
+    "golden": ("tools/golden", {"core", "scene", "run", "msgs", "mcap", "mcap_tools", "recordings"}),
+    "render": ("tools/render", {"core", "scene", "run", "msgs", "mcap", "recordings"}),
     "sros2": ("node/sros2", {"msgs"}),
     "middleware": ("node/middleware", {"core", "msgs"}),
     "dds": ("node/dds", {"middleware", "sros2", "core", "msgs"}),
     "memory": ("node/memory", {"middleware", "core", "msgs"}),
-    "sim_node": ("node/sim", {"middleware", "core", "scene", "io", "control", "msgs"}),
-    "bag": ("node/bag", {"middleware", "core", "scene", "io", "control", "msgs", "mcap", "mcap_tools", "log"}),
-    "bridge": ("node/bridge", {"middleware", "core", "scene", "io", "control", "msgs"}),
-    "testing": ("tools/testing", {"core", "scene", "io", "msgs", "mcap", "log", "check", "golden", "control"}),
-    "foxglove": ("tools/foxglove", {"core", "scene", "io", "control", "msgs"}),
-    "python": ("python", {"core", "scene", "io", "control", "msgs", "mcap", "log", "check"}),
+    "sim_node": ("node/sim", {"middleware", "core", "scene", "run", "control", "msgs"}),
+    "bag": ("node/bag", {"middleware", "core", "scene", "run", "control", "msgs", "mcap", "mcap_tools", "recordings"}),
+    "bridge": ("node/bridge", {"middleware", "core", "scene", "run", "control", "msgs"}),
+    "testing": ("tools/testing", {"core", "scene", "run", "msgs", "mcap", "recordings", "check", "golden", "control"}),
+    "foxglove": ("tools/foxglove", {"core", "scene", "run", "control", "msgs"}),
+    "python": ("python", {"core", "scene", "run", "control", "msgs", "mcap", "recordings", "check"}),
     "cli": ("tools/cli", None),  # the executable: any module
 }
 # Cyclone DDS lives in node/dds alone (the seam's backend on the network, as rmw_cyclonedds_cpp is
@@ -61,8 +61,8 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"rbsim/([A-Za-z0-9_]+\.hpp)"', re.M)
 SOURCE_SUFFIXES = (".cpp", ".hpp", ".h", ".in")
 
 # The reading side of rbsim/mcap.hpp (the Writer and the record types are for everyone): other
-# modules read recordings through log (rbsim/recording.hpp) or an mcap_tools tool.
-READER_MODULES = {"mcap", "mcap_tools", "log"}
+# modules read recordings through the recordings module (rbsim/recording.hpp) or an mcap_tools tool.
+READER_MODULES = {"mcap", "mcap_tools", "recordings"}
 READER_API = re.compile(r"\bmcap\s*::\s*(StreamReader|IndexedReader|StreamOptions|IndexedOptions|"
                         r"ReadMessagesOptions|MessageEntry|RecordEntry|parse_record|decompress_chunk)\b")
 # MCAP's framing by hand: the magic, the record prefix <opcode u8><length u64>, opcodes.

@@ -23,22 +23,22 @@ def function(name, lines):
 
 
 class Tree:
-    """A temporary source tree: the modules core (sim_core), mcap, log, check and node, each with a
+    """A temporary source tree: the modules core (sim_core), mcap, recordings, check and node, each with a
     public header, and whatever files a test adds."""
 
     def __init__(self):
         self.tmp = tempfile.TemporaryDirectory()
         self.root = pathlib.Path(self.tmp.name)
-        for folder, header in [("sim_core", "core"), ("tools/mcap", "mcap"), ("tools/log", "recording"),
+        for folder, header in [("sim_core", "core"), ("tools/mcap", "mcap"), ("tools/recordings", "recording"),
                                ("tools/check", "check"), ("node", "replay")]:
             self.write(f"{folder}/include/rbsim/{header}.hpp", "#pragma once\n")
         self.write("sim_core/src/world.cpp", '#include "rbsim/core.hpp"\n' + function("step", 20))
-        self.write("tools/log/src/recording.cpp",
+        self.write("tools/recordings/src/recording.cpp",
                    '#include "rbsim/mcap.hpp"\n#include "rbsim/recording.hpp"\n'
                    "void read() { rbsim::mcap::IndexedReader reader; }\n")
         self.write("node/src/replay.cpp",
                    '#include "rbsim/recording.hpp"\n#include "rbsim/replay.hpp"\n'
-                   "// not mcap::IndexedReader, which log wraps\n" + function("play", 100))
+                   "// not mcap::IndexedReader, which recordings wraps\n" + function("play", 100))
 
     def write(self, rel, text):
         path = self.root / rel
@@ -77,7 +77,7 @@ class CheckModulesTest(CheckerTest):
 
     def test_include_of_a_module_not_allowed_fails(self):
         self.tree.write("sim_core/src/bad.cpp", '#include "rbsim/recording.hpp"\n')
-        self.assertFails("sim_core/src/bad.cpp: module core includes rbsim/recording.hpp of module log "
+        self.assertFails("sim_core/src/bad.cpp: module core includes rbsim/recording.hpp of module recordings "
                          "(allowed: base)")
 
     def test_base_is_for_everyone_and_includes_nothing(self):
@@ -87,16 +87,16 @@ class CheckModulesTest(CheckerTest):
         self.tree.write("sim_core/base/src/bad.cpp", '#include "rbsim/core.hpp"\n')
         self.assertFails("sim_core/base/src/bad.cpp: module base includes rbsim/core.hpp of module core")
 
-    def test_reader_outside_mcap_log_and_mcap_tools_fails(self):
+    def test_reader_outside_mcap_mcap_tools_and_recordings_fails(self):
         self.tree.write("tools/check/src/compare.cpp", "void f() { rbsim::mcap::StreamReader r; }\n")
         self.assertFails("tools/check/src/compare.cpp: module check uses the MCAP readers (mcap::StreamReader); "
-                         "only log, mcap, mcap_tools may")
+                         "only mcap, mcap_tools, recordings may")
 
     def test_framing_outside_mcap_fails(self):
-        self.tree.write("tools/log/src/sniff.cpp",
+        self.tree.write("tools/recordings/src/sniff.cpp",
                         "const unsigned char kHead[] = {0x89, 'M', 'C', 'A', 'P', 0x30, '\\r', '\\n'};\n")
-        self.assertFails("tools/log/src/sniff.cpp: module log frames MCAP by hand (a copy of the magic)")
-        self.tree.write("tools/log/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
+        self.assertFails("tools/recordings/src/sniff.cpp: module recordings frames MCAP by hand (a copy of the magic)")
+        self.tree.write("tools/recordings/src/sniff.cpp", "unsigned long n = le64(p + 1);\n")
         self.assertFails("(little-endian fields read by hand (le64))")
 
     def test_dds_header_outside_the_backends_fails(self):
@@ -144,13 +144,13 @@ class CheckSizesTest(CheckerTest):
         self.assertPasses()
 
     def test_file_over_700_lines_fails(self):
-        self.tree.write("tools/log/src/big.py", "x = 1\n" * 700)
+        self.tree.write("tools/recordings/src/big.py", "x = 1\n" * 700)
         self.assertEqual(self.tree.run("check_sizes.py")[0], 0)
-        self.tree.write("tools/log/src/big.py", "x = 1\n" * 701)
-        self.assertFails("tools/log/src/big.py:1: file is 701 lines (limit 700)")
+        self.tree.write("tools/recordings/src/big.py", "x = 1\n" * 701)
+        self.assertFails("tools/recordings/src/big.py:1: file is 701 lines (limit 700)")
 
     def test_tests_are_exempt(self):
-        self.tree.write("test/log/big_test.cpp", "int x;\n" * 900)
+        self.tree.write("test/recordings/big_test.cpp", "int x;\n" * 900)
         self.tree.write("examples/demo/demo_test.cpp", "int x;\n" * 900)
         self.assertEqual(self.tree.run("check_sizes.py")[0], 0)
 
@@ -170,12 +170,12 @@ class CheckSizesTest(CheckerTest):
         self.assertPasses()
         self.tree.write("python/rbsim/world.py", py(101))
         self.assertFails("python/rbsim/world.py:2: function World.state is 101 lines (limit 100)")
-        self.tree.write("tools/log/src/gen.py", "def main():\n" + "    pass\n" * 101)
-        self.assertFails("tools/log/src/gen.py:1: function main is 102 lines (limit 100)")
+        self.tree.write("tools/recordings/src/gen.py", "def main():\n" + "    pass\n" * 101)
+        self.assertFails("tools/recordings/src/gen.py:1: function main is 102 lines (limit 100)")
 
     def test_member_functions_and_constructors_are_measured(self):
         body = "\n".join(["    ++n_;"] * 100)
-        self.tree.write("tools/log/src/sink.hpp", textwrap.dedent("""\
+        self.tree.write("tools/recordings/src/sink.hpp", textwrap.dedent("""\
             struct Sink {
              public:
               explicit Sink(int n) : n_{n}, f_([this] { return n_; }) {
@@ -184,7 +184,7 @@ class CheckSizesTest(CheckerTest):
               int n_{0};
             };
             """).replace("BODY", body))
-        self.assertFails("tools/log/src/sink.hpp:3: function Sink is 102 lines (limit 100)")
+        self.assertFails("tools/recordings/src/sink.hpp:3: function Sink is 102 lines (limit 100)")
 
     def test_allowlist_ratchets(self):
         self.tree.write("node/src/replay.cpp", function("play", 110))

@@ -14,8 +14,8 @@
 //                               RBSIM_BENCH_RECORD_STEPS steps (default 2000): World::step,
 //                               find_nonfinite, sinks; sink begin and finish are timed too
 //     off                         no sink (the baseline)
-//     all_zstd|all_lz4|all_none   log::make_mcap_sink, the default topics (what --record does)
-//     body_states                 only /rbsim/body_states (RecordOptions::topics), zstd
+//     all_zstd|all_lz4|all_none   recordings::make_mcap_sink, the default topics (what --record does)
+//     body_states                 only /rbsim/body_states (McapSinkOptions::topics), zstd
 //     tf                          only /tf, zstd
 //     every_topic                 every topic, poses included, zstd
 //     every10, every100           the default topics, zstd, --record-every 10 / 100
@@ -58,7 +58,7 @@ using namespace rbsim;
 
 constexpr std::int64_t kSizes[] = {100, 10'000};
 constexpr std::size_t kFileBytes = 8u << 20;   // uncompressed message bytes per file
-constexpr std::size_t kChunkBytes = 1u << 20;  // the recorder's chunk size (log::RecordOptions)
+constexpr std::size_t kChunkBytes = 1u << 20;  // the recorder's chunk size (recordings::McapSinkOptions)
 constexpr std::int32_t kRecordBodies = 1000;
 
 std::string temp_path(const std::string& tag) {
@@ -128,13 +128,13 @@ std::uint64_t write_file(benchmark::State& state, const std::string& path, const
                          const Snapshots& snaps, const msgs::Encoder& encoder, std::size_t count,
                          msgs::Bytes& buf, std::size_t first_snapshot = 0) {
   mcap::Writer writer;
-  mcap::WriterOptions options = log::writer_options(codec.compression);
+  mcap::WriterOptions options = recordings::writer_options(codec.compression);
   options.compression_level = codec.level;
   if (auto st = writer.open(path, options); !st.ok()) {
     state.SkipWithError(st.error().message.c_str());
     return 0;
   }
-  auto channel = log::add_topic(writer, msgs::topic(msgs::TopicId::BodyStates), "rbsim");
+  auto channel = recordings::add_topic(writer, msgs::topic(msgs::TopicId::BodyStates), "rbsim");
   if (!channel.ok()) {
     state.SkipWithError(channel.error().message.c_str());
     return 0;
@@ -343,11 +343,11 @@ void bm_record(benchmark::State& state, const RecordVariant& v) {
     World world = initial;  // untimed: the run starts from the loaded scene
     std::unique_ptr<Sink> sink;
     if (v.record) {
-      log::RecordOptions ro;
+      recordings::McapSinkOptions ro;
       ro.compression = v.compression;
       ro.topics = v.topics;
       ro.every = v.every;
-      sink = log::make_mcap_sink(path, ro);
+      sink = recordings::make_mcap_sink(path, ro);
     }
     const auto t0 = std::chrono::steady_clock::now();
     bool ok = true;

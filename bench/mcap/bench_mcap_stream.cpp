@@ -9,7 +9,7 @@
 // `rbsim run --record` (default topics, uncompressed chunks): the message stream of that run.
 // Otherwise CAPTURE is any MCAP file: its schemas, channels and messages (ids, sequences, log and
 // publish times, payloads) are read into memory first, untimed. Then, timed on the wall clock:
-//   rbsim   mcap::Writer::open(OUT) with log::writer_options() (what rbsim run --record uses) and
+//   rbsim   mcap::Writer::open(OUT) with recordings::writer_options() (what rbsim run --record uses) and
 //           the given compression, level, chunk size and CRCs; --threads 2 compresses on a second
 //           thread (WriterOptions::background_compression, as recordings do), 1 on the caller's;
 //           the same schema and channel records; every message in capture order; close()
@@ -137,9 +137,9 @@ int capture(const std::string& scene_path, const std::string& steps_text, const 
     std::fprintf(stderr, "capture: %s\n", driver.error().message.c_str());
     return 1;
   }
-  log::RecordOptions options;  // the default topics, as rbsim run --record
+  recordings::McapSinkOptions options;  // the default topics, as rbsim run --record
   options.compression = mcap::Compression::None;
-  auto sink = log::make_mcap_sink(out, options);
+  auto sink = recordings::make_mcap_sink(out, options);
   driver->add(*sink);
   DriverOptions run;
   run.steps = steps;
@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
 
   Capture cap;
   if (!load(capture_path, cap)) return 1;
-  mcap::WriterOptions options = log::writer_options(compression, chunk_size, level);
+  mcap::WriterOptions options = recordings::writer_options(compression, chunk_size, level);
   options.enable_crcs = crc;
   options.background_compression = threads == 2;
 

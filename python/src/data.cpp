@@ -1,5 +1,5 @@
 // rbsim.run (the outputs of `rbsim run`, through the same driver and sinks), the recording reader
-// behind rbsim.Recording (log::Recording's read_steps into NumPy columns), and rbsim.check
+// behind rbsim.Recording (recordings::Recording's read_steps into NumPy columns), and rbsim.check
 // (check::check_logs and its report).
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
@@ -45,8 +45,8 @@ struct RunArgs {
   bool overwrite = false, allow_nonfinite = false;
 };
 
-log::RecordOptions record_options(const RunArgs& a) {
-  log::RecordOptions ro;
+recordings::McapSinkOptions record_options(const RunArgs& a) {
+  recordings::McapSinkOptions ro;
   if (a.record_every < 1) throw nb::value_error("rbsim.run: record_every must be >= 1");
   ro.every = a.record_every;
   if (const std::string problem = msgs::ros_namespace_problem(a.ns); !problem.empty())
@@ -146,13 +146,13 @@ msgs::TopicId topic_id(const std::string& topic) {
       ("unknown per-step topic " + topic + " (body_states, spring_states, energy)").c_str());
 }
 
-std::unique_ptr<log::Recording> open_recording(const std::string& path, const std::string& ns,
-                                               std::vector<msgs::TopicId> read) {
-  log::RecordingOptions o;
+std::unique_ptr<recordings::Recording> open_recording(const std::string& path, const std::string& ns,
+                                                      std::vector<msgs::TopicId> read) {
+  recordings::RecordingOptions o;
   o.ns = ns;
   o.require = read;
   o.read = std::move(read);
-  Result<std::unique_ptr<log::Recording>> opened = log::Recording::open(path, o);
+  Result<std::unique_ptr<recordings::Recording>> opened = recordings::Recording::open(path, o);
   if (!opened) raise_error(opened.error().message);
   return std::move(opened.value());
 }
@@ -161,11 +161,11 @@ std::unique_ptr<log::Recording> open_recording(const std::string& path, const st
 // (bodies or springs; 0 for scene-wide columns).
 nb::dict read_topic(const std::string& path, const std::string& ns, const std::string& topic) {
   const msgs::TopicId id = topic_id(topic);
-  std::unique_ptr<log::Recording> rec = open_recording(path, ns, {id});
+  std::unique_ptr<recordings::Recording> rec = open_recording(path, ns, {id});
   if (id == msgs::TopicId::Energy) {
     // A recording made before the potential split, with several gravity fields: its U_gravity
-    // comes from the body states (log::recorded_energy).
-    for (const log::RecordedChannel& c : rec->channels()) {
+    // comes from the body states (recordings::recorded_energy).
+    for (const recordings::RecordedChannel& c : rec->channels()) {
       if (c.spec != nullptr && c.spec->id == id &&
           c.energy_version == msgs::EnergyTermsVersion::WithoutSplit && rec->scene()->gravity.size() > 1) {
         rec = open_recording(path, ns, {id, msgs::TopicId::BodyStates});
@@ -189,7 +189,7 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
     add({"U", "T_point", "T_spin", "T", "E", "U_gravity", "U_spring", "px", "py", "L"});
   }
   std::uint64_t expected = 0;
-  for (const log::RecordedChannel& c : rec->channels()) {
+  for (const recordings::RecordedChannel& c : rec->channels()) {
     if (c.spec != nullptr && c.spec->id == id && c.channel->topic == rec->topic(id))
       expected = c.message_count.value_or(0);
   }
@@ -200,7 +200,7 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
   Status read;
   {
     nb::gil_scoped_release unlocked;
-    read = rec->read_steps([&](const log::RecordedStep& s) -> Status {
+    read = rec->read_steps([&](const recordings::RecordedStep& s) -> Status {
       const void* message = id == msgs::TopicId::BodyStates     ? static_cast<const void*>(s.body_states)
                             : id == msgs::TopicId::SpringStates ? static_cast<const void*>(s.spring_states)
                                                                 : static_cast<const void*>(s.energy);
@@ -227,7 +227,7 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
         }
       } else {
         // The energy CSV's numbers: World::energy() as recorded, U, T and E by Energy's formulas.
-        const Energy e = log::recorded_energy(scene, *s.energy, s.body_states);
+        const Energy e = recordings::recorded_energy(scene, *s.energy, s.body_states);
         put(0, e.potential());
         put(1, e.t_point);
         put(2, e.t_spin);
@@ -255,7 +255,7 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
 
 // What rbsim.Recording shows before any topic is read: the scene description and the topics.
 nb::dict recording_info(const std::string& path, const std::string& ns) {
-  std::unique_ptr<log::Recording> rec = open_recording(path, ns, {});
+  std::unique_ptr<recordings::Recording> rec = open_recording(path, ns, {});
   const msgs::SceneMessage& s = *rec->scene();
   nb::dict scene;
   scene["name"] = s.name;
@@ -277,7 +277,7 @@ nb::dict recording_info(const std::string& path, const std::string& ns) {
   scene["inertia"] = to_numpy(std::move(inertia), n);
   scene["radius"] = to_numpy(std::move(radius), n);
   nb::list topics;
-  for (const log::RecordedChannel& c : rec->channels()) topics.append(c.channel->topic);
+  for (const recordings::RecordedChannel& c : rec->channels()) topics.append(c.channel->topic);
   nb::dict per_step;
   for (const msgs::TopicId id :
        {msgs::TopicId::BodyStates, msgs::TopicId::SpringStates, msgs::TopicId::Energy})

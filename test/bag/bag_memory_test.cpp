@@ -34,10 +34,11 @@ Participant participant(const std::shared_ptr<MemoryNetwork>& network, const std
 // Every message of a recording, per topic in log-time order: the CDR payloads.
 using Payloads = std::map<std::string, std::vector<Bytes>>;
 Payloads payloads_of(const std::string& path, std::vector<std::string>* order = nullptr) {
-  Result<std::unique_ptr<log::Recording>> r = log::Recording::open(path, log::raw_options());
+  Result<std::unique_ptr<recordings::Recording>> r =
+      recordings::Recording::open(path, recordings::raw_options());
   if (!r) throw std::runtime_error(r.error().message);
   Payloads out;
-  const Status st = r.value()->read_messages({}, [&](const log::RecordedMessage& m) {
+  const Status st = r.value()->read_messages({}, [&](const recordings::RecordedMessage& m) {
     out[m.topic()].emplace_back(m.cdr().begin(), m.cdr().end());
     if (order != nullptr) order->push_back(m.topic());
     return true;
@@ -49,7 +50,7 @@ Payloads payloads_of(const std::string& path, std::vector<std::string>* order = 
 // `rbsim run --record`'s file of the control scene: what a node publishes, step for step.
 std::string record_offline(const test::TempDir& dir, const Scene& scene) {
   const std::string path = (dir / "offline.mcap").string();
-  std::unique_ptr<log::McapSink> sink = log::make_mcap_sink(path);
+  std::unique_ptr<recordings::McapSink> sink = recordings::make_mcap_sink(path);
   Result<Driver> driver = Driver::create(scene);
   EXPECT_TRUE(driver.ok());
   driver.value().add(*sink);
@@ -136,7 +137,7 @@ struct HandNode {
   Bytes cdr;
   explicit HandNode(const std::shared_ptr<MemoryNetwork>& network)
       : participant(node::participant(network, "rbsim")),
-        scene_pub(make(msgs::TopicId::Scene)),
+        scene_pub(make(msgs::TopicId::SceneDescription)),
         markers_pub(make(msgs::TopicId::Markers)),
         body_pub(make(msgs::TopicId::BodyStates)) {}
   Publisher make(msgs::TopicId id) {

@@ -282,7 +282,7 @@ TEST(CheckSentences, NumbersAndValues) {
   EXPECT_EQ(rbsim::check::value_text(f), "0.1");
   EXPECT_EQ(rbsim::check::quoted(""), "(none)");
   EXPECT_EQ(rbsim::check::quoted("chain"), "'chain'");
-  EXPECT_STREQ(rbsim::check::kind_label(Scalar::Kind::Length), "length");
+  EXPECT_STREQ(rbsim::check::to_string(Scalar::Kind::Length), "length");
 }
 
 TEST(CheckSentences, TopicAndMessageDifferences) {

@@ -1,8 +1,8 @@
 // One rule per shared decision, seen from the command line: the commands that take the same input
 // decide the same about it (issue 36, point 2). Which topics a name selects and how an unknown one
 // is worded (msgs::select_topics, also for an enclave's permissions); whether a path is a recording or a
-// scene (log::path_kind); seconds to nanoseconds (rbsim::seconds_to_ns). DDS commands on rbsim's loopback
-// configuration, on a domain no other test uses.
+// scene (recordings::path_kind); seconds to nanoseconds (rbsim::seconds_to_ns). DDS commands on rbsim's
+// loopback configuration, on a domain no other test uses.
 #include <gtest/gtest.h>
 
 #include <filesystem>

@@ -380,7 +380,7 @@ struct TypeCase {
 };
 
 const TypeCase kCases[] = {
-    {TopicId::Scene, &rbsim_msgs_msg_dds__SceneDescription__desc, fill_scene},
+    {TopicId::SceneDescription, &rbsim_msgs_msg_dds__SceneDescription__desc, fill_scene},
     {TopicId::BodyStates, &rbsim_msgs_msg_dds__BodyStates__desc, fill_body_states},
     {TopicId::SpringStates, &rbsim_msgs_msg_dds__SpringStates__desc, fill_spring_states},
     {TopicId::Energy, &rbsim_msgs_msg_dds__EnergyTerms__desc, fill_energy},

@@ -1,4 +1,4 @@
-// RemoteSteering (rbsim/relay.hpp), what rbsim bridge steers a node with: a node of this process
+// RemoteSteering (rbsim/remote_steering.hpp), what rbsim bridge steers a node with: a node of this process
 // (a Controller and its NodeServices, run by the control tests' loop on another thread) steered
 // through its ROS 2 services, over the loopback DDS configuration and over the in-memory
 // middleware (the same seam), and what it refuses.
@@ -15,7 +15,7 @@
 #include "rbsim/dds.hpp"
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
-#include "rbsim/relay.hpp"
+#include "rbsim/remote_steering.hpp"
 
 namespace rbsim::node {
 namespace {

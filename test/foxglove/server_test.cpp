@@ -420,7 +420,7 @@ TEST(FoxgloveSink, PublishesTheSceneLatchedAndSubscribedStepsAtSimulatedTime) {
   ASSERT_TRUE(channels);
   auto server = start({}, channels.value());
   ASSERT_TRUE(server);
-  const ChannelId scene_ch = ids[static_cast<std::size_t>(msgs::TopicId::Scene)];
+  const ChannelId scene_ch = ids[static_cast<std::size_t>(msgs::TopicId::SceneDescription)];
   const ChannelId states_ch = ids[static_cast<std::size_t>(msgs::TopicId::BodyStates)];
   ASSERT_GT(scene_ch, 0u);
   ASSERT_GT(states_ch, 0u);

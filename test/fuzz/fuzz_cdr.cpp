@@ -39,7 +39,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (i < scalars.size()) (void)decoder.path(cdr, i);
     }
   }
-  if (id == rbsim::msgs::TopicId::Scene) (void)rbsim::msgs::decode_scene(cdr);
+  if (id == rbsim::msgs::TopicId::SceneDescription) (void)rbsim::msgs::decode_scene(cdr);
   if (id == rbsim::msgs::TopicId::BodyStates) {
     rbsim::msgs::BodyStatesMessage states;
     (void)rbsim::msgs::decode_body_states(cdr, states);

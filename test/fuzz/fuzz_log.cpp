@@ -41,11 +41,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)rbsim::mcap_tools::info(in);
   (void)rbsim::mcap_tools::doctor(in);
   (void)rbsim::mcap_tools::recover(in, out);
-  rbsim::log::RecordingOptions ro;
+  rbsim::recordings::RecordingOptions ro;
   ro.require_scene = false;
-  if (auto recording = rbsim::log::Recording::open(in, ro); recording.ok()) {
+  if (auto recording = rbsim::recordings::Recording::open(in, ro); recording.ok()) {
     (void)recording.value()->read_steps(
-        [](const rbsim::log::RecordedStep&) -> rbsim::Status { return rbsim::Ok{}; });
+        [](const rbsim::recordings::RecordedStep&) -> rbsim::Status { return rbsim::Ok{}; });
   }
   std::remove(out.c_str());
   return 0;

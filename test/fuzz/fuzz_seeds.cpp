@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
     rbsim::msgs::Bytes bytes;
     for (int step = 0; step <= 3; ++step) {
       for (const rbsim::msgs::TopicSpec& spec : rbsim::msgs::topics()) {
-        if ((spec.id == rbsim::msgs::TopicId::Scene && step > 0) || spec.event) continue;  // events: no World
+        if ((spec.id == rbsim::msgs::TopicId::SceneDescription && step > 0) || spec.event)
+          continue;  // events: no World
         encoder.encode(spec.id, world.value(), bytes);
         std::ofstream f(out / "cdr" / (stem + "-" + std::string(spec.suffix) + "-" + std::to_string(step)),
                         std::ios::binary);
@@ -82,11 +83,12 @@ int main(int argc, char** argv) {
       world.value().step();
     }
     for (const char* name : {"none", "lz4", "zstd"}) {
-      rbsim::log::RecordOptions options;
+      rbsim::recordings::McapSinkOptions options;
       if (!rbsim::mcap::parse_compression(name, options.compression)) return fail(name);
       options.chunk_size = 4096;  // several chunks in a small file
       auto w = rbsim::World::create(scene.value().world);
-      auto sink = rbsim::log::make_mcap_sink((out / "log" / (stem + "-" + name + ".mcap")).string(), options);
+      auto sink =
+          rbsim::recordings::make_mcap_sink((out / "log" / (stem + "-" + name + ".mcap")).string(), options);
       if (!sink->begin(scene.value(), w.value())) return fail("cannot record " + stem);
       for (int step = 0; step < 4; ++step) {
         w.value().step();

@@ -270,7 +270,7 @@ void copy_without(const fs::path& in, const fs::path& out, const std::string& to
   mcap::IndexedReader reader;
   ASSERT_TRUE(reader.open(in.string()).ok());
   mcap::Writer writer;
-  ASSERT_TRUE(writer.open(out.string(), log::writer_options(mcap::Compression::Zstd)).ok());
+  ASSERT_TRUE(writer.open(out.string(), recordings::writer_options(mcap::Compression::Zstd)).ok());
   for (const auto& [id, schema] : reader.schemas()) ASSERT_TRUE(writer.add_schema(schema).ok());
   for (const auto& [id, channel] : reader.channels()) {
     if (channel.topic != topic) {
@@ -389,7 +389,7 @@ void copy_joined_late(const fs::path& in, const fs::path& out, std::size_t n) {
   mcap::IndexedReader reader;
   ASSERT_TRUE(reader.open(in.string()).ok());
   mcap::Writer writer;
-  ASSERT_TRUE(writer.open(out.string(), log::writer_options(mcap::Compression::Zstd)).ok());
+  ASSERT_TRUE(writer.open(out.string(), recordings::writer_options(mcap::Compression::Zstd)).ok());
   for (const auto& [id, schema] : reader.schemas()) ASSERT_TRUE(writer.add_schema(schema).ok());
   for (const auto& [id, channel] : reader.channels()) ASSERT_TRUE(writer.add_channel(channel).ok());
   std::map<std::string, std::size_t> seen;

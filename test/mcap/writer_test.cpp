@@ -365,7 +365,7 @@ TEST(Writer, BackgroundCompressionWritesTheSameBytes) {
         const Bytes inline_file = write_sample_file(o, input);
         o.background_compression = true;
         EXPECT_EQ(write_sample_file(o, input), inline_file)
-            << compression_name(c) << " chunk_size " << chunk_size << " crcs " << crcs;
+            << to_string(c) << " chunk_size " << chunk_size << " crcs " << crcs;
       }
     }
   }

@@ -6,8 +6,8 @@
 #include <functional>
 #include <regex>
 
-#include "log_test_util.hpp"
 #include "rbsim/subprocess.hpp"
+#include "recordings_test_util.hpp"
 
 namespace rbsim::test {
 namespace {
@@ -262,7 +262,7 @@ TEST(DoctorCrafted, UnknownSchemaAndChannelReferences) {
 
 TEST(DoctorCrafted, OutOfOrderMessagesInChunksAreWarningsUnlessStrict) {
   mcap::Writer w;
-  ASSERT_TRUE(w.open_buffer(log::writer_options(mcap::Compression::Zstd)).ok());
+  ASSERT_TRUE(w.open_buffer(recordings::writer_options(mcap::Compression::Zstd)).ok());
   const auto ch = w.add_channel(0, "/t", "raw");
   ASSERT_TRUE(ch.ok());
   for (std::uint32_t i = 0; i < 10; ++i)
@@ -306,7 +306,7 @@ TEST_F(DoctorTest, TruncatedEmptyAndForeignFiles) {
 // Every single-byte flip and every truncation of a small file is an error: the data section and
 // summary CRCs cover every byte. Also proves the doctor terminates on all of them.
 TEST(DoctorHostile, EveryFlipAndEveryTruncationOfASmallFileIsAnError) {
-  mcap::WriterOptions o = log::writer_options(mcap::Compression::Zstd, 200);
+  mcap::WriterOptions o = recordings::writer_options(mcap::Compression::Zstd, 200);
   mcap::Writer w;
   ASSERT_TRUE(w.open_buffer(o).ok());
   const auto schema = w.add_schema("S", "jsonschema", bytes_of("{}"));

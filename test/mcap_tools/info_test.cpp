@@ -1,8 +1,8 @@
 // mcap_tools::info at library level: from the summary, from a scan, and refusing damaged files.
 #include <gtest/gtest.h>
 
-#include "log_test_util.hpp"
 #include "rbsim/subprocess.hpp"
+#include "recordings_test_util.hpp"
 
 namespace rbsim::test {
 namespace {
@@ -47,7 +47,7 @@ TEST(Info, RecordingFromItsSummary) {
 }
 
 TEST(Info, FileWithoutSummaryIsScanned) {
-  mcap::WriterOptions o = log::writer_options(mcap::Compression::Lz4, 100);
+  mcap::WriterOptions o = recordings::writer_options(mcap::Compression::Lz4, 100);
   o.emit_statistics = o.emit_chunk_indexes = o.emit_summary_offsets = o.repeat_channels = o.repeat_schemas =
       false;
   o.emit_attachment_indexes = o.emit_metadata_indexes = false;

@@ -3,8 +3,8 @@
 // the output is a clean, indexed file holding those messages unchanged.
 #include <gtest/gtest.h>
 
-#include "log_test_util.hpp"
 #include "rbsim/subprocess.hpp"
+#include "recordings_test_util.hpp"
 
 namespace rbsim::test {
 namespace {
@@ -195,10 +195,10 @@ TEST_F(RecoverTest, RecoveredRecordingExportsItsCompleteSteps) {
   write_bytes(
       cut_, mcap::Bytes(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(bytes_.size() * 2 / 3)));
   ASSERT_TRUE(mcap_tools::recover(cut_.string(), recovered_.string()).ok());
-  log::ExportOptions eo;
+  recordings::ExportOptions eo;
   eo.csv = (dir_ / "x.csv").string();
   eo.energy_csv = (dir_ / "x_energy.csv").string();
-  const auto r = log::export_csv(recovered_.string(), eo);
+  const auto r = recordings::export_csv(recovered_.string(), eo);
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_EQ(r.value().first_step, 0u);
   EXPECT_GT(r.value().last_step, 10u);

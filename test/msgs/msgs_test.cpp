@@ -249,7 +249,7 @@ TEST(EncoderMarkersAndScene, DecodeCleanly) {
   auto w = rbsim::World::create(scene.world);
   ASSERT_TRUE(w.ok());
   rbsim::msgs::Encoder enc(scene);
-  for (TopicId id : {TopicId::Markers, TopicId::Scene, TopicId::SpringStates}) {
+  for (TopicId id : {TopicId::Markers, TopicId::SceneDescription, TopicId::SpringStates}) {
     rbsim::msgs::Bytes out;
     enc.encode(id, w.value(), out);
     std::vector<Scalar> v;
@@ -372,7 +372,7 @@ TEST(MessageDecoder, RejectsEveryTruncationAndSurvivesMutation) {
   ASSERT_TRUE(w.ok());
   rbsim::msgs::Bytes good;
   rbsim::msgs::Encoder(scene).scene(w.value(), good);
-  const auto d = decoder_for(TopicId::Scene);
+  const auto d = decoder_for(TopicId::SceneDescription);
   std::vector<Scalar> v;
   for (std::size_t n = 0; n < good.size(); ++n) {
     EXPECT_FALSE(d.decode(std::span(good).first(n), v).ok()) << "prefix " << n;
@@ -542,7 +542,7 @@ TEST(DecodeStamp, GivesTheSimulatedTimeOfEveryPerStepTopic) {
     if (spec.event) continue;  // not encoded from a World: below
     encoder.encode(spec.id, w.value(), out);
     const auto got = rbsim::msgs::decode_stamp(spec.id, out);
-    if (spec.id == TopicId::Scene) {
+    if (spec.id == TopicId::SceneDescription) {
       EXPECT_FALSE(got.has_value());
       continue;
     }
@@ -585,7 +585,7 @@ TEST(MessageStep, UsesTheStepFieldElseTheStampOverDt) {
     if (spec.event) continue;  // not encoded from a World: below
     encoder.encode(spec.id, w.value(), out);
     const auto step = rbsim::msgs::message_step(spec.id, out, dt);
-    if (spec.id == TopicId::Scene) {
+    if (spec.id == TopicId::SceneDescription) {
       EXPECT_FALSE(step.has_value());
       continue;
     }

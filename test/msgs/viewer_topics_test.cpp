@@ -270,8 +270,8 @@ TEST(TopicSet, DefaultIsEverythingButPoses) {
 TEST(TopicSet, ParsesNamesInEveryForm) {
   const auto set = rbsim::msgs::parse_topic_set("poses, /tf,rbsim/springs,/rbsim/body_states,clock");
   ASSERT_TRUE(set.ok()) << set.error().message;
-  const std::vector<TopicId> want = {TopicId::Scene,   TopicId::BodyStates, TopicId::Tf,
-                                     TopicId::Springs, TopicId::Clock,      TopicId::Poses};
+  const std::vector<TopicId> want = {TopicId::SceneDescription, TopicId::BodyStates, TopicId::Tf,
+                                     TopicId::Springs,          TopicId::Clock,      TopicId::Poses};
   EXPECT_EQ(rbsim::msgs::topic_ids(set.value()), want);  // scene always, topics() order
   const auto tf = rbsim::msgs::parse_topic_set("tf");
   ASSERT_TRUE(tf.ok());

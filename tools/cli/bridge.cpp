@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/relay.hpp"
+#include "rbsim/remote_steering.hpp"
 #include "rbsim/rosout.hpp"
 #include "validators.hpp"
 
@@ -26,7 +27,7 @@ struct BridgeArgs {
 // header stamp or clock; nullopt when it has none.
 std::optional<std::uint64_t> sim_time(const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
   std::optional<msgs::Time> stamp;
-  if (spec.id == msgs::TopicId::Scene) {
+  if (spec.id == msgs::TopicId::SceneDescription) {
     if (auto scene = msgs::decode_scene(cdr)) stamp = scene.value().stamp;
   } else {
     stamp = msgs::decode_stamp(spec.id, cdr);
@@ -68,7 +69,7 @@ int bridge_command(const BridgeArgs& a) {
   std::uint64_t last_time = 0, scenes = 0;
   const node::Relay::OnSample on_sample = [&](const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
     const std::optional<std::uint64_t> t = sim_time(spec, cdr);
-    if (spec.id == msgs::TopicId::Scene) {
+    if (spec.id == msgs::TopicId::SceneDescription) {
       // A scene (re)started: its node's parameters (read before the new session, which hands them
       // to the viewers), and a new session, so viewers drop what they showed of the last one. A
       // source without services (rbsim replay) costs a bounded wait and a line.

@@ -36,18 +36,19 @@ struct LogOptions {
 };
 
 // The output options of filter, merge and compress: codec and chunk size.
-Result<log::OutputOptions> output_options(const LogOptions& o) {
+Result<recordings::OutputOptions> output_options(const LogOptions& o) {
   const Result<mcap::Compression> codec = compression_option(o.compression);
   if (!codec) return codec.error();
-  log::OutputOptions out;
+  recordings::OutputOptions out;
   out.compression = codec.value();
   out.chunk_size = o.chunk_size;
   return out;
 }
 
 // Writes one rewrite's OUT (filter, merge, compress): outputs checked first, the report on stdout.
-int rewrite_command(const char* command, const LogOptions& o, const std::vector<std::string>& inputs,
-                    const std::function<Result<log::RewriteReport>(const log::OutputOptions&)>& write) {
+int rewrite_command(
+    const char* command, const LogOptions& o, const std::vector<std::string>& inputs,
+    const std::function<Result<recordings::RewriteReport>(const recordings::OutputOptions&)>& write) {
   if (Status st = check_outputs({{o.out, "OUT"}}, inputs, o.overwrite); !st)
     return fail(command, st.error().message);
   auto options = output_options(o);
@@ -63,14 +64,14 @@ int filter_command(const LogOptions& o) {
   if (o.start && o.end && *o.end < *o.start)
     return fail("log filter",
                 "--end " + std::to_string(*o.end) + " is before --start " + std::to_string(*o.start), 2);
-  return rewrite_command("log filter", o, {o.file}, [&](const log::OutputOptions& output) {
-    log::FilterOptions options;
+  return rewrite_command("log filter", o, {o.file}, [&](const recordings::OutputOptions& output) {
+    recordings::FilterOptions options;
     options.topics = o.topics;
     options.exclude_topics = o.exclude_topics;
     options.start = o.start;
     options.end = o.end;
     options.output = output;
-    return log::filter(o.file, o.out, options);
+    return recordings::filter(o.file, o.out, options);
   });
 }
 
@@ -90,23 +91,23 @@ int merge_command(const LogOptions& o) {
     if (const std::string problem = ns == "/" ? "" : msgs::ros_namespace_problem(ns); !problem.empty())
       return fail("log merge", "--namespaces: \"" + ns + "\" is not a ROS 2 namespace: it " + problem, 2);
   }
-  return rewrite_command("log merge", m, inputs, [&](const log::OutputOptions& output) {
-    log::MergeOptions options;
+  return rewrite_command("log merge", m, inputs, [&](const recordings::OutputOptions& output) {
+    recordings::MergeOptions options;
     options.namespaces = o.namespaces;
     options.output = output;
-    return log::merge(inputs, m.out, options);
+    return recordings::merge(inputs, m.out, options);
   });
 }
 
 int compress_command(const LogOptions& o) {
-  return rewrite_command("log compress", o, {o.file}, [&](const log::OutputOptions& output) {
-    return log::compress(o.file, o.out, output);
+  return rewrite_command("log compress", o, {o.file}, [&](const recordings::OutputOptions& output) {
+    return recordings::compress(o.file, o.out, output);
   });
 }
 
 // A bag directory: its files, then each file's summary.
 int info_command(const LogOptions& o) {
-  const Result<std::vector<std::string>> files = log::recording_files(o.file);
+  const Result<std::vector<std::string>> files = recordings::recording_files(o.file);
   if (!files) return fail("log info", files.error().message);
   const bool bag = files->size() != 1 || files->front() != o.file;
   if (bag) {
@@ -127,7 +128,7 @@ int info_command(const LogOptions& o) {
 int doctor_command(const LogOptions& o) {
   mcap_tools::DoctorOptions options;
   options.strict_message_order = o.strict_message_order;
-  const Result<std::vector<std::string>> files = log::recording_files(o.file);
+  const Result<std::vector<std::string>> files = recordings::recording_files(o.file);
   if (!files) return fail("log doctor", files.error().message);
   int status = 0;
   for (const std::string& file : files.value()) {
@@ -172,20 +173,20 @@ int recover_command(const LogOptions& o) {
 }
 
 int export_command(const LogOptions& o) {
-  log::ExportOptions options;
+  recordings::ExportOptions options;
   if (Status st = check_outputs({{o.csv, "--csv"}, {o.energy_csv, "--energy-csv"}}, {o.file}, o.overwrite);
       !st)
     return fail("log export", st.error().message);
   options.csv = o.csv;
   options.energy_csv = o.energy_csv;
   options.ns = o.ns;
-  auto report = log::export_csv(o.file, options);
+  auto report = recordings::export_csv(o.file, options);
   if (!report) return fail("log export", report.error().message);
   for (const std::string& w : report.value().warnings) {
     std::fprintf(stderr, "rbsim log export: warning: %s: %s\n", o.file.c_str(), w.c_str());
   }
   if (!o.quiet) {
-    const log::ExportReport& r = report.value();
+    const recordings::ExportReport& r = report.value();
     std::fprintf(stderr, "rbsim log export: %s: %llu steps (%llu..%llu)\n", o.file.c_str(),
                  static_cast<unsigned long long>(r.steps), static_cast<unsigned long long>(r.first_step),
                  static_cast<unsigned long long>(r.last_step));
@@ -194,14 +195,14 @@ int export_command(const LogOptions& o) {
 }
 
 int cat_command(const LogOptions& o) {
-  log::CatOptions options;
+  recordings::CatOptions options;
   for (const std::string& t : o.topics) {
     if (!t.empty()) options.topics.push_back(t);
   }
   options.start = o.start;
   options.end = o.end;
-  options.format = o.format == "csv" ? log::CatFormat::Csv : log::CatFormat::Json;
-  Status st = log::cat(o.file, options, [](std::string_view line) {
+  options.format = o.format == "csv" ? recordings::CatFormat::Csv : recordings::CatFormat::Json;
+  Status st = recordings::cat(o.file, options, [](std::string_view line) {
     std::fwrite(line.data(), 1, line.size(), stdout);
     std::fputc('\n', stdout);
   });

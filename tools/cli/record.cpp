@@ -76,9 +76,9 @@ std::optional<int> choose_outputs(RecordArgs& a, std::string& bag, std::vector<O
   if (!file_ns || !snapshot_ns) return fail("record", (file_ns ? snapshot_ns : file_ns).error().message, 2);
   a.rec.max_file_duration_ns = file_ns.value();
   a.rec.snapshot_duration_ns = snapshot_ns.value();
-  if (log::is_bag_output(a.rec.path)) {
+  if (recordings::is_bag_output(a.rec.path)) {
     bag = a.rec.path;
-    outputs = log::bag_outputs(bag, "OUT");
+    outputs = recordings::bag_outputs(bag, "OUT");
     a.rec.bag = bag;
   } else if (a.rec.max_file_bytes > 0 || a.rec.max_file_duration_ns > 0 || a.rec.snapshot_duration_ns > 0) {
     return fail("record",
@@ -154,7 +154,7 @@ int record_command(RecordArgs a) {
   std::error_code ec;
   const bool made_bag = !bag.empty() && !std::filesystem::exists(bag, ec);
   if (!bag.empty()) {
-    if (Status st = log::make_bag_directory(bag); !st) return fail("record", st.error().message);
+    if (Status st = recordings::make_bag_directory(bag); !st) return fail("record", st.error().message);
   }
   auto participant = node::create_dds_participant(a.domain, a.node);
   if (!participant) return fail("record", participant.error().message);

@@ -60,7 +60,7 @@ int plot_command(const PlotArgs& a) {
     std::fprintf(stderr, "rbsim plot: error: invalid --size \"%s\" (expected WxH)\n", a.size.c_str());
     return 1;
   }
-  if (a.duration && log::is_recording(a.input)) {  // a recording plots what it holds
+  if (a.duration && recordings::is_recording(a.input)) {  // a recording plots what it holds
     std::fprintf(stderr,
                  "rbsim plot: error: --duration applies to a scene, not to a recording (%s)\n"
                  "Run 'rbsim plot --help' for usage.\n",

@@ -95,9 +95,10 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
 
 // The next file: options.path, or the bag's file files_.size().
 Status Recorder::open_file() {
-  const std::string path = options_.bag.empty() ? options_.path : log::bag_file(options_.bag, files_.size());
-  if (auto st = writer_.open(
-          path, log::writer_options(options_.compression, options_.chunk_size, options_.compression_level));
+  const std::string path =
+      options_.bag.empty() ? options_.path : recordings::bag_file(options_.bag, files_.size());
+  if (auto st = writer_.open(path, recordings::writer_options(options_.compression, options_.chunk_size,
+                                                              options_.compression_level));
       !st.ok()) {
     return with_context(path + ": ", st.error());
   }
@@ -135,7 +136,7 @@ Status Recorder::split(std::uint64_t log_time) {
 Status Recorder::add_channels() {
   for (const std::size_t i : channel_order_) {
     Topic& t = topics_[i];
-    auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, t.offered);
+    auto channel = recordings::add_topic(writer_, t.subscription.spec(), options_.ns, t.offered);
     if (!channel.ok()) return with_context(options_.path + ": ", channel.error());
     if (channel.value() != t.channel) {
       return Error{options_.path + ": channel of " + t.subscription.ros_topic() + " got id " +
@@ -231,7 +232,8 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       const bool latched = t.subscription.spec().latched();
       // Held: per-step samples while a latched topic is outstanding, and the markers while the
       // scene description is (it goes first).
-      if (holding_ && (!latched || (t.subscription.spec().id != msgs::TopicId::Scene && scene_pending()))) {
+      if (holding_ &&
+          (!latched || (t.subscription.spec().id != msgs::TopicId::SceneDescription && scene_pending()))) {
         held_bytes_ += sample.cdr.size();
         held_.push_back({index, std::move(sample), now});
         if (latched) t.latched_pending = false;  // it came: only its writing waits
@@ -281,7 +283,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
     if (snapshots) {  // no file open: the id add_channels() gives it (one schema and channel each, in order)
       t.channel = static_cast<std::uint16_t>(channel_order_.size());
     } else {
-      auto channel = log::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
+      auto channel = recordings::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
       if (!channel.ok()) return with_context(options_.path + ": ", channel.error());
       t.channel = channel.value();
     }
@@ -299,7 +301,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
   }
   ++t.received;
   const msgs::TopicId id = t.subscription.spec().id;
-  if (id == msgs::TopicId::Scene) {
+  if (id == msgs::TopicId::SceneDescription) {
     if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
   } else if (!t.subscription.spec().per_step) {
     // latched or an event: no per-step sequence to check for gaps
@@ -315,7 +317,8 @@ bool Recorder::latched_outstanding() const {
     if (!t.latched_pending) continue;
     // The scene description is always waited for; other latched topics while a node offers them
     // (or until the scene description came, discovery of their writer having had that long).
-    if (t.subscription.spec().id == msgs::TopicId::Scene || !scene_seen || t.subscription.matched() > 0)
+    if (t.subscription.spec().id == msgs::TopicId::SceneDescription || !scene_seen ||
+        t.subscription.matched() > 0)
       return true;
   }
   return false;
@@ -323,7 +326,7 @@ bool Recorder::latched_outstanding() const {
 
 bool Recorder::scene_pending() const {
   return std::any_of(topics_.begin(), topics_.end(), [](const Topic& t) {
-    return t.latched_pending && t.subscription.spec().id == msgs::TopicId::Scene;
+    return t.latched_pending && t.subscription.spec().id == msgs::TopicId::SceneDescription;
   });
 }
 

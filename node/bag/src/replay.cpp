@@ -28,7 +28,7 @@ bool sleep_until_or_stop(std::int64_t deadline_ns, bool (*stop)()) {
 
 struct Replay::Impl {
   ReplayOptions options;
-  std::unique_ptr<log::Recording> recording;
+  std::unique_ptr<recordings::Recording> recording;
   std::vector<Publisher> publishers;
   std::map<std::uint16_t, std::size_t> route;       // replayed channel id -> publisher index
   std::set<std::uint16_t> latched_channels;         // replayed channels of latched topics (scene, markers)
@@ -62,7 +62,7 @@ struct Replay::Impl {
   End end_of(std::uint64_t start) const;
 
   // open()'s stages, in order.
-  using Candidate = const log::RecordedChannel*;
+  using Candidate = const recordings::RecordedChannel*;
   // The channels that carry one of our types as CDR (found by type), by id (file order); those
   // that cannot be read are skipped with a warning.
   Result<std::vector<Candidate>> candidates(std::vector<std::string>& warnings) const;
@@ -93,7 +93,7 @@ Result<std::unique_ptr<Replay>> Replay::open(const Participant& participant, con
   im.options = options;
   const std::string& path = options.path;
   // Raw messages only: every channel of our types is replayed as recorded, whatever it holds.
-  auto opened = log::Recording::open(path, log::raw_options());
+  auto opened = recordings::Recording::open(path, recordings::raw_options());
   if (!opened) return with_context("cannot read ", opened.error());
   im.recording = std::move(opened.value());
 
@@ -111,7 +111,7 @@ Result<std::vector<Replay::Impl::Candidate>> Replay::Impl::candidates(
     std::vector<std::string>& warnings) const {
   const std::string& path = options.path;
   std::vector<Candidate> candidates;
-  for (const log::RecordedChannel& c : recording->channels()) {
+  for (const recordings::RecordedChannel& c : recording->channels()) {
     if (c.spec == nullptr) continue;
     if (!c.problem.empty()) {
       warnings.push_back("skipping " + c.channel->topic + ": " + c.problem);
@@ -202,7 +202,7 @@ Status Replay::Impl::find_span(Replay& r) const {
   const std::string& path = options.path;
   // The first message is where pacing and --start-offset count from.
   bool any = false;
-  Status st = recording->read_messages({topics}, [&](const log::RecordedMessage& m) {
+  Status st = recording->read_messages({topics}, [&](const recordings::RecordedMessage& m) {
     r.first_log_time_ = m.message->log_time;
     any = true;
     return false;
@@ -263,7 +263,7 @@ std::optional<std::uint64_t> Replay::Impl::sim_time(std::uint16_t channel,
                                                     std::span<const std::byte> cdr) const {
   const msgs::TopicId id = topic_of.at(channel);
   std::optional<msgs::Time> stamp;
-  if (id == msgs::TopicId::Scene) {
+  if (id == msgs::TopicId::SceneDescription) {
     // A live recording's log time is wall time, the scene's stamp is simulated.
     if (auto scene = msgs::decode_scene(cdr)) stamp = scene.value().stamp;
   } else {
@@ -281,11 +281,11 @@ Status Replay::Impl::send_latched(std::uint64_t start, std::set<std::uint16_t>& 
   latched.clear();
   sent_early.clear();
   if (latched_channels.empty()) return Ok{};
-  log::MessageFilter latched_topics;
-  for (const log::RecordedChannel& c : recording->channels()) {
+  recordings::MessageFilter latched_topics;
+  for (const recordings::RecordedChannel& c : recording->channels()) {
     if (latched_channels.count(c.channel->id) > 0) latched_topics.topics.push_back(c.channel->topic);
   }
-  Status st = recording->read_messages(latched_topics, [&](const log::RecordedMessage& rm) {
+  Status st = recording->read_messages(latched_topics, [&](const recordings::RecordedMessage& rm) {
     const mcap::Message& m = *rm.message;
     const std::uint16_t ch = m.channel_id;
     if (latched_channels.count(ch) == 0) return true;
@@ -305,7 +305,7 @@ Status Replay::Impl::send_latched(std::uint64_t start, std::set<std::uint16_t>& 
 
 Result<std::optional<std::uint64_t>> Replay::Impl::seek_position(std::uint64_t sim_ns) {
   std::optional<std::uint64_t> found;
-  Status st = recording->read_messages({topics}, [&](const log::RecordedMessage& rm) {
+  Status st = recording->read_messages({topics}, [&](const recordings::RecordedMessage& rm) {
     const mcap::Message& m = *rm.message;
     const auto id = topic_of.find(m.channel_id);
     if (id == topic_of.end() || !msgs::topic(id->second).per_step) return true;
@@ -393,13 +393,13 @@ struct Replay::Impl::Pass {
   void latched_sent(std::uint16_t ch, const mcap::Message& m) {
     const std::optional<std::uint64_t> sim = im.sim_time(ch, m.data);
     to_tap(ch, m.log_time, m.data, sim);
-    if (sim && im.topic_of.at(ch) != msgs::TopicId::Scene) last_sim = sim;
+    if (sim && im.topic_of.at(ch) != msgs::TopicId::SceneDescription) last_sim = sim;
     ++r.published_;
   }
   // Reads from `from` to the end, a stop (`stopped`) or a seek asked for (`interrupted`).
   Status read_segment();
   // One message of the segment, paced and published; false ends the read.
-  bool play_message(const log::RecordedMessage& rm);
+  bool play_message(const recordings::RecordedMessage& rm);
   // After `interrupted`: the seek carried out, or refused.
   Status seek();
 };
@@ -411,12 +411,12 @@ Status Replay::Impl::Pass::read_segment() {
   seen_at = 0;
   seen_count = 0;
   skip = skip_at_from;
-  log::MessageFilter played{im.topics, from};
-  return im.recording->read_messages(played,
-                                     [this](const log::RecordedMessage& rm) { return play_message(rm); });
+  recordings::MessageFilter played{im.topics, from};
+  return im.recording->read_messages(
+      played, [this](const recordings::RecordedMessage& rm) { return play_message(rm); });
 }
 
-bool Replay::Impl::Pass::play_message(const log::RecordedMessage& rm) {
+bool Replay::Impl::Pass::play_message(const recordings::RecordedMessage& rm) {
   const mcap::Message& m = *rm.message;
   if (m.log_time != seen_at) {
     seen_at = m.log_time;
@@ -470,7 +470,7 @@ bool Replay::Impl::Pass::play_message(const log::RecordedMessage& rm) {
   }
   const bool per_step = msgs::topic(im.topic_of.at(m.channel_id)).per_step;
   to_tap(m.channel_id, m.log_time, m.data, sim);
-  if (sim && im.topic_of.at(m.channel_id) != msgs::TopicId::Scene) last_sim = sim;
+  if (sim && im.topic_of.at(m.channel_id) != msgs::TopicId::SceneDescription) last_sim = sim;
   ++r.published_;
   control.published(m.log_time, per_step ? sim : std::nullopt);
   return true;

@@ -5,7 +5,7 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/parameter_events.hpp"
-#include "rbsim/relay.hpp"
+#include "rbsim/remote_steering.hpp"
 #include "rbsim/service_set.hpp"
 #include "rbsim/time.hpp"
 

@@ -14,7 +14,7 @@
 namespace rbsim::node {
 const dds_topic_descriptor_t* descriptor(msgs::TopicId id) {
   switch (id) {
-    case msgs::TopicId::Scene:
+    case msgs::TopicId::SceneDescription:
       return &rbsim_msgs_msg_dds__SceneDescription__desc;
     case msgs::TopicId::BodyStates:
       return &rbsim_msgs_msg_dds__BodyStates__desc;

@@ -77,7 +77,7 @@ struct Topic {
 
 struct Side {
   std::string path, role;  // role: "run" or "golden"
-  log::RecordStream pump;
+  recordings::RecordStream pump;
   std::map<std::uint16_t, mcap::Schema> schemas;
   std::map<std::uint16_t, std::size_t> channel_topic;
   std::set<std::string> summary_topics;
@@ -143,11 +143,12 @@ class Comparer {
   Status open(Side& s) {
     // The summary first: a clear error for a truncated or non-MCAP file before any comparing, and
     // the file's whole topic list (so messages of a topic the other file lacks are not queued).
-    auto recording = log::Recording::open(s.path, log::raw_options());  // any file, whatever it carries
+    auto recording =
+        recordings::Recording::open(s.path, recordings::raw_options());  // any file, whatever it carries
     if (!recording) return with_context(s.role + " log ", recording.error());
-    const log::Recording& r = *recording.value();
+    const recordings::Recording& r = *recording.value();
     s.header = r.header();
-    for (const log::RecordedChannel& c : r.channels()) s.summary_topics.insert(c.channel->topic);
+    for (const recordings::RecordedChannel& c : r.channels()) s.summary_topics.insert(c.channel->topic);
     // The summary's channels are known to be complete when every chunk's message index names
     // only channels it lists (rbsim writes indexes and repeats channels; other writers may not).
     s.summary_known = r.lists_every_channel();
@@ -159,13 +160,14 @@ class Comparer {
   // The first scene description: its time step (the step of a message that carries only a stamp is
   // round(stamp / dt)) and, for the
   // different-scene check, the scene itself.
-  static Status read_dt(Side& s, log::Recording& recording) {
-    log::MessageFilter scenes;
-    for (const log::RecordedChannel& c : recording.channels()) {
-      if (c.spec != nullptr && c.spec->id == msgs::TopicId::Scene) scenes.topics.push_back(c.channel->topic);
+  static Status read_dt(Side& s, recordings::Recording& recording) {
+    recordings::MessageFilter scenes;
+    for (const recordings::RecordedChannel& c : recording.channels()) {
+      if (c.spec != nullptr && c.spec->id == msgs::TopicId::SceneDescription)
+        scenes.topics.push_back(c.channel->topic);
     }
     if (scenes.topics.empty()) return Ok{};
-    const Status st = recording.read_messages(scenes, [&](const log::RecordedMessage& m) {
+    const Status st = recording.read_messages(scenes, [&](const recordings::RecordedMessage& m) {
       Result<msgs::SceneMessage> scene = msgs::decode_scene(m.cdr());
       if (scene && std::isfinite(scene->dt) && scene->dt > 0.0) s.dt = scene->dt;
       if (scene) s.scene = std::move(scene.value());
@@ -292,7 +294,7 @@ class Comparer {
           for (Pending& p : t.queue[si]) p.step = step_of_message(t, si, p.data);
         }
       }
-      const bool scene = is_type(g.schema_name, msgs::TopicId::Scene);
+      const bool scene = is_type(g.schema_name, msgs::TopicId::SceneDescription);
       if (scene || is_type(g.schema_name, msgs::TopicId::Commands)) {
         const auto& groups = t.layout->groups();
         t.tally.meta.assign(groups.size(), 0);
@@ -595,7 +597,7 @@ class Comparer {
         const auto& groups = t.layout->groups();
         for (std::size_t gi = 0; gi < groups.size(); ++gi) {
           if (t.tally.stats[gi].values > 0)
-            row(groups[gi].path, kind_label(groups[gi].kind), t.tally.stats[gi], has_step);
+            row(groups[gi].path, to_string(groups[gi].kind), t.tally.stats[gi], has_step);
         }
       } else {
         row("(bytes)", "bytes", t.tally.stats[t.bytes_stat], false);

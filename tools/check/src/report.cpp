@@ -101,7 +101,7 @@ std::string value_text(const msgs::Scalar& s) {
   return ec == std::errc() ? std::string(buf, end) : s.to_string();
 }
 
-const char* kind_label(msgs::Scalar::Kind k) {
+const char* to_string(msgs::Scalar::Kind k) {
   using Kind = msgs::Scalar::Kind;
   switch (k) {
     case Kind::Bool:

@@ -15,7 +15,7 @@ namespace rbsim::check {
 std::string ordinal(std::uint64_t n);           // "2nd", "10th"
 std::string fmt_short(double v);                // "%.6g"
 std::string value_text(const msgs::Scalar& s);  // floats in shortest round-trip form
-const char* kind_label(msgs::Scalar::Kind k);   // FieldStats::kind: "float", "length", ...
+const char* to_string(msgs::Scalar::Kind k);    // FieldStats::kind: "float", "length", ...
 std::string quoted(const std::string& s);       // "'chain'", or "(none)" for ""
 
 // Steps in one file only: "0..999", "5, 15, ..., 995", "0, 10, 20 and more".

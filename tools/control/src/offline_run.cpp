@@ -29,8 +29,8 @@ Status check_run_outputs(const OfflineRunDef& def) {
   if (!def.commands.empty()) inputs.push_back(def.commands);
   std::vector<OutputPath> outputs = {def.csv, def.energy_csv, def.fosssim_out};
   for (const OutputPath& p : def.more_outputs) outputs.push_back(p);
-  if (!def.record.path.empty() && log::is_bag_output(def.record.path)) {  // a bag directory
-    for (OutputPath& p : log::bag_outputs(def.record.path, def.record.option))
+  if (!def.record.path.empty() && recordings::is_bag_output(def.record.path)) {  // a bag directory
+    for (OutputPath& p : recordings::bag_outputs(def.record.path, def.record.option))
       outputs.push_back(std::move(p));
   } else {
     outputs.push_back(def.record);
@@ -77,7 +77,7 @@ void OfflineRun::make_sinks(const OfflineRunDef& def) {
   if (!def.energy_csv.path.empty()) sinks_.push_back(make_energy_csv_sink(def.energy_csv.path));
   if (!def.fosssim_out.path.empty()) sinks_.push_back(make_fosssim_sink(def.fosssim_out.path));
   if (!def.record.path.empty()) {
-    std::unique_ptr<log::McapSink> mcap = log::make_mcap_sink(def.record.path, def.recording);
+    std::unique_ptr<recordings::McapSink> mcap = recordings::make_mcap_sink(def.record.path, def.recording);
     // A steered run records its commands as the node publishes them (/<ns>/commands), so it can
     // be re-run in turn.
     if (script_) script_->record_to(*mcap);

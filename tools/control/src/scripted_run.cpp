@@ -13,7 +13,7 @@ namespace rbsim::control {
 Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,
                                                    std::int64_t steps) {
   std::vector<ScriptedCommand> out;
-  if (!log::is_recording(path)) {
+  if (!recordings::is_recording(path)) {
     Result<std::vector<Command>> script = load_command_script(path, scene, steps);
     if (!script) return script.error();
     for (Command& c : script.value()) {
@@ -22,14 +22,14 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
     }
     return out;
   }
-  log::RecordingOptions ro;
+  recordings::RecordingOptions ro;
   ro.require_scene = false;
-  Result<std::unique_ptr<log::Recording>> recording = log::Recording::open(path, ro);
+  Result<std::unique_ptr<recordings::Recording>> recording = recordings::Recording::open(path, ro);
   if (!recording) return recording.error();
   if (recording.value()->topic(msgs::TopicId::Commands).empty()) {
     return Error{path + ": no commands topic (rbsim_msgs/msg/Command): not a recording of a steered session"};
   }
-  Result<std::vector<msgs::CommandMessage>> recorded = log::read_commands(*recording.value());
+  Result<std::vector<msgs::CommandMessage>> recorded = recordings::read_commands(*recording.value());
   if (!recorded) return recorded.error();
   for (const msgs::CommandMessage& m : recorded.value()) {
     Result<Command> c = from_message(m);
@@ -55,7 +55,7 @@ ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<Scr
   }
 }
 
-void ScriptedRun::record_to(log::McapSink& sink) {
+void ScriptedRun::record_to(recordings::McapSink& sink) {
   controller_.on_command([this, &sink](const Command& c, const CommandResult& r) {
     cdr_.clear();
     msgs::encode(to_message(c, r, seq_++, scene_.world.dt), cdr_);
@@ -76,7 +76,7 @@ Status ScriptedRun::finish(const std::string& path) {
   return Error{path + ": " + std::to_string(mismatches_.size()) +
                plural(mismatches_.size(), " command", " commands") + " (of " +
                std::to_string(counted.commands) + ") did not apply as " +
-               (log::is_recording(path) ? "recorded" : "written")};
+               (recordings::is_recording(path) ? "recorded" : "written")};
 }
 
 }  // namespace rbsim::control

@@ -27,7 +27,7 @@ bool same_file_contents(const fs::path& a, const std::string& bytes) {
 // checked.
 bool has_required_topics(const GoldenLog& log, Report& report) {
   using msgs::TopicId;
-  for (auto [missing, id] : {std::pair{!log.scene.description, TopicId::Scene},
+  for (auto [missing, id] : {std::pair{!log.scene.description, TopicId::SceneDescription},
                              {log.states.messages.empty(), TopicId::BodyStates},
                              {log.springs.messages.empty(), TopicId::SpringStates},
                              {log.energy.messages.empty(), TopicId::Energy}}) {

@@ -1,5 +1,5 @@
 // Reading a golden log (golden_log.hpp) through the recording reader, in one pass: the per-step
-// topics joined by step (their topics, order and counts checked by log::Recording), and in the
+// topics joined by step (their topics, order and counts checked by recordings::Recording), and in the
 // same pass the raw messages of the scene description's topic and of the topics only the verifier
 // reads (poses, /tf, the springs marker, the markers), each decoded into its collection.
 #include "golden_log.hpp"
@@ -16,7 +16,7 @@ namespace {
 
 using msgs::TopicId;
 
-// The topics only the verifier reads (log::Recording joins the per-step ones).
+// The topics only the verifier reads (recordings::Recording joins the per-step ones).
 constexpr std::array<TopicId, 4> kMarkerTopics = {TopicId::Poses, TopicId::Tf, TopicId::Springs,
                                                   TopicId::Markers};
 
@@ -25,10 +25,10 @@ class GoldenLogReader {
   explicit GoldenLogReader(const std::string& path) : path_(path) {}
 
   Result<GoldenLog> read() {
-    log::RecordingOptions options;
+    recordings::RecordingOptions options;
     options.require_scene = false;  // a missing scene description is a failed check, not an error
     options.verify_crc = true;
-    auto opened = log::Recording::open(path_, options);
+    auto opened = recordings::Recording::open(path_, options);
     if (!opened) return opened.error();
     recording_ = std::move(opened.value());
     if (Status st = find_marker_topics(); !st) return st.error();
@@ -42,7 +42,7 @@ class GoldenLogReader {
   // Every channel of a marker topic's type that this build decodes (one topic per type).
   Status find_marker_topics() {
     std::array<std::string, msgs::kTopicCount> names;
-    for (const log::RecordedChannel& c : recording_->channels()) {
+    for (const recordings::RecordedChannel& c : recording_->channels()) {
       if (c.spec == nullptr || !c.problem.empty()) continue;
       const TopicId id = c.spec->id;
       if (std::find(kMarkerTopics.begin(), kMarkerTopics.end(), id) == kMarkerTopics.end()) continue;
@@ -66,8 +66,8 @@ class GoldenLogReader {
 
   // The one pass: steps from the recording reader, the other topics' messages beside them.
   Status read_messages() {
-    log::MessageFilter also;
-    if (const std::string& scene = recording_->topic(TopicId::Scene); !scene.empty())
+    recordings::MessageFilter also;
+    if (const std::string& scene = recording_->topic(TopicId::SceneDescription); !scene.empty())
       also.topics.push_back(scene);
     for (const auto* to :
          {&log_.poses.topic, &log_.tf.topic, &log_.springs_marker.topic, &log_.markers.topic}) {
@@ -75,26 +75,26 @@ class GoldenLogReader {
     }
     if (recording_->scene() != nullptr) log_.scene.description = *recording_->scene();
     Status failure = Ok{};
-    const auto on_message = [&](const log::RecordedMessage& m) {
+    const auto on_message = [&](const recordings::RecordedMessage& m) {
       failure = dispatch(m);
       return static_cast<bool>(failure);
     };
-    const Status st =
-        recording_->read_steps([&](const log::RecordedStep& s) { return on_step(s); }, also, on_message);
+    const Status st = recording_->read_steps([&](const recordings::RecordedStep& s) { return on_step(s); },
+                                             also, on_message);
     if (!failure) return failure;
     return st;
   }
 
-  Status on_step(const log::RecordedStep& s) {
+  Status on_step(const recordings::RecordedStep& s) {
     if (s.body_states != nullptr) log_.states.add(*s.body_states, s.log_time.body_states);
     if (s.spring_states != nullptr) log_.springs.add(*s.spring_states, s.log_time.spring_states);
     if (s.energy != nullptr) log_.energy.add(*s.energy, s.log_time.energy);
     return Ok{};
   }
 
-  Status dispatch(const log::RecordedMessage& m) {
+  Status dispatch(const recordings::RecordedMessage& m) {
     // Every message of the scene description's type on its topic counts: one is expected.
-    if (m.channel->spec != nullptr && m.channel->spec->id == TopicId::Scene) {
+    if (m.channel->spec != nullptr && m.channel->spec->id == TopicId::SceneDescription) {
       if (log_.scene.messages++ == 0) log_.scene.log_time = m.message->log_time;
       return Ok{};
     }
@@ -114,7 +114,7 @@ class GoldenLogReader {
   }
 
   template <class M>
-  Status on_marker_topic(const Status& decoded, const log::RecordedMessage& m, const M& message,
+  Status on_marker_topic(const Status& decoded, const recordings::RecordedMessage& m, const M& message,
                          TopicMessages<M>& to) {
     if (!decoded) {
       return fail(to.topic + " message " + std::to_string(to.messages.size()) + ": " +
@@ -125,7 +125,7 @@ class GoldenLogReader {
   }
 
   std::string path_;
-  std::unique_ptr<log::Recording> recording_;
+  std::unique_ptr<recordings::Recording> recording_;
   std::map<std::uint16_t, TopicId> route_;  // marker channel id -> the topic it carries
   GoldenLog log_;
   // Decoding targets, reused from one message to the next.

@@ -44,7 +44,7 @@ struct GoldenLog {
 };
 
 // Reads `path` in one pass over its messages, each decoded and handed to the collection of its
-// topic (topics found by type, as rbsim::log::Recording finds them). The one place the verifier
+// topic (topics found by type, as rbsim::recordings::Recording finds them). The one place the verifier
 // opens a golden. A missing topic is not an error here (it is a failed check): errors are an
 // unreadable or corrupt file, several topics of one type, a schema differing from this build's, a
 // malformed message, a step that does not increase on its topic, or a per-step message whose

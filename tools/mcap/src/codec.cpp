@@ -207,7 +207,7 @@ Status lz4_decompress(LZ4F_dctx* ctx, ByteView in, std::uint64_t expected, Bytes
 
 }  // namespace
 
-std::string_view compression_name(Compression compression) {
+std::string_view to_string(Compression compression) {
   switch (compression) {
     case Compression::Lz4:
       return "lz4";

@@ -114,7 +114,7 @@ struct Writer::Impl {
   // payload, through the payload's length prefix.
   void chunk_header(Bytes& out, std::uint64_t records, std::uint64_t payload, std::uint32_t crc,
                     const ChunkMeta& meta) const {
-    const std::string_view compression = compression_name(options.compression);
+    const std::string_view compression = to_string(options.compression);
     put_u8(out, static_cast<std::uint8_t>(Opcode::Chunk));
     put_u64(out, 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + payload);
     put_u64(out, meta.has_messages ? meta.start_time : 0);
@@ -237,7 +237,7 @@ struct Writer::Impl {
   // After a chunk record: its message indexes, its chunk index, and the bytes to the OS.
   Status finish_chunk(ChunkIndex& index, ChunkMeta& meta) {
     Status s;
-    index.compression = std::string(compression_name(options.compression));
+    index.compression = std::string(to_string(options.compression));
     if (options.emit_message_indexes) {
       const std::uint64_t start = offset;
       for (auto& [channel_id, entries] : meta.message_index) {
@@ -483,9 +483,9 @@ Status Writer::copy_chunk(const Chunk& chunk, const std::vector<MessageIndex>& i
   if (Status s = w.check_open(); !s.ok()) return s;
   if (!w.options.use_chunks)
     return Error{"copy_chunk: the writer writes no chunks", ErrorCode::InvalidArgument};
-  if (chunk.compression != compression_name(w.options.compression)) {
+  if (chunk.compression != to_string(w.options.compression)) {
     return Error{"copy_chunk: a chunk compressed with \"" + chunk.compression + "\" into a file of \"" +
-                     std::string(compression_name(w.options.compression)) + "\" chunks",
+                     std::string(to_string(w.options.compression)) + "\" chunks",
                  ErrorCode::InvalidArgument};
   }
   Impl::ChunkMeta meta;

@@ -427,7 +427,7 @@ void Encoder::clock(const World& world, Bytes& out) const {
 
 void Encoder::encode(TopicId id, const World& world, Bytes& out) const {
   switch (id) {
-    case TopicId::Scene:
+    case TopicId::SceneDescription:
       return scene(world, out);
     case TopicId::BodyStates:
       return body_states(world, out);

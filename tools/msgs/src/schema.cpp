@@ -11,7 +11,7 @@ namespace rbsim::msgs {
 
 namespace {
 constexpr TopicSpec kTopics[kTopicCount] = {
-    {TopicId::Scene, "scene", "rbsim_msgs/msg/SceneDescription", true, false},
+    {TopicId::SceneDescription, "scene", "rbsim_msgs/msg/SceneDescription", true, false},
     {TopicId::Markers, "markers", "visualization_msgs/msg/MarkerArray", true, false},
     {TopicId::BodyStates, "body_states", "rbsim_msgs/msg/BodyStates", false, true},
     {TopicId::SpringStates, "spring_states", "rbsim_msgs/msg/SpringStates", false, true},
@@ -121,7 +121,7 @@ Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns) {
   Result<std::vector<std::size_t>> chosen = select_topics(filter, candidates);
   if (!chosen) return chosen.error();
   TopicSet set;
-  set.set(static_cast<std::size_t>(TopicId::Scene));
+  set.set(static_cast<std::size_t>(TopicId::SceneDescription));
   for (const std::size_t i : chosen.value()) set.set(static_cast<std::size_t>(candidates[i].spec->id));
   return set;
 }

@@ -245,7 +245,7 @@ Status decode_marker_array(std::span<const std::byte> cdr, std::vector<MarkerMes
 }
 
 std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr) {
-  if (id == TopicId::Scene) return std::nullopt;
+  if (id == TopicId::SceneDescription) return std::nullopt;
   Reader r(cdr);
   if ((id == TopicId::Markers || id == TopicId::Tf) && r.get<std::uint32_t>() == 0) return std::nullopt;
   if (id == TopicId::Commands) {  // seq, step, then the stamp

@@ -68,14 +68,14 @@ Result<std::vector<Sample>> samples_from_scene(const std::string& path, std::opt
 
 // The totals of every recorded rbsim_msgs/msg/EnergyTerms, at the time its header stamp says.
 Result<std::vector<Sample>> samples_from_log(const std::string& path) {
-  log::RecordingOptions ro;
+  recordings::RecordingOptions ro;
   ro.read = {msgs::TopicId::Energy};
   ro.require = {msgs::TopicId::Energy};
   ro.require_scene = false;
-  auto recording = log::Recording::open(path, ro);
+  auto recording = recordings::Recording::open(path, ro);
   if (!recording) return recording.error();
   std::vector<Sample> out;
-  Status st = recording.value()->read_steps([&](const log::RecordedStep& step) -> Status {
+  Status st = recording.value()->read_steps([&](const recordings::RecordedStep& step) -> Status {
     if (step.energy == nullptr) return Ok{};
     const msgs::EnergyTermsMessage& e = *step.energy;
     const double t = static_cast<double>(e.stamp.sec) + 1e-9 * static_cast<double>(e.stamp.nanosec);
@@ -94,7 +94,7 @@ Result<std::vector<Sample>> samples_from_log(const std::string& path) {
 
 Status plot(const std::string& input, const PlotOptions& o) {
   Result<std::vector<Sample>> samples =
-      log::is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
+      recordings::is_recording(input) ? samples_from_log(input) : samples_from_scene(input, o.duration);
   if (!samples) return samples.error();
 
   AtomicFile png;  // gnuplot writes it

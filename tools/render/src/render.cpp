@@ -178,12 +178,12 @@ std::unique_ptr<Sink> make_frame_sink(std::string dir, int width, int height, do
 }
 
 Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
-  if (log::is_recording(input)) {
+  if (recordings::is_recording(input)) {
     FrameWriter frames(o.out_dir, o.width, o.height, o.fps, o.overwrite);
     std::vector<Pose> poses;
-    log::RecordingOptions ro;
+    recordings::RecordingOptions ro;
     ro.read = {msgs::TopicId::BodyStates};
-    auto recording = log::Recording::open(input, ro);
+    auto recording = recordings::Recording::open(input, ro);
     if (!recording) return recording.error();
     const msgs::SceneMessage& scene = *recording.value()->scene();
     Stage stage = stage_of(scene);
@@ -192,7 +192,7 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
     stage.duration = o.duration.value_or(INFINITY);
     if (Status st = frames.open(); !st) return st.error();
     std::optional<std::uint64_t> last;
-    Status st = recording.value()->read_steps([&](const log::RecordedStep& step) -> Status {
+    Status st = recording.value()->read_steps([&](const recordings::RecordedStep& step) -> Status {
       if (step.body_states == nullptr) return Ok{};
       last = step.step;
       poses.clear();

@@ -126,7 +126,7 @@ class Recorder {
   std::uint64_t written_ = 0;
   [[nodiscard]] Status open_file();
   [[nodiscard]] Status close_bag_file();
-  log::BagMetadata bag_metadata_;  // the bag's closed files
+  recordings::BagMetadata bag_metadata_;  // the bag's closed files
   [[nodiscard]] Status split(std::uint64_t log_time);
   [[nodiscard]] Status add_channels();
   // Snapshot mode's buffer: per-step and event messages in arrival order.

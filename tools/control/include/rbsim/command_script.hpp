@@ -47,7 +47,7 @@ struct ScriptedCommand {
   bool expect_success = true;
   std::string origin;  // "steer.yaml:3", "live.mcap: command 4"
 };
-// The commands of `path`: a script (above), or a recording (log::is_recording: an MCAP file or a bag
+// The commands of `path`: a script (above), or a recording (recordings::is_recording: an MCAP file or a bag
 // directory: its
 // /<ns>/commands, rbsim/recording.hpp's read_commands, which refuses one that lost a command).
 [[nodiscard]] Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, const Scene& scene,
@@ -62,7 +62,7 @@ class ScriptedRun {
   ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<ScriptedCommand> commands);
   Controller& controller() { return controller_; }
   // Every command the controller applies or refuses goes to `sink` as rbsim_msgs/msg/Command.
-  void record_to(log::McapSink& sink);
+  void record_to(recordings::McapSink& sink);
   // After the run: closes the controller. The first recording error, or, when commands did not
   // have their outcome, "PATH: N commands (of M) did not apply as written|recorded", each named
   // in mismatches().

@@ -27,7 +27,7 @@ struct OfflineRunDef {
   // Each output's path (empty: not written) and how its caller names it in errors ("--csv").
   OutputPath csv, energy_csv, fosssim_out;
   OutputPath record;                             // an .mcap file, or a bag directory (rbsim/bag.hpp)
-  log::RecordOptions recording;                  // how `record` is written
+  recordings::McapSinkOptions recording;         // how `record` is written
   std::vector<OutputPath> more_outputs;          // checked with the rest (rbsim run's --frames)
   bool overwrite = false;                        // replace outputs that exist
   std::string overwrite_option = "--overwrite";  // how the caller names `overwrite` in errors

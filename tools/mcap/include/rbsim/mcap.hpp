@@ -199,7 +199,7 @@ std::uint32_t crc32(ByteView data, std::uint32_t crc = 0);
 std::uint32_t crc32_combine(std::uint32_t crc_a, std::uint32_t crc_b, std::uint64_t length_b);
 
 enum class Compression : std::uint8_t { None, Lz4, Zstd };
-std::string_view compression_name(Compression compression);  // "", "lz4", "zstd"
+std::string_view to_string(Compression compression);  // "", "lz4", "zstd"
 // A CRC-32 as every rbsim tool prints one: "0x" and 8 lowercase hex digits.
 std::string crc_text(std::uint32_t crc);
 // Parses a codec's command-line name: "zstd", "lz4", "none".

@@ -36,7 +36,7 @@ namespace rbsim::msgs {
 // encoded from a World, so no sink's --topics selects it; the node publishes it, the recorder,
 // replay and bridge carry it like any topic.
 enum class TopicId : std::uint8_t {
-  Scene,
+  SceneDescription,
   Markers,
   BodyStates,
   SpringStates,

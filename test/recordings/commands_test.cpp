@@ -1,0 +1,134 @@
+// recordings::read_commands: a steered run's commands (rbsim_msgs/msg/Command on /<ns>/commands) read back
+// in sequence order, each once, and a recording that lost one refused with the number it lacks.
+#include <gtest/gtest.h>
+
+#include "rbsim/mcap_sink.hpp"
+#include "rbsim/recording.hpp"
+#include "rbsim/run.hpp"
+#include "rbsim/scene.hpp"
+#include "rbsim/subprocess.hpp"
+#include "recordings_test_util.hpp"
+
+namespace rbsim::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Records 20 steps of scenes/cantilever.xml with the MCAP sink, and after step 5 the commands
+// numbered `seqs` (in that order), each at step 5 + its number.
+void record_with_commands(const fs::path& out, const std::vector<std::uint64_t>& seqs) {
+  Result<Scene> scene = load_scene(source_path("scenes/cantilever.xml"));
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  Result<World> world = World::create(scene.value().world);
+  ASSERT_TRUE(world.ok());
+  std::unique_ptr<recordings::McapSink> sink = recordings::make_mcap_sink(out.string());
+  ASSERT_TRUE(sink->begin(scene.value(), world.value()).ok());
+  for (int i = 0; i < 20; ++i) {
+    world.value().step();
+    ASSERT_TRUE(sink->write(world.value()).ok());
+    if (i != 5) continue;
+    for (std::uint64_t seq : seqs) {
+      msgs::CommandMessage c;
+      c.seq = seq;
+      c.step = 5 + seq;
+      c.kind = msgs::CommandMessage::Pause;
+      c.source = "test";
+      c.success = true;
+      msgs::Bytes cdr;
+      msgs::encode(c, cdr);
+      ASSERT_TRUE(sink->record_command(cdr, static_cast<std::int64_t>(c.step)).ok());
+    }
+  }
+  ASSERT_TRUE(sink->finish().ok());
+}
+
+Result<std::vector<msgs::CommandMessage>> commands_of(const fs::path& path) {
+  Result<std::unique_ptr<recordings::Recording>> r = recordings::Recording::open(path.string());
+  if (!r) return r.error();
+  return recordings::read_commands(*r.value());
+}
+
+TEST(ReadCommands, InSequenceOrderEachOnce) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "a.mcap", {1, 0, 1, 2}));
+  Result<std::vector<msgs::CommandMessage>> got = commands_of(dir / "a.mcap");
+  ASSERT_TRUE(got) << got.error().message;
+  ASSERT_EQ(got->size(), 3u);
+  for (std::uint64_t i = 0; i < 3; ++i) {
+    EXPECT_EQ((*got)[i].seq, i);
+    EXPECT_EQ((*got)[i].step, 5 + i);
+    EXPECT_EQ((*got)[i].source, "test");
+  }
+}
+
+TEST(ReadCommands, AMissingCommandIsAnErrorNamingIt) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "gap.mcap", {0, 2, 3}));
+  Result<std::vector<msgs::CommandMessage>> got = commands_of(dir / "gap.mcap");
+  ASSERT_FALSE(got);
+  EXPECT_NE(got.error().message.find("/rbsim/commands: command 1 is missing"), std::string::npos)
+      << got.error().message;
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "late.mcap", {4, 5}));
+  got = commands_of(dir / "late.mcap");
+  ASSERT_FALSE(got);
+  EXPECT_NE(got.error().message.find("command 0 is missing"), std::string::npos) << got.error().message;
+}
+
+TEST(ReadCommands, NoneWithoutTheTopic) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "none.mcap", {}));
+  Result<std::vector<msgs::CommandMessage>> got = commands_of(dir / "none.mcap");
+  ASSERT_TRUE(got) << got.error().message;
+  EXPECT_TRUE(got->empty());
+}
+
+// rbsim run --commands REC.mcap: a steered run re-run from its own recording gives the same file,
+// byte for byte; a recording that lost a command is refused before any output.
+TEST(RunCommands, ARecordingRerunsToTheSameBytes) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/chain.xml");
+  write_text(dir / "c.yaml",
+             "- {step: 20, set: {forces.0.fy: -3.7}}\n- {step: 30, pause: true}\n- {step: 30, steps: 4}\n"
+             "- {step: 34, impulse: {body: 2, j: [0.5, 2.0], p: [0.1, 0.0]}}\n- {step: 34, resume: true}\n");
+  const Outcome a = rbsim({"run", scene, "--steps", "100", "--commands", (dir / "c.yaml").string(),
+                           "--record", (dir / "a.mcap").string()});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const Outcome b = rbsim({"run", scene, "--steps", "100", "--commands", (dir / "a.mcap").string(),
+                           "--record", (dir / "b.mcap").string()});
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(read_bytes(dir / "a.mcap"), read_bytes(dir / "b.mcap"));
+  Result<std::vector<msgs::CommandMessage>> got = commands_of(dir / "b.mcap");
+  ASSERT_TRUE(got) << got.error().message;
+  ASSERT_EQ(got->size(), 5u);
+  EXPECT_EQ((*got)[3].step, 34u);
+  EXPECT_EQ((*got)[3].source, "script " + (dir / "c.yaml").string() + ":4");
+
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "gap.mcap", {0, 2}));
+  const Outcome gap = rbsim({"run", source_path("scenes/cantilever.xml"), "--commands",
+                             (dir / "gap.mcap").string(), "--csv", (dir / "out.csv").string()});
+  EXPECT_EQ(gap.exit_code, 1) << gap.err;
+  EXPECT_NE(gap.err.find("command 1 is missing"), std::string::npos) << gap.err;
+  EXPECT_FALSE(fs::exists(dir / "out.csv"));
+}
+
+// A recording whose last command left the session paused ends the re-run there, not idling.
+TEST(RunCommands, ARecordingThatEndsPausedEndsTheRerunThere) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "paused.mcap", {0}));  // pause at step 5
+  const Outcome o = rbsim({"run", source_path("scenes/cantilever.xml"), "--commands",
+                           (dir / "paused.mcap").string(), "--csv", (dir / "out.csv").string()});
+  EXPECT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_NE(o.err.find("left the run paused at step 5"), std::string::npos) << o.err;
+  EXPECT_EQ(lines_of(read_text(dir / "out.csv")).size(), 1 + 6u * 5);  // the header, steps 0..5 of 5 bodies
+  // A command for a later step is never reached while paused: the re-run still ends there, and
+  // says that command did not apply.
+  ASSERT_NO_FATAL_FAILURE(record_with_commands(dir / "later.mcap", {0, 1}));  // pauses at 5 and 6
+  const Outcome later = rbsim({"run", source_path("scenes/cantilever.xml"), "--commands",
+                               (dir / "later.mcap").string(), "--csv", (dir / "later.csv").string()});
+  EXPECT_EQ(later.exit_code, 1) << later.err;
+  EXPECT_NE(later.err.find("left the run paused at step 5"), std::string::npos) << later.err;
+  EXPECT_NE(later.err.find("1 of its commands never applied"), std::string::npos) << later.err;
+}
+
+}  // namespace
+}  // namespace rbsim::test
