@@ -14,9 +14,9 @@
 #include "rbsim/interfaces.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/memory_middleware.hpp"
+#include "rbsim/player.hpp"
 #include "rbsim/recorder.hpp"
 #include "rbsim/recording.hpp"
-#include "rbsim/replay.hpp"
 #include "rbsim/service.hpp"
 #include "rbsim/subprocess.hpp"
 
@@ -242,7 +242,7 @@ std::vector<Bytes> take_all(Subscription& s) {
   return out;
 }
 
-TEST(Replay, RepublishesEveryRecordedMessageByteForByte) {
+TEST(Player, RepublishesEveryRecordedMessageByteForByte) {
   test::TempDir dir;
   const Scene scene = test::control_scene();
   const std::string path = record_offline(dir, scene);
@@ -263,11 +263,11 @@ TEST(Replay, RepublishesEveryRecordedMessageByteForByte) {
   ASSERT_FALSE(subs.empty());
 
   Participant player = participant(network, "rbsim_player");
-  ReplayOptions options;
+  PlayOptions options;
   options.path = path;
   options.rate = 0.0;
   options.services = false;
-  Result<std::unique_ptr<Replay>> replay = Replay::open(player, options);
+  Result<std::unique_ptr<Player>> replay = Player::open(player, options);
   ASSERT_TRUE(replay.ok()) << replay.error().message;
   Result<bool> played = replay.value()->play(+[] { return false; });
   ASSERT_TRUE(played.ok()) << played.error().message;
@@ -281,16 +281,16 @@ TEST(Replay, RepublishesEveryRecordedMessageByteForByte) {
   EXPECT_EQ(replay.value()->published(), total(recorded));
 }
 
-TEST(Replay, ServesThePlayersServicesOnTheNetwork) {
+TEST(Player, ServesThePlayersServicesOnTheNetwork) {
   test::TempDir dir;
   const std::string path = record_offline(dir, test::control_scene());
   auto network = std::make_shared<MemoryNetwork>();
   Participant player = participant(network, "rbsim_player");
-  ReplayOptions options;
+  PlayOptions options;
   options.path = path;
   options.rate = 0.0;
   options.start_paused = true;
-  Result<std::unique_ptr<Replay>> replay = Replay::open(player, options);
+  Result<std::unique_ptr<Player>> replay = Player::open(player, options);
   ASSERT_TRUE(replay.ok()) << replay.error().message;
 
   Participant client_node = participant(network, "client");

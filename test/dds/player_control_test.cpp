@@ -8,7 +8,7 @@
 #include <limits>
 #include <thread>
 
-#include "player.hpp"
+#include "player_clock.hpp"
 
 namespace rbsim::node {
 namespace {
@@ -22,12 +22,12 @@ bool always() {
 
 constexpr std::uint64_t kMs = 1'000'000;
 
-TEST(PlayerControl, PacesAtItsRateAndHoldsWhilePaused) {
-  PlayerControl c(2.0, false);
+TEST(PlayerClock, PacesAtItsRateAndHoldsWhilePaused) {
+  PlayerClock c(2.0, false);
   c.jump(10 * kMs);
   const auto t0 = std::chrono::steady_clock::now();
   // 200 ms of log at 2x: due 100 ms after the jump.
-  EXPECT_EQ(c.wait_due(210 * kMs, never), PlayerControl::Next::Publish);
+  EXPECT_EQ(c.wait_due(210 * kMs, never), PlayerClock::Next::Publish);
   const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_GE(waited, 0.095);
   EXPECT_LT(waited, 0.5);
@@ -38,14 +38,14 @@ TEST(PlayerControl, PacesAtItsRateAndHoldsWhilePaused) {
   EXPECT_EQ(c.status().log_time, frozen);  // the clock stands while paused
   // A paused loop waits for a request; stop ends the wait.
   auto stopped = std::async(std::launch::async, [&] { return c.wait_due(frozen, always); });
-  EXPECT_EQ(stopped.get(), PlayerControl::Next::Stop);
+  EXPECT_EQ(stopped.get(), PlayerClock::Next::Stop);
   c.resume();
   EXPECT_FALSE(c.status().paused);
   EXPECT_GE(c.status().log_time, frozen);
 }
 
-TEST(PlayerControl, RefusesRatesNotAboveZero) {
-  PlayerControl c(1.0, false);
+TEST(PlayerClock, RefusesRatesNotAboveZero) {
+  PlayerClock c(1.0, false);
   EXPECT_FALSE(c.set_rate(0.0));
   EXPECT_FALSE(c.set_rate(-1.0));
   EXPECT_FALSE(c.set_rate(std::numeric_limits<double>::quiet_NaN()));
@@ -57,15 +57,15 @@ TEST(PlayerControl, RefusesRatesNotAboveZero) {
   EXPECT_FALSE(c.toggle_paused());
 }
 
-TEST(PlayerControl, BurstOnlyWhilePausedCountsWhatTheLoopPublishes) {
-  PlayerControl c(1.0, false);
+TEST(PlayerClock, BurstOnlyWhilePausedCountsWhatTheLoopPublishes) {
+  PlayerClock c(1.0, false);
   EXPECT_EQ(c.burst(3, 1.0), 0u);  // playing: refused at once
   c.pause();
   c.jump(0);
   std::thread loop([&] {
     for (std::uint64_t t = 1; t <= 3; ++t) {
       ASSERT_EQ(c.wait_due(t * 1000 * kMs, never),
-                PlayerControl::Next::Publish);  // far in the future: only a burst
+                PlayerClock::Next::Publish);  // far in the future: only a burst
       c.published(t * 1000 * kMs, t);
     }
   });
@@ -75,7 +75,7 @@ TEST(PlayerControl, BurstOnlyWhilePausedCountsWhatTheLoopPublishes) {
   EXPECT_EQ(c.status().sim_time, 3u);
   // A burst longer than the pass: what was published when the pass ended.
   std::thread short_pass([&] {
-    ASSERT_EQ(c.wait_due(4000 * kMs, never), PlayerControl::Next::Publish);
+    ASSERT_EQ(c.wait_due(4000 * kMs, never), PlayerClock::Next::Publish);
     c.published(4000 * kMs, std::nullopt);
     c.pass_end();
   });
@@ -83,10 +83,10 @@ TEST(PlayerControl, BurstOnlyWhilePausedCountsWhatTheLoopPublishes) {
   short_pass.join();
 }
 
-TEST(PlayerControl, SeekIsAnsweredByTheLoopWithdrawnWithoutOneRefusedOnceClosed) {
-  PlayerControl c(1.0, true);
+TEST(PlayerClock, SeekIsAnsweredByTheLoopWithdrawnWithoutOneRefusedOnceClosed) {
+  PlayerClock c(1.0, true);
   std::thread loop([&] {
-    ASSERT_EQ(c.wait_due(0, never), PlayerControl::Next::Seek);
+    ASSERT_EQ(c.wait_due(0, never), PlayerClock::Next::Seek);
     ASSERT_EQ(c.take_seek(), std::optional<std::uint64_t>(1'500 * kMs));
     c.seek_done(true, 42 * kMs);
   });

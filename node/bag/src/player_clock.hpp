@@ -11,14 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "rbsim/replay.hpp"
+#include "rbsim/player.hpp"
 #include "rbsim/service.hpp"
 
 namespace rbsim::node {
 
-class PlayerControl {
+class PlayerClock {
  public:
-  PlayerControl(double rate, bool paused) : rate_(rate), paused_(paused) {}
+  PlayerClock(double rate, bool paused) : rate_(rate), paused_(paused) {}
 
   // --- the services' side (any thread) ---
   void pause();
@@ -86,14 +86,14 @@ struct PlayerService {
 // The player's services, as rosbag2's player offers them (rosbag2_interfaces): pause, resume,
 // toggle_paused, is_paused, get_rate, set_rate, seek, play_next, burst. Seek, play_next and burst
 // wait up to `wait_s` for the loop. Served over DDS (add_player_services) and, through
-// Replay::player_services(), by the Foxglove server.
-std::vector<PlayerService> player_services(PlayerControl& control, double wait_s);
+// Player::player_services(), by the Foxglove server.
+std::vector<PlayerService> player_services(PlayerClock& control, double wait_s);
 
 class ServiceSet;
 // The player's services on `set` (rosbag2_interfaces, as rosbag2's player offers them):
 // <node>/pause, resume, toggle_paused, is_paused, get_rate, set_rate, seek, play_next, burst.
 // Seek, play_next and burst wait up to `wait_s` for the loop.
 [[nodiscard]] Status add_player_services(ServiceSet& set, const Participant& participant,
-                                         const std::string& node, PlayerControl& control, double wait_s);
+                                         const std::string& node, PlayerClock& control, double wait_s);
 
 }  // namespace rbsim::node

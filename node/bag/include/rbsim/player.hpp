@@ -18,9 +18,9 @@ namespace rbsim::node {
 // its recorded timing. Every channel whose schema names one of our types (msgs::topics()) and
 // whose messages are CDR gets a publisher with that topic's QoS; messages go out in log-time
 // order, paced by their log-time differences divided by `rate`, steered by rosbag2's player
-// services (ReplayOptions::services).
+// services (PlayOptions::services).
 
-struct ReplayOptions {
+struct PlayOptions {
   std::string path;
   double rate = 1.0;  // real-time factor on log time; 0: as fast as possible
   std::vector<std::string>
@@ -42,7 +42,7 @@ struct ReplayOptions {
   double service_wait_s = 10.0;             // how long seek, play_next and burst wait for the loop
 };
 
-// Where the player stands (Replay::status(), from any thread).
+// Where the player stands (Player::status(), from any thread).
 struct PlayerStatus {
   std::uint64_t log_time = 0;             // the player's clock, log time (ns)
   std::optional<std::uint64_t> sim_time;  // the simulated time of the last message published (ns)
@@ -50,12 +50,12 @@ struct PlayerStatus {
   bool paused = false;
 };
 
-class Replay {
+class Player {
  public:
   // Opens the recording and creates the publishers. Errors: unreadable or non-MCAP input, no rbsim
   // topics in the log, --topics names the log does not have.
-  static Result<std::unique_ptr<Replay>> open(const Participant& participant, const ReplayOptions& options);
-  ~Replay();
+  static Result<std::unique_ptr<Player>> open(const Participant& participant, const PlayOptions& options);
+  ~Player();
 
   struct Output {
     std::string
@@ -109,7 +109,7 @@ class Replay {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
-  Replay() = default;
+  Player() = default;
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<Output> outputs_;
