@@ -20,7 +20,9 @@
 #include "rbsim/service.hpp"
 #include "rbsim/subprocess.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
+
+using namespace node;
 namespace {
 
 constexpr std::int64_t kSteps = 40;
@@ -67,7 +69,7 @@ struct MemoryNode {
   std::unique_ptr<DdsSink> sink;
   std::optional<Driver> driver;
   MemoryNode(const std::shared_ptr<MemoryNetwork>& network, const Scene& scene)
-      : participant(node::participant(network, "rbsim")) {
+      : participant(bag::participant(network, "rbsim")) {
     Result<std::unique_ptr<DdsSink>> s = DdsSink::create(participant, NodeOptions{});
     if (!s) throw std::runtime_error(s.error().message);
     sink = std::move(s.value());
@@ -136,7 +138,7 @@ struct HandNode {
   Publisher scene_pub, markers_pub, body_pub;
   Bytes cdr;
   explicit HandNode(const std::shared_ptr<MemoryNetwork>& network)
-      : participant(node::participant(network, "rbsim")),
+      : participant(bag::participant(network, "rbsim")),
         scene_pub(make(msgs::TopicId::SceneDescription)),
         markers_pub(make(msgs::TopicId::Markers)),
         body_pub(make(msgs::TopicId::BodyStates)) {}
@@ -322,4 +324,4 @@ TEST(Player, ServesThePlayersServicesOnTheNetwork) {
 }
 
 }  // namespace
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

@@ -13,7 +13,9 @@
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/relay.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bridge {
+
+using namespace node;
 namespace {
 
 constexpr std::int64_t kSteps = 25;
@@ -132,4 +134,4 @@ TEST(Relay, StartedAfterTheNodeStillGetsTheSceneDescription) {
 }
 
 }  // namespace
-}  // namespace rbsim::node
+}  // namespace rbsim::bridge

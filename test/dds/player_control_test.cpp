@@ -10,7 +10,9 @@
 
 #include "player_clock.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
+
+using namespace node;
 namespace {
 
 bool never() {
@@ -103,4 +105,4 @@ TEST(PlayerClock, SeekIsAnsweredByTheLoopWithdrawnWithoutOneRefusedOnceClosed) {
 }
 
 }  // namespace
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

@@ -17,7 +17,9 @@
 #include "rbsim/node_services.hpp"
 #include "rbsim/remote_steering.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bridge {
+
+using namespace node;
 namespace {
 
 using namespace std::chrono_literals;
@@ -164,4 +166,4 @@ INSTANTIATE_TEST_SUITE_P(Middleware, RemoteSteeringSeam, ::testing::Values("dds"
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace
-}  // namespace rbsim::node
+}  // namespace rbsim::bridge

@@ -49,14 +49,14 @@ int bridge_command(const BridgeArgs& a) {
   all.set();  // every topic a node may publish: the viewer chooses what to subscribe to
   auto channels = foxglove::ros2_channels(all, a.ns, &ids);
   if (!channels) return fail("bridge", channels.error().message);
-  auto relay = node::Relay::create(participant.value(), a.ns);
+  auto relay = bridge::Relay::create(participant.value(), a.ns);
   if (!relay) return fail("bridge", relay.error().message);
   // The steered node is the one whose topics are relayed: /<namespace> (as rbsim node names itself).
   const Result<node::NodeName> target = node::parse_node_name(a.ns);
   if (!target) return fail("bridge", target.error().message, 2);
-  node::RemoteSteeringOptions steer;
+  bridge::RemoteSteeringOptions steer;
   steer.node = target->fully_qualified();
-  auto steering = node::RemoteSteering::create(participant.value(), steer);
+  auto steering = bridge::RemoteSteering::create(participant.value(), steer);
   if (!steering) return fail("bridge", steering.error().message);
   auto started = start_foxglove("rbsim bridge", a.foxglove, std::move(channels.value()),
                                 steering.value().get(), steer.node);
@@ -67,7 +67,7 @@ int bridge_command(const BridgeArgs& a) {
               participant.value().description().c_str());
   }
   std::uint64_t last_time = 0, scenes = 0;
-  const node::Relay::OnSample on_sample = [&](const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
+  const bridge::Relay::OnSample on_sample = [&](const msgs::TopicSpec& spec, std::span<const std::byte> cdr) {
     const std::optional<std::uint64_t> t = sim_time(spec, cdr);
     if (spec.id == msgs::TopicId::SceneDescription) {
       // A scene (re)started: its node's parameters (read before the new session, which hands them

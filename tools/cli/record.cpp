@@ -23,7 +23,7 @@ namespace {
 constexpr int kLiveZstdLevel = -5;
 
 struct RecordArgs {
-  node::RecorderOptions rec;
+  bag::RecorderOptions rec;
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   std::optional<double> duration;
   std::optional<double> max_file_duration;  // seconds
@@ -94,8 +94,8 @@ std::optional<int> choose_outputs(RecordArgs& a, std::string& bag, std::vector<O
 }
 
 // Records until a stop, --wall-duration or --max-messages; what failed, if anything did.
-std::optional<std::string> record_until_stopped(const RecordArgs& a, node::Recorder& recorder,
-                                                node::RecorderServices& services) {
+std::optional<std::string> record_until_stopped(const RecordArgs& a, bag::Recorder& recorder,
+                                                bag::RecorderServices& services) {
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = a.duration ? start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                  std::chrono::duration<double>(*a.duration))
@@ -117,7 +117,7 @@ std::optional<std::string> record_until_stopped(const RecordArgs& a, node::Recor
 }
 
 // The end lines: per topic what arrived and what was lost, then the totals.
-void print_counts(const node::Recorder& recorder, const std::string& path) {
+void print_counts(const bag::Recorder& recorder, const std::string& path) {
   std::uint64_t lost = 0, duplicates = 0;
   for (const auto& c : recorder.counts()) {
     RBSIM_LOG(Info, "  %-28s received %8llu  lost %llu%s\n", c.topic.c_str(),
@@ -160,14 +160,14 @@ int record_command(RecordArgs a) {
   if (!participant) return fail("record", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
   if (!rosout) return fail("record", rosout.error().message);
-  auto recorder = node::Recorder::create(participant.value(), a.rec);
+  auto recorder = bag::Recorder::create(participant.value(), a.rec);
   if (!recorder) {
     if (made_bag) std::filesystem::remove_all(bag, ec);  // it holds at most the file just opened
     return fail("record", recorder.error().message,
                 recorder.error().code == ErrorCode::InvalidArgument ? 2 : 1);
   }
   // rosbag2's recorder services on the recorder's node (/rbsim_recorder/snapshot, ...).
-  auto services = node::RecorderServices::create(participant.value(), *recorder.value());
+  auto services = bag::RecorderServices::create(participant.value(), *recorder.value());
   if (!services) return fail("record", services.error().message);
   install_snapshot_handler();
   if (!a.quiet) {

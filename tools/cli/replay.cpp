@@ -21,7 +21,7 @@ namespace rbsim::cli {
 
 namespace {
 struct ReplayArgs {
-  node::PlayOptions replay;
+  bag::PlayOptions replay;
   std::string ns;
   std::uint32_t domain = node::kDomainFromEnvironment;  // add_domain_option sets it
   node::NodeName node{"/", "rbsim_player"};             // as rosbag2's player names its node
@@ -36,7 +36,7 @@ struct ReplayArgs {
 // terminal or with --quiet. Cleared when it stops.
 class ProgressLine {
  public:
-  ProgressLine(const node::Player& replay, bool on) {
+  ProgressLine(const bag::Player& replay, bool on) {
     if (!on || ::isatty(STDERR_FILENO) == 0) return;
     thread_ = std::thread([this, &replay] {
       std::unique_lock lock(mutex_);
@@ -58,8 +58,8 @@ class ProgressLine {
   }
 
  private:
-  static void draw(const node::Player& replay) {
-    const node::PlayerStatus s = replay.status();
+  static void draw(const bag::Player& replay) {
+    const bag::PlayerStatus s = replay.status();
     const double at = static_cast<double>(s.log_time - std::min(s.log_time, replay.first_log_time())) * 1e-9;
     const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
     char sim[48] = "-";
@@ -78,9 +78,9 @@ class ProgressLine {
 
 // The player's services for Foxglove's Service Call panel, <node>/pause ... burst in cdr: the same
 // handlers as the player's DDS services. A request too malformed to answer fails the call.
-std::vector<foxglove::HostedService> player_services(const node::Player& replay, const std::string& node) {
+std::vector<foxglove::HostedService> player_services(const bag::Player& replay, const std::string& node) {
   std::vector<foxglove::HostedService> hosted;
-  for (node::Player::PlayerService& s : replay.player_services()) {
+  for (bag::Player::PlayerService& s : replay.player_services()) {
     foxglove::HostedService h;
     h.spec = foxglove::service_spec(node, s.name, s.type);
     h.call = [call = std::move(s.call), type = s.type](std::string_view request) -> Result<std::string> {
@@ -95,7 +95,7 @@ std::vector<foxglove::HostedService> player_services(const node::Player& replay,
 }
 
 // One Foxglove channel per replayed output, with the recording's own schema.
-std::vector<foxglove::ChannelSpec> foxglove_channels(const node::Player& replay) {
+std::vector<foxglove::ChannelSpec> foxglove_channels(const bag::Player& replay) {
   std::vector<foxglove::ChannelSpec> channels;
   for (const auto& o : replay.outputs()) {
     foxglove::ChannelSpec c;
@@ -109,7 +109,7 @@ std::vector<foxglove::ChannelSpec> foxglove_channels(const node::Player& replay)
 }
 
 // The start lines: the file, its span, the rate, then each output with its message count.
-void print_start(const ReplayArgs& a, const node::Player& replay, const node::Participant& participant) {
+void print_start(const ReplayArgs& a, const bag::Player& replay, const node::Participant& participant) {
   const double span = static_cast<double>(replay.last_log_time() - replay.first_log_time()) * 1e-9;
   char rate[32] = "as fast as possible";
   if (a.replay.rate > 0) std::snprintf(rate, sizeof rate, "%gx", a.replay.rate);
@@ -137,9 +137,9 @@ int replay_command(ReplayArgs a) {
   if (!participant) return fail("replay", participant.error().message);
   auto rosout = node::Rosout::create(participant.value());
   if (!rosout) return fail("replay", rosout.error().message);
-  auto opened = node::Player::open(participant.value(), a.replay);
+  auto opened = bag::Player::open(participant.value(), a.replay);
   if (!opened) return fail("replay", opened.error().message);
-  node::Player& replay = *opened.value();
+  bag::Player& replay = *opened.value();
   for (const std::string& w : replay.warnings()) RBSIM_LOG(Warn, "rbsim replay: warning: %s\n", w.c_str());
   // --foxglove: one channel per replayed output with the recording's own schema; the replay's
   // pacing is the one clock, the server is fed from the tap as each message goes out over DDS.
@@ -147,10 +147,10 @@ int replay_command(ReplayArgs a) {
   // Before the server goes (its service thread may be serving a seek that waits for the loop),
   // the player is closed: that seek is answered at once.
   struct ClosePlayer {
-    node::Player& replay;
+    bag::Player& replay;
     ~ClosePlayer() { replay.close_player(); }
   } close_player{replay};
-  node::Player::Tap tap;
+  bag::Player::Tap tap;
   std::uint64_t last_time = 0;
   if (a.foxglove.address) {
     auto started = start_foxglove("rbsim replay", a.foxglove, foxglove_channels(replay), nullptr,

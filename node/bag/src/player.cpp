@@ -10,7 +10,9 @@
 #include "rbsim/recording.hpp"
 #include "rbsim/service_set.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
+
+using namespace node;
 
 namespace {
 // Sleeps until `deadline_ns` (monotonic) in slices of at most 50 ms, so a stop request is seen
@@ -236,7 +238,7 @@ void Player::close_player() {
 
 std::vector<Player::PlayerService> Player::player_services() const {
   std::vector<PlayerService> out;
-  for (node::PlayerService& s : node::player_services(*impl_->control, impl_->options.service_wait_s)) {
+  for (bag::PlayerService& s : bag::player_services(*impl_->control, impl_->options.service_wait_s)) {
     out.push_back(
         {std::move(s.name), std::move(s.type),
          [handler = std::move(s.handler)](std::span<const std::byte> request) -> std::optional<Bytes> {
@@ -532,4 +534,4 @@ Result<bool> Player::play(bool (*stop)(), const Tap* tap) {
   return !stop();
 }
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

@@ -12,7 +12,9 @@
 #include "rbsim/service.hpp"
 #include "rbsim/service_set.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
+
+using namespace node;
 
 namespace {
 constexpr auto kPoll = std::chrono::milliseconds(50);  // the longest the loop waits without looking at stop
@@ -275,12 +277,12 @@ std::vector<PlayerService> player_services(PlayerClock& control, double wait_s) 
   return out;
 }
 
-Status add_player_services(ServiceSet& set, const Participant& participant, const std::string& node,
+Status add_player_services(ServiceSet& set, const Participant& participant, const std::string& node_name,
                            PlayerClock& control, double wait_s) {
   for (PlayerService& s : player_services(control, wait_s)) {
-    if (Status st = set.add(participant, node, s.name, s.type, std::move(s.handler)); !st) return st;
+    if (Status st = set.add(participant, node_name, s.name, s.type, std::move(s.handler)); !st) return st;
   }
   return Ok{};
 }
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

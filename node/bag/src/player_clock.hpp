@@ -15,6 +15,10 @@
 #include "rbsim/service.hpp"
 
 namespace rbsim::node {
+class ServiceSet;
+}  // namespace rbsim::node
+
+namespace rbsim::bag {
 
 class PlayerClock {
  public:
@@ -81,7 +85,7 @@ class PlayerClock {
 struct PlayerService {
   std::string name;  // "pause"
   std::string type;  // "rosbag2_interfaces/srv/Pause"
-  ServiceServer::Handler handler;
+  node::ServiceServer::Handler handler;
 };
 // The player's services, as rosbag2's player offers them (rosbag2_interfaces): pause, resume,
 // toggle_paused, is_paused, get_rate, set_rate, seek, play_next, burst. Seek, play_next and burst
@@ -89,11 +93,10 @@ struct PlayerService {
 // Player::player_services(), by the Foxglove server.
 std::vector<PlayerService> player_services(PlayerClock& control, double wait_s);
 
-class ServiceSet;
 // The player's services on `set` (rosbag2_interfaces, as rosbag2's player offers them):
 // <node>/pause, resume, toggle_paused, is_paused, get_rate, set_rate, seek, play_next, burst.
 // Seek, play_next and burst wait up to `wait_s` for the loop.
-[[nodiscard]] Status add_player_services(ServiceSet& set, const Participant& participant,
-                                         const std::string& node, PlayerClock& control, double wait_s);
+[[nodiscard]] Status add_player_services(node::ServiceSet& set, const node::Participant& participant,
+                                         const std::string& node_name, PlayerClock& control, double wait_s);
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

@@ -12,7 +12,9 @@
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/recorder.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
+
+using namespace node;
 
 namespace {
 std::uint64_t wall_ns() {
@@ -367,4 +369,4 @@ Status Recorder::close() {
   return Ok{};
 }
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

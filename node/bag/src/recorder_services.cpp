@@ -11,7 +11,9 @@
 #include "rbsim/rosout.hpp"
 #include "rbsim/service_set.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
+
+using namespace node;
 
 namespace {
 constexpr auto kWait = std::chrono::seconds(5);  // a split or snapshot answered by then at the latest
@@ -144,4 +146,4 @@ Status RecorderServices::carry_out(bool quiet, bool snapshot) {
   return failure;
 }
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

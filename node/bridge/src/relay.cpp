@@ -1,7 +1,9 @@
 // The relay's DDS side: raw CDR samples of every rbsim topic, handed on as they come.
 #include "rbsim/relay.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bridge {
+
+using namespace node;
 
 Result<std::unique_ptr<Relay>> Relay::create(const Participant& participant, const std::string& ns) {
   std::unique_ptr<Relay> r(new Relay());
@@ -43,4 +45,4 @@ std::uint64_t Relay::lost() const {
   return n;
 }
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bridge

@@ -9,7 +9,9 @@
 #include "rbsim/service_set.hpp"
 #include "rbsim/time.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bridge {
+
+using namespace node;
 
 namespace {
 
@@ -387,4 +389,4 @@ void RemoteSteering::take_events() {
   }
 }
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bridge

@@ -12,7 +12,7 @@
 
 #include "rbsim/middleware.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
 
 // The replay: an MCAP recording (rbsim run --record or rbsim record) republished over DDS with
 // its recorded timing. Every channel whose schema names one of our types (msgs::topics()) and
@@ -54,7 +54,8 @@ class Player {
  public:
   // Opens the recording and creates the publishers. Errors: unreadable or non-MCAP input, no rbsim
   // topics in the log, --topics names the log does not have.
-  static Result<std::unique_ptr<Player>> open(const Participant& participant, const PlayOptions& options);
+  static Result<std::unique_ptr<Player>> open(const node::Participant& participant,
+                                              const PlayOptions& options);
   ~Player();
 
   struct Output {
@@ -118,4 +119,4 @@ class Player {
   std::uint64_t published_ = 0;
 };
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

@@ -14,7 +14,7 @@
 #include "rbsim/mcap.hpp"
 #include "rbsim/middleware.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bag {
 
 // The recorder: subscribes to rbsim topics and writes the exact CDR payloads to MCAP (rosbag2
 // layout), log_time = receive time, publish_time = the sample's source timestamp (both ns since
@@ -62,7 +62,7 @@ struct RecorderOptions {
 
 class Recorder {
  public:
-  static Result<std::unique_ptr<Recorder>> create(const Participant& participant,
+  static Result<std::unique_ptr<Recorder>> create(const node::Participant& participant,
                                                   const RecorderOptions& options);
   ~Recorder();
   // Waits up to `timeout_ns` for data and records everything available; true if anything came.
@@ -99,7 +99,7 @@ class Recorder {
     std::uint64_t lost(double dt) const;
   };
   struct Topic {
-    Subscription subscription;
+    node::Subscription subscription;
     std::uint16_t channel;  // 0 until the first sample: its writer's QoS goes into the channel
     std::uint32_t received;
     msgs::OfferedQos offered{};  // what its channel says (the first publisher's offer)
@@ -139,13 +139,13 @@ class Recorder {
   std::deque<Kept> kept_;
   std::uint64_t kept_bytes_ = 0;
   std::uint64_t snapshot_dropped_ = 0;  // for the end line: dropped to keep within the bounds
-  void keep(Topic& t, const Received& sample, std::uint64_t log_time, std::uint64_t source);
+  void keep(Topic& t, const node::Received& sample, std::uint64_t log_time, std::uint64_t source);
 
  public:
   std::uint64_t snapshot_dropped() const { return snapshot_dropped_; }
 
  private:
-  WaitSet waitset_;
+  node::WaitSet waitset_;
   std::vector<Topic> topics_;
   std::uint64_t received_ = 0;
   double dt_ = 0.0;  // from the scene description; 0 until it arrives
@@ -162,14 +162,14 @@ class Recorder {
   std::uint64_t held_bytes_ = 0;
   struct Held {
     std::size_t topic;
-    Received sample;
+    node::Received sample;
     std::uint64_t log_time;
   };
   bool holding_ = false;  // a latched topic is recorded and has not delivered yet
   [[nodiscard]] bool latched_outstanding() const;
   [[nodiscard]] bool scene_pending() const;
   std::vector<Held> held_;
-  [[nodiscard]] Status write(Topic& topic, const Received& sample, std::uint64_t log_time);
+  [[nodiscard]] Status write(Topic& topic, const node::Received& sample, std::uint64_t log_time);
   [[nodiscard]] Status release_held();
 };
 
@@ -182,7 +182,8 @@ class Recorder {
 // a split of one .mcap file or in snapshot mode, fails (success false; the split is not made).
 class RecorderServices {
  public:
-  static Result<std::unique_ptr<RecorderServices>> create(const Participant& participant, Recorder& recorder);
+  static Result<std::unique_ptr<RecorderServices>> create(const node::Participant& participant,
+                                                          Recorder& recorder);
   ~RecorderServices();
   RecorderServices(const RecorderServices&) = delete;
   RecorderServices& operator=(const RecorderServices&) = delete;
@@ -197,4 +198,4 @@ class RecorderServices {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bag

@@ -12,7 +12,7 @@
 
 #include "rbsim/middleware.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bridge {
 
 // Subscribes to every topic of msgs::topics() under `ns`: the latched scene description with a
 // transient-local reader (a relay started after the node still gets it), the per-step topics with
@@ -22,7 +22,7 @@ class Relay {
  public:
   static constexpr std::int32_t kDepth = 256;  // per-step samples a reader keeps
 
-  static Result<std::unique_ptr<Relay>> create(const Participant& participant, const std::string& ns);
+  static Result<std::unique_ptr<Relay>> create(const node::Participant& participant, const std::string& ns);
   ~Relay();
   Relay(const Relay&) = delete;
   Relay& operator=(const Relay&) = delete;
@@ -36,10 +36,10 @@ class Relay {
 
  private:
   Relay() = default;
-  std::vector<Subscription> subscriptions_;
-  WaitSet waitset_;
-  Received sample_;
+  std::vector<node::Subscription> subscriptions_;
+  node::WaitSet waitset_;
+  node::Received sample_;
   std::uint64_t received_ = 0;
 };
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bridge

@@ -20,7 +20,7 @@
 #include "rbsim/middleware.hpp"
 #include "rbsim/service.hpp"
 
-namespace rbsim::node {
+namespace rbsim::bridge {
 
 struct RemoteSteeringOptions {
   std::string node = "/rbsim";  // the steered node's fully qualified name: its services are <node>/<name>
@@ -42,7 +42,7 @@ struct RemoteSteeringOptions {
 // the next one) and a timed pause. The node records what it applied with source "ros2 service".
 class RemoteSteering final : public control::Steering {
  public:
-  static Result<std::unique_ptr<RemoteSteering>> create(const Participant& participant,
+  static Result<std::unique_ptr<RemoteSteering>> create(const node::Participant& participant,
                                                         const RemoteSteeringOptions& options);
   ~RemoteSteering() override;  // queued commands are answered as failed
   RemoteSteering(const RemoteSteering&) = delete;
@@ -79,12 +79,12 @@ class RemoteSteering final : public control::Steering {
   void send(Pending pending, std::vector<InFlight>& out);
   void collect(std::vector<InFlight>& out, Bytes& reply);
   void take_events();
-  ServiceClient& client(std::size_t index) { return clients_[index]; }
+  node::ServiceClient& client(std::size_t index) { return clients_[index]; }
 
   RemoteSteeringOptions options_;
-  std::vector<ServiceClient> clients_;  // list, get, set, set atomically, then control_services()
-  std::optional<Subscription> events_;  // /parameter_events
-  Received event_sample_;
+  std::vector<node::ServiceClient> clients_;  // list, get, set, set atomically, then control_services()
+  std::optional<node::Subscription> events_;  // /parameter_events
+  node::Received event_sample_;
   // Added from any thread (on_command), called on the run thread: guarded by its own mutex, held
   // while they run (an observer must not add another).
   std::mutex observers_mutex_;
@@ -100,4 +100,4 @@ class RemoteSteering final : public control::Steering {
   std::thread thread_;
 };
 
-}  // namespace rbsim::node
+}  // namespace rbsim::bridge

@@ -92,7 +92,7 @@ struct ControlCounters {
 };
 
 // What steers a run from outside its loop (the Foxglove server): the run's own Controller, or a
-// relay of the same requests to a node over DDS (rbsim bridge, node::RemoteSteering). An I/O
+// relay of the same requests to a node over DDS (rbsim bridge, bridge::RemoteSteering). An I/O
 // boundary, so an interface. All of it may be called from any thread; submit()'s `done` and the
 // observers run on the steering's own thread and must not block.
 class Steering {
