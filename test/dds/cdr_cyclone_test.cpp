@@ -41,6 +41,7 @@
 #include "rbsim/builders.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/msgs.hpp"
+#include "rbsim/simulation_interfaces.hpp"
 
 namespace {
 
@@ -750,6 +751,89 @@ TEST(CycloneCdrCommand, EncoderBytesEqualCycloneSerialisation) {
   const SerdataPtr cyclone = dds.write_sample(sample.get());
   ASSERT_NE(cyclone, nullptr);
   EXPECT_TRUE(same_bytes(ours, serialized(*cyclone)));
+}
+
+// simulation_interfaces (the node's simulator services, rbsim/simulation_interfaces.hpp): the
+// messages its replies and requests are made of, msgs::simulation::encode's bytes against Cyclone's
+// serialisation of the idlc-generated types filled alike (nested types, a uint16 sequence, a
+// sequence of one-byte structs, strings).
+TEST(CycloneCdrSimulationInterfaces, EncoderBytesEqualCycloneSerialisation) {
+  namespace sim = rbsim::msgs::simulation;
+  const auto check = [](const dds_topic_descriptor_t& desc, const Sample& sample, const Bytes& ours) {
+    Loopback dds;
+    ASSERT_NO_FATAL_FAILURE(dds.open(desc));
+    const SerdataPtr cyclone = dds.write_sample(sample.get());
+    ASSERT_NE(cyclone, nullptr);
+    EXPECT_TRUE(same_bytes(ours, serialized(*cyclone))) << desc.m_typename;
+  };
+  {
+    sim::EntityState m;
+    m.stamp = {12, 340000000};
+    m.frame_id = "world";
+    m.position = {1.5, -2.25, 0.0};
+    m.orientation = rbsim::msgs::quaternion_z(0.7);
+    m.linear_velocity = {0.1, 0.2, 0.0};
+    m.angular_velocity = {0.0, 0.0, -0.3};
+    m.linear_acceleration = {0.0, -9.81, 0.0};
+    m.angular_acceleration = {0.0, 0.0, 1e-300};
+    Bytes ours;
+    sim::encode(m, ours);
+    const dds_topic_descriptor_t& desc = simulation_interfaces_msg_dds__EntityState__desc;
+    Sample sample(desc);
+    auto& c = *static_cast<simulation_interfaces_msg_dds__EntityState_*>(sample.get());
+    c.header.stamp = {m.stamp.sec, m.stamp.nanosec};
+    c.header.frame_id = str(m.frame_id);
+    c.pose.position = {m.position.x, m.position.y, m.position.z};
+    c.pose.orientation = {m.orientation.x, m.orientation.y, m.orientation.z, m.orientation.w};
+    const auto v3 = [](const sim::Vector3& v) { return geometry_msgs_msg_dds__Vector3_{v.x, v.y, v.z}; };
+    c.twist.linear = v3(m.linear_velocity);
+    c.twist.angular = v3(m.angular_velocity);
+    c.acceleration.linear = v3(m.linear_acceleration);
+    c.acceleration.angular = v3(m.angular_acceleration);
+    check(desc, sample, ours);
+  }
+  {
+    sim::EntityFilters m;
+    m.filter = "^body_[0-9]+$";
+    m.categories = {4, 1};
+    m.tags.tags = {"wheel", ""};
+    m.tags.filter_mode = 1;
+    m.bounds.type = 3;
+    m.bounds.points = {{1.0, 2.0, 3.0}, {0.5, 0.0, 0.0}};
+    Bytes ours;
+    sim::encode(m, ours);
+    const dds_topic_descriptor_t& desc = simulation_interfaces_msg_dds__EntityFilters__desc;
+    Sample sample(desc);
+    auto& c = *static_cast<simulation_interfaces_msg_dds__EntityFilters_*>(sample.get());
+    c.filter = str(m.filter);
+    auto* cats = alloc_seq(c.categories, m.categories.size());
+    for (std::size_t k = 0; k < m.categories.size(); ++k) cats[k].category = m.categories[k];
+    auto* tags = alloc_seq(c.tags.tags, m.tags.tags.size());
+    for (std::size_t k = 0; k < m.tags.tags.size(); ++k) tags[k] = str(m.tags.tags[k]);
+    c.tags.filter_mode = m.tags.filter_mode;
+    c.bounds.type = m.bounds.type;
+    auto* points = alloc_seq(c.bounds.points, m.bounds.points.size());
+    for (std::size_t k = 0; k < m.bounds.points.size(); ++k)
+      points[k] = {m.bounds.points[k].x, m.bounds.points[k].y, m.bounds.points[k].z};
+    check(desc, sample, ours);
+  }
+  {
+    sim::SimulatorFeatures m;
+    m.features = {5, 6, 8, 10, 12, 20, 24, 25, 26, 31, 32};
+    m.spawn_formats = {"sdf"};
+    m.custom_info = "rbsim";
+    Bytes ours;
+    sim::encode(m, ours);
+    const dds_topic_descriptor_t& desc = simulation_interfaces_msg_dds__SimulatorFeatures__desc;
+    Sample sample(desc);
+    auto& c = *static_cast<simulation_interfaces_msg_dds__SimulatorFeatures_*>(sample.get());
+    auto* f = alloc_seq(c.features, m.features.size());
+    for (std::size_t k = 0; k < m.features.size(); ++k) f[k] = m.features[k];
+    auto* formats = alloc_seq(c.spawn_formats, m.spawn_formats.size());
+    formats[0] = str(m.spawn_formats[0]);
+    c.custom_info = str(m.custom_info);
+    check(desc, sample, ours);
+  }
 }
 
 // The comparison itself must be able to fail: one altered byte, one ulp in one field of the C

@@ -11,6 +11,7 @@
 #include "rbsim/parameter_events.hpp"
 #include "rbsim/service.hpp"
 #include "rbsim/service_set.hpp"
+#include "simulation_services.hpp"
 
 namespace rbsim::node {
 
@@ -43,6 +44,7 @@ struct NodeServices::Impl {
   Bytes event_cdr;
   std::atomic<std::uint64_t> event_count{0};
   std::atomic<std::uint64_t> command_count{0};
+  std::unique_ptr<SimulationServices> simulation;  // simulation_interfaces' services
   ServiceSet services;  // last: stopped first, before the members its handlers use go
 
   Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
@@ -179,6 +181,10 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
   std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services;
   impl->add_controls(services);
   impl->add_parameters(services);
+  impl->simulation = std::make_unique<SimulationServices>(
+      controller, [raw = impl.get()](Command c) { return raw->apply(std::move(c)); }, options.apply_timeout_s,
+      options.dt);
+  impl->simulation->add(services);
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
       return st.error();

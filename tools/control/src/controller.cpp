@@ -88,6 +88,7 @@ void Controller::enqueue(Pending pending) {
 
 void Controller::close(const std::string& reason) {
   std::vector<Pending> refused;
+  std::vector<Read> reads;
   {
     const std::lock_guard lock(mutex_);
     if (!closed_) {
@@ -95,6 +96,7 @@ void Controller::close(const std::string& reason) {
       close_reason_ = reason;
     }
     refused.swap(incoming_);
+    reads.swap(reads_);
     counters_.commands += refused.size();
     // Takes a running loop off its fast path: its next boundary sees closed_ and stops the pass.
     has_incoming_.store(true, std::memory_order_release);
@@ -103,6 +105,37 @@ void Controller::close(const std::string& reason) {
   for (Pending& p : refused) {
     if (p.done) p.done(failed(std::string(to_string(p.command.kind)) + ": " + close_reason_));
   }
+  for (Read& r : reads) r.reader(nullptr);
+}
+
+void Controller::read(std::function<void(const World*)> reader, std::int64_t at_step) {
+  {
+    const std::lock_guard lock(mutex_);
+    ++counters_.queries;
+    if (!closed_) {
+      reads_.push_back(Read{at_step, std::move(reader)});
+      has_incoming_.store(true, std::memory_order_release);
+      wake_.notify_all();
+      return;
+    }
+  }
+  reader(nullptr);
+}
+
+void Controller::serve_reads(const World& world, bool idle) {
+  std::vector<Read> due;
+  {
+    const std::lock_guard lock(mutex_);
+    if (reads_.empty()) return;
+    const auto later = [&](const Read& r) { return !idle && r.at_step > world.step_index(); };
+    const auto split = std::stable_partition(reads_.begin(), reads_.end(), later);
+    due.assign(std::make_move_iterator(split), std::make_move_iterator(reads_.end()));
+    reads_.erase(split, reads_.end());
+    // A read still waiting for its step keeps the loop off its fast path, so the next boundary
+    // looks again.
+    if (!reads_.empty()) has_incoming_.store(true, std::memory_order_release);
+  }
+  for (Read& r : due) r.reader(&world);
 }
 
 std::vector<std::optional<ParameterValue>> Controller::get(const std::vector<std::string>& names) const {
@@ -218,6 +251,7 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       publish_values(world);
       answer();
     }
+    serve_reads(world, settings_.paused && step_budget_ == 0);
     bool closed = false;
     {
       const std::lock_guard lock(mutex_);
@@ -243,7 +277,7 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     auto wait = std::chrono::steady_clock::duration(kIdleWait);
     if (resume_at_) wait = std::min(wait, *resume_at_ - std::chrono::steady_clock::now());
     std::unique_lock lock(mutex_);
-    wake_.wait_for(lock, wait, [this] { return !incoming_.empty() || closed_; });
+    wake_.wait_for(lock, wait, [this] { return !incoming_.empty() || !reads_.empty() || closed_; });
     idled = true;
   }
   if (settings_.paused) --step_budget_;  // one step of a `step N`

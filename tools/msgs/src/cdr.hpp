@@ -35,6 +35,7 @@ class CdrWriter {
   CdrWriter& operator=(const CdrWriter&) = delete;
   void u8(std::uint8_t v) { put(v); }
   void boolean(bool v) { put(static_cast<std::uint8_t>(v ? 1 : 0)); }
+  void u16(std::uint16_t v) { put(v); }
   void i32(std::int32_t v) { put(v); }
   void u32(std::uint32_t v) { put(v); }
   void u64(std::uint64_t v) { put(v); }

@@ -4,8 +4,7 @@
 
 #include <type_traits>
 
-#include "cdr.hpp"
-#include "cdr_reader.hpp"
+#include "interface_codec.hpp"
 
 namespace rbsim::msgs {
 
@@ -39,10 +38,13 @@ using detail::Reader;
 
 namespace {
 
+using detail::get_strings;
+using detail::kMinString;
+using detail::put_strings;
+
 // The fewest bytes one element can take on the wire, before any padding: what a sequence length is
 // checked against (detail::Reader::length), so a huge length in a short message fails before
 // anything is allocated. Never more than the real minimum, so no valid message is refused.
-constexpr std::size_t kMinString = 5;  // u32 length + the NUL
 // type, bool, int64, float64, string, five sequence lengths
 constexpr std::size_t kMinValue = 1 + 1 + 8 + 8 + kMinString + 5 * 4;
 constexpr std::size_t kMinParameter = kMinString + kMinValue;
@@ -50,14 +52,6 @@ constexpr std::size_t kMinParameter = kMinString + kMinValue;
 constexpr std::size_t kMinDescriptor = 3 * kMinString + 3 + 2 * 4;
 constexpr std::size_t kMinResult = 1 + kMinString;
 
-void put_strings(CdrWriter& w, const std::vector<std::string>& v) {
-  w.sequence_length(v.size());
-  for (const std::string& s : v) w.string(s);
-}
-void get_strings(Reader& r, std::vector<std::string>& v) {
-  v.resize(r.length(kMinString));
-  for (std::string& s : v) s = r.string();
-}
 template <class T>
 void put_values(CdrWriter& w, const std::vector<T>& v) {
   w.sequence_length(v.size());
@@ -451,46 +445,14 @@ void get(Reader& r, BurstResponse& m) {
   m.actually_burst = r.get<std::uint64_t>();
 }
 
-// "rcl_interfaces/msg/Parameter", or "std_srvs/srv/Trigger request" for a service half.
-template <class T>
-std::string name_of(std::string_view half) {
-  if constexpr (requires { T::kType; }) {
-    return std::string(T::kType);
-  } else {
-    return std::string(T::kService) + std::string(half);
-  }
-}
-
-template <class T>
-void encode_message(const T& m, Bytes& out) {
-  CdrWriter w(out);
-  put(w, m);
-}
-template <class T>
-Status decode_message(std::span<const std::byte> cdr, T& out, std::string_view half) {
-  Reader r(cdr);
-  if (!r.ok()) {
-    return Error{"malformed " + name_of<T>(half) + ": not plain little-endian CDR (a 4-byte header 00 01)",
-                 ErrorCode::Malformed};
-  }
-  out = T{};
-  get(r, out);
-  if (!r.ok()) {
-    return Error{"malformed or truncated " + name_of<T>(half) + ": bad or missing data at byte " +
-                     std::to_string(r.pos()) + " of " + std::to_string(cdr.size()),
-                 ErrorCode::Truncated};
-  }
-  return Ok{};
-}
-
 }  // namespace
 
-#define RBSIM_INTERFACE_CODEC(T, half)                    \
-  void encode(const T& message, Bytes& out) {             \
-    encode_message(message, out);                         \
-  }                                                       \
-  Status decode(std::span<const std::byte> cdr, T& out) { \
-    return decode_message(cdr, out, half);                \
+#define RBSIM_INTERFACE_CODEC(T, half)                                                 \
+  void encode(const T& message, Bytes& out) {                                          \
+    detail::encode_message(message, out, [](CdrWriter& w, const T& m) { put(w, m); }); \
+  }                                                                                    \
+  Status decode(std::span<const std::byte> cdr, T& out) {                              \
+    return detail::decode_message(cdr, out, half, [](Reader& r, T& m) { get(r, m); }); \
   }
 RBSIM_INTERFACE_CODEC(ParameterValue, "")
 RBSIM_INTERFACE_CODEC(Parameter, "")

@@ -102,14 +102,18 @@ template <class Req, class Res, class Answer, class OnMalformed>
 ServiceServer::Handler typed_handler(Answer answer, OnMalformed on_malformed) {
   return [answer = std::move(answer), on_malformed = std::move(on_malformed)](
              const RequestHeader& header, std::span<const std::byte> request, Bytes& reply) {
+    // The codecs of rbsim/interfaces.hpp, or of the request's own namespace (found by
+    // argument-dependent lookup: rbsim/simulation_interfaces.hpp's).
+    using msgs::decode;
+    using msgs::encode;
     Req req;
-    if (Status st = msgs::decode(request, req); !st) {
+    if (Status st = decode(request, req); !st) {
       const std::optional<Res> res = on_malformed(st.error());
       if (!res) return false;
-      msgs::encode(*res, reply);
+      encode(*res, reply);
       return true;
     }
-    msgs::encode(static_cast<const Res&>(answer(header, req)), reply);
+    encode(static_cast<const Res&>(answer(header, req)), reply);
     return true;
   };
 }

@@ -132,6 +132,13 @@ class Controller final : public StepHook, public Steering {
   std::vector<ParameterType> types(const std::vector<std::string>& names) const override;
   ListParametersResult list(const std::vector<std::string>& prefixes, std::uint64_t depth) const;
   std::vector<std::string> names() const override { return list({}, kDepthRecursive).names; }
+  // Runs `reader` on the run loop's thread at the first boundary at or after step `at_step` (0:
+  // the next one), after the commands due there, with the world as it stands there; earlier at a
+  // boundary where the loop stops stepping (paused with no steps left to take), when the reader
+  // sees a world short of `at_step`; with nullptr when the controller closes first. For reads of
+  // the world's state (simulation_interfaces' services): the world is the loop's alone, so a
+  // reader copies what it needs and must not block. Counted as a query.
+  void read(std::function<void(const World*)> reader, std::int64_t at_step = 0);
   RunSettings settings() const;
   ControlCounters counters() const;
   // Answers every queued command with failure (`reason`) and refuses later ones at once. A
@@ -180,6 +187,9 @@ class Controller final : public StepHook, public Steering {
   // observers and its caller, after publish_values(), so a read after an answer sees the change.
   void apply_now(Pending& pending, World& world, Boundary& boundary);
   void answer();
+  // Runs the reads queued by read() that are due at this boundary (all of them when `idle`: the
+  // loop is about to wait for a command).
+  void serve_reads(const World& world, bool idle);
   std::vector<std::pair<Pending, CommandResult>> answered_;  // run loop thread only
   void publish_values(const World& world);
 
@@ -189,6 +199,11 @@ class Controller final : public StepHook, public Steering {
   mutable std::mutex mutex_;  // guards the members down to closed_
   std::condition_variable wake_;
   std::vector<Pending> incoming_;
+  struct Read {
+    std::int64_t at_step = 0;
+    std::function<void(const World*)> reader;
+  };
+  std::vector<Read> reads_;   // read()
   ParameterTable published_;  // what readers see: the table as of the last boundary
   RunSettings published_settings_;
   mutable ControlCounters counters_;

@@ -1,0 +1,486 @@
+// simulation_interfaces' services on the node (simulation_services.hpp).
+#include "simulation_services.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <future>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <regex>
+
+#include "rbsim/simulation_interfaces.hpp"
+
+namespace rbsim::node {
+
+namespace {
+
+namespace sim = msgs::simulation;
+using control::Command;
+using control::CommandKind;
+using control::CommandResult;
+using sim::Result;
+
+// What GetSimulatorFeatures lists: exactly what these services do. Not listed, and answered
+// RESULT_FEATURE_UNSUPPORTED: SetEntityState, tags and convex-hull filters, resetting time or
+// state alone (rbsim's time is its step index, part of its state) and spawned entities (issue 29).
+constexpr sim::Feature kFeatures[] = {
+    sim::Feature::EntityBounds,          sim::Feature::EntityBoundsBox,        sim::Feature::EntityCategories,
+    sim::Feature::EntityStateGetting,    sim::Feature::EntityInfoGetting,      sim::Feature::SimulationReset,
+    sim::Feature::SimulationStateGetting, sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
+    sim::Feature::StepSimulationSingle,  sim::Feature::StepSimulationMultiple,
+};
+constexpr std::size_t kMaxFilterBytes = 256;  // a longer name pattern is refused before it is compiled
+
+Result ok() {
+  return Result{Result::kOk, {}};
+}
+Result failure(std::uint8_t code, std::string message) {
+  return Result{code, std::move(message)};
+}
+
+// The entity's body index, when `name` is body_<i> of a body of the world (no sign, no leading
+// zero: each body has one name).
+std::optional<std::int32_t> body_of(const std::string& name, std::int32_t bodies) {
+  const std::string prefix = msgs::body_frame("", 0).substr(0, 5);  // "body_"
+  if (!name.starts_with(prefix) || name.size() == prefix.size() || name.size() > prefix.size() + 10)
+    return std::nullopt;
+  const std::string digits = name.substr(prefix.size());
+  if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+      (digits.size() > 1 && digits[0] == '0'))
+    return std::nullopt;
+  const long long i = std::stoll(digits);
+  if (i >= bodies) return std::nullopt;
+  return static_cast<std::int32_t>(i);
+}
+
+sim::Vector3 planar(double x, double y) {
+  return {x, y, 0.0};
+}
+sim::Vector3 about_z(double w) {
+  return {0.0, 0.0, w};
+}
+
+// The body's state as simulation_interfaces says it: header (frame world, stamp the simulated time
+// of this boundary), pose (x, y, 0; theta about +z as a unit quaternion), twist (vx, vy, 0;
+// 0, 0, omega), acceleration F/M and Gamma/I (N / kg = m/s^2, N m / kg m^2 = rad/s^2) of the
+// forces the last step accumulated (zero at step 0 and after a reset: no step has run).
+sim::EntityState entity_state(const World& world, BodyId b) {
+  sim::EntityState s;
+  s.stamp = msgs::sim_time(world);
+  s.frame_id = "world";
+  const BodyState st = world.state(b);
+  s.position = planar(st.position.x(), st.position.y());
+  s.orientation = msgs::quaternion_z(st.theta);
+  s.linear_velocity = planar(st.velocity.x(), st.velocity.y());
+  s.angular_velocity = about_z(st.omega);
+  const Vec2 f = world.force(b);
+  s.linear_acceleration = planar(f.x() / world.mass(b), f.y() / world.mass(b));
+  s.angular_acceleration = about_z(world.torque(b) / world.inertia(b));
+  return s;
+}
+
+// --- Bounds filters: whether a body's hull (a polygon in the plane z = 0, world frame) overlaps.
+
+// Whether p lies inside the closed polygon (crossing rule; a 2-vertex hull has no inside).
+bool inside(std::span<const Vec2> poly, const Vec2& p) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
+  }
+  return poly.size() >= 3 && in;
+}
+// The distance from p to the segment ab.
+double distance(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+// Whether the segment ab meets the box [lo, hi] (Liang-Barsky clipping of the parameter range).
+bool meets_box(const Vec2& a, const Vec2& b, const Vec2& lo, const Vec2& hi) {
+  double t0 = 0.0, t1 = 1.0;
+  const Vec2 d = b - a;
+  for (int k = 0; k < 2; ++k) {
+    if (d[k] == 0.0) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return false;
+      continue;
+    }
+    double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+struct BoundsFilter {
+  sim::BoundsType type = sim::BoundsType::Empty;
+  Vec2 lo{0.0, 0.0}, hi{0.0, 0.0};  // Box: the box's extent in the plane z = 0
+  Vec2 centre{0.0, 0.0};            // Sphere: its circle in the plane z = 0
+  double radius = 0.0;
+  bool misses_plane = false;  // the bounds do not reach z = 0: nothing overlaps
+};
+
+// Checks the request's bounds; a Result when they are refused.
+std::optional<Result> read_bounds(const sim::Bounds& in, BoundsFilter& out) {
+  for (const sim::Vector3& p : in.points) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      return failure(Result::kOperationFailed, "filters.bounds: every point must be finite");
+  }
+  out.type = static_cast<sim::BoundsType>(in.type);
+  switch (out.type) {
+    case sim::BoundsType::Empty:
+      return std::nullopt;
+    case sim::BoundsType::ConvexHull:
+      return failure(Result::kFeatureUnsupported,
+                     "filters.bounds: TYPE_CONVEX_HULL is not supported (ENTITY_BOUNDS_CONVEX is not listed)");
+    case sim::BoundsType::Box: {
+      if (in.points.size() != 2)
+        return failure(Result::kOperationFailed, "filters.bounds: TYPE_BOX takes 2 points (two opposite corners), got " +
+                                                     std::to_string(in.points.size()));
+      const sim::Vector3 &a = in.points[0], &b = in.points[1];
+      out.lo = {std::min(a.x, b.x), std::min(a.y, b.y)};
+      out.hi = {std::max(a.x, b.x), std::max(a.y, b.y)};
+      out.misses_plane = std::min(a.z, b.z) > 0.0 || std::max(a.z, b.z) < 0.0;
+      return std::nullopt;
+    }
+    case sim::BoundsType::Sphere: {
+      if (in.points.size() != 2 || in.points[1].x < 0.0)
+        return failure(Result::kOperationFailed,
+                       "filters.bounds: TYPE_SPHERE takes 2 points (the centre, then the radius >= 0 as x)");
+      const sim::Vector3& c = in.points[0];
+      const double r = in.points[1].x;
+      out.centre = {c.x, c.y};
+      out.misses_plane = std::abs(c.z) > r;
+      out.radius = out.misses_plane ? 0.0 : std::sqrt(r * r - c.z * c.z);  // its circle at z = 0
+      return std::nullopt;
+    }
+  }
+  return failure(Result::kOperationFailed, "filters.bounds: unknown type " + std::to_string(in.type));
+}
+
+bool overlaps(const BoundsFilter& f, std::span<const Vec2> hull) {
+  if (f.type == sim::BoundsType::Empty) return true;
+  if (f.misses_plane) return false;
+  const bool box = f.type == sim::BoundsType::Box;
+  if (inside(hull, box ? Vec2(0.5 * (f.lo + f.hi)) : f.centre)) return true;
+  for (std::size_t i = 0, j = hull.size() - 1; i < hull.size(); j = i++) {
+    if (box ? meets_box(hull[j], hull[i], f.lo, f.hi) : distance(f.centre, hull[j], hull[i]) <= f.radius)
+      return true;
+  }
+  return false;
+}
+
+// The request's filters, checked once (a Result when they are refused), then applied per body.
+struct Filters {
+  std::optional<std::regex> name;
+  bool dynamic_objects = true;  // every body is CATEGORY_DYNAMIC_OBJECT: whether the categories take it
+  BoundsFilter bounds;
+
+  std::optional<Result> read(const sim::EntityFilters& in) {
+    if (!in.tags.tags.empty())
+      return failure(Result::kFeatureUnsupported, "filters.tags: entity tags are not supported (ENTITY_TAGS is not listed)");
+    if (in.filter.size() > kMaxFilterBytes)
+      return failure(Result::kOperationFailed, "filters.filter: longer than " + std::to_string(kMaxFilterBytes) + " bytes");
+    if (!in.filter.empty()) {
+      try {
+        name.emplace(in.filter, std::regex::extended | std::regex::nosubs);
+      } catch (const std::regex_error& e) {
+        return failure(Result::kOperationFailed,
+                       "filters.filter: not a POSIX extended regular expression (" + std::string(e.what()) + ")");
+      }
+    }
+    dynamic_objects = in.categories.empty() ||
+                      std::find(in.categories.begin(), in.categories.end(),
+                                static_cast<std::uint8_t>(sim::Category::DynamicObject)) != in.categories.end();
+    return read_bounds(in.bounds, bounds);
+  }
+
+  // The names of the bodies that pass, in body order; `hull` is scratch.
+  std::vector<std::int32_t> select(const World& world, std::vector<Vec2>& hull) const {
+    std::vector<std::int32_t> out;
+    if (!dynamic_objects) return out;
+    for (std::int32_t i = 0; i < world.body_count(); ++i) {
+      if (name && !std::regex_search(msgs::body_frame("", i), *name)) continue;
+      const BodyId b{i};
+      hull.resize(world.hull(b).size());
+      for (std::size_t v = 0; v < hull.size(); ++v) hull[v] = world.world_vertex(b, static_cast<std::int32_t>(v));
+      if (overlaps(bounds, hull)) out.push_back(i);
+    }
+    return out;
+  }
+};
+
+template <class Res>
+auto refuse_malformed() {
+  return [](const Error& e) {
+    Res r;
+    r.result = failure(Result::kOperationFailed, e.message);
+    return std::optional<Res>(std::move(r));
+  };
+}
+
+}  // namespace
+
+namespace {
+
+// Runs `f(world)` on the run loop's thread at the next step boundary at or after `at_step`
+// (Controller::read) and waits up to `timeout_s` for it; nullopt when it timed out or the run
+// ended first.
+template <class F>
+auto at_boundary(control::Controller& controller, double timeout_s, F f, std::int64_t at_step = 0)
+    -> std::optional<decltype(f(std::declval<const World&>()))> {
+  using T = decltype(f(std::declval<const World&>()));
+  auto promise = std::make_shared<std::promise<std::optional<T>>>();
+  std::future<std::optional<T>> answer = promise->get_future();
+  controller.read(
+      [promise, f = std::move(f)](const World* world) {
+        promise->set_value(world ? std::optional<T>(f(*world)) : std::nullopt);
+      },
+      at_step);
+  if (answer.wait_for(std::chrono::duration<double>(timeout_s)) != std::future_status::ready) return std::nullopt;
+  return answer.get();
+}
+
+Result unanswered(double timeout_s) {
+  return failure(Result::kOperationFailed,
+                 "the run loop did not reach a step boundary within " + std::to_string(timeout_s) + " s (or the run ended)");
+}
+
+}  // namespace
+
+void SimulationServices::add(std::vector<Entry>& out) {
+  out.emplace_back("get_simulator_features", std::string(sim::GetSimulatorFeaturesRequest::kService),
+                   typed_handler<sim::GetSimulatorFeaturesRequest, sim::GetSimulatorFeaturesResponse>(
+                       [](const RequestHeader&, const sim::GetSimulatorFeaturesRequest&) {
+                         sim::GetSimulatorFeaturesResponse res;
+                         for (const sim::Feature f : kFeatures)
+                           res.features.features.push_back(static_cast<std::uint16_t>(f));
+                         res.features.custom_info =
+                             "rbsim: every body is an entity body_<i> (CATEGORY_DYNAMIC_OBJECT); state changes "
+                             "are recorded on <node>/commands and re-simulate exactly";
+                         return res;
+                       },
+                       [](const Error&) { return std::optional<sim::GetSimulatorFeaturesResponse>(); }));
+  add_state(out);
+  add_entities(out);
+}
+
+// Simulation state, reset and stepping. The state is read at a boundary: STOPPED while stopped_ is
+// set and the world is paused at step 0, else PAUSED or PLAYING as the run's `paused` setting.
+void SimulationServices::add_state(std::vector<Entry>& out) {
+  const auto state_now = [this]() -> std::optional<sim::State> {
+    return at_boundary(controller_, timeout_s_, [this](const World& world) {
+      const bool paused = controller_.settings().paused;
+      if (paused && world.step_index() == 0 && stopped_.load()) return sim::State::Stopped;
+      return paused ? sim::State::Paused : sim::State::Playing;
+    });
+  };
+  const auto command = [this](CommandKind kind) {
+    Command c;
+    c.kind = kind;
+    return apply_(std::move(c));
+  };
+  out.emplace_back("get_simulation_state", std::string(sim::GetSimulationStateRequest::kService),
+                   typed_handler<sim::GetSimulationStateRequest, sim::GetSimulationStateResponse>(
+                       [this, state_now](const RequestHeader&, const sim::GetSimulationStateRequest&) {
+                         const std::optional<sim::State> st = state_now();
+                         if (!st) return sim::GetSimulationStateResponse{0, unanswered(timeout_s_)};
+                         return sim::GetSimulationStateResponse{static_cast<std::uint8_t>(*st), ok()};
+                       },
+                       [](const Error& e) {
+                         return std::optional<sim::GetSimulationStateResponse>(
+                             sim::GetSimulationStateResponse{0, failure(Result::kOperationFailed, e.message)});
+                       }));
+  out.emplace_back("set_simulation_state", std::string(sim::SetSimulationStateRequest::kService),
+                   typed_handler<sim::SetSimulationStateRequest, sim::SetSimulationStateResponse>(
+                       [this, state_now, command](const RequestHeader&, const sim::SetSimulationStateRequest& req) {
+                         return sim::SetSimulationStateResponse{set_state(req.state, state_now, command)};
+                       },
+                       refuse_malformed<sim::SetSimulationStateResponse>()));
+  out.emplace_back("reset_simulation", std::string(sim::ResetSimulationRequest::kService),
+                   typed_handler<sim::ResetSimulationRequest, sim::ResetSimulationResponse>(
+                       [command](const RequestHeader&, const sim::ResetSimulationRequest& req) {
+                         using R = sim::ResetSimulationRequest;
+                         // Time and state are one in rbsim (the step index is part of the world's
+                         // state): a reset of both is the full one; and nothing is ever spawned.
+                         if (req.scope != R::kScopeDefault && req.scope != R::kScopeAll &&
+                             req.scope != (R::kScopeTime | R::kScopeState)) {
+                           return sim::ResetSimulationResponse{failure(
+                               Result::kFeatureUnsupported,
+                               "scope " + std::to_string(req.scope) +
+                                   ": only SCOPE_DEFAULT, SCOPE_ALL or SCOPE_TIME | SCOPE_STATE (a full reset to step 0)")};
+                         }
+                         const CommandResult r = command(CommandKind::Reset);
+                         return sim::ResetSimulationResponse{r.successful ? ok()
+                                                                          : failure(Result::kOperationFailed, r.message)};
+                       },
+                       refuse_malformed<sim::ResetSimulationResponse>()));
+  out.emplace_back("step_simulation", std::string(sim::StepSimulationRequest::kService),
+                   typed_handler<sim::StepSimulationRequest, sim::StepSimulationResponse>(
+                       [this](const RequestHeader&, const sim::StepSimulationRequest& req) {
+                         return sim::StepSimulationResponse{step(req.steps)};
+                       },
+                       refuse_malformed<sim::StepSimulationResponse>()));
+}
+
+// SetSimulationState's transitions: to PLAYING a resume, to PAUSED a pause (from STOPPED: paused
+// at step 0, no step taken), to STOPPED a pause and a reset to step 0; the same state again
+// ALREADY_IN_TARGET_STATE; QUITTING is not supported; NO_WORLD, LOADING_WORLD and unknown values
+// are INCORRECT_TRANSITION.
+Result SimulationServices::set_state(std::uint8_t target, const StateNow& state_now, const Run& command) {
+  using R = sim::SetSimulationStateResponse;
+  const auto to = static_cast<sim::State>(target);
+  if (to == sim::State::Quitting)
+    return failure(Result::kFeatureUnsupported, "STATE_QUITTING is not supported: stop the node with SIGINT or SIGTERM");
+  if (to != sim::State::Playing && to != sim::State::Paused && to != sim::State::Stopped)
+    return failure(R::kIncorrectTransition, "state " + std::to_string(target) + ": rbsim has one world, always loaded");
+  const std::optional<sim::State> now = state_now();
+  if (!now) return unanswered(timeout_s_);
+  if (*now == to) return failure(R::kAlreadyInTargetState, "already in the target state");
+  std::vector<CommandKind> kinds;
+  if (to == sim::State::Playing) kinds = {CommandKind::Resume};
+  if (to == sim::State::Paused) kinds = {CommandKind::Pause};
+  if (to == sim::State::Stopped) kinds = {CommandKind::Pause, CommandKind::Reset};
+  for (const CommandKind k : kinds) {
+    const CommandResult r = command(k);
+    if (!r.successful) return failure(R::kStateTransitionError, r.message);
+  }
+  stopped_.store(to == sim::State::Stopped);
+  return ok();
+}
+
+// StepSimulation: only while paused (RESULT_OPERATION_FAILED otherwise, as the definition says);
+// answered once the world reached the step `steps` past the boundary the step command applied at.
+Result SimulationServices::step(std::uint64_t steps) {
+  if (steps == 0 || steps > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+    return failure(Result::kOperationFailed, "steps must be >= 1 (got " + std::to_string(steps) + ")");
+  Command c;
+  c.kind = CommandKind::Step;
+  c.steps = static_cast<std::int64_t>(steps);
+  const CommandResult r = apply_(std::move(c));
+  if (!r.successful) return failure(Result::kOperationFailed, r.message);
+  stopped_.store(false);
+  const std::int64_t target = r.step + static_cast<std::int64_t>(steps);
+  // Stepping takes its own time: at most the run's pace for these steps, on top of the wait.
+  const control::RunSettings settings = controller_.settings();
+  const double pace = settings.rate > 0.0 ? static_cast<double>(steps) * dt_ / settings.rate : 0.0;
+  const std::optional<std::int64_t> reached =
+      at_boundary(controller_, timeout_s_ + 2.0 * pace, [](const World& w) { return w.step_index(); }, target);
+  if (!reached) return unanswered(timeout_s_ + 2.0 * pace);
+  if (*reached < target) {
+    return failure(Result::kOperationFailed, "stepping stopped at step " + std::to_string(*reached) + " short of step " +
+                                                 std::to_string(target) + " (a reset or a pause came first)");
+  }
+  return ok();
+}
+
+// The entities: every body, body_<i>, CATEGORY_DYNAMIC_OBJECT.
+void SimulationServices::add_entities(std::vector<Entry>& out) {
+  // The world at a boundary, then the answer made from it: f(world) returns the response.
+  const auto read = [this](auto f) { return at_boundary(controller_, timeout_s_, std::move(f)); };
+  out.emplace_back("get_entities", std::string(sim::GetEntitiesRequest::kService),
+                   typed_handler<sim::GetEntitiesRequest, sim::GetEntitiesResponse>(
+                       [this, read](const RequestHeader&, const sim::GetEntitiesRequest& req) {
+                         auto filters = std::make_shared<Filters>();
+                         if (std::optional<Result> bad = filters->read(req.filters)) return sim::GetEntitiesResponse{*bad, {}};
+                         std::optional<sim::GetEntitiesResponse> res = read([filters](const World& w) {
+                           std::vector<Vec2> hull;
+                           sim::GetEntitiesResponse r{ok(), {}};
+                           for (const std::int32_t i : filters->select(w, hull)) r.entities.push_back(msgs::body_frame("", i));
+                           return r;
+                         });
+                         return res ? std::move(*res) : sim::GetEntitiesResponse{unanswered(timeout_s_), {}};
+                       },
+                       refuse_malformed<sim::GetEntitiesResponse>()));
+  out.emplace_back("get_entities_states", std::string(sim::GetEntitiesStatesRequest::kService),
+                   typed_handler<sim::GetEntitiesStatesRequest, sim::GetEntitiesStatesResponse>(
+                       [this, read](const RequestHeader&, const sim::GetEntitiesStatesRequest& req) {
+                         auto filters = std::make_shared<Filters>();
+                         if (std::optional<Result> bad = filters->read(req.filters))
+                           return sim::GetEntitiesStatesResponse{*bad, {}, {}};
+                         std::optional<sim::GetEntitiesStatesResponse> res = read([filters](const World& w) {
+                           std::vector<Vec2> hull;
+                           sim::GetEntitiesStatesResponse r{ok(), {}, {}};
+                           for (const std::int32_t i : filters->select(w, hull)) {
+                             r.entities.push_back(msgs::body_frame("", i));
+                             r.states.push_back(entity_state(w, BodyId{i}));
+                           }
+                           return r;
+                         });
+                         return res ? std::move(*res) : sim::GetEntitiesStatesResponse{unanswered(timeout_s_), {}, {}};
+                       },
+                       refuse_malformed<sim::GetEntitiesStatesResponse>()));
+  add_entity(out);
+}
+
+// The services on one entity, named in the request: NOT_FOUND for a name no body has.
+void SimulationServices::add_entity(std::vector<Entry>& out) {
+  // f(world, body) makes the response's payload at a boundary; `Res` carries it with the result.
+  const auto one = [this]<class Res, class Payload>(const std::string& entity, auto f) -> Res {
+    std::optional<std::optional<Payload>> got =
+        at_boundary(controller_, timeout_s_, [entity, f](const World& w) -> std::optional<Payload> {
+          const std::optional<std::int32_t> i = body_of(entity, w.body_count());
+          if (!i) return std::nullopt;
+          return f(w, BodyId{*i});
+        });
+    if (!got) return Res{unanswered(timeout_s_), {}};
+    if (!*got) return Res{failure(Result::kNotFound, "no entity '" + entity + "' (entities are body_0 .. body_<n-1>)"), {}};
+    return Res{ok(), std::move(**got)};
+  };
+  out.emplace_back("get_entity_info", std::string(sim::GetEntityInfoRequest::kService),
+                   typed_handler<sim::GetEntityInfoRequest, sim::GetEntityInfoResponse>(
+                       [one](const RequestHeader&, const sim::GetEntityInfoRequest& req) {
+                         return one.template operator()<sim::GetEntityInfoResponse, sim::EntityInfo>(
+                             req.entity, [](const World& w, BodyId b) {
+                               sim::EntityInfo info;
+                               info.category = static_cast<std::uint8_t>(sim::Category::DynamicObject);
+                               info.description = "rigid body " + std::to_string(b.index) + ": " +
+                                                  std::to_string(w.hull(b).size()) + " point masses, M = " +
+                                                  std::to_string(w.mass(b)) + " kg, I = " +
+                                                  std::to_string(w.inertia(b)) + " kg m^2";
+                               return info;
+                             });
+                       },
+                       refuse_malformed<sim::GetEntityInfoResponse>()));
+  out.emplace_back("get_entity_state", std::string(sim::GetEntityStateRequest::kService),
+                   typed_handler<sim::GetEntityStateRequest, sim::GetEntityStateResponse>(
+                       [one](const RequestHeader&, const sim::GetEntityStateRequest& req) {
+                         return one.template operator()<sim::GetEntityStateResponse, sim::EntityState>(
+                             req.entity, [](const World& w, BodyId b) { return entity_state(w, b); });
+                       },
+                       refuse_malformed<sim::GetEntityStateResponse>()));
+  out.emplace_back("get_entity_bounds", std::string(sim::GetEntityBoundsRequest::kService),
+                   typed_handler<sim::GetEntityBoundsRequest, sim::GetEntityBoundsResponse>(
+                       [one](const RequestHeader&, const sim::GetEntityBoundsRequest& req) {
+                         // TYPE_BOX in the body's own frame: the hull's extent about the centre of
+                         // mass at theta = 0, upper right corner first.
+                         return one.template operator()<sim::GetEntityBoundsResponse, sim::Bounds>(
+                             req.entity, [](const World& w, BodyId b) {
+                               Vec2 lo = w.hull(b)[0], hi = lo;
+                               for (const Vec2& v : w.hull(b)) {
+                                 lo = lo.cwiseMin(v);
+                                 hi = hi.cwiseMax(v);
+                               }
+                               return sim::Bounds{static_cast<std::uint8_t>(sim::BoundsType::Box),
+                                                  {planar(hi.x(), hi.y()), planar(lo.x(), lo.y())}};
+                             });
+                       },
+                       refuse_malformed<sim::GetEntityBoundsResponse>()));
+  out.emplace_back("set_entity_state", std::string(sim::SetEntityStateRequest::kService),
+                   typed_handler<sim::SetEntityStateRequest, sim::SetEntityStateResponse>(
+                       [](const RequestHeader&, const sim::SetEntityStateRequest&) {
+                         return sim::SetEntityStateResponse{
+                             failure(Result::kFeatureUnsupported,
+                                     "SetEntityState is not supported yet (ENTITY_STATE_SETTING is not listed)")};
+                       },
+                       refuse_malformed<sim::SetEntityStateResponse>()));
+}
+
+}  // namespace rbsim::node
