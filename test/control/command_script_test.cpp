@@ -202,11 +202,67 @@ TEST(CommandMessage, ToMessageAndBackKeepsEveryCommand) {
   }
   msgs::CommandMessage bad;
   bad.seq = 4;
-  bad.kind = 6;
+  bad.kind = 7;
   Result<Command> refused = from_message(bad);
   ASSERT_FALSE(refused);
-  EXPECT_NE(refused.error().message.find("command 4: unknown kind 6"), std::string::npos)
+  EXPECT_NE(refused.error().message.find("command 4: unknown kind 7"), std::string::npos)
       << refused.error().message;
+}
+
+// set_entity_state (simulation_interfaces' SetEntityState) as a message: its values as named
+// float64 parameters beside the body, a pose or a twist whole; anything else is refused naming the
+// command.
+TEST(CommandMessage, SetStateTravelsAsNamedParameters) {
+  Command c;
+  c.step = 12;
+  c.kind = CommandKind::SetState;
+  c.state.body = 3;
+  c.state.set_twist = true;
+  c.state.velocity = Vec2(-0.25, 1e-300);
+  c.state.omega = 4.5;
+  CommandResult r;
+  r.successful = true;
+  r.step = 12;
+  msgs::CommandMessage m = to_message(c, r, 0, 0.01);
+  EXPECT_EQ(m.kind, msgs::CommandMessage::SetEntityState);
+  EXPECT_EQ(m.body, 3u);
+  ASSERT_EQ(m.parameters.size(), 3u);
+  EXPECT_EQ(m.parameters[0].name, "vx");
+  EXPECT_EQ(m.parameters[2].value, ParameterValue::of_double(4.5));
+  Result<Command> back = from_message(m);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->kind, CommandKind::SetState);
+  EXPECT_EQ(back->state.body, 3);
+  EXPECT_FALSE(back->state.set_pose);
+  EXPECT_TRUE(back->state.set_twist);
+  EXPECT_EQ(back->state.velocity, c.state.velocity);
+  EXPECT_EQ(back->state.omega, 4.5);
+  EXPECT_TRUE(back->parameters.empty());
+
+  c.state.set_pose = true;
+  c.state.position = Vec2(1.0, 2.0);
+  c.state.theta = -0.5;
+  m = to_message(c, r, 1, 0.01);
+  ASSERT_EQ(m.parameters.size(), 6u);
+  back = from_message(m);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_TRUE(back->state.set_pose);
+  EXPECT_EQ(back->state.position, c.state.position);
+  EXPECT_EQ(back->state.theta, -0.5);
+
+  for (const auto& [params, rule] : std::vector<std::pair<std::vector<Parameter>, std::string>>{
+           {{{"x", ParameterValue::of_double(1)}}, "together"},
+           {{{"mass", ParameterValue::of_double(1)}}, "none of x, y, theta"},
+           {{{"x", ParameterValue::of_integer(1)}}, "not a double"}}) {
+    msgs::CommandMessage wrong = m;
+    wrong.seq = 9;
+    wrong.parameters = params;
+    Result<Command> no = from_message(wrong);
+    ASSERT_FALSE(no) << rule;
+    EXPECT_NE(no.error().message.find("command 9: set_entity_state"), std::string::npos)
+        << no.error().message;
+    EXPECT_NE(no.error().message.find(rule), std::string::npos) << no.error().message;
+  }
 }
 
 }  // namespace

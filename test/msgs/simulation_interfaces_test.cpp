@@ -80,8 +80,9 @@ TEST(SimulationInterfacesCodec, EveryTypeRoundTrips) {
 
   EXPECT_EQ(round_trip(GetSimulationStateResponse{2, {Result::kOk, ""}}).state, 2);
   EXPECT_EQ(round_trip(SetSimulationStateRequest{3}).state, 3);
-  EXPECT_EQ(round_trip(SetSimulationStateResponse{{SetSimulationStateResponse::kIncorrectTransition, "x"}}).result,
-            (Result{103, "x"}));
+  EXPECT_EQ(
+      round_trip(SetSimulationStateResponse{{SetSimulationStateResponse::kIncorrectTransition, "x"}}).result,
+      (Result{103, "x"}));
   EXPECT_EQ(round_trip(ResetSimulationRequest{ResetSimulationRequest::kScopeAll}).scope, 255);
   EXPECT_EQ(round_trip(StepSimulationRequest{7}).steps, 7u);
   EXPECT_EQ(round_trip(GetEntityStateRequest{"body_9"}).entity, "body_9");
@@ -124,19 +125,20 @@ TEST(SimulationInterfacesCodec, TruncatedOrHostileBytesAreErrorsNamingTheType) {
     GetEntitiesStatesResponse out;
     const Status st = decode(std::span<const std::byte>(cdr.data(), n), out);
     ASSERT_FALSE(st.ok()) << n << " bytes decoded";
-    EXPECT_NE(st.error().message.find("simulation_interfaces/srv/GetEntitiesStates response"), std::string::npos)
+    EXPECT_NE(st.error().message.find("simulation_interfaces/srv/GetEntitiesStates response"),
+              std::string::npos)
         << st.error().message;
   }
   // A sequence length far past the data fails before anything is allocated.
-  Bytes hostile{std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0}, std::byte{0xff}, std::byte{0xff},
-                std::byte{0xff}, std::byte{0x7f}};
+  Bytes hostile{std::byte{0},    std::byte{1},    std::byte{0},    std::byte{0},
+                std::byte{0xff}, std::byte{0xff}, std::byte{0xff}, std::byte{0x7f}};
   SimulatorFeatures f;
   const Status st = decode(hostile, f);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("SimulatorFeatures"), std::string::npos) << st.error().message;
   // A big-endian header is refused.
-  Bytes be{std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0},
-           std::byte{0}};
+  Bytes be{std::byte{0}, std::byte{0}, std::byte{0}, std::byte{0},
+           std::byte{1}, std::byte{0}, std::byte{0}, std::byte{0}};
   StepSimulationRequest step;
   EXPECT_FALSE(decode(be, step).ok());
 }

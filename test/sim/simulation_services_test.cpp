@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "control_test_util.hpp"
+#include "rbsim/command_script.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
@@ -28,7 +29,7 @@ using SimResult = sim::Result;
 using State = sim::State;
 using SetRes = sim::SetSimulationStateResponse;
 
-constexpr std::uint32_t kDomain = 159;  // its own: test/dds has 143..157, test/middleware 158
+constexpr std::uint32_t kDomain = 159;    // its own: test/dds has 143..157, test/middleware 158
 constexpr std::int64_t kSteps = 1000000;  // never reached: each test ends the run itself
 
 std::string node_name() {
@@ -52,6 +53,7 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
       services_->command_applied(c, r);
       const std::lock_guard lock(mu_);
       applied_.push_back(c.kind);
+      recorded_.push_back(control::to_message(c, r, recorded_.size(), scene_.world.dt));
     });
     run_ = std::async(std::launch::async, [this] { return run(); });
     client_.emplace(participant(node_ + "_client"));
@@ -65,7 +67,8 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
 
   Participant participant(const std::string& name) {
     const NodeName n{"/", name};
-    auto p = GetParam() == "memory" ? create_memory_participant(network_, n) : create_dds_participant(kDomain, n);
+    auto p =
+        GetParam() == "memory" ? create_memory_participant(network_, n) : create_dds_participant(kDomain, n);
     if (!p) throw std::runtime_error(p.error().message);
     return std::move(p.value());
   }
@@ -103,7 +106,8 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
   }
 
   std::uint8_t state() {
-    const auto res = call<sim::GetSimulationStateResponse>("get_simulation_state", sim::GetSimulationStateRequest{});
+    const auto res =
+        call<sim::GetSimulationStateResponse>("get_simulation_state", sim::GetSimulationStateRequest{});
     EXPECT_EQ(res.result.result, SimResult::kOk) << res.result.error_message;
     return res.state;
   }
@@ -143,6 +147,7 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
   std::future<Status> run_;
   std::mutex mu_;
   std::vector<control::CommandKind> applied_;
+  std::vector<msgs::CommandMessage> recorded_;  // as <node>/commands carries them
 };
 
 sim::EntityFilters named(const std::string& pattern) {
@@ -171,28 +176,28 @@ World stepped(const Scene& scene, std::int64_t steps) {
 }
 
 TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
-  const auto features = call<sim::GetSimulatorFeaturesResponse>("get_simulator_features",
-                                                                sim::GetSimulatorFeaturesRequest{});
+  const auto features =
+      call<sim::GetSimulatorFeaturesResponse>("get_simulator_features", sim::GetSimulatorFeaturesRequest{});
   const std::vector<std::uint16_t> listed = features.features.features;
   const auto has = [&](sim::Feature f) {
     return std::find(listed.begin(), listed.end(), static_cast<std::uint16_t>(f)) != listed.end();
   };
   for (const sim::Feature f :
        {sim::Feature::EntityBounds, sim::Feature::EntityBoundsBox, sim::Feature::EntityCategories,
-        sim::Feature::EntityStateGetting, sim::Feature::EntityInfoGetting, sim::Feature::SimulationReset,
-        sim::Feature::SimulationStateGetting, sim::Feature::SimulationStateSetting,
-        sim::Feature::SimulationStatePause, sim::Feature::StepSimulationSingle,
-        sim::Feature::StepSimulationMultiple}) {
+        sim::Feature::EntityStateGetting, sim::Feature::EntityStateSetting, sim::Feature::EntityInfoGetting,
+        sim::Feature::SimulationReset, sim::Feature::SimulationStateGetting,
+        sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
+        sim::Feature::StepSimulationSingle, sim::Feature::StepSimulationMultiple}) {
     EXPECT_TRUE(has(f)) << static_cast<int>(f);
   }
-  EXPECT_EQ(listed.size(), 11u);
+  EXPECT_EQ(listed.size(), 12u);
 
   // What is not listed answers RESULT_FEATURE_UNSUPPORTED.
-  EXPECT_FALSE(has(sim::Feature::EntityStateSetting));
   sim::SetEntityStateRequest set;
   set.entity = "body_0";
-  set.set_pose = true;
-  EXPECT_EQ(call<sim::SetEntityStateResponse>("set_entity_state", set).result.result, SimResult::kFeatureUnsupported);
+  set.set_acceleration = true;
+  EXPECT_EQ(call<sim::SetEntityStateResponse>("set_entity_state", set).result.result,
+            SimResult::kFeatureUnsupported);
   EXPECT_FALSE(has(sim::Feature::EntityTags));
   sim::EntityFilters tagged;
   tagged.tags.tags = {"wheel"};
@@ -203,8 +208,9 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
   EXPECT_FALSE(has(sim::Feature::SimulationResetTime));
   EXPECT_FALSE(has(sim::Feature::SimulationResetState));
   EXPECT_FALSE(has(sim::Feature::SimulationResetSpawned));
-  for (const std::uint8_t scope : {sim::ResetSimulationRequest::kScopeTime, sim::ResetSimulationRequest::kScopeState,
-                                   sim::ResetSimulationRequest::kScopeSpawned}) {
+  for (const std::uint8_t scope :
+       {sim::ResetSimulationRequest::kScopeTime, sim::ResetSimulationRequest::kScopeState,
+        sim::ResetSimulationRequest::kScopeSpawned}) {
     sim::ResetSimulationRequest reset;
     reset.scope = scope;
     EXPECT_EQ(call<sim::ResetSimulationResponse>("reset_simulation", reset).result.result,
@@ -266,7 +272,15 @@ TEST_P(SimulationServicesTest, StateMovesAsTheDefinitionSays) {
   std::future<control::CommandResult> stepped_elsewhere = controller_.submit(other);
   ASSERT_EQ(stepped_elsewhere.wait_for(20s), std::future_status::ready);
   EXPECT_TRUE(stepped_elsewhere.get().successful);
-  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::Paused));
+  // Its reply comes at the boundary where stepping begins (still step 0): the state follows once
+  // the world left step 0.
+  std::uint8_t after = state();
+  for (const auto end = std::chrono::steady_clock::now() + 20s;
+       after != static_cast<std::uint8_t>(State::Paused) && std::chrono::steady_clock::now() < end;) {
+    std::this_thread::sleep_for(5ms);
+    after = state();
+  }
+  EXPECT_EQ(after, static_cast<std::uint8_t>(State::Paused));
 
   // Every change went through the controller as a command (recorded on <node>/commands).
   using K = control::CommandKind;
@@ -295,7 +309,8 @@ TEST_P(SimulationServicesTest, EntityStatesAreTheWorldsAtTheStepReached) {
     EXPECT_EQ(e.orientation.x, 0.0);
     EXPECT_EQ(e.linear_velocity, (sim::Vector3{st.velocity.x(), st.velocity.y(), 0.0}));
     EXPECT_EQ(e.angular_velocity, (sim::Vector3{0.0, 0.0, st.omega}));
-    EXPECT_EQ(e.linear_acceleration, (sim::Vector3{w.force(b).x() / w.mass(b), w.force(b).y() / w.mass(b), 0.0}));
+    EXPECT_EQ(e.linear_acceleration,
+              (sim::Vector3{w.force(b).x() / w.mass(b), w.force(b).y() / w.mass(b), 0.0}));
     EXPECT_EQ(e.angular_acceleration, (sim::Vector3{0.0, 0.0, w.torque(b) / w.inertia(b)}));
     EXPECT_NE(e.linear_acceleration.y, 0.0) << "gravity acts";
 
@@ -307,11 +322,111 @@ TEST_P(SimulationServicesTest, EntityStatesAreTheWorldsAtTheStepReached) {
   }
 }
 
+// SetEntityState on a moving body: applied at the boundary (paused: the current one), read back at
+// once, recorded as a command, and the session re-simulated offline from those commands (as
+// rbsim run --commands does with a recording) reaches the same state, bit for bit.
+TEST_P(SimulationServicesTest, SetEntityStateIsACommandAndReSimulatesExactly) {
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  ASSERT_EQ(step(10).result, SimResult::kOk);
+  sim::SetEntityStateRequest set;
+  set.entity = "body_1";
+  set.state.position = {1.25, -0.5, 0.0};
+  set.state.orientation = msgs::quaternion_z(0.75);
+  set.state.linear_velocity = {-2.0, 3.0, 0.0};
+  set.state.angular_velocity = {0.0, 0.0, 1.5};
+  set.set_pose = true;
+  set.set_twist = true;
+  const auto applied_set = call<sim::SetEntityStateResponse>("set_entity_state", set);
+  ASSERT_EQ(applied_set.result.result, SimResult::kOk) << applied_set.result.error_message;
+  sim::GetEntityStateRequest get;
+  get.entity = "body_1";
+  const sim::EntityState now = call<sim::GetEntityStateResponse>("get_entity_state", get).state;
+  EXPECT_EQ(now.position, set.state.position);
+  EXPECT_EQ(now.linear_velocity, set.state.linear_velocity);
+  EXPECT_EQ(now.angular_velocity, set.state.angular_velocity);
+  EXPECT_NEAR(now.orientation.z, set.state.orientation.z, 1e-15);
+  EXPECT_NEAR(now.orientation.w, set.state.orientation.w, 1e-15);
+  EXPECT_EQ(now.stamp.nanosec, msgs::sim_time(10, scene_.world.dt).nanosec) << "still at step 10";
+
+  // Only the twist: the pose stays.
+  sim::SetEntityStateRequest twist = set;
+  twist.set_pose = false;
+  twist.state.position = {99.0, 99.0, 0.0};
+  twist.state.linear_velocity = {0.5, 0.0, 0.0};
+  ASSERT_EQ(call<sim::SetEntityStateResponse>("set_entity_state", twist).result.result, SimResult::kOk);
+  EXPECT_EQ(call<sim::GetEntityStateResponse>("get_entity_state", get).state.position, set.state.position);
+
+  // Refused, each with its code; nothing of them applied.
+  const auto refused = [&](sim::SetEntityStateRequest r) {
+    return call<sim::SetEntityStateResponse>("set_entity_state", r).result.result;
+  };
+  using SetState = sim::SetEntityStateResponse;
+  sim::SetEntityStateRequest bad = set;
+  bad.state.orientation = {0.5, 0.0, 0.0, std::sqrt(0.75)};  // a rotation about x
+  EXPECT_EQ(refused(bad), SetState::kInvalidPose);
+  bad.state.orientation = {0.0, 0.0, 0.0, 2.0};  // not unit
+  EXPECT_EQ(refused(bad), SetState::kInvalidPose);
+  bad.state.orientation = msgs::quaternion_z(0.1);
+  bad.state.position.x = std::nan("");
+  EXPECT_EQ(refused(bad), SetState::kInvalidPose);
+  bad.state.position = {0.0, 0.0, 1.0};  // off the plane
+  EXPECT_EQ(refused(bad), SetState::kInvalidPose);
+  bad = set;
+  bad.state.angular_velocity = {1.0, 0.0, 0.0};
+  EXPECT_EQ(refused(bad), SimResult::kOperationFailed);
+  bad = set;
+  bad.state.linear_velocity = {1e300, 0.0, 0.0};  // past what the run can report: the controller refuses
+  EXPECT_EQ(refused(bad), SimResult::kOperationFailed);
+  bad = set;
+  bad.state.frame_id = "map";
+  EXPECT_EQ(refused(bad), SimResult::kOperationFailed);
+  bad = set;
+  bad.entity = "body_2";
+  EXPECT_EQ(refused(bad), SimResult::kNotFound);
+  ASSERT_EQ(step(20).result, SimResult::kOk);
+  const auto live = states();
+  ASSERT_EQ(live.states.size(), 2u);
+
+  // The session's commands, as /NS/commands carries them, applied again offline.
+  std::vector<control::ScriptedCommand> script;
+  {
+    const std::lock_guard lock(mu_);
+    for (std::size_t k = 0; k < recorded_.size(); ++k) {
+      Result<control::Command> back = control::from_message(recorded_[k]);
+      ASSERT_TRUE(back.ok()) << back.error().message;
+      script.push_back({back.value(), recorded_[k].success, "command " + std::to_string(k)});
+    }
+  }
+  const auto resimulate = [&](bool with_set) {
+    std::vector<control::ScriptedCommand> commands;
+    for (const control::ScriptedCommand& c : script) {
+      if (with_set || c.command.kind != control::CommandKind::SetState) commands.push_back(c);
+    }
+    control::ScriptedRun run(scene_, kSteps, std::move(commands));
+    std::vector<test::Snapshot> snaps = test::run(scene_, kSteps, &run.controller());
+    EXPECT_TRUE(run.finish("session").ok()) << (run.mismatches().empty() ? "" : run.mismatches()[0]);
+    return snaps.back();
+  };
+  const test::Snapshot again = resimulate(true);
+  ASSERT_EQ(again.step, 30);
+  const std::size_t n = 2;  // the snapshot's columns: x, y, theta, vx, vy, omega of every body
+  for (std::size_t b = 0; b < n; ++b) {
+    EXPECT_EQ(live.states[b].position.x, again.state[0 * n + b]);
+    EXPECT_EQ(live.states[b].position.y, again.state[1 * n + b]);
+    EXPECT_EQ(live.states[b].orientation.z, msgs::quaternion_z(again.state[2 * n + b]).z);
+    EXPECT_EQ(live.states[b].linear_velocity.x, again.state[3 * n + b]);
+    EXPECT_EQ(live.states[b].linear_velocity.y, again.state[4 * n + b]);
+    EXPECT_EQ(live.states[b].angular_velocity.z, again.state[5 * n + b]);
+  }
+  EXPECT_NE(resimulate(false).state, again.state) << "without the set, the run differs";
+}
+
 TEST_P(SimulationServicesTest, FiltersSelectByNameCategoryAndBounds) {
   const World w = stepped(scene_, 0);
   EXPECT_EQ(entities(named("1$")), std::vector<std::string>{"body_1"});
   EXPECT_EQ(entities(named("^body_[0-9]+$")), (std::vector<std::string>{"body_0", "body_1"}));
-  EXPECT_EQ(entities(of_category(sim::Category::DynamicObject)), (std::vector<std::string>{"body_0", "body_1"}));
+  EXPECT_EQ(entities(of_category(sim::Category::DynamicObject)),
+            (std::vector<std::string>{"body_0", "body_1"}));
   EXPECT_TRUE(entities(of_category(sim::Category::Robot)).empty());
 
   // Body 0 is the square x in [-3, -1], body 1 the triangle (2, -1), (2, 1), (4, 0).
@@ -331,7 +446,8 @@ TEST_P(SimulationServicesTest, FiltersSelectByNameCategoryAndBounds) {
   EXPECT_EQ(states(named("(")).result.result, SimResult::kOperationFailed);
   EXPECT_EQ(states(named(std::string(300, 'a'))).result.result, SimResult::kOperationFailed);
   EXPECT_EQ(states(within(sim::BoundsType::Box, {{0, 0, 0}})).result.result, SimResult::kOperationFailed);
-  EXPECT_EQ(states(within(sim::BoundsType::Sphere, {{0, 0, 0}, {-1, 0, 0}})).result.result, SimResult::kOperationFailed);
+  EXPECT_EQ(states(within(sim::BoundsType::Sphere, {{0, 0, 0}, {-1, 0, 0}})).result.result,
+            SimResult::kOperationFailed);
   EXPECT_EQ(states(within(sim::BoundsType::Box, {{0, 0, 0}, {std::nan(""), 0, 0}})).result.result,
             SimResult::kOperationFailed);
   EXPECT_EQ(states(within(static_cast<sim::BoundsType>(7), {})).result.result, SimResult::kOperationFailed);
@@ -359,7 +475,8 @@ TEST_P(SimulationServicesTest, FiltersSelectByNameCategoryAndBounds) {
   for (const std::string name : {"body_2", "body_01", "body_", "body_-1", "Body_0", "body_99999999999"}) {
     sim::GetEntityStateRequest req;
     req.entity = name;
-    EXPECT_EQ(call<sim::GetEntityStateResponse>("get_entity_state", req).result.result, SimResult::kNotFound) << name;
+    EXPECT_EQ(call<sim::GetEntityStateResponse>("get_entity_state", req).result.result, SimResult::kNotFound)
+        << name;
   }
 }
 
@@ -368,7 +485,8 @@ TEST_P(SimulationServicesTest, AMalformedRequestIsAnsweredAsFailed) {
   const auto res = call_raw<sim::GetEntityStateResponse>(
       "get_entity_state", std::string(sim::GetEntityStateRequest::kService), garbage);
   EXPECT_EQ(res.result.result, SimResult::kOperationFailed);
-  EXPECT_NE(res.result.error_message.find("GetEntityState request"), std::string::npos) << res.result.error_message;
+  EXPECT_NE(res.result.error_message.find("GetEntityState request"), std::string::npos)
+      << res.result.error_message;
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, SimulationServicesTest, ::testing::Values("dds", "memory"),

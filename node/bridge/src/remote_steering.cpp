@@ -97,6 +97,8 @@ Result<Request> request_for(const Command& command, const RemoteSteeringOptions&
                           msgs::ApplyImpulseRequest{static_cast<std::uint32_t>(a.body), a.impulse.x(),
                                                     a.impulse.y(), a.point.x(), a.point.y()});
     }
+    case CommandKind::SetState:
+      return Error{"set_entity_state is not relayed: call the node's set_entity_state service"};
   }
   return Error{"unknown command"};
 }
@@ -179,6 +181,8 @@ CommandResult result_of(const Command& command, std::span<const std::byte> reply
       return control_result(decode_reply<msgs::StepResponse>(reply, o));
     case CommandKind::Impulse:
       return control_result(decode_reply<msgs::ApplyImpulseResponse>(reply, o));
+    case CommandKind::SetState:
+      break;  // never sent (make_request refuses it)
   }
   return failed("unknown command");
 }

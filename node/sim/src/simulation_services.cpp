@@ -23,13 +23,16 @@ using control::CommandResult;
 using sim::Result;
 
 // What GetSimulatorFeatures lists: exactly what these services do. Not listed, and answered
-// RESULT_FEATURE_UNSUPPORTED: SetEntityState, tags and convex-hull filters, resetting time or
-// state alone (rbsim's time is its step index, part of its state) and spawned entities (issue 29).
+// RESULT_FEATURE_UNSUPPORTED: tags and convex-hull filters, resetting time or state alone (rbsim's
+// time is its step index, part of its state), spawned entities (issue 29), setting an
+// acceleration, quitting.
 constexpr sim::Feature kFeatures[] = {
-    sim::Feature::EntityBounds,          sim::Feature::EntityBoundsBox,        sim::Feature::EntityCategories,
-    sim::Feature::EntityStateGetting,    sim::Feature::EntityInfoGetting,      sim::Feature::SimulationReset,
-    sim::Feature::SimulationStateGetting, sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
-    sim::Feature::StepSimulationSingle,  sim::Feature::StepSimulationMultiple,
+    sim::Feature::EntityBounds,           sim::Feature::EntityBoundsBox,
+    sim::Feature::EntityCategories,       sim::Feature::EntityStateGetting,
+    sim::Feature::EntityStateSetting,     sim::Feature::EntityInfoGetting,
+    sim::Feature::SimulationReset,        sim::Feature::SimulationStateGetting,
+    sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
+    sim::Feature::StepSimulationSingle,   sim::Feature::StepSimulationMultiple,
 };
 constexpr std::size_t kMaxFilterBytes = 256;  // a longer name pattern is refused before it is compiled
 
@@ -89,7 +92,8 @@ bool inside(std::span<const Vec2> poly, const Vec2& p) {
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
     const Vec2& a = poly[i];
     const Vec2& b = poly[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
       in = !in;
   }
   return poly.size() >= 3 && in;
@@ -138,12 +142,14 @@ std::optional<Result> read_bounds(const sim::Bounds& in, BoundsFilter& out) {
     case sim::BoundsType::Empty:
       return std::nullopt;
     case sim::BoundsType::ConvexHull:
-      return failure(Result::kFeatureUnsupported,
-                     "filters.bounds: TYPE_CONVEX_HULL is not supported (ENTITY_BOUNDS_CONVEX is not listed)");
+      return failure(
+          Result::kFeatureUnsupported,
+          "filters.bounds: TYPE_CONVEX_HULL is not supported (ENTITY_BOUNDS_CONVEX is not listed)");
     case sim::BoundsType::Box: {
       if (in.points.size() != 2)
-        return failure(Result::kOperationFailed, "filters.bounds: TYPE_BOX takes 2 points (two opposite corners), got " +
-                                                     std::to_string(in.points.size()));
+        return failure(Result::kOperationFailed,
+                       "filters.bounds: TYPE_BOX takes 2 points (two opposite corners), got " +
+                           std::to_string(in.points.size()));
       const sim::Vector3 &a = in.points[0], &b = in.points[1];
       out.lo = {std::min(a.x, b.x), std::min(a.y, b.y)};
       out.hi = {std::max(a.x, b.x), std::max(a.y, b.y)};
@@ -185,20 +191,23 @@ struct Filters {
 
   std::optional<Result> read(const sim::EntityFilters& in) {
     if (!in.tags.tags.empty())
-      return failure(Result::kFeatureUnsupported, "filters.tags: entity tags are not supported (ENTITY_TAGS is not listed)");
+      return failure(Result::kFeatureUnsupported,
+                     "filters.tags: entity tags are not supported (ENTITY_TAGS is not listed)");
     if (in.filter.size() > kMaxFilterBytes)
-      return failure(Result::kOperationFailed, "filters.filter: longer than " + std::to_string(kMaxFilterBytes) + " bytes");
+      return failure(Result::kOperationFailed,
+                     "filters.filter: longer than " + std::to_string(kMaxFilterBytes) + " bytes");
     if (!in.filter.empty()) {
       try {
         name.emplace(in.filter, std::regex::extended | std::regex::nosubs);
       } catch (const std::regex_error& e) {
-        return failure(Result::kOperationFailed,
-                       "filters.filter: not a POSIX extended regular expression (" + std::string(e.what()) + ")");
+        return failure(Result::kOperationFailed, "filters.filter: not a POSIX extended regular expression (" +
+                                                     std::string(e.what()) + ")");
       }
     }
-    dynamic_objects = in.categories.empty() ||
-                      std::find(in.categories.begin(), in.categories.end(),
-                                static_cast<std::uint8_t>(sim::Category::DynamicObject)) != in.categories.end();
+    dynamic_objects =
+        in.categories.empty() ||
+        std::find(in.categories.begin(), in.categories.end(),
+                  static_cast<std::uint8_t>(sim::Category::DynamicObject)) != in.categories.end();
     return read_bounds(in.bounds, bounds);
   }
 
@@ -210,7 +219,8 @@ struct Filters {
       if (name && !std::regex_search(msgs::body_frame("", i), *name)) continue;
       const BodyId b{i};
       hull.resize(world.hull(b).size());
-      for (std::size_t v = 0; v < hull.size(); ++v) hull[v] = world.world_vertex(b, static_cast<std::int32_t>(v));
+      for (std::size_t v = 0; v < hull.size(); ++v)
+        hull[v] = world.world_vertex(b, static_cast<std::int32_t>(v));
       if (overlaps(bounds, hull)) out.push_back(i);
     }
     return out;
@@ -244,30 +254,32 @@ auto at_boundary(control::Controller& controller, double timeout_s, F f, std::in
         promise->set_value(world ? std::optional<T>(f(*world)) : std::nullopt);
       },
       at_step);
-  if (answer.wait_for(std::chrono::duration<double>(timeout_s)) != std::future_status::ready) return std::nullopt;
+  if (answer.wait_for(std::chrono::duration<double>(timeout_s)) != std::future_status::ready)
+    return std::nullopt;
   return answer.get();
 }
 
 Result unanswered(double timeout_s) {
-  return failure(Result::kOperationFailed,
-                 "the run loop did not reach a step boundary within " + std::to_string(timeout_s) + " s (or the run ended)");
+  return failure(Result::kOperationFailed, "the run loop did not reach a step boundary within " +
+                                               std::to_string(timeout_s) + " s (or the run ended)");
 }
 
 }  // namespace
 
 void SimulationServices::add(std::vector<Entry>& out) {
-  out.emplace_back("get_simulator_features", std::string(sim::GetSimulatorFeaturesRequest::kService),
-                   typed_handler<sim::GetSimulatorFeaturesRequest, sim::GetSimulatorFeaturesResponse>(
-                       [](const RequestHeader&, const sim::GetSimulatorFeaturesRequest&) {
-                         sim::GetSimulatorFeaturesResponse res;
-                         for (const sim::Feature f : kFeatures)
-                           res.features.features.push_back(static_cast<std::uint16_t>(f));
-                         res.features.custom_info =
-                             "rbsim: every body is an entity body_<i> (CATEGORY_DYNAMIC_OBJECT); state changes "
-                             "are recorded on <node>/commands and re-simulate exactly";
-                         return res;
-                       },
-                       [](const Error&) { return std::optional<sim::GetSimulatorFeaturesResponse>(); }));
+  out.emplace_back(
+      "get_simulator_features", std::string(sim::GetSimulatorFeaturesRequest::kService),
+      typed_handler<sim::GetSimulatorFeaturesRequest, sim::GetSimulatorFeaturesResponse>(
+          [](const RequestHeader&, const sim::GetSimulatorFeaturesRequest&) {
+            sim::GetSimulatorFeaturesResponse res;
+            for (const sim::Feature f : kFeatures)
+              res.features.features.push_back(static_cast<std::uint16_t>(f));
+            res.features.custom_info =
+                "rbsim: every body is an entity body_<i> (CATEGORY_DYNAMIC_OBJECT); state changes "
+                "are recorded on <node>/commands and re-simulate exactly";
+            return res;
+          },
+          [](const Error&) { return std::optional<sim::GetSimulatorFeaturesResponse>(); }));
   add_state(out);
   add_entities(out);
 }
@@ -287,41 +299,44 @@ void SimulationServices::add_state(std::vector<Entry>& out) {
     c.kind = kind;
     return apply_(std::move(c));
   };
-  out.emplace_back("get_simulation_state", std::string(sim::GetSimulationStateRequest::kService),
-                   typed_handler<sim::GetSimulationStateRequest, sim::GetSimulationStateResponse>(
-                       [this, state_now](const RequestHeader&, const sim::GetSimulationStateRequest&) {
-                         const std::optional<sim::State> st = state_now();
-                         if (!st) return sim::GetSimulationStateResponse{0, unanswered(timeout_s_)};
-                         return sim::GetSimulationStateResponse{static_cast<std::uint8_t>(*st), ok()};
-                       },
-                       [](const Error& e) {
-                         return std::optional<sim::GetSimulationStateResponse>(
-                             sim::GetSimulationStateResponse{0, failure(Result::kOperationFailed, e.message)});
-                       }));
-  out.emplace_back("set_simulation_state", std::string(sim::SetSimulationStateRequest::kService),
-                   typed_handler<sim::SetSimulationStateRequest, sim::SetSimulationStateResponse>(
-                       [this, state_now, command](const RequestHeader&, const sim::SetSimulationStateRequest& req) {
-                         return sim::SetSimulationStateResponse{set_state(req.state, state_now, command)};
-                       },
-                       refuse_malformed<sim::SetSimulationStateResponse>()));
-  out.emplace_back("reset_simulation", std::string(sim::ResetSimulationRequest::kService),
-                   typed_handler<sim::ResetSimulationRequest, sim::ResetSimulationResponse>(
-                       [command](const RequestHeader&, const sim::ResetSimulationRequest& req) {
-                         using R = sim::ResetSimulationRequest;
-                         // Time and state are one in rbsim (the step index is part of the world's
-                         // state): a reset of both is the full one; and nothing is ever spawned.
-                         if (req.scope != R::kScopeDefault && req.scope != R::kScopeAll &&
-                             req.scope != (R::kScopeTime | R::kScopeState)) {
-                           return sim::ResetSimulationResponse{failure(
-                               Result::kFeatureUnsupported,
-                               "scope " + std::to_string(req.scope) +
-                                   ": only SCOPE_DEFAULT, SCOPE_ALL or SCOPE_TIME | SCOPE_STATE (a full reset to step 0)")};
-                         }
-                         const CommandResult r = command(CommandKind::Reset);
-                         return sim::ResetSimulationResponse{r.successful ? ok()
-                                                                          : failure(Result::kOperationFailed, r.message)};
-                       },
-                       refuse_malformed<sim::ResetSimulationResponse>()));
+  out.emplace_back(
+      "get_simulation_state", std::string(sim::GetSimulationStateRequest::kService),
+      typed_handler<sim::GetSimulationStateRequest, sim::GetSimulationStateResponse>(
+          [this, state_now](const RequestHeader&, const sim::GetSimulationStateRequest&) {
+            const std::optional<sim::State> st = state_now();
+            if (!st) return sim::GetSimulationStateResponse{0, unanswered(timeout_s_)};
+            return sim::GetSimulationStateResponse{static_cast<std::uint8_t>(*st), ok()};
+          },
+          [](const Error& e) {
+            return std::optional<sim::GetSimulationStateResponse>(
+                sim::GetSimulationStateResponse{0, failure(Result::kOperationFailed, e.message)});
+          }));
+  out.emplace_back(
+      "set_simulation_state", std::string(sim::SetSimulationStateRequest::kService),
+      typed_handler<sim::SetSimulationStateRequest, sim::SetSimulationStateResponse>(
+          [this, state_now, command](const RequestHeader&, const sim::SetSimulationStateRequest& req) {
+            return sim::SetSimulationStateResponse{set_state(req.state, state_now, command)};
+          },
+          refuse_malformed<sim::SetSimulationStateResponse>()));
+  out.emplace_back(
+      "reset_simulation", std::string(sim::ResetSimulationRequest::kService),
+      typed_handler<sim::ResetSimulationRequest, sim::ResetSimulationResponse>(
+          [command](const RequestHeader&, const sim::ResetSimulationRequest& req) {
+            using R = sim::ResetSimulationRequest;
+            // Time and state are one in rbsim (the step index is part of the world's
+            // state): a reset of both is the full one; and nothing is ever spawned.
+            if (req.scope != R::kScopeDefault && req.scope != R::kScopeAll &&
+                req.scope != (R::kScopeTime | R::kScopeState)) {
+              return sim::ResetSimulationResponse{
+                  failure(Result::kFeatureUnsupported, "scope " + std::to_string(req.scope) +
+                                                           ": only SCOPE_DEFAULT, SCOPE_ALL or SCOPE_TIME | "
+                                                           "SCOPE_STATE (a full reset to step 0)")};
+            }
+            const CommandResult r = command(CommandKind::Reset);
+            return sim::ResetSimulationResponse{r.successful ? ok()
+                                                             : failure(Result::kOperationFailed, r.message)};
+          },
+          refuse_malformed<sim::ResetSimulationResponse>()));
   out.emplace_back("step_simulation", std::string(sim::StepSimulationRequest::kService),
                    typed_handler<sim::StepSimulationRequest, sim::StepSimulationResponse>(
                        [this](const RequestHeader&, const sim::StepSimulationRequest& req) {
@@ -338,9 +353,11 @@ Result SimulationServices::set_state(std::uint8_t target, const StateNow& state_
   using R = sim::SetSimulationStateResponse;
   const auto to = static_cast<sim::State>(target);
   if (to == sim::State::Quitting)
-    return failure(Result::kFeatureUnsupported, "STATE_QUITTING is not supported: stop the node with SIGINT or SIGTERM");
+    return failure(Result::kFeatureUnsupported,
+                   "STATE_QUITTING is not supported: stop the node with SIGINT or SIGTERM");
   if (to != sim::State::Playing && to != sim::State::Paused && to != sim::State::Stopped)
-    return failure(R::kIncorrectTransition, "state " + std::to_string(target) + ": rbsim has one world, always loaded");
+    return failure(R::kIncorrectTransition,
+                   "state " + std::to_string(target) + ": rbsim has one world, always loaded");
   const std::optional<sim::State> now = state_now();
   if (!now) return unanswered(timeout_s_);
   if (*now == to) return failure(R::kAlreadyInTargetState, "already in the target state");
@@ -371,14 +388,78 @@ Result SimulationServices::step(std::uint64_t steps) {
   // Stepping takes its own time: at most the run's pace for these steps, on top of the wait.
   const control::RunSettings settings = controller_.settings();
   const double pace = settings.rate > 0.0 ? static_cast<double>(steps) * dt_ / settings.rate : 0.0;
-  const std::optional<std::int64_t> reached =
-      at_boundary(controller_, timeout_s_ + 2.0 * pace, [](const World& w) { return w.step_index(); }, target);
+  const std::optional<std::int64_t> reached = at_boundary(
+      controller_, timeout_s_ + 2.0 * pace, [](const World& w) { return w.step_index(); }, target);
   if (!reached) return unanswered(timeout_s_ + 2.0 * pace);
   if (*reached < target) {
-    return failure(Result::kOperationFailed, "stepping stopped at step " + std::to_string(*reached) + " short of step " +
-                                                 std::to_string(target) + " (a reset or a pause came first)");
+    return failure(Result::kOperationFailed, "stepping stopped at step " + std::to_string(*reached) +
+                                                 " short of step " + std::to_string(target) +
+                                                 " (a reset or a pause came first)");
   }
   return ok();
+}
+
+// Checks SetEntityState's request against a planar world and makes its StateArgs (body unset): a
+// Result when it is refused.
+std::optional<Result> state_args(const sim::SetEntityStateRequest& req, control::StateArgs& a) {
+  using R = sim::SetEntityStateResponse;
+  const sim::EntityState& s = req.state;
+  if (req.set_acceleration) {
+    return failure(Result::kFeatureUnsupported,
+                   "set_acceleration: a body's acceleration is its forces' (gravity, springs, wind) over its "
+                   "mass and inertia; set the pose or the twist");
+  }
+  if (!s.frame_id.empty() && s.frame_id != "world")
+    return failure(Result::kOperationFailed,
+                   "state.header.frame_id '" + s.frame_id + "': only 'world' (or empty)");
+  if (req.set_pose) {
+    const msgs::Quaternion& q = s.orientation;
+    const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    for (double v : {s.position.x, s.position.y, s.position.z, q.x, q.y, q.z, q.w}) {
+      if (!std::isfinite(v)) return failure(R::kInvalidPose, "the pose must be finite");
+    }
+    if (s.position.z != 0.0) return failure(R::kInvalidPose, "position.z must be 0 (a planar world)");
+    // A unit quaternion of a rotation about +z: (0, 0, sin(theta/2), cos(theta/2)).
+    if (std::abs(norm - 1.0) > 1e-9)
+      return failure(R::kInvalidPose, "the orientation is not a unit quaternion");
+    if (std::abs(q.x) > 1e-9 || std::abs(q.y) > 1e-9)
+      return failure(R::kInvalidPose, "the orientation must be a rotation about z (x and y 0)");
+    a.set_pose = true;
+    a.position = Vec2(s.position.x, s.position.y);
+    a.theta = 2.0 * std::atan2(q.z, q.w);
+  }
+  if (req.set_twist) {
+    const sim::Vector3 &v = s.linear_velocity, &w = s.angular_velocity;
+    for (double x : {v.x, v.y, v.z, w.x, w.y, w.z}) {
+      if (!std::isfinite(x)) return failure(Result::kOperationFailed, "the twist must be finite");
+    }
+    if (v.z != 0.0 || w.x != 0.0 || w.y != 0.0)
+      return failure(Result::kOperationFailed,
+                     "a planar world: twist.linear.z, angular.x and angular.y must be 0");
+    a.set_twist = true;
+    a.velocity = Vec2(v.x, v.y);
+    a.omega = w.z;
+  }
+  return std::nullopt;
+}
+
+// SetEntityState: the pose and/or twist as a command, applied at the next step boundary (while
+// paused, the current one: a get right after the reply reads the new state).
+Result SimulationServices::set_entity_state(const sim::SetEntityStateRequest& req) {
+  Command c;
+  c.kind = CommandKind::SetState;
+  if (std::optional<Result> refused = state_args(req, c.state)) return *refused;
+  if (!c.state.set_pose && !c.state.set_twist)
+    return failure(Result::kOk, "nothing to set (set_pose and set_twist false)");
+  const std::optional<std::int32_t> bodies =
+      at_boundary(controller_, timeout_s_, [](const World& w) { return w.body_count(); });
+  if (!bodies) return unanswered(timeout_s_);
+  const std::optional<std::int32_t> body = body_of(req.entity, *bodies);
+  if (!body)
+    return failure(Result::kNotFound, "no entity '" + req.entity + "' (entities are body_0 .. body_<n-1>)");
+  c.state.body = *body;
+  const CommandResult r = apply_(std::move(c));
+  return r.successful ? ok() : failure(Result::kOperationFailed, r.message);
 }
 
 // The entities: every body, body_<i>, CATEGORY_DYNAMIC_OBJECT.
@@ -389,34 +470,37 @@ void SimulationServices::add_entities(std::vector<Entry>& out) {
                    typed_handler<sim::GetEntitiesRequest, sim::GetEntitiesResponse>(
                        [this, read](const RequestHeader&, const sim::GetEntitiesRequest& req) {
                          auto filters = std::make_shared<Filters>();
-                         if (std::optional<Result> bad = filters->read(req.filters)) return sim::GetEntitiesResponse{*bad, {}};
+                         if (std::optional<Result> bad = filters->read(req.filters))
+                           return sim::GetEntitiesResponse{*bad, {}};
                          std::optional<sim::GetEntitiesResponse> res = read([filters](const World& w) {
                            std::vector<Vec2> hull;
                            sim::GetEntitiesResponse r{ok(), {}};
-                           for (const std::int32_t i : filters->select(w, hull)) r.entities.push_back(msgs::body_frame("", i));
+                           for (const std::int32_t i : filters->select(w, hull))
+                             r.entities.push_back(msgs::body_frame("", i));
                            return r;
                          });
                          return res ? std::move(*res) : sim::GetEntitiesResponse{unanswered(timeout_s_), {}};
                        },
                        refuse_malformed<sim::GetEntitiesResponse>()));
-  out.emplace_back("get_entities_states", std::string(sim::GetEntitiesStatesRequest::kService),
-                   typed_handler<sim::GetEntitiesStatesRequest, sim::GetEntitiesStatesResponse>(
-                       [this, read](const RequestHeader&, const sim::GetEntitiesStatesRequest& req) {
-                         auto filters = std::make_shared<Filters>();
-                         if (std::optional<Result> bad = filters->read(req.filters))
-                           return sim::GetEntitiesStatesResponse{*bad, {}, {}};
-                         std::optional<sim::GetEntitiesStatesResponse> res = read([filters](const World& w) {
-                           std::vector<Vec2> hull;
-                           sim::GetEntitiesStatesResponse r{ok(), {}, {}};
-                           for (const std::int32_t i : filters->select(w, hull)) {
-                             r.entities.push_back(msgs::body_frame("", i));
-                             r.states.push_back(entity_state(w, BodyId{i}));
-                           }
-                           return r;
-                         });
-                         return res ? std::move(*res) : sim::GetEntitiesStatesResponse{unanswered(timeout_s_), {}, {}};
-                       },
-                       refuse_malformed<sim::GetEntitiesStatesResponse>()));
+  out.emplace_back(
+      "get_entities_states", std::string(sim::GetEntitiesStatesRequest::kService),
+      typed_handler<sim::GetEntitiesStatesRequest, sim::GetEntitiesStatesResponse>(
+          [this, read](const RequestHeader&, const sim::GetEntitiesStatesRequest& req) {
+            auto filters = std::make_shared<Filters>();
+            if (std::optional<Result> bad = filters->read(req.filters))
+              return sim::GetEntitiesStatesResponse{*bad, {}, {}};
+            std::optional<sim::GetEntitiesStatesResponse> res = read([filters](const World& w) {
+              std::vector<Vec2> hull;
+              sim::GetEntitiesStatesResponse r{ok(), {}, {}};
+              for (const std::int32_t i : filters->select(w, hull)) {
+                r.entities.push_back(msgs::body_frame("", i));
+                r.states.push_back(entity_state(w, BodyId{i}));
+              }
+              return r;
+            });
+            return res ? std::move(*res) : sim::GetEntitiesStatesResponse{unanswered(timeout_s_), {}, {}};
+          },
+          refuse_malformed<sim::GetEntitiesStatesResponse>()));
   add_entity(out);
 }
 
@@ -431,7 +515,9 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
           return f(w, BodyId{*i});
         });
     if (!got) return Res{unanswered(timeout_s_), {}};
-    if (!*got) return Res{failure(Result::kNotFound, "no entity '" + entity + "' (entities are body_0 .. body_<n-1>)"), {}};
+    if (!*got)
+      return Res{failure(Result::kNotFound, "no entity '" + entity + "' (entities are body_0 .. body_<n-1>)"),
+                 {}};
     return Res{ok(), std::move(**got)};
   };
   out.emplace_back("get_entity_info", std::string(sim::GetEntityInfoRequest::kService),
@@ -442,9 +528,9 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
                                sim::EntityInfo info;
                                info.category = static_cast<std::uint8_t>(sim::Category::DynamicObject);
                                info.description = "rigid body " + std::to_string(b.index) + ": " +
-                                                  std::to_string(w.hull(b).size()) + " point masses, M = " +
-                                                  std::to_string(w.mass(b)) + " kg, I = " +
-                                                  std::to_string(w.inertia(b)) + " kg m^2";
+                                                  std::to_string(w.hull(b).size()) +
+                                                  " point masses, M = " + std::to_string(w.mass(b)) +
+                                                  " kg, I = " + std::to_string(w.inertia(b)) + " kg m^2";
                                return info;
                              });
                        },
@@ -475,10 +561,8 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
                        refuse_malformed<sim::GetEntityBoundsResponse>()));
   out.emplace_back("set_entity_state", std::string(sim::SetEntityStateRequest::kService),
                    typed_handler<sim::SetEntityStateRequest, sim::SetEntityStateResponse>(
-                       [](const RequestHeader&, const sim::SetEntityStateRequest&) {
-                         return sim::SetEntityStateResponse{
-                             failure(Result::kFeatureUnsupported,
-                                     "SetEntityState is not supported yet (ENTITY_STATE_SETTING is not listed)")};
+                       [this](const RequestHeader&, const sim::SetEntityStateRequest& req) {
+                         return sim::SetEntityStateResponse{set_entity_state(req)};
                        },
                        refuse_malformed<sim::SetEntityStateResponse>()));
 }

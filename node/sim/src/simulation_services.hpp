@@ -44,6 +44,7 @@ class SimulationServices {
   void add_state(std::vector<Entry>& out);
   msgs::simulation::Result set_state(std::uint8_t target, const StateNow& state_now, const Run& command);
   msgs::simulation::Result step(std::uint64_t steps);
+  msgs::simulation::Result set_entity_state(const msgs::simulation::SetEntityStateRequest& req);
   void add_entities(std::vector<Entry>& out);
   void add_entity(std::vector<Entry>& out);
 };

@@ -41,6 +41,8 @@ const char* to_string(CommandKind kind) {
       return "reset";
     case CommandKind::Impulse:
       return "apply_impulse";
+    case CommandKind::SetState:
+      return "set_entity_state";
   }
   return "?";
 }
@@ -384,6 +386,11 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       boundary.state_changed |= applied.successful;
       return applied;
     }
+    case CommandKind::SetState: {
+      CommandResult applied = set_state(command, world);
+      boundary.state_changed |= applied.successful;
+      return applied;
+    }
   }
   return failed("unknown command");
 }
@@ -471,6 +478,42 @@ CommandResult Controller::impulse(const Command& command, World& world) {
   CommandResult r;
   r.successful = true;
   r.message = "impulse applied to body " + std::to_string(a.body) + " at " + at(now);
+  return r;
+}
+
+CommandResult Controller::set_state(const Command& command, World& world) {
+  const StateArgs& a = command.state;
+  if (a.body < 0 || a.body >= world.body_count()) {
+    return failed("set_entity_state: no body " + std::to_string(a.body) + " (the scene has " +
+                  std::to_string(world.body_count()) + " bodies)");
+  }
+  if (!a.set_pose && !a.set_twist) return failed("set_entity_state: neither the pose nor the twist is set");
+  // The same bound as an impulse's: every quantity the run reports stays finite from this state.
+  const double bound = world.finite_bound();
+  for (double v : {a.position.x(), a.position.y(), a.theta, a.velocity.x(), a.velocity.y(), a.omega}) {
+    if (!std::isfinite(v) || (bound > 0.0 && std::abs(v) > bound)) {
+      return failed("set_entity_state: body " + std::to_string(a.body) +
+                    ": every value must be finite and within the range the run can report");
+    }
+  }
+  const BodyId body{static_cast<std::int32_t>(a.body)};
+  BodyState s = world.state(body);
+  if (a.set_pose) {
+    s.position = a.position;
+    s.theta = a.theta;
+  }
+  if (a.set_twist) {
+    s.velocity = a.velocity;
+    s.omega = a.omega;
+  }
+  world.set_state(body, s);
+  CommandResult r;
+  r.successful = true;
+  r.message = std::string("set body ") + std::to_string(a.body) + "'s " +
+              (a.set_pose && a.set_twist ? "pose and twist"
+               : a.set_pose              ? "pose"
+                                         : "twist") +
+              " at " + at(world.step_index());
   return r;
 }
 

@@ -61,3 +61,13 @@ Status decode_message(std::span<const std::byte> cdr, T& out, std::string_view h
 }
 
 }  // namespace rbsim::msgs::detail
+
+// Defines encode() and decode() of type T (declared in its public header) on the put() and get()
+// overloads in scope where it is expanded; `half` names a service half in errors (" request").
+#define RBSIM_DEFINE_CODEC(T, half)                                                    \
+  void encode(const T& message, Bytes& out) {                                          \
+    detail::encode_message(message, out, [](CdrWriter& w, const T& m) { put(w, m); }); \
+  }                                                                                    \
+  Status decode(std::span<const std::byte> cdr, T& out) {                              \
+    return detail::decode_message(cdr, out, half, [](Reader& r, T& m) { get(r, m); }); \
+  }

@@ -271,39 +271,31 @@ void get(Reader& r, GetEntityBoundsResponse& m) {
 
 }  // namespace
 
-#define RBSIM_SIMULATION_CODEC(T, half)                                                  \
-  void encode(const T& message, Bytes& out) {                                            \
-    detail::encode_message(message, out, [](CdrWriter& w, const T& m) { put(w, m); });   \
-  }                                                                                      \
-  Status decode(std::span<const std::byte> cdr, T& out) {                                \
-    return detail::decode_message(cdr, out, half, [](Reader& r, T& m) { get(r, m); });   \
-  }
-RBSIM_SIMULATION_CODEC(SimulatorFeatures, "")
-RBSIM_SIMULATION_CODEC(Bounds, "")
-RBSIM_SIMULATION_CODEC(EntityFilters, "")
-RBSIM_SIMULATION_CODEC(EntityState, "")
-RBSIM_SIMULATION_CODEC(GetSimulatorFeaturesRequest, " request")
-RBSIM_SIMULATION_CODEC(GetSimulatorFeaturesResponse, " response")
-RBSIM_SIMULATION_CODEC(GetSimulationStateRequest, " request")
-RBSIM_SIMULATION_CODEC(GetSimulationStateResponse, " response")
-RBSIM_SIMULATION_CODEC(SetSimulationStateRequest, " request")
-RBSIM_SIMULATION_CODEC(SetSimulationStateResponse, " response")
-RBSIM_SIMULATION_CODEC(ResetSimulationRequest, " request")
-RBSIM_SIMULATION_CODEC(ResetSimulationResponse, " response")
-RBSIM_SIMULATION_CODEC(StepSimulationRequest, " request")
-RBSIM_SIMULATION_CODEC(StepSimulationResponse, " response")
-RBSIM_SIMULATION_CODEC(GetEntitiesRequest, " request")
-RBSIM_SIMULATION_CODEC(GetEntitiesResponse, " response")
-RBSIM_SIMULATION_CODEC(GetEntitiesStatesRequest, " request")
-RBSIM_SIMULATION_CODEC(GetEntitiesStatesResponse, " response")
-RBSIM_SIMULATION_CODEC(GetEntityInfoRequest, " request")
-RBSIM_SIMULATION_CODEC(GetEntityInfoResponse, " response")
-RBSIM_SIMULATION_CODEC(GetEntityStateRequest, " request")
-RBSIM_SIMULATION_CODEC(GetEntityStateResponse, " response")
-RBSIM_SIMULATION_CODEC(SetEntityStateRequest, " request")
-RBSIM_SIMULATION_CODEC(SetEntityStateResponse, " response")
-RBSIM_SIMULATION_CODEC(GetEntityBoundsRequest, " request")
-RBSIM_SIMULATION_CODEC(GetEntityBoundsResponse, " response")
-#undef RBSIM_SIMULATION_CODEC
+RBSIM_DEFINE_CODEC(SimulatorFeatures, "")
+RBSIM_DEFINE_CODEC(Bounds, "")
+RBSIM_DEFINE_CODEC(EntityFilters, "")
+RBSIM_DEFINE_CODEC(EntityState, "")
+RBSIM_DEFINE_CODEC(GetSimulatorFeaturesRequest, " request")
+RBSIM_DEFINE_CODEC(GetSimulatorFeaturesResponse, " response")
+RBSIM_DEFINE_CODEC(GetSimulationStateRequest, " request")
+RBSIM_DEFINE_CODEC(GetSimulationStateResponse, " response")
+RBSIM_DEFINE_CODEC(SetSimulationStateRequest, " request")
+RBSIM_DEFINE_CODEC(SetSimulationStateResponse, " response")
+RBSIM_DEFINE_CODEC(ResetSimulationRequest, " request")
+RBSIM_DEFINE_CODEC(ResetSimulationResponse, " response")
+RBSIM_DEFINE_CODEC(StepSimulationRequest, " request")
+RBSIM_DEFINE_CODEC(StepSimulationResponse, " response")
+RBSIM_DEFINE_CODEC(GetEntitiesRequest, " request")
+RBSIM_DEFINE_CODEC(GetEntitiesResponse, " response")
+RBSIM_DEFINE_CODEC(GetEntitiesStatesRequest, " request")
+RBSIM_DEFINE_CODEC(GetEntitiesStatesResponse, " response")
+RBSIM_DEFINE_CODEC(GetEntityInfoRequest, " request")
+RBSIM_DEFINE_CODEC(GetEntityInfoResponse, " response")
+RBSIM_DEFINE_CODEC(GetEntityStateRequest, " request")
+RBSIM_DEFINE_CODEC(GetEntityStateResponse, " response")
+RBSIM_DEFINE_CODEC(SetEntityStateRequest, " request")
+RBSIM_DEFINE_CODEC(SetEntityStateResponse, " response")
+RBSIM_DEFINE_CODEC(GetEntityBoundsRequest, " request")
+RBSIM_DEFINE_CODEC(GetEntityBoundsResponse, " response")
 
 }  // namespace rbsim::msgs::simulation

@@ -33,9 +33,9 @@
 
 namespace rbsim::control {
 
-enum class CommandKind : std::uint8_t { SetParameters, Pause, Resume, Step, Reset, Impulse };
-const char* to_string(
-    CommandKind kind);  // "set_parameters", "pause", "resume", "step", "reset", "apply_impulse"
+enum class CommandKind : std::uint8_t { SetParameters, Pause, Resume, Step, Reset, Impulse, SetState };
+// "set_parameters", "pause", "resume", "step", "reset", "apply_impulse", "set_entity_state"
+const char* to_string(CommandKind kind);
 
 // A linear impulse J (N s, world axes) at the point p (m, body frame, relative to the centre of
 // mass) of body `body`: V += J / M, omega += ((R(theta) p) x J) / I (World::apply_impulse).
@@ -43,6 +43,19 @@ struct ImpulseArgs {
   std::int64_t body = 0;  // as received: checked against the body count when applied
   Vec2 impulse{0.0, 0.0};
   Vec2 point{0.0, 0.0};
+};
+
+// The state of body `body` set at a step boundary (simulation_interfaces' SetEntityState): its pose
+// (centre of mass X in m, world frame; theta in rad, CCW > 0) and/or its velocities (V in m/s,
+// omega in rad/s), the rest kept. The forces are not state: the next step computes them afresh.
+struct StateArgs {
+  std::int64_t body = 0;  // as received: checked against the body count when applied
+  bool set_pose = false;
+  bool set_twist = false;
+  Vec2 position{0.0, 0.0};
+  double theta = 0.0;
+  Vec2 velocity{0.0, 0.0};
+  double omega = 0.0;
 };
 
 // One control input as data (issue 23 records these as rbsim_msgs/msg/Command).
@@ -59,6 +72,7 @@ struct Command {
   double pause_seconds = 0.0;         // Pause: resume by itself after this much wall time (0: stay
                                       // paused until a Resume); wall time only, never the run
   ImpulseArgs impulse;                // Impulse
+  StateArgs state;                    // SetState
   std::string source;                 // "ros2 service", "foxglove", "script", ...
 };
 
@@ -180,6 +194,7 @@ class Controller final : public StepHook, public Steering {
   CommandResult execute(Command& command, World& world, Boundary& boundary);
   CommandResult set_parameters(const Command& command, World& world, Boundary& boundary);
   CommandResult impulse(const Command& command, World& world);
+  CommandResult set_state(const Command& command, World& world);
   void settings_changed(Boundary& boundary);
   // Applies one command now (from the schedule, or a timed pause's own resume): result, counters,
   // observer and callback.

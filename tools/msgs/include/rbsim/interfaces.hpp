@@ -119,7 +119,10 @@ struct CommandMessage {
     Resume = 2,
     Step = 3,
     Reset = 4,
-    ApplyImpulse = 5
+    ApplyImpulse = 5,
+    // Not a constant of Command.msg (whose text recordings are checked against): set_entity_state,
+    // its values in `parameters` (x, y, theta; vx, vy, omega) and its body in `body`.
+    SetEntityState = 6
   };
   std::uint64_t seq = 0;  // the sequence number (`sequence` is an IDL keyword)
   std::uint64_t step = 0;

@@ -76,7 +76,14 @@ struct SimulatorFeatures {
 };
 
 // simulation_interfaces/msg/SimulationState's values.
-enum class State : std::uint8_t { Stopped = 0, Playing = 1, Paused = 2, Quitting = 3, NoWorld = 4, LoadingWorld = 5 };
+enum class State : std::uint8_t {
+  Stopped = 0,
+  Playing = 1,
+  Paused = 2,
+  Quitting = 3,
+  NoWorld = 4,
+  LoadingWorld = 5
+};
 
 // simulation_interfaces/msg/EntityCategory's values.
 enum class Category : std::uint8_t { Object = 0, Robot = 1, Human = 2, DynamicObject = 4, StaticObject = 5 };
