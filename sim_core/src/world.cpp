@@ -241,6 +241,21 @@ std::span<const Vec2> World::hull(BodyId b) const {
   return {shape_vertices_.data() + s.first, static_cast<std::size_t>(s.count)};
 }
 
+bool polygon_contains(std::span<const Vec2> polygon, const Vec2& q) {
+  // Each edge crossing the horizontal line through q, with q on its left going up (+1) or on its
+  // right going down (-1): the sum is how often the boundary winds around q.
+  int winding = 0;
+  for (std::size_t k = 0; k < polygon.size(); ++k) {
+    const Vec2& a = polygon[k];
+    const Vec2& e = polygon[(k + 1) % polygon.size()];
+    const Vec2 edge = e - a, to_q = q - a;
+    const double side = edge.x() * to_q.y() - edge.y() * to_q.x();  // (e - a) x (q - a)
+    if (a.y() <= q.y() && e.y() > q.y() && side > 0) ++winding;
+    if (a.y() > q.y() && e.y() <= q.y() && side < 0) --winding;
+  }
+  return winding != 0;
+}
+
 Vec2 World::world_vertex(BodyId b, std::int32_t vertex) const {
   const Vec2& r0 = hull(b)[vertex];
   const double c = std::cos(theta_[b.index]), s = std::sin(theta_[b.index]);

@@ -155,5 +155,24 @@ TEST(WorldCreate, BitIdenticalHullsShareOneShape) {
   EXPECT_EQ(w.state(BodyId{1}).position, Vec2(10.0, 0.0));
 }
 
+// polygon_contains: a hull's inside by winding number, in either vertex order, a concave notch
+// outside, and a 2-vertex hull (a rod) enclosing nothing.
+TEST(PolygonContains, InsideByWindingInEitherOrder) {
+  const std::vector<Vec2> square{{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  const std::vector<Vec2> clockwise(square.rbegin(), square.rend());
+  for (const auto& hull : {square, clockwise}) {
+    EXPECT_TRUE(polygon_contains(hull, Vec2(0.0, 0.0)));
+    EXPECT_TRUE(polygon_contains(hull, Vec2(0.99, -0.99)));
+    EXPECT_FALSE(polygon_contains(hull, Vec2(1.01, 0.0)));
+    EXPECT_FALSE(polygon_contains(hull, Vec2(0.0, -1.5)));
+  }
+  // A U shape: the notch between its arms is outside.
+  const std::vector<Vec2> u{{0, 0}, {3, 0}, {3, 3}, {2, 3}, {2, 1}, {1, 1}, {1, 3}, {0, 3}};
+  EXPECT_TRUE(polygon_contains(u, Vec2(0.5, 2.5)));
+  EXPECT_FALSE(polygon_contains(u, Vec2(1.5, 2.0)));
+  EXPECT_FALSE(polygon_contains(std::vector<Vec2>{{0, 0}, {2, 0}}, Vec2(1.0, 0.0)));
+  EXPECT_FALSE(polygon_contains(std::vector<Vec2>{}, Vec2(0.0, 0.0)));
+}
+
 }  // namespace
 }  // namespace rbsim

@@ -86,18 +86,6 @@ sim::EntityState entity_state(const World& world, BodyId b) {
 
 // --- Bounds filters: whether a body's hull (a polygon in the plane z = 0, world frame) overlaps.
 
-// Whether p lies inside the closed polygon (crossing rule; a 2-vertex hull has no inside).
-bool inside(std::span<const Vec2> poly, const Vec2& p) {
-  bool in = false;
-  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Vec2& a = poly[i];
-    const Vec2& b = poly[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) &&
-        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
-      in = !in;
-  }
-  return poly.size() >= 3 && in;
-}
 // The distance from p to the segment ab.
 double distance(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 ab = b - a;
@@ -175,7 +163,7 @@ bool overlaps(const BoundsFilter& f, std::span<const Vec2> hull) {
   if (f.type == sim::BoundsType::Empty) return true;
   if (f.misses_plane) return false;
   const bool box = f.type == sim::BoundsType::Box;
-  if (inside(hull, box ? Vec2(0.5 * (f.lo + f.hi)) : f.centre)) return true;
+  if (polygon_contains(hull, box ? Vec2(0.5 * (f.lo + f.hi)) : f.centre)) return true;
   for (std::size_t i = 0, j = hull.size() - 1; i < hull.size(); j = i++) {
     if (box ? meets_box(hull[j], hull[i], f.lo, f.hi) : distance(f.centre, hull[j], hull[i]) <= f.radius)
       return true;
@@ -235,10 +223,6 @@ auto refuse_malformed() {
     return std::optional<Res>(std::move(r));
   };
 }
-
-}  // namespace
-
-namespace {
 
 // Runs `f(world)` on the run loop's thread at the next step boundary at or after `at_step`
 // (Controller::read) and waits up to `timeout_s` for it; nullopt when it timed out or the run
@@ -377,7 +361,8 @@ Result SimulationServices::set_state(std::uint8_t target, const StateNow& state_
 // answered once the world reached the step `steps` past the boundary the step command applied at.
 Result SimulationServices::step(std::uint64_t steps) {
   if (steps == 0 || steps > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
-    return failure(Result::kOperationFailed, "steps must be >= 1 (got " + std::to_string(steps) + ")");
+    return failure(Result::kOperationFailed,
+                   "steps must be in [1, 2^63) (got " + std::to_string(steps) + ")");
   Command c;
   c.kind = CommandKind::Step;
   c.steps = static_cast<std::int64_t>(steps);

@@ -27,6 +27,10 @@ const char* version();
 
 using Vec2 = Eigen::Vector2d;
 
+// Whether `q` lies inside `polygon` (a non-zero winding number, either vertex order; fewer than 3
+// vertices enclose nothing): a hull's inside, for the checks and the entity filters above the core.
+bool polygon_contains(std::span<const Vec2> polygon, const Vec2& q);
+
 // ---------------------------------------------------------------------------------------------
 // Definitions (what a scene describes). Plain structs with defaults.
 

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <utility>
 
@@ -24,6 +25,14 @@ CommandResult failed(std::string message) {
 
 std::string at(std::int64_t step) {
   return "step " + std::to_string(step);
+}
+
+// Whether a state value a command writes (an impulse's result, a set state) keeps every quantity
+// the run reports finite: finite, and within World::finite_bound() (0: none computed).
+bool reportable(std::initializer_list<double> values, double bound) {
+  return std::all_of(values.begin(), values.end(), [bound](double v) {
+    return std::isfinite(v) && (bound <= 0.0 || std::abs(v) <= bound);
+  });
 }
 }  // namespace
 
@@ -467,13 +476,10 @@ CommandResult Controller::impulse(const Command& command, World& world) {
   // A finite impulse can still be too large: refuse one that takes a velocity past the bound
   // under which every quantity the run reports stays finite, restoring the state exactly.
   const BodyState after = world.state(body);
-  const double bound = world.finite_bound();
-  for (double v : {after.velocity.x(), after.velocity.y(), after.omega}) {
-    if (!std::isfinite(v) || (bound > 0.0 && std::abs(v) > bound)) {
-      world.set_state(body, before);
-      return failed("apply_impulse: too large: body " + std::to_string(a.body) +
-                    "'s velocity would leave the range the run can report");
-    }
+  if (!reportable({after.velocity.x(), after.velocity.y(), after.omega}, world.finite_bound())) {
+    world.set_state(body, before);
+    return failed("apply_impulse: too large: body " + std::to_string(a.body) +
+                  "'s velocity would leave the range the run can report");
   }
   CommandResult r;
   r.successful = true;
@@ -488,13 +494,10 @@ CommandResult Controller::set_state(const Command& command, World& world) {
                   std::to_string(world.body_count()) + " bodies)");
   }
   if (!a.set_pose && !a.set_twist) return failed("set_entity_state: neither the pose nor the twist is set");
-  // The same bound as an impulse's: every quantity the run reports stays finite from this state.
-  const double bound = world.finite_bound();
-  for (double v : {a.position.x(), a.position.y(), a.theta, a.velocity.x(), a.velocity.y(), a.omega}) {
-    if (!std::isfinite(v) || (bound > 0.0 && std::abs(v) > bound)) {
-      return failed("set_entity_state: body " + std::to_string(a.body) +
-                    ": every value must be finite and within the range the run can report");
-    }
+  if (!reportable({a.position.x(), a.position.y(), a.theta, a.velocity.x(), a.velocity.y(), a.omega},
+                  world.finite_bound())) {
+    return failed("set_entity_state: body " + std::to_string(a.body) +
+                  ": every value must be finite and within the range the run can report");
   }
   const BodyId body{static_cast<std::int32_t>(a.body)};
   BodyState s = world.state(body);

@@ -15,19 +15,6 @@ double cross(const Vec2& a, const Vec2& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
 
-// Whether `q` is inside `hull` (a non-zero winding number).
-bool inside(const std::vector<Vec2>& hull, const Vec2& q) {
-  int winding = 0;
-  for (std::size_t k = 0; k < hull.size(); ++k) {
-    const Vec2& a = hull[k];
-    const Vec2& e = hull[(k + 1) % hull.size()];
-    const double side = cross(e - a, q - a);
-    if (a.y() <= q.y() && e.y() > q.y() && side > 0) ++winding;
-    if (a.y() > q.y() && e.y() <= q.y() && side < 0) --winding;
-  }
-  return winding != 0;
-}
-
 // The triangles of `fill` tile `hull`: each counter-clockwise with its centroid inside, the
 // areas summing to the hull's. False when `fill` is not a triangle list at all.
 bool check_fill(const std::string& id, const msgs::MarkerMessage& fill, const std::vector<Vec2>& hull,
@@ -42,7 +29,7 @@ bool check_fill(const std::string& id, const msgs::MarkerMessage& fill, const st
     const Vec2 &p0 = fill.points[k], &p1 = fill.points[k + 1], &p2 = fill.points[k + 2];
     const double a = 0.5 * cross(p1 - p0, p2 - p0);
     if (a < 0.0) tally.fail(id + ": triangle " + std::to_string(k / 3) + " is clockwise");
-    if (!inside(hull, (p0 + p1 + p2) / 3.0))
+    if (!polygon_contains(hull, (p0 + p1 + p2) / 3.0))
       tally.fail(id + ": triangle " + std::to_string(k / 3) + " lies outside the hull");
     tiles += a;
   }

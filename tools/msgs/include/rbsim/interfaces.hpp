@@ -102,11 +102,7 @@ struct ParameterEvent {
   Time stamp;
   std::string node;
   std::vector<Parameter> new_parameters, changed_parameters, deleted_parameters;
-  bool operator==(const ParameterEvent& o) const {
-    return stamp.sec == o.stamp.sec && stamp.nanosec == o.stamp.nanosec && node == o.node &&
-           new_parameters == o.new_parameters && changed_parameters == o.changed_parameters &&
-           deleted_parameters == o.deleted_parameters;
-  }
+  bool operator==(const ParameterEvent&) const = default;
 };
 
 // rbsim_msgs/msg/Command (/<ns>/commands): one control input as data, with its outcome.
@@ -137,12 +133,7 @@ struct CommandMessage {
   double jx = 0.0, jy = 0.0, px = 0.0, py = 0.0;
   bool success = false;
   std::string message;
-  bool operator==(const CommandMessage& o) const {
-    return seq == o.seq && step == o.step && stamp.sec == o.stamp.sec && stamp.nanosec == o.stamp.nanosec &&
-           kind == o.kind && source == o.source && parameters == o.parameters && atomic == o.atomic &&
-           steps == o.steps && pause_seconds == o.pause_seconds && body == o.body && jx == o.jx &&
-           jy == o.jy && px == o.px && py == o.py && success == o.success && message == o.message;
-  }
+  bool operator==(const CommandMessage&) const = default;
 };
 
 // ---------------------------------------------------------------------------------------------

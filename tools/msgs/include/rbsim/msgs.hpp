@@ -170,6 +170,7 @@ std::optional<EnergyTermsVersion> energy_terms_version(std::string_view schema);
 struct Time {
   std::int32_t sec = 0;
   std::uint32_t nanosec = 0;
+  bool operator==(const Time&) const = default;
 };
 // Simulated time of the world's current step, t = step * dt, rounded to the nanosecond (base's
 // seconds_to_ns_clamped()).
@@ -184,6 +185,7 @@ using rbsim::Bytes;
 // The quaternion of a rotation by theta about +z (a planar body's orientation).
 struct Quaternion {
   double x = 0.0, y = 0.0, z = 0.0, w = 1.0;
+  bool operator==(const Quaternion&) const = default;
 };
 Quaternion quaternion_z(double theta);
 

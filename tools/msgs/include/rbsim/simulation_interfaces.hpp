@@ -141,15 +141,7 @@ struct EntityState {
   Quaternion orientation;
   Vector3 linear_velocity, angular_velocity;
   Vector3 linear_acceleration, angular_acceleration;
-  bool operator==(const EntityState& o) const {
-    const auto q = [](const Quaternion& a, const Quaternion& b) {
-      return a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w;
-    };
-    return stamp.sec == o.stamp.sec && stamp.nanosec == o.stamp.nanosec && frame_id == o.frame_id &&
-           position == o.position && q(orientation, o.orientation) && linear_velocity == o.linear_velocity &&
-           angular_velocity == o.angular_velocity && linear_acceleration == o.linear_acceleration &&
-           angular_acceleration == o.angular_acceleration;
-  }
+  bool operator==(const EntityState&) const = default;
 };
 
 // ---------------------------------------------------------------------------------------------
