@@ -200,12 +200,26 @@ TEST(CommandMessage, ToMessageAndBackKeepsEveryCommand) {
     EXPECT_EQ(back->impulse.point, c.impulse.point);
     EXPECT_EQ(back->source, c.source);
   }
+  // stop_stepping (a SimulateSteps cancel): kind 7, no arguments.
+  Command stop;
+  stop.step = 40;
+  stop.kind = CommandKind::StopStepping;
+  stop.source = "ros2 action simulate_steps cancel";
+  CommandResult stopped;
+  stopped.successful = true;
+  stopped.step = 40;
+  const msgs::CommandMessage sm = to_message(stop, stopped, 9, 0.01);
+  EXPECT_EQ(sm.kind, msgs::CommandMessage::StopStepping);
+  Result<Command> stop_back = from_message(sm);
+  ASSERT_TRUE(stop_back) << stop_back.error().message;
+  EXPECT_EQ(stop_back->kind, CommandKind::StopStepping);
+  EXPECT_EQ(stop_back->step, 40);
   msgs::CommandMessage bad;
   bad.seq = 4;
-  bad.kind = 7;
+  bad.kind = 8;
   Result<Command> refused = from_message(bad);
   ASSERT_FALSE(refused);
-  EXPECT_NE(refused.error().message.find("command 4: unknown kind 7"), std::string::npos)
+  EXPECT_NE(refused.error().message.find("command 4: unknown kind 8"), std::string::npos)
       << refused.error().message;
 }
 

@@ -215,8 +215,44 @@ TEST(ControllerPause, PauseStepResumeGiveTheStatesOfAnUnpausedRun) {
   const CommandResult stepped = wait(step);
   EXPECT_TRUE(stepped.successful) << stepped.message;
   EXPECT_EQ(stepped.step, 10);
+  EXPECT_EQ(stepped.ends_at, 15);
   EXPECT_EQ(wait(resume).step, 15);
   expect_same_runs(run, test::run(scene, kSteps));
+}
+
+// stop_stepping (a SimulateSteps cancel) ends a `step N` at its boundary, the run paused there;
+// a pause leaves the stepping alone; not stepping, stop_stepping does nothing.
+TEST(ControllerStopStepping, EndsAStepNAtItsBoundary) {
+  const Scene scene = test::control_scene();
+  const auto session = [&](bool stop) {
+    Controller controller(scene, kSteps, RunSettings{0.0, 1, false});
+    controller.end_when_idle(true);  // offline: the pass ends where the loop would idle
+    std::future<CommandResult> idle = controller.submit(simple(5, CommandKind::StopStepping));
+    (void)controller.submit(simple(10, CommandKind::Pause));
+    (void)controller.submit(simple(10, CommandKind::Step, 50));
+    std::future<CommandResult> paused = controller.submit(simple(20, CommandKind::Pause));
+    std::optional<std::future<CommandResult>> stopped;
+    if (stop) stopped = controller.submit(simple(20, CommandKind::StopStepping));
+    const std::vector<Snapshot> run = test::run(scene, kSteps, &controller);
+    const CommandResult not_stepping = wait(idle);
+    EXPECT_TRUE(not_stepping.successful);
+    EXPECT_NE(not_stepping.message.find("not stepping at step 5"), std::string::npos) << not_stepping.message;
+    EXPECT_NE(wait(paused).message.find("already paused"), std::string::npos);
+    if (stopped) {
+      const CommandResult r = wait(*stopped);
+      EXPECT_TRUE(r.successful);
+      EXPECT_NE(r.message.find("stopped stepping at step 20 with 40 steps left"), std::string::npos)
+          << r.message;
+    }
+    EXPECT_EQ(run.back().step, controller.ended_paused().value_or(-1));
+    return run;
+  };
+  const std::vector<Snapshot> stopped = session(true);
+  EXPECT_EQ(stopped.back().step, 20);
+  const std::vector<Snapshot> stepped_on = session(false);
+  EXPECT_EQ(stepped_on.back().step, 60);
+  const std::vector<Snapshot> plain = test::run(scene, 20);
+  EXPECT_EQ(stopped.back(), plain.back()) << "the stop changes where the run idles, not its states";
 }
 
 // A live session: another thread pauses, steps, checks where the run idles, and resumes.
@@ -406,6 +442,10 @@ TEST(ControlServices, OneMappingOfRequestsAndReplies) {
   EXPECT_EQ(step_response(r), (msgs::StepResponse{true, "done", 12}));
   EXPECT_EQ(impulse_response(r), (msgs::ApplyImpulseResponse{true, "done", 12}));
   EXPECT_EQ(trigger_response(r), (msgs::TriggerResponse{true, "done"}));
+  r.ends_at = 17;  // a step N: where the stepping ends
+  EXPECT_EQ(step_response(r), (msgs::StepResponse{true, "done", 17}));
+  EXPECT_EQ(impulse_response(r).step, 12u);
+  r.successful = false;
   r.step = Command::kNextStep;  // never applied
   EXPECT_EQ(step_response(r).step, 0u);
 }

@@ -117,12 +117,12 @@ TEST_P(RemoteSteeringSeam, RelaysParametersAndControlsToTheNodesServices) {
   EXPECT_TRUE(atomic.changed.empty());
   EXPECT_EQ(controller.get({"forces.1.fy"})[0], V::of_double(0.5));
 
-  // Controls: step while paused (the reply names the step), an impulse, then resume ends the run.
-  // The run is still paused at step 0 (the parameter sets above stepped nothing), so `step 3`
-  // applies at the boundary of step 0 and its reply says so.
+  // Controls: step while paused (the reply names the step it ends at), an impulse, then resume
+  // ends the run. The run is still paused at step 0 (the parameter sets above stepped nothing), so
+  // `step 3` applies at the boundary of step 0 and ends at step 3.
   const CommandResult stepped = submit(remote, kind(CommandKind::Step, 3));
   EXPECT_TRUE(stepped.successful) << stepped.message;
-  EXPECT_EQ(stepped.step, 0);
+  EXPECT_EQ(stepped.ends_at, 3);
   Command impulse = kind(CommandKind::Impulse);
   impulse.impulse.body = 99;
   const CommandResult refused = submit(remote, impulse);

@@ -244,7 +244,7 @@ TEST(FoxgloveSteering, ServicesInCdrAndJsonMoveTheRun) {
   ASSERT_TRUE(
       msgs::decode({reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, step).ok());
   EXPECT_TRUE(step.success) << step.message;
-  EXPECT_EQ(step.step, 0u);
+  EXPECT_EQ(step.step, 5u) << "the step the stepping ends at";
   // An impulse in json: applied at step 5, the boundary the run waits at.
   ASSERT_TRUE(c.send_binary(call_frame(5, 12, "json", R"({"body":1,"jx":0.5,"jy":2.0})")));
   r = next_response(c);

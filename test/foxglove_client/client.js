@@ -468,10 +468,10 @@ async function caseSteer(check) {
   await update("paused", true);
   await steady("paused", at);
   const stepped = await call("step", { steps: 5 });
-  check(stepped.success === true && Number(stepped.step) === at, `step: ${JSON.stringify(stepped, (k, v) => (typeof v === "bigint" ? Number(v) : v))}`);
+  check(stepped.success === true && Number(stepped.step) === at + 5, `step: ${JSON.stringify(stepped, (k, v) => (typeof v === "bigint" ? Number(v) : v))}`);
   await steady("stepped 5", at + 5);
   const jsonStep = await call("step", { steps: 2 }, "json");
-  check(jsonStep.success === true && jsonStep.step === at + 5, `step (json): ${JSON.stringify(jsonStep)}`);
+  check(jsonStep.success === true && jsonStep.step === at + 7, `step (json): ${JSON.stringify(jsonStep)}`);
   await steady("stepped 2 more", at + 7);
   const resumed = await call("resume", {});
   check(resumed.success === true, `resume: ${JSON.stringify(resumed)}`);

@@ -274,7 +274,8 @@ def case_steered(ctx):
             sets = peer_json(ctx, net, "set", "params", svc, "set-atomic", "forces.0.fy=-3.7")
             ctx.require([m.get("set-atomic") for m in sets] == [True], f"set forces.0.fy: {sets}")
             stepped = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 5)
-            ctx.require(stepped and stepped[0]["success"] and stepped[0]["step"] == s0, f"step 5 at {s0}: {stepped}")
+            # The reply names the step the stepping ends at.
+            ctx.require(stepped and stepped[0]["success"] and stepped[0]["step"] == s0 + 5, f"step 5 at {s0}: {stepped}")
             kick = peer_json(ctx, net, "impulse", "call", f"{svc}/apply_impulse", "impulse", 2, 0.5, 2.0, 0.1, 0.0)
             ctx.require(kick and kick[0]["success"], f"impulse: {kick}")
             s1 = kick[0]["step"]
@@ -500,7 +501,7 @@ def case_killed_client(ctx):
         fresh("pause")
         r = peer_json(ctx, net, "step", "call", f"{svc}/step", "step", 30000)  # 30 s at --rate 1
         ctx.check(r and r[0]["success"], f"step 30000 while paused: {r}")
-        at = r[0]["step"] if r else 0
+        at = r[0]["step"] - 30000 if r else 0  # the reply names where the stepping ends
         for name, service, kind, n in (("step-paused", "step", "step", 50), ("pause-paused", "pause", "trigger", 50),
                                        ("get-paused", "get_parameters", "get", 100)):
             killed(f"killed-{name}", service, kind, n)

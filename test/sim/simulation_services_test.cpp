@@ -6,16 +6,21 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "control_test_util.hpp"
+#include "rbsim/cdr.hpp"
 #include "rbsim/command_script.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/dds_sink.hpp"
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
 #include "rbsim/simulation_interfaces.hpp"
@@ -46,11 +51,23 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
   void SetUp() override {
     node_ = node_name();
     server_.emplace(participant(node_));
-    auto services = NodeServices::create(*server_, controller_, {"/" + node_, scene_.world.dt});
+    NodeServicesOptions options;
+    options.node = "/" + node_;
+    options.dt = scene_.world.dt;
+    // As rbsim node's STATE_QUITTING asks its loop to stop: here the controller ends the run.
+    options.quit = [this] {
+      ++quits_;
+      controller_.close("quitting");
+    };
+    auto services = NodeServices::create(*server_, controller_, options);
     ASSERT_TRUE(services.ok()) << services.error().message;
     services_ = std::move(services.value());
     controller_.on_command([this](const control::Command& c, const control::CommandResult& r) {
       services_->command_applied(c, r);
+      // As rbsim node wires it: a reset's time goes out on /clock at once (the loop's thread, where
+      // run() made the sink).
+      if (c.kind == control::CommandKind::Reset && r.successful && clock_sink_ != nullptr)
+        clock_sink_->time_reset();
       const std::lock_guard lock(mu_);
       applied_.push_back(c.kind);
       recorded_.push_back(control::to_message(c, r, recorded_.size(), scene_.world.dt));
@@ -98,11 +115,26 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
   Status run() {
     Result<Driver> driver = Driver::create(scene_);
     if (!driver) return driver.error();
+    // /clock, on the in-memory network only: it is one global topic, which other test processes
+    // on the DDS domain publish too.
+    std::unique_ptr<DdsSink> clock;
+    if (GetParam() == "memory") {
+      NodeOptions o;
+      o.ns = node_;
+      o.topics = msgs::TopicSet{}.set(static_cast<std::size_t>(msgs::TopicId::Clock));
+      auto sink = DdsSink::create(*server_, o);
+      if (!sink) return sink.error();
+      clock = std::move(sink.value());
+      driver.value().add(*clock);
+      clock_sink_ = clock.get();
+    }
     DriverOptions options;
     options.steps = kSteps;
     options.control = &controller_;
     options.pace = [](const World&) { std::this_thread::sleep_for(200us); };
-    return driver.value().run_pass(options);
+    Status st = driver.value().run_pass(options);
+    clock_sink_ = nullptr;
+    return st;
   }
 
   std::uint8_t state() {
@@ -138,12 +170,47 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
     return applied_;
   }
 
+  // The session's commands, as <node>/commands carried them (but those of kind `without`), applied
+  // again offline: the last step's snapshot.
+  test::Snapshot resimulated(std::optional<control::CommandKind> without = std::nullopt) {
+    std::vector<control::ScriptedCommand> commands;
+    {
+      const std::lock_guard lock(mu_);
+      for (std::size_t k = 0; k < recorded_.size(); ++k) {
+        Result<control::Command> back = control::from_message(recorded_[k]);
+        if (!back) throw std::runtime_error(back.error().message);
+        if (back.value().kind == without) continue;
+        commands.push_back({back.value(), recorded_[k].success, "command " + std::to_string(k)});
+      }
+    }
+    control::ScriptedRun run(scene_, kSteps, std::move(commands));
+    std::vector<test::Snapshot> snaps = test::run(scene_, kSteps, &run.controller());
+    EXPECT_TRUE(run.finish("session").ok()) << (run.mismatches().empty() ? "" : run.mismatches()[0]);
+    return snaps.back();
+  }
+  // The live states equal, bit for bit, a snapshot's columns (x, y, theta, vx, vy, omega of every
+  // body).
+  static void expect_states_equal(const sim::GetEntitiesStatesResponse& live, const test::Snapshot& again) {
+    const std::size_t n = live.states.size();
+    ASSERT_EQ(again.state.size(), 6 * n);
+    for (std::size_t b = 0; b < n; ++b) {
+      EXPECT_EQ(live.states[b].position.x, again.state[0 * n + b]);
+      EXPECT_EQ(live.states[b].position.y, again.state[1 * n + b]);
+      EXPECT_EQ(live.states[b].orientation.z, msgs::quaternion_z(again.state[2 * n + b]).z);
+      EXPECT_EQ(live.states[b].linear_velocity.x, again.state[3 * n + b]);
+      EXPECT_EQ(live.states[b].linear_velocity.y, again.state[4 * n + b]);
+      EXPECT_EQ(live.states[b].angular_velocity.z, again.state[5 * n + b]);
+    }
+  }
+
   const Scene scene_ = test::control_scene();
   control::Controller controller_{scene_, kSteps, control::RunSettings{1.0, 1, true}};
   std::shared_ptr<MemoryNetwork> network_ = std::make_shared<MemoryNetwork>();
   std::string node_;
   std::optional<Participant> server_, client_;
   std::unique_ptr<NodeServices> services_;
+  DdsSink* clock_sink_ = nullptr;  // the run loop's thread only
+  std::atomic<int> quits_{0};
   std::future<Status> run_;
   std::mutex mu_;
   std::vector<control::CommandKind> applied_;
@@ -187,10 +254,11 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
         sim::Feature::EntityStateGetting, sim::Feature::EntityStateSetting, sim::Feature::EntityInfoGetting,
         sim::Feature::SimulationReset, sim::Feature::SimulationStateGetting,
         sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
-        sim::Feature::StepSimulationSingle, sim::Feature::StepSimulationMultiple}) {
+        sim::Feature::StepSimulationSingle, sim::Feature::StepSimulationMultiple,
+        sim::Feature::StepSimulationAction}) {
     EXPECT_TRUE(has(f)) << static_cast<int>(f);
   }
-  EXPECT_EQ(listed.size(), 12u);
+  EXPECT_EQ(listed.size(), 13u);
 
   // What is not listed answers RESULT_FEATURE_UNSUPPORTED.
   sim::SetEntityStateRequest set;
@@ -217,7 +285,6 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
               SimResult::kFeatureUnsupported)
         << "scope " << int(scope);
   }
-  EXPECT_EQ(set_state(State::Quitting).result, SimResult::kFeatureUnsupported);
   EXPECT_TRUE(applied().empty()) << "nothing unsupported became a command";
 }
 
@@ -286,6 +353,52 @@ TEST_P(SimulationServicesTest, StateMovesAsTheDefinitionSays) {
   using K = control::CommandKind;
   EXPECT_EQ(applied(), (std::vector<K>{K::Pause, K::Step, K::Step, K::Resume, K::Step, K::Pause, K::Reset,
                                        K::Pause, K::Step, K::Reset, K::Pause, K::Reset, K::Step}));
+}
+
+// STATE_QUITTING ends the run (the node's quit), answered first; from then on the state reads
+// QUITTING and no other state can be set.
+TEST_P(SimulationServicesTest, QuittingEndsTheRun) {
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  EXPECT_EQ(set_state(State::Quitting).result, SimResult::kOk);
+  EXPECT_EQ(quits_.load(), 1);
+  ASSERT_EQ(run_.wait_for(20s), std::future_status::ready) << "the run loop ended";
+  EXPECT_TRUE(run_.get().ok());
+  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::Quitting));
+  EXPECT_EQ(set_state(State::Quitting).result, SetRes::kAlreadyInTargetState);
+  EXPECT_EQ(set_state(State::Playing).result, SetRes::kIncorrectTransition);
+  EXPECT_EQ(quits_.load(), 1);
+}
+
+// A full reset while paused publishes the new /clock at once (ROS time jumps back to 0), before any
+// step is taken.
+TEST_P(SimulationServicesTest, AResetPublishesTheNewClockAtOnce) {
+  if (GetParam() != "memory") GTEST_SKIP() << "/clock is global: on DDS other test processes publish theirs";
+  const msgs::TopicSpec& spec = msgs::topic(msgs::TopicId::Clock);
+  auto sub = Subscription::create(*client_, spec, "/clock", qos_for(spec, 1000));
+  ASSERT_TRUE(sub.ok()) << sub.error().message;
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  ASSERT_EQ(step(20).result, SimResult::kOk);
+  const auto clock_ns = [](std::span<const std::byte> cdr) {
+    msgs::CdrCursor c(cdr);
+    std::int32_t sec = 0;
+    std::uint32_t nanosec = 0;
+    EXPECT_TRUE(c.read(sec) && c.read(nanosec));
+    return std::int64_t{sec} * 1'000'000'000 + nanosec;
+  };
+  Received r;
+  std::int64_t last = -1;
+  while (sub.value().take(r)) last = clock_ns(r.cdr);
+  EXPECT_EQ(last, static_cast<std::int64_t>(msgs::sim_time_ns(stepped(scene_, 20))));
+  sim::ResetSimulationRequest reset;
+  reset.scope = sim::ResetSimulationRequest::kScopeAll;
+  ASSERT_EQ(call<sim::ResetSimulationResponse>("reset_simulation", reset).result.result, SimResult::kOk);
+  bool back = false;
+  for (int i = 0; i < 4000 && !back; ++i) {
+    while (sub.value().take(r)) back |= clock_ns(r.cdr) == 0;
+    if (!back) std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_TRUE(back) << "no /clock of time 0 within 20 s of the reset";
+  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::Paused)) << "and no step taken";
 }
 
 TEST_P(SimulationServicesTest, EntityStatesAreTheWorldsAtTheStepReached) {
@@ -388,37 +501,11 @@ TEST_P(SimulationServicesTest, SetEntityStateIsACommandAndReSimulatesExactly) {
   ASSERT_EQ(live.states.size(), 2u);
 
   // The session's commands, as /NS/commands carries them, applied again offline.
-  std::vector<control::ScriptedCommand> script;
-  {
-    const std::lock_guard lock(mu_);
-    for (std::size_t k = 0; k < recorded_.size(); ++k) {
-      Result<control::Command> back = control::from_message(recorded_[k]);
-      ASSERT_TRUE(back.ok()) << back.error().message;
-      script.push_back({back.value(), recorded_[k].success, "command " + std::to_string(k)});
-    }
-  }
-  const auto resimulate = [&](bool with_set) {
-    std::vector<control::ScriptedCommand> commands;
-    for (const control::ScriptedCommand& c : script) {
-      if (with_set || c.command.kind != control::CommandKind::SetState) commands.push_back(c);
-    }
-    control::ScriptedRun run(scene_, kSteps, std::move(commands));
-    std::vector<test::Snapshot> snaps = test::run(scene_, kSteps, &run.controller());
-    EXPECT_TRUE(run.finish("session").ok()) << (run.mismatches().empty() ? "" : run.mismatches()[0]);
-    return snaps.back();
-  };
-  const test::Snapshot again = resimulate(true);
+  const test::Snapshot again = resimulated();
   ASSERT_EQ(again.step, 30);
-  const std::size_t n = 2;  // the snapshot's columns: x, y, theta, vx, vy, omega of every body
-  for (std::size_t b = 0; b < n; ++b) {
-    EXPECT_EQ(live.states[b].position.x, again.state[0 * n + b]);
-    EXPECT_EQ(live.states[b].position.y, again.state[1 * n + b]);
-    EXPECT_EQ(live.states[b].orientation.z, msgs::quaternion_z(again.state[2 * n + b]).z);
-    EXPECT_EQ(live.states[b].linear_velocity.x, again.state[3 * n + b]);
-    EXPECT_EQ(live.states[b].linear_velocity.y, again.state[4 * n + b]);
-    EXPECT_EQ(live.states[b].angular_velocity.z, again.state[5 * n + b]);
-  }
-  EXPECT_NE(resimulate(false).state, again.state) << "without the set, the run differs";
+  expect_states_equal(live, again);
+  EXPECT_NE(resimulated(control::CommandKind::SetState).state, again.state)
+      << "without the set, the run differs";
 }
 
 TEST_P(SimulationServicesTest, FiltersSelectByNameCategoryAndBounds) {
@@ -490,6 +577,254 @@ TEST_P(SimulationServicesTest, AMalformedRequestIsAnsweredAsFailed) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, SimulationServicesTest, ::testing::Values("dds", "memory"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// ---------------------------------------------------------------------------------------------
+// The SimulateSteps action, as a ROS 2 action client uses it: its three services and two topics.
+struct ActionClient {
+  ServiceClient send_goal, cancel_goal, get_result;
+  Subscription feedback, status;
+};
+
+msgs::GoalUuid goal_id(std::uint8_t k) {
+  msgs::GoalUuid id{};
+  id[0] = 0xab;
+  id[15] = k;
+  return id;
+}
+
+class SimulateStepsTest : public SimulationServicesTest {
+ protected:
+  using Feedback = sim::SimulateStepsFeedbackMessage;
+  using GetResult = sim::SimulateStepsGetResultResponse;
+
+  std::unique_ptr<ActionClient> action_client(Participant& p) {
+    const std::string base = "/" + node_ + "/simulate_steps/_action/";
+    const std::string type(sim::SimulateStepsSendGoalRequest::kAction);
+    const auto client = [&](const std::string& name, const std::string& srv) {
+      auto c = ServiceClient::create(p, base + name, srv);
+      if (!c) throw std::runtime_error(c.error().message);
+      if (Status st = c.value().wait_for_server(20.0); !st) throw std::runtime_error(st.error().message);
+      return std::move(c.value());
+    };
+    const auto topic = [&](const std::string& name, const std::string& msg, bool latched) {
+      QosSpec q;
+      q.transient_local = latched;
+      q.depth = latched ? 1 : 100;
+      auto s = Subscription::create(p, RawTopic{base + name, msg}, q);
+      if (!s) throw std::runtime_error(s.error().message);
+      return std::move(s.value());
+    };
+    auto a = std::unique_ptr<ActionClient>(new ActionClient{
+        client("send_goal", type + "_SendGoal"),
+        client("cancel_goal", std::string(msgs::CancelGoalRequest::kService)),
+        client("get_result", type + "_GetResult"), topic("feedback", type + "_FeedbackMessage", false),
+        topic("status", std::string(msgs::GoalStatusArray::kType), true)});
+    // Feedback is volatile: the reader matches the node's writer before a goal is sent (bounded).
+    for (int i = 0; i < 4000 && (a->feedback.matched() < 1 || a->status.matched() < 1); ++i)
+      std::this_thread::sleep_for(5ms);
+    if (a->feedback.matched() < 1) throw std::runtime_error("the feedback topic did not match in 20 s");
+    return a;
+  }
+  std::unique_ptr<ActionClient> action_client() { return action_client(*client_); }
+
+  template <class Res>
+  static Res call_with(ServiceClient& client, const Bytes& body, double timeout_s = 60.0) {
+    Result<Bytes> reply = client.call(body, timeout_s);
+    if (!reply) throw std::runtime_error(reply.error().message);
+    Res res;
+    if (Status st = decode(std::span<const std::byte>(reply.value()), res); !st)
+      throw std::runtime_error(st.error().message);
+    return res;
+  }
+  static bool send_goal(ActionClient& a, const msgs::GoalUuid& id, std::uint64_t steps) {
+    Bytes body;
+    encode(sim::SimulateStepsSendGoalRequest{id, steps}, body);
+    return call_with<msgs::SendGoalResponse>(a.send_goal, body).accepted;
+  }
+  static GetResult result(ActionClient& a, const msgs::GoalUuid& id) {
+    Bytes body;
+    encode(msgs::GetResultRequest{id}, body);
+    return call_with<GetResult>(a.get_result, body);
+  }
+  static msgs::CancelGoalResponse cancel(ActionClient& a, const msgs::GoalInfo& which) {
+    Bytes body;
+    encode(msgs::CancelGoalRequest{which}, body);
+    return call_with<msgs::CancelGoalResponse>(a.cancel_goal, body);
+  }
+  // Every feedback message that arrived since the last call.
+  static std::vector<Feedback> feedback(ActionClient& a) {
+    std::vector<Feedback> out;
+    Received r;
+    while (a.feedback.take(r)) {
+      Feedback f;
+      if (decode(r.cdr, f)) out.push_back(f);
+    }
+    return out;
+  }
+  // Waits (at most 20 s) until the status topic says `want` of goal `id`.
+  static bool status_reaches(ActionClient& a, const msgs::GoalUuid& id, std::int8_t want) {
+    Received r;
+    for (int i = 0; i < 4000; ++i) {
+      while (a.status.take(r)) {
+        msgs::GoalStatusArray arr;
+        if (!decode(r.cdr, arr)) continue;
+        for (const msgs::GoalStatus& g : arr.status_list)
+          if (g.goal_info.goal_id == id && g.status == want) return true;
+      }
+      std::this_thread::sleep_for(5ms);
+    }
+    return false;
+  }
+  std::int64_t step_now() {
+    const auto res = states(named("^body_0$"));
+    const std::uint64_t ns = static_cast<std::uint64_t>(res.states.at(0).stamp.sec) * 1'000'000'000u +
+                             res.states.at(0).stamp.nanosec;
+    return static_cast<std::int64_t>(std::llround(static_cast<double>(ns) * 1e-9 / scene_.world.dt));
+  }
+};
+
+TEST_P(SimulateStepsTest, AGoalStepsFeedsBackAndSucceeds) {
+  auto a = action_client();
+  const msgs::GoalUuid id = goal_id(1);
+  ASSERT_TRUE(send_goal(*a, id, 300)) << "paused at step 0: accepted";
+  const GetResult r = result(*a, id);  // answered when the goal ends
+  EXPECT_EQ(r.status, msgs::GoalStatus::kSucceeded);
+  EXPECT_EQ(r.result.result, SimResult::kOk) << r.result.error_message;
+  EXPECT_EQ(step_now(), 300) << "the world paused at the step the goal reached";
+  EXPECT_TRUE(status_reaches(*a, id, msgs::GoalStatus::kSucceeded));
+  // Feedback: completed + remaining = 300, never going back, the last one at the end.
+  std::vector<Feedback> fb;
+  for (int i = 0; i < 4000 && (fb.empty() || fb.back().remaining_steps != 0); ++i) {
+    for (const Feedback& f : feedback(*a)) fb.push_back(f);
+    if (fb.empty() || fb.back().remaining_steps != 0) std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_FALSE(fb.empty());
+  for (std::size_t k = 0; k < fb.size(); ++k) {
+    EXPECT_EQ(fb[k].goal_id, id);
+    EXPECT_EQ(fb[k].completed_steps + fb[k].remaining_steps, 300u);
+    if (k > 0) {
+      EXPECT_GE(fb[k].completed_steps, fb[k - 1].completed_steps);
+    }
+  }
+  EXPECT_EQ(fb.back().completed_steps, 300u);
+  // The result stays: a second get_result answers the same at once.
+  EXPECT_EQ(result(*a, id), r);
+  // The goal was a `step 300` command (recorded), and a second goal goes on from there.
+  ASSERT_TRUE(send_goal(*a, goal_id(2), 5));
+  EXPECT_EQ(result(*a, goal_id(2)).status, msgs::GoalStatus::kSucceeded);
+  EXPECT_EQ(step_now(), 305);
+  using K = control::CommandKind;
+  EXPECT_EQ(applied(), (std::vector<K>{K::Step, K::Step}));
+}
+
+TEST_P(SimulateStepsTest, ACancelStopsAtTheNextBoundaryAndReSimulatesExactly) {
+  // STOPPED -> PAUSED, a pause command: an offline re-run starts running, the live node paused.
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  auto a = action_client();
+  const msgs::GoalUuid id = goal_id(3);
+  ASSERT_TRUE(send_goal(*a, id, 100000));  // 20 s or more at 200 us a step: canceled long before
+  bool moving = false;
+  for (int i = 0; i < 4000 && !moving; ++i) {
+    for (const Feedback& f : feedback(*a)) moving |= f.completed_steps > 1;
+    if (!moving) std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_TRUE(moving) << "no feedback of a completed step within 20 s";
+  const msgs::CancelGoalResponse c = cancel(*a, msgs::GoalInfo{id, {}});
+  EXPECT_EQ(c.return_code, msgs::CancelGoalResponse::kErrorNone);
+  ASSERT_EQ(c.goals_canceling.size(), 1u);
+  EXPECT_EQ(c.goals_canceling[0].goal_id, id);
+  const GetResult r = result(*a, id);
+  EXPECT_EQ(r.status, msgs::GoalStatus::kCanceled);
+  EXPECT_EQ(r.result.result, SimResult::kOk);
+  const std::int64_t at = step_now();
+  EXPECT_GT(at, 0);
+  EXPECT_LT(at, 100000);
+  EXPECT_NE(r.result.error_message.find("canceled after " + std::to_string(at) +
+                                        " steps of 100000, paused at step " + std::to_string(at)),
+            std::string::npos)
+      << r.result.error_message;
+  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::Paused));
+  EXPECT_EQ(cancel(*a, msgs::GoalInfo{id, {}}).return_code, msgs::CancelGoalResponse::kErrorGoalTerminated);
+  // The session (a step 100000, then a stop_stepping) re-simulates to the same step and states.
+  const auto live = states();
+  const test::Snapshot again = resimulated();
+  EXPECT_EQ(again.step, at);
+  expect_states_equal(live, again);
+  using K = control::CommandKind;
+  EXPECT_EQ(applied(), (std::vector<K>{K::Pause, K::Step, K::StopStepping}));
+}
+
+TEST_P(SimulateStepsTest, RefusedGoalsAndHostileClientsAreAnsweredNeverStalled) {
+  auto a = action_client();
+  EXPECT_FALSE(send_goal(*a, goal_id(10), 0)) << "0 steps";
+  EXPECT_FALSE(send_goal(*a, goal_id(11), std::uint64_t{1} << 63)) << "past int64";
+  ASSERT_EQ(set_state(State::Playing).result, SimResult::kOk);
+  EXPECT_FALSE(send_goal(*a, goal_id(12), 10)) << "not paused";
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+
+  // Unknown goals: a cancel says so, a result is answered at once with status UNKNOWN.
+  EXPECT_EQ(cancel(*a, msgs::GoalInfo{goal_id(13), {}}).return_code,
+            msgs::CancelGoalResponse::kErrorUnknownGoalId);
+  EXPECT_EQ(result(*a, goal_id(13)).status, msgs::GoalStatus::kUnknown);
+  EXPECT_EQ(cancel(*a, msgs::GoalInfo{}).return_code, msgs::CancelGoalResponse::kErrorRejected)
+      << "nothing to cancel";
+
+  // Malformed requests get no reply; the server goes on.
+  const Bytes garbage{std::byte{0}, std::byte{1}, std::byte{0}, std::byte{0}, std::byte{0xff}};
+  ASSERT_TRUE(a->send_goal.send(garbage).ok());
+  ASSERT_TRUE(a->get_result.send(garbage).ok());
+  ASSERT_TRUE(a->cancel_goal.send(garbage).ok());
+
+  // One goal at a time: a second goal, and the same id again, are refused while it runs.
+  const msgs::GoalUuid running = goal_id(14);
+  ASSERT_TRUE(send_goal(*a, running, 100000));
+  EXPECT_FALSE(send_goal(*a, goal_id(15), 10));
+  EXPECT_FALSE(send_goal(*a, running, 10));
+
+  // A flood of goals from one client, without waiting: each is refused or dropped (counted), none
+  // is accepted, and the server answers again at once.
+  Bytes body;
+  for (std::uint8_t k = 0; k < 200; ++k) {
+    encode(sim::SimulateStepsSendGoalRequest{goal_id(static_cast<std::uint8_t>(k + 50)), 10}, body);
+    ASSERT_TRUE(a->send_goal.send(body).ok());
+  }
+  std::size_t replies = 0;
+  RequestHeader h;
+  Bytes reply;
+  // Until every request is answered, or none came for a second (the rest were dropped).
+  for (int i = 0; i < 400 && replies < 200 && a->send_goal.wait_reply(1.0); ++i) {
+    while (a->send_goal.take_reply(h, reply)) {
+      msgs::SendGoalResponse res;
+      ASSERT_TRUE(decode(std::span<const std::byte>(reply), res).ok());
+      EXPECT_FALSE(res.accepted);
+      ++replies;
+    }
+  }
+  EXPECT_GT(replies, 0u);
+
+  // A client that vanished with a get_result waiting: the goal goes on; a cancel of every goal
+  // (zero id and stamp) from another client ends it CANCELED, and a new client reads the result.
+  {
+    auto gone = action_client();
+    Bytes ask;
+    encode(msgs::GetResultRequest{running}, ask);
+    ASSERT_TRUE(gone->get_result.send(ask).ok());
+  }
+  const msgs::CancelGoalResponse all = cancel(*a, msgs::GoalInfo{});
+  EXPECT_EQ(all.return_code, msgs::CancelGoalResponse::kErrorNone);
+  ASSERT_EQ(all.goals_canceling.size(), 1u);
+  auto later = action_client();
+  EXPECT_EQ(result(*later, running).status, msgs::GoalStatus::kCanceled);
+  // Every request is accounted for in the node's counters: answered, or dropped and counted.
+  const NodeServiceCounters n = services_->counters();
+  EXPECT_GE(n.received, n.calls);
+  EXPECT_GE(n.dropped, 3u) << "the three malformed requests";
+  ASSERT_TRUE(send_goal(*later, goal_id(16), 3)) << "the server takes goals again";
+  EXPECT_EQ(result(*later, goal_id(16)).status, msgs::GoalStatus::kSucceeded);
+}
+
+INSTANTIATE_TEST_SUITE_P(Middleware, SimulateStepsTest, ::testing::Values("dds", "memory"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace

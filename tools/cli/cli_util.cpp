@@ -14,6 +14,7 @@ namespace rbsim::cli {
 
 namespace {
 std::atomic<int> g_stop_signal{0};
+std::atomic<bool> g_stop_asked{false};  // request_stop()
 extern "C" void on_stop_signal(int sig) {
   g_stop_signal.store(sig, std::memory_order_relaxed);
 }
@@ -34,7 +35,10 @@ void install_stop_handlers() {
   pthread_sigmask(SIG_UNBLOCK, &stops, nullptr);
 }
 bool stop_requested() {
-  return g_stop_signal.load(std::memory_order_relaxed) != 0;
+  return g_stop_signal.load(std::memory_order_relaxed) != 0 || g_stop_asked.load(std::memory_order_relaxed);
+}
+void request_stop() {
+  g_stop_asked.store(true, std::memory_order_relaxed);
 }
 int stop_signal() {
   return g_stop_signal.load(std::memory_order_relaxed);

@@ -16,6 +16,8 @@ namespace rbsim::cli {
 void install_stop_handlers();
 bool stop_requested();
 int stop_signal();  // the signal that asked to stop, or 0
+// Asks to stop as a signal would, from inside (simulation_interfaces' STATE_QUITTING).
+void request_stop();
 
 // A one-line progress bar on stderr, shown only on a terminal and only once a run has taken
 // longer than `delay`. update() is cheap enough to call every step: it looks at the clock only

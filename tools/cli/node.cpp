@@ -110,12 +110,15 @@ void follow_settings(control::Controller& controller, node::Pacer& pacer, node::
   });
 }
 
-// Every applied command goes out on /<ns>/commands over DDS (the node's services) and to viewers.
-void publish_commands(control::Controller& controller, node::NodeServices& services, const NodeFoxglove& fox,
-                      double dt) {
-  controller.on_command([&applied = services, &server = fox.server, commands_channel = fox.commands_channel,
+// Every applied command goes out on /<ns>/commands over DDS (the node's services) and to viewers;
+// a reset's new time goes out on /clock at once.
+void publish_commands(control::Controller& controller, node::NodeServices& services, node::DdsSink& sink,
+                      const NodeFoxglove& fox, double dt) {
+  controller.on_command([&applied = services, &sink, &server = fox.server,
+                         commands_channel = fox.commands_channel,
                          dt](const control::Command& c, const control::CommandResult& r) {
     applied.command_applied(c, r);
+    if (c.kind == control::CommandKind::Reset && r.successful) sink.time_reset();
     if (server && commands_channel != 0) {
       server->publish(commands_channel, msgs::sim_time_ns(r.step >= 0 ? r.step : 0, dt),
                       applied.last_command());
@@ -231,10 +234,17 @@ int node_command(const NodeArgs& a) {
   // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse)
   // answer through the controller; every parameter change also goes out on /parameter_events
   // (an observer beside the Foxglove server's parameter updates).
-  auto services =
-      node::NodeServices::create(participant.value(), controller, {name->fully_qualified(), scene.world.dt});
+  node::NodeServicesOptions service_options;
+  service_options.node = name->fully_qualified();
+  service_options.dt = scene.world.dt;
+  // STATE_QUITTING: the node ends as on SIGINT (outputs finished, the end line, exit 0).
+  service_options.quit = [quiet = a.quiet] {
+    if (!quiet) RBSIM_LOG(Info, "rbsim node: quitting (set_simulation_state STATE_QUITTING)\n");
+    request_stop();
+  };
+  auto services = node::NodeServices::create(participant.value(), controller, service_options);
   if (!services) return fail("node", services.error().message);
-  publish_commands(controller, *services.value(), foxglove, scene.world.dt);
+  publish_commands(controller, *services.value(), *sink.value(), foxglove, scene.world.dt);
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;

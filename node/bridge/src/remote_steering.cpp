@@ -99,6 +99,8 @@ Result<Request> request_for(const Command& command, const RemoteSteeringOptions&
     }
     case CommandKind::SetState:
       return Error{"set_entity_state is not relayed: call the node's set_entity_state service"};
+    case CommandKind::StopStepping:
+      return Error{"stop_stepping is not relayed: cancel the node's simulate_steps goal"};
   }
   return Error{"unknown command"};
 }
@@ -134,7 +136,8 @@ CommandResult control_result(const Result<Res>& reply) {
   r.message = reply->message;
   if constexpr (requires { reply->step; }) {
     if (reply->step <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
-      r.step = static_cast<std::int64_t>(reply->step);
+      // A step reply names where the stepping ends, an impulse reply the boundary it applied at.
+      (std::is_same_v<Res, msgs::StepResponse> ? r.ends_at : r.step) = static_cast<std::int64_t>(reply->step);
     }
   }
   return r;
@@ -182,7 +185,8 @@ CommandResult result_of(const Command& command, std::span<const std::byte> reply
     case CommandKind::Impulse:
       return control_result(decode_reply<msgs::ApplyImpulseResponse>(reply, o));
     case CommandKind::SetState:
-      break;  // never sent (make_request refuses it)
+    case CommandKind::StopStepping:
+      break;  // never sent (make_request refuses them)
   }
   return failed("unknown command");
 }

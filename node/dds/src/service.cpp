@@ -252,7 +252,7 @@ struct DdsServer final : ServiceServerImpl {
   };
   std::vector<Pending> pending;
   Slot current;
-  Bytes reply, sample, taken;
+  Bytes answer, sample, taken;
   // The clientid of each matched request writer (none: it sent none), and the clientids of the
   // matched reply readers, each valid while the match counts they were read at hold.
   std::unordered_map<std::uint64_t, std::optional<std::string>> writer_ids;
@@ -266,6 +266,9 @@ struct DdsServer final : ServiceServerImpl {
   }
 
   std::size_t serve(const ServiceHandler& handler, std::size_t budget) override;
+  void reply(const RequestHeader& header, std::span<const std::byte> body) override {
+    deliver(header, header.route, body);
+  }
   bool wait(double timeout_s) override;
   ServiceStats stats() const override;
 
@@ -361,7 +364,7 @@ struct DdsServer final : ServiceServerImpl {
     count_one(rc < 0 ? &ServiceStats::write_failed : &ServiceStats::answered);
   }
 
-  void deliver(const RequestHeader& header, std::uint64_t publication, const Bytes& body) {
+  void deliver(const RequestHeader& header, std::uint64_t publication, std::span<const std::byte> body) {
     switch (client(publication)) {
       case Client::Present:
         write(header, body);
@@ -375,7 +378,7 @@ struct DdsServer final : ServiceServerImpl {
           return;
         }
         pending.push_back(
-            {header, publication, body,
+            {header, publication, Bytes(body.begin(), body.end()),
              Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                 std::chrono::duration<double>(options.client_match_timeout_s))});
         return;
@@ -469,12 +472,13 @@ std::size_t DdsServer::serve(const ServiceHandler& handler, std::size_t budget) 
   std::size_t handled = 0;
   while (handled < budget && pop()) {
     ++handled;
-    reply.clear();
-    if (!handler(current.header, current.body, reply)) {
+    current.header.route = current.publication;
+    answer.clear();
+    if (!handler(current.header, current.body, answer)) {
       count_one(&ServiceStats::unanswered);
       continue;
     }
-    deliver(current.header, current.publication, reply);
+    deliver(current.header, current.publication, answer);
   }
   std::lock_guard lock(mu);
   stats_.pending = pending.size();  // for stats() from any thread

@@ -57,6 +57,8 @@ class MemServer final : public ServiceServerImpl {
             const ServiceOptions& options);
   ~MemServer() override;
   std::size_t serve(const ServiceHandler& handler, std::size_t budget) override;
+  // Delivers a reply to the calling client alone (serve()'s, or a deferred one).
+  void reply(const RequestHeader& header, std::span<const std::byte> body) override;
   bool wait(double timeout_s) override;
   ServiceStats stats() const override;
 
@@ -70,7 +72,6 @@ class MemServer final : public ServiceServerImpl {
     RequestHeader header;
     Bytes body;
   };
-  void reply(const RequestHeader& header, std::span<const std::byte> body);
   Network network_;
   std::string service_, type_;
   ServiceOptions options_;

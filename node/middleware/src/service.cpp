@@ -22,6 +22,9 @@ ServiceServer::~ServiceServer() = default;
 std::size_t ServiceServer::serve(const Handler& handler, std::size_t budget) {
   return impl_->serve(handler, budget);
 }
+void ServiceServer::reply(const RequestHeader& header, std::span<const std::byte> reply) {
+  impl_->reply(header, reply);
+}
 bool ServiceServer::wait(double timeout_s) {
   return impl_->wait(timeout_s);
 }

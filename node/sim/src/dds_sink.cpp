@@ -35,6 +35,7 @@ Status DdsSink::publish(msgs::TopicId id, const World& world) {
 }
 
 Status DdsSink::begin(const Scene& scene, const World& world) {
+  world_ = &world;
   messages_ =
       options_.messages ? options_.messages : std::make_shared<msgs::StepMessages>(scene, options_.ns);
   for (const msgs::TopicId id : ids_) {
@@ -51,6 +52,12 @@ Status DdsSink::write(const World& world) {
     if (Status st = publish(id, world); !st) return st;
   }
   return Ok{};
+}
+
+void DdsSink::time_reset() {
+  if (world_ == nullptr || !publishers_[static_cast<std::size_t>(msgs::TopicId::Clock)]) return;
+  // A failed write is the next step's to report (an observer has no status).
+  (void)publish(msgs::TopicId::Clock, *world_);
 }
 
 Status DdsSink::finish() {

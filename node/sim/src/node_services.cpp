@@ -11,6 +11,7 @@
 #include "rbsim/parameter_events.hpp"
 #include "rbsim/service.hpp"
 #include "rbsim/service_set.hpp"
+#include "simulate_steps.hpp"
 #include "simulation_services.hpp"
 
 namespace rbsim::node {
@@ -45,6 +46,7 @@ struct NodeServices::Impl {
   std::atomic<std::uint64_t> event_count{0};
   std::atomic<std::uint64_t> command_count{0};
   std::unique_ptr<SimulationServices> simulation;  // simulation_interfaces' services
+  std::unique_ptr<SimulateSteps> simulate_steps;   // and its action
   ServiceSet services;  // last: stopped first, before the members its handlers use go
 
   Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
@@ -183,12 +185,15 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
   impl->add_parameters(services);
   impl->simulation = std::make_unique<SimulationServices>(
       controller, [raw = impl.get()](Command c) { return raw->apply(std::move(c)); }, options.apply_timeout_s,
-      options.dt);
+      options.dt, options.quit);
   impl->simulation->add(services);
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
       return st.error();
   }
+  auto action = SimulateSteps::create(participant, options.node, controller);
+  if (!action) return action.error();
+  impl->simulate_steps = std::move(action.value());
   auto events = Publisher::create(participant, parameter_events_topic(), parameter_events_qos());
   if (!events) return events.error();
   impl->events.emplace(std::move(events.value()));
@@ -223,7 +228,10 @@ std::span<const std::byte> NodeServices::last_command() const {
 
 NodeServiceCounters NodeServices::counters() const {
   NodeServiceCounters c;
-  for (const ServiceStats& st : impl_->services.stats()) {
+  std::vector<ServiceStats> all = impl_->services.stats();
+  const ActionStats action = impl_->simulate_steps->stats();
+  all.insert(all.end(), {action.send_goal, action.cancel_goal, action.get_result});
+  for (const ServiceStats& st : all) {
     c.received += st.received;
     c.calls += st.answered;
     c.dropped += st.dropped_full + st.dropped_large + st.malformed + st.client_gone + st.client_unmatched +

@@ -25,7 +25,7 @@ using sim::Result;
 // What GetSimulatorFeatures lists: exactly what these services do. Not listed, and answered
 // RESULT_FEATURE_UNSUPPORTED: tags and convex-hull filters, resetting time or state alone (rbsim's
 // time is its step index, part of its state), spawned entities (issue 29), setting an
-// acceleration, quitting.
+// acceleration. (QUITTING has no feature of its own: rbsim node supports it, SIMULATION_STATE_SETTING.)
 constexpr sim::Feature kFeatures[] = {
     sim::Feature::EntityBounds,           sim::Feature::EntityBoundsBox,
     sim::Feature::EntityCategories,       sim::Feature::EntityStateGetting,
@@ -33,6 +33,7 @@ constexpr sim::Feature kFeatures[] = {
     sim::Feature::SimulationReset,        sim::Feature::SimulationStateGetting,
     sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
     sim::Feature::StepSimulationSingle,   sim::Feature::StepSimulationMultiple,
+    sim::Feature::StepSimulationAction,
 };
 constexpr std::size_t kMaxFilterBytes = 256;  // a longer name pattern is refused before it is compiled
 
@@ -272,6 +273,8 @@ void SimulationServices::add(std::vector<Entry>& out) {
 // set and the world is paused at step 0, else PAUSED or PLAYING as the run's `paused` setting.
 void SimulationServices::add_state(std::vector<Entry>& out) {
   const auto state_now = [this]() -> std::optional<sim::State> {
+    // Quitting, the loop may be gone: no boundary to wait for.
+    if (quitting_.load()) return sim::State::Quitting;
     return at_boundary(controller_, timeout_s_, [this](const World& world) {
       const bool paused = controller_.settings().paused;
       if (paused && world.step_index() == 0 && stopped_.load()) return sim::State::Stopped;
@@ -331,14 +334,21 @@ void SimulationServices::add_state(std::vector<Entry>& out) {
 
 // SetSimulationState's transitions: to PLAYING a resume, to PAUSED a pause (from STOPPED: paused
 // at step 0, no step taken), to STOPPED a pause and a reset to step 0; the same state again
-// ALREADY_IN_TARGET_STATE; QUITTING is not supported; NO_WORLD, LOADING_WORLD and unknown values
-// are INCORRECT_TRANSITION.
+// ALREADY_IN_TARGET_STATE; QUITTING ends the node as a SIGINT does (the reply goes out first), after
+// which every other state is INCORRECT_TRANSITION; NO_WORLD, LOADING_WORLD and unknown values are
+// INCORRECT_TRANSITION.
 Result SimulationServices::set_state(std::uint8_t target, const StateNow& state_now, const Run& command) {
   using R = sim::SetSimulationStateResponse;
   const auto to = static_cast<sim::State>(target);
-  if (to == sim::State::Quitting)
-    return failure(Result::kFeatureUnsupported,
-                   "STATE_QUITTING is not supported: stop the node with SIGINT or SIGTERM");
+  if (to == sim::State::Quitting) {
+    if (!quit_)
+      return failure(Result::kFeatureUnsupported,
+                     "STATE_QUITTING is not supported here: stop the node with SIGINT or SIGTERM");
+    if (quitting_.exchange(true)) return failure(R::kAlreadyInTargetState, "already quitting");
+    quit_();
+    return ok();
+  }
+  if (quitting_.load()) return failure(R::kIncorrectTransition, "the node is quitting");
   if (to != sim::State::Playing && to != sim::State::Paused && to != sim::State::Stopped)
     return failure(R::kIncorrectTransition,
                    "state " + std::to_string(target) + ": rbsim has one world, always loaded");

@@ -24,8 +24,14 @@ class SimulationServices {
   using Apply = std::function<control::CommandResult(control::Command)>;
   // `apply` submits a command and waits (bounded) for its result, as NodeServices does for its own
   // services; reads wait up to `timeout_s` for their boundary. `dt`: the scene's step (s).
-  SimulationServices(control::Controller& controller, Apply apply, double timeout_s, double dt)
-      : controller_(controller), apply_(std::move(apply)), timeout_s_(timeout_s), dt_(dt) {}
+  // `quit` ends the node (STATE_QUITTING); empty: QUITTING is unsupported.
+  SimulationServices(control::Controller& controller, Apply apply, double timeout_s, double dt,
+                     std::function<void()> quit = {})
+      : controller_(controller),
+        apply_(std::move(apply)),
+        timeout_s_(timeout_s),
+        dt_(dt),
+        quit_(std::move(quit)) {}
 
   // The services, as (name under the node, type, handler).
   using Entry = std::tuple<std::string, std::string, ServiceServer::Handler>;
@@ -39,6 +45,8 @@ class SimulationServices {
   // STOPPED: set by a stop (and at start), cleared by a play or a pause; the state reads STOPPED
   // while it is set and the world is paused at step 0.
   std::atomic<bool> stopped_{true};
+  std::function<void()> quit_;
+  std::atomic<bool> quitting_{false};  // QUITTING asked: the state reads QUITTING from then on
   using StateNow = std::function<std::optional<msgs::simulation::State>()>;
   using Run = std::function<control::CommandResult(control::CommandKind)>;
   void add_state(std::vector<Entry>& out);

@@ -17,6 +17,7 @@ static_assert(static_cast<int>(CommandKind::Step) == msgs::CommandMessage::Step)
 static_assert(static_cast<int>(CommandKind::Reset) == msgs::CommandMessage::Reset);
 static_assert(static_cast<int>(CommandKind::Impulse) == msgs::CommandMessage::ApplyImpulse);
 static_assert(static_cast<int>(CommandKind::SetState) == msgs::CommandMessage::SetEntityState);
+static_assert(static_cast<int>(CommandKind::StopStepping) == msgs::CommandMessage::StopStepping);
 
 // SetEntityState's values travel as named float64 parameters (the message's layout predates the
 // kind, and recordings made before it stay readable): x, y, theta for a pose, vx, vy, omega for a
@@ -96,8 +97,8 @@ msgs::CommandMessage to_message(const Command& command, const CommandResult& res
 
 Result<Command> from_message(const msgs::CommandMessage& m) {
   const std::string which = "command " + std::to_string(m.seq);
-  if (m.kind > msgs::CommandMessage::SetEntityState) {
-    return Error{which + ": unknown kind " + std::to_string(m.kind) + " (rbsim_msgs/msg/Command has 0..6)",
+  if (m.kind > msgs::CommandMessage::StopStepping) {
+    return Error{which + ": unknown kind " + std::to_string(m.kind) + " (rbsim_msgs/msg/Command has 0..7)",
                  ErrorCode::Malformed};
   }
   if (m.step > static_cast<std::uint64_t>(INT64_MAX) || m.steps > static_cast<std::uint64_t>(INT64_MAX)) {

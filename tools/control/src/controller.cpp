@@ -52,6 +52,8 @@ const char* to_string(CommandKind kind) {
       return "apply_impulse";
     case CommandKind::SetState:
       return "set_entity_state";
+    case CommandKind::StopStepping:
+      return "stop_stepping";
   }
   return "?";
 }
@@ -372,6 +374,7 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
                       (step_budget_ > 0 ? ", already stepping" : "") + ")");
       }
       step_budget_ += command.steps;
+      r.ends_at = now + step_budget_;
       r.message = "stepping from " + at(now) + " to " + at(now + step_budget_) + ", then paused";
       return r;
     case CommandKind::Reset: {
@@ -395,6 +398,12 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       boundary.state_changed |= applied.successful;
       return applied;
     }
+    case CommandKind::StopStepping:
+      r.message = step_budget_ > 0 ? "stopped stepping at " + at(now) + " with " +
+                                         std::to_string(step_budget_) + " steps left, paused"
+                                   : "not stepping at " + at(now);
+      step_budget_ = 0;
+      return r;
     case CommandKind::SetState: {
       CommandResult applied = set_state(command, world);
       boundary.state_changed |= applied.successful;

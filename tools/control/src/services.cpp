@@ -49,6 +49,8 @@ msgs::TriggerResponse trigger_response(const CommandResult& result) {
 }
 
 msgs::StepResponse step_response(const CommandResult& result) {
+  if (result.successful && result.ends_at >= 0)
+    return {result.successful, result.message, static_cast<std::uint64_t>(result.ends_at)};
   return {result.successful, result.message, step_of(result)};
 }
 

@@ -2,6 +2,8 @@
 // type's name in an error, strings, and one encode/decode driver around a type's put()/get().
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -24,6 +26,14 @@ inline void put_strings(CdrWriter& w, const std::vector<std::string>& v) {
 inline void get_strings(Reader& r, std::vector<std::string>& v) {
   v.resize(r.length(kMinString));
   for (std::string& s : v) s = r.string();
+}
+
+// unique_identifier_msgs/msg/UUID (an action's goal id): 16 octets.
+inline void put_uuid(CdrWriter& w, const std::array<std::uint8_t, 16>& id) {
+  for (const std::uint8_t b : id) w.u8(b);
+}
+inline void get_uuid(Reader& r, std::array<std::uint8_t, 16>& id) {
+  for (std::uint8_t& b : id) b = r.get<std::uint8_t>();
 }
 
 // "rcl_interfaces/msg/Parameter", or "std_srvs/srv/Trigger request" for a service half.

@@ -445,6 +445,61 @@ void get(Reader& r, BurstResponse& m) {
   m.actually_burst = r.get<std::uint64_t>();
 }
 
+void put(CdrWriter& w, const GoalInfo& m) {
+  detail::put_uuid(w, m.goal_id);
+  w.time(m.stamp);
+}
+void get(Reader& r, GoalInfo& m) {
+  detail::get_uuid(r, m.goal_id);
+  m.stamp = r.time();
+}
+// uuid (16) + time (8)
+constexpr std::size_t kMinGoalInfo = 24;
+void put(CdrWriter& w, const GoalStatusArray& m) {
+  w.sequence_length(m.status_list.size());
+  for (const GoalStatus& s : m.status_list) {
+    put(w, s.goal_info);
+    w.u8(static_cast<std::uint8_t>(s.status));
+  }
+}
+void get(Reader& r, GoalStatusArray& m) {
+  m.status_list.resize(r.length(kMinGoalInfo + 1));
+  for (GoalStatus& s : m.status_list) {
+    get(r, s.goal_info);
+    s.status = r.get<std::int8_t>();
+  }
+}
+void put(CdrWriter& w, const CancelGoalRequest& m) {
+  put(w, m.goal_info);
+}
+void get(Reader& r, CancelGoalRequest& m) {
+  get(r, m.goal_info);
+}
+void put(CdrWriter& w, const CancelGoalResponse& m) {
+  w.u8(static_cast<std::uint8_t>(m.return_code));
+  w.sequence_length(m.goals_canceling.size());
+  for (const GoalInfo& g : m.goals_canceling) put(w, g);
+}
+void get(Reader& r, CancelGoalResponse& m) {
+  m.return_code = r.get<std::int8_t>();
+  m.goals_canceling.resize(r.length(kMinGoalInfo));
+  for (GoalInfo& g : m.goals_canceling) get(r, g);
+}
+void put(CdrWriter& w, const SendGoalResponse& m) {
+  w.boolean(m.accepted);
+  w.time(m.stamp);
+}
+void get(Reader& r, SendGoalResponse& m) {
+  m.accepted = r.get<std::uint8_t>() != 0;
+  m.stamp = r.time();
+}
+void put(CdrWriter& w, const GetResultRequest& m) {
+  detail::put_uuid(w, m.goal_id);
+}
+void get(Reader& r, GetResultRequest& m) {
+  detail::get_uuid(r, m.goal_id);
+}
+
 }  // namespace
 
 RBSIM_DEFINE_CODEC(ParameterValue, "")
@@ -494,5 +549,16 @@ RBSIM_DEFINE_CODEC(SnapshotRequest, " request")
 RBSIM_DEFINE_CODEC(SnapshotResponse, " response")
 RBSIM_DEFINE_CODEC(SplitBagfileRequest, " request")
 RBSIM_DEFINE_CODEC(SplitBagfileResponse, " response")
+RBSIM_DEFINE_CODEC(GoalStatusArray, "")
+RBSIM_DEFINE_CODEC(CancelGoalRequest, " request")
+RBSIM_DEFINE_CODEC(CancelGoalResponse, " response")
+RBSIM_DEFINE_CODEC(SendGoalResponse, "")
+RBSIM_DEFINE_CODEC(GetResultRequest, "")
+
+Result<GoalUuid> request_goal_id(std::span<const std::byte> cdr) {
+  GetResultRequest prefix;  // the goal id alone: what every action request begins with
+  if (Status st = decode(cdr, prefix); !st) return st.error();
+  return prefix.goal_id;
+}
 
 }  // namespace rbsim::msgs

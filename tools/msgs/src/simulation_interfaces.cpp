@@ -269,6 +269,33 @@ void get(Reader& r, GetEntityBoundsResponse& m) {
   get(r, m.bounds);
 }
 
+void put(CdrWriter& w, const SimulateStepsSendGoalRequest& m) {
+  detail::put_uuid(w, m.goal_id);
+  w.u64(m.steps);
+}
+void get(Reader& r, SimulateStepsSendGoalRequest& m) {
+  detail::get_uuid(r, m.goal_id);
+  m.steps = r.get<std::uint64_t>();
+}
+void put(CdrWriter& w, const SimulateStepsGetResultResponse& m) {
+  w.u8(static_cast<std::uint8_t>(m.status));
+  put(w, m.result);
+}
+void get(Reader& r, SimulateStepsGetResultResponse& m) {
+  m.status = r.get<std::int8_t>();
+  get(r, m.result);
+}
+void put(CdrWriter& w, const SimulateStepsFeedbackMessage& m) {
+  detail::put_uuid(w, m.goal_id);
+  w.u64(m.completed_steps);
+  w.u64(m.remaining_steps);
+}
+void get(Reader& r, SimulateStepsFeedbackMessage& m) {
+  detail::get_uuid(r, m.goal_id);
+  m.completed_steps = r.get<std::uint64_t>();
+  m.remaining_steps = r.get<std::uint64_t>();
+}
+
 }  // namespace
 
 RBSIM_DEFINE_CODEC(SimulatorFeatures, "")
@@ -297,5 +324,8 @@ RBSIM_DEFINE_CODEC(SetEntityStateRequest, " request")
 RBSIM_DEFINE_CODEC(SetEntityStateResponse, " response")
 RBSIM_DEFINE_CODEC(GetEntityBoundsRequest, " request")
 RBSIM_DEFINE_CODEC(GetEntityBoundsResponse, " response")
+RBSIM_DEFINE_CODEC(SimulateStepsSendGoalRequest, " request")
+RBSIM_DEFINE_CODEC(SimulateStepsGetResultResponse, " response")
+RBSIM_DEFINE_CODEC(SimulateStepsFeedbackMessage, "")
 
 }  // namespace rbsim::msgs::simulation

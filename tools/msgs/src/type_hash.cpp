@@ -415,10 +415,25 @@ Result<std::string> type_hash(std::string_view type) {
   return hash;
 }
 
-Result<ServiceEndpointHashes> service_endpoint_type_hashes(std::string_view service) {
+// A service rbsim carries: a shipped "pkg/srv/Name", or one of the two services of a shipped action
+// ("pkg/action/Name_SendGoal", "..._GetResult").
+bool carried_service(std::string_view service) {
   const auto name = split_type(service);
-  if (!name || name->kind != "srv" || !shipped_definition(service)) {
-    return Error{"\"" + std::string(service) + "\" is not a service rbsim carries (pkg/srv/Name)"};
+  if (!name) return false;
+  if (name->kind == "srv") return shipped_definition(service).has_value();
+  if (name->kind != "action") return false;
+  for (const std::string_view part : {std::string_view("_SendGoal"), std::string_view("_GetResult")}) {
+    if (service.ends_with(part))
+      return shipped_definition(service.substr(0, service.size() - part.size())).has_value();
+  }
+  return false;
+}
+
+Result<ServiceEndpointHashes> service_endpoint_type_hashes(std::string_view service) {
+  if (!carried_service(service)) {
+    return Error{
+        "\"" + std::string(service) +
+        "\" is not a service rbsim carries (pkg/srv/Name, or pkg/action/Name_SendGoal or _GetResult)"};
   }
   auto request = type_hash(std::string(service) + std::string(kRequest));
   if (!request) return request.error();

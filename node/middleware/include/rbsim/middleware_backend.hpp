@@ -52,6 +52,7 @@ class ServiceServerImpl {
  public:
   virtual ~ServiceServerImpl() = default;
   virtual std::size_t serve(const ServiceHandler& handler, std::size_t budget) = 0;
+  virtual void reply(const RequestHeader& header, std::span<const std::byte> body) = 0;
   virtual bool wait(double timeout_s) = 0;
   virtual ServiceStats stats() const = 0;
 };

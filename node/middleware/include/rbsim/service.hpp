@@ -27,7 +27,11 @@ namespace rbsim::node {
 struct RequestHeader {
   std::uint64_t guid = 0;  // the client's id (ServiceClient::id())
   std::int64_t seq = 0;    // the client's sequence number of the call
-  bool operator==(const RequestHeader&) const = default;
+  // The backend's own note of how to reach the caller (DDS: its request writer's instance
+  // handle), set on what a server hands its handler, for a reply written later
+  // (ServiceServer::reply). Not part of the call's identity.
+  std::uint64_t route = 0;
+  bool operator==(const RequestHeader& o) const { return guid == o.guid && seq == o.seq; }
 };
 
 struct ServiceOptions {
@@ -48,7 +52,8 @@ struct ServiceOptions {
 struct ServiceStats {
   std::uint64_t received = 0;
   std::uint64_t answered = 0;          // a reply written
-  std::uint64_t unanswered = 0;        // the handler chose not to reply
+  std::uint64_t unanswered = 0;        // the handler wrote no reply (one written later by
+                                       // ServiceServer::reply() is counted again, by its outcome)
   std::uint64_t dropped_full = 0;      // the queue was full
   std::uint64_t dropped_large = 0;     // over max_request_bytes
   std::uint64_t malformed = 0;         // not a service sample (bad CDR header, shorter than the header)
@@ -83,6 +88,9 @@ class ServiceServer {
   // Handles up to `budget` queued requests on the caller's thread, writing their replies, and
   // retries the replies waiting for their client's reader. Returns the requests handled.
   std::size_t serve(const Handler& handler, std::size_t budget = SIZE_MAX);
+  // Answers, later, a request whose handler wrote no reply (an action's get_result, answered when
+  // its goal ends): `header` as the handler got it. On the thread that calls serve() only.
+  void reply(const RequestHeader& header, std::span<const std::byte> reply);
   // Waits until a request is queued or `timeout_s` passes; true when one is.
   bool wait(double timeout_s);
   ServiceStats stats() const;  // from any thread

@@ -38,6 +38,10 @@ class DdsSink final : public Sink {
   // Waits (bounded) until subscribers acknowledged everything, so nothing in flight is lost
   // when the node exits.
   Status finish() override;
+  // A reset applied (the controller's observer, on the run loop's thread, the world at step 0 by
+  // then): publishes /clock at once, so subscribers see time jump back to 0 while the run stays
+  // paused (the other topics follow with the next step). Nothing before begin().
+  void time_reset();
   // Waits until `count` subscriptions match the first selected per-step topic (body states by
   // default); false when `stop` turned true.
   bool wait_for_subscribers(std::int32_t count, bool (*stop)());
@@ -53,6 +57,7 @@ class DdsSink final : public Sink {
   std::vector<msgs::TopicId> ids_;                    // the selected topics, latched first
   std::shared_ptr<msgs::StepMessages> messages_;
   std::uint64_t published_ = 0;
+  const World* world_ = nullptr;  // the run's world (begin()), for time_reset()
 };
 
 // Paces a run to wall time: published step n (every k-th) is computed and released at start +

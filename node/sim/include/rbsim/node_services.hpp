@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -23,6 +24,10 @@ struct NodeServicesOptions {
   // How long a request waits for its step boundary before it is answered unsuccessfully (a run
   // that ended, or one stopped by Ctrl-C, answers at once).
   double apply_timeout_s = 10.0;
+  // simulation_interfaces' STATE_QUITTING: called once (on the services' thread, after which the
+  // reply goes out) to end the node as a SIGINT would, outputs finished, exit 0. Empty: QUITTING
+  // answers RESULT_FEATURE_UNSUPPORTED.
+  std::function<void()> quit = nullptr;
 };
 
 // For the end line.

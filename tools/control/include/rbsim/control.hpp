@@ -33,8 +33,20 @@
 
 namespace rbsim::control {
 
-enum class CommandKind : std::uint8_t { SetParameters, Pause, Resume, Step, Reset, Impulse, SetState };
-// "set_parameters", "pause", "resume", "step", "reset", "apply_impulse", "set_entity_state"
+// StopStepping ends a `step N` in progress at its boundary, the run staying paused there (the
+// SimulateSteps action's cancel; a Pause leaves the stepping alone); not stepping, it does nothing.
+enum class CommandKind : std::uint8_t {
+  SetParameters,
+  Pause,
+  Resume,
+  Step,
+  Reset,
+  Impulse,
+  SetState,
+  StopStepping
+};
+// "set_parameters", "pause", "resume", "step", "reset", "apply_impulse", "set_entity_state",
+// "stop_stepping"
 const char* to_string(CommandKind kind);
 
 // A linear impulse J (N s, world axes) at the point p (m, body frame, relative to the centre of
@@ -89,6 +101,9 @@ struct CommandResult {
   bool successful = false;
   std::string message;
   std::int64_t step = Command::kNextStep;  // the boundary at which it applied (kNextStep: it never did)
+  // A step N: the boundary its stepping ends at, where the world stands paused next (`step` plus
+  // every step still to take, this command's included); kNextStep for the other commands.
+  std::int64_t ends_at = Command::kNextStep;
   // SetParameters: one result for an atomic batch, one per parameter otherwise.
   std::vector<SetParametersResult> results;
   // Every parameter the command changed, with its new value, in table order for a reset (which
@@ -242,8 +257,9 @@ class Controller final : public StepHook, public Steering {
 // The control services, one mapping from their requests to Commands and from results to their
 // replies for every front end (the node's DDS services, the Foxglove server): pause, resume and
 // reset (std_srvs/srv/Trigger), step (rbsim_msgs/srv/Step), apply_impulse
-// (rbsim_msgs/srv/ApplyImpulse), in that order. A reply's `step` is the boundary the command
-// applied at (0 if it never did).
+// (rbsim_msgs/srv/ApplyImpulse), in that order. A step reply's `step` is the step the world reaches
+// when the stepping ends (CommandResult::ends_at; answered as it begins, the published state
+// reaches it N steps later), an impulse reply's the boundary it applied at (0 if it never did).
 struct ControlService {
   std::string_view name;  // "pause"
   std::string_view type;  // "std_srvs/srv/Trigger"

@@ -12,6 +12,7 @@
 // proportional to the input.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -118,7 +119,9 @@ struct CommandMessage {
     ApplyImpulse = 5,
     // Not a constant of Command.msg (whose text recordings are checked against): set_entity_state,
     // its values in `parameters` (x, y, theta; vx, vy, omega) and its body in `body`.
-    SetEntityState = 6
+    SetEntityState = 6,
+    // Not a constant of Command.msg either: stop_stepping (a SimulateSteps cancel), no arguments.
+    StopStepping = 7
   };
   std::uint64_t seq = 0;  // the sequence number (`sequence` is an IDL keyword)
   std::uint64_t step = 0;
@@ -319,6 +322,73 @@ struct BurstResponse {
 };
 
 // ---------------------------------------------------------------------------------------------
+// Actions (Jazzy's action_msgs and unique_identifier_msgs): what every ROS 2 action carries beside
+// its own goal, result and feedback, whatever the action. rosidl makes of an action "pkg/action/X"
+// the services X_SendGoal (request: goal id, then the goal; response: SendGoalResponse) and
+// X_GetResult (request: GetResultRequest; response: status, then the result) and the message
+// X_FeedbackMessage (goal id, then the feedback); the action's own halves are in its package's
+// header (rbsim/simulation_interfaces.hpp).
+
+using GoalUuid = std::array<std::uint8_t, 16>;  // unique_identifier_msgs/msg/UUID
+// action_msgs/msg/GoalInfo: the goal's id and when the server accepted it.
+struct GoalInfo {
+  GoalUuid goal_id{};
+  Time stamp;
+  bool operator==(const GoalInfo&) const = default;
+};
+// action_msgs/msg/GoalStatus.
+struct GoalStatus {
+  static constexpr std::int8_t kUnknown = 0;
+  static constexpr std::int8_t kAccepted = 1;
+  static constexpr std::int8_t kExecuting = 2;
+  static constexpr std::int8_t kCanceling = 3;
+  static constexpr std::int8_t kSucceeded = 4;
+  static constexpr std::int8_t kCanceled = 5;
+  static constexpr std::int8_t kAborted = 6;
+  GoalInfo goal_info;
+  std::int8_t status = kUnknown;
+  bool operator==(const GoalStatus&) const = default;
+};
+// action_msgs/msg/GoalStatusArray: an action's <action>/_action/status topic.
+struct GoalStatusArray {
+  static constexpr std::string_view kType = "action_msgs/msg/GoalStatusArray";
+  std::vector<GoalStatus> status_list;
+  bool operator==(const GoalStatusArray&) const = default;
+};
+// action_msgs/srv/CancelGoal: a zero goal id and a zero stamp cancel every goal; a zero id and a
+// stamp, every goal accepted at or before it; an id, that goal (and, with a stamp, every goal
+// accepted at or before it too).
+struct CancelGoalRequest {
+  static constexpr std::string_view kService = "action_msgs/srv/CancelGoal";
+  GoalInfo goal_info;
+  bool operator==(const CancelGoalRequest&) const = default;
+};
+struct CancelGoalResponse {
+  static constexpr std::string_view kService = CancelGoalRequest::kService;
+  static constexpr std::int8_t kErrorNone = 0;
+  static constexpr std::int8_t kErrorRejected = 1;
+  static constexpr std::int8_t kErrorUnknownGoalId = 2;
+  static constexpr std::int8_t kErrorGoalTerminated = 3;
+  std::int8_t return_code = kErrorNone;
+  std::vector<GoalInfo> goals_canceling;
+  bool operator==(const CancelGoalResponse&) const = default;
+};
+// Every action's SendGoal response and GetResult request (the same fields for any action).
+struct SendGoalResponse {
+  static constexpr std::string_view kType = "<action>_SendGoal_Response";
+  bool accepted = false;
+  Time stamp;
+  bool operator==(const SendGoalResponse&) const = default;
+};
+struct GetResultRequest {
+  static constexpr std::string_view kType = "<action>_GetResult_Request";
+  GoalUuid goal_id{};
+  bool operator==(const GetResultRequest&) const = default;
+};
+// The goal id that begins every action request (SendGoal's and GetResult's), read from its CDR.
+[[nodiscard]] Result<GoalUuid> request_goal_id(std::span<const std::byte> cdr);
+
+// ---------------------------------------------------------------------------------------------
 // Codecs: encode() replaces `out` with the message's CDR (encapsulation header included);
 // decode() fills `out` (replaced whole) or fails naming the type and the offset, `out` then
 // unspecified.
@@ -373,6 +443,11 @@ RBSIM_INTERFACE_CODEC(SnapshotRequest)
 RBSIM_INTERFACE_CODEC(SnapshotResponse)
 RBSIM_INTERFACE_CODEC(SplitBagfileRequest)
 RBSIM_INTERFACE_CODEC(SplitBagfileResponse)
+RBSIM_INTERFACE_CODEC(GoalStatusArray)
+RBSIM_INTERFACE_CODEC(CancelGoalRequest)
+RBSIM_INTERFACE_CODEC(CancelGoalResponse)
+RBSIM_INTERFACE_CODEC(SendGoalResponse)
+RBSIM_INTERFACE_CODEC(GetResultRequest)
 #undef RBSIM_INTERFACE_CODEC
 
 }  // namespace rbsim::msgs

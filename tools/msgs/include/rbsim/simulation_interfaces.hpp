@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rbsim/interfaces.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs::simulation {
@@ -253,6 +254,31 @@ struct GetEntityBoundsResponse {
 };
 
 // ---------------------------------------------------------------------------------------------
+// The SimulateSteps action: its goal request, result response and feedback message (the halves
+// every action shares are rbsim/interfaces.hpp's SendGoalResponse and GetResultRequest, its cancel
+// action_msgs' CancelGoal).
+struct SimulateStepsSendGoalRequest {
+  static constexpr std::string_view kAction = "simulation_interfaces/action/SimulateSteps";
+  static constexpr std::string_view kService = "simulation_interfaces/action/SimulateSteps_SendGoal";
+  GoalUuid goal_id{};
+  std::uint64_t steps = 0;
+  bool operator==(const SimulateStepsSendGoalRequest&) const = default;
+};
+struct SimulateStepsGetResultResponse {
+  static constexpr std::string_view kService = "simulation_interfaces/action/SimulateSteps_GetResult";
+  std::int8_t status = GoalStatus::kUnknown;
+  Result result;
+  bool operator==(const SimulateStepsGetResultResponse&) const = default;
+};
+struct SimulateStepsFeedbackMessage {
+  static constexpr std::string_view kType = "simulation_interfaces/action/SimulateSteps_FeedbackMessage";
+  GoalUuid goal_id{};
+  std::uint64_t completed_steps = 0;
+  std::uint64_t remaining_steps = 0;
+  bool operator==(const SimulateStepsFeedbackMessage&) const = default;
+};
+
+// ---------------------------------------------------------------------------------------------
 // Codecs (found by argument-dependent lookup beside rbsim/interfaces.hpp's): encode() replaces
 // `out` with the message's CDR; decode() fills `out` (replaced whole) or fails naming the type and
 // the offset.
@@ -286,6 +312,9 @@ RBSIM_SIMULATION_CODEC(SetEntityStateRequest)
 RBSIM_SIMULATION_CODEC(SetEntityStateResponse)
 RBSIM_SIMULATION_CODEC(GetEntityBoundsRequest)
 RBSIM_SIMULATION_CODEC(GetEntityBoundsResponse)
+RBSIM_SIMULATION_CODEC(SimulateStepsSendGoalRequest)
+RBSIM_SIMULATION_CODEC(SimulateStepsGetResultResponse)
+RBSIM_SIMULATION_CODEC(SimulateStepsFeedbackMessage)
 #undef RBSIM_SIMULATION_CODEC
 
 }  // namespace rbsim::msgs::simulation
