@@ -6,7 +6,6 @@
 // the node type cache (rbsim/node_types.hpp) and the hash parser on their own.
 #include <dds/dds.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstring>
@@ -21,6 +20,7 @@
 #include "rbsim/node_services.hpp"
 #include "rbsim/node_types.hpp"
 #include "rbsim/type_hash.hpp"
+#include "sim_test_util.hpp"
 
 namespace rbsim::node {
 namespace {
@@ -77,19 +77,12 @@ TEST(ParseTypeHash, ReadsWhatRosidlReads) {
 
 // --- The service on a node ---------------------------------------------------------------------
 
-std::string node_name() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string test = info->name();
-  for (char& c : test) c = (c == '/') ? '_' : c;
-  return "type_description_" + std::to_string(::getpid()) + "_" + test;
-}
-
 // A node of this process with rbsim node's endpoints (its DDS sink's publishers, its services and
 // their publishers), and a client participant.
 class GetTypeDescriptionService : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    node_ = node_name();
+    node_ = test::node_name("type_description");
     server_.emplace(participant(node_));
     NodeOptions sink_options;
     sink_options.ns = node_;
@@ -107,11 +100,7 @@ class GetTypeDescriptionService : public ::testing::TestWithParam<std::string> {
   }
 
   Participant participant(const std::string& name) {
-    const NodeName n{"/", name};
-    auto p =
-        GetParam() == "memory" ? create_memory_participant(network_, n) : create_dds_participant(kDomain, n);
-    if (!p) throw std::runtime_error(p.error().message);
-    return std::move(p.value());
+    return test::participant(GetParam(), network_, kDomain, name);
   }
 
   Result<ServiceClient> client() {

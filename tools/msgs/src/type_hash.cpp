@@ -19,6 +19,7 @@
 #include <set>
 #include <vector>
 
+#include "list_items.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
@@ -185,16 +186,9 @@ Result<std::string> rosidl_default_value(const MsgField& f) {
   std::string_view list = f.default_text;
   if (list.size() < 2 || list.front() != '[' || list.back() != ']')
     return Error{"an array default must be written [a, b, ...]: " + f.default_text};
-  list = list.substr(1, list.size() - 2);
   std::string out = "(";
   std::size_t count = 0;
-  while (!list.empty()) {
-    const auto comma = list.find(',');
-    std::string_view item = list.substr(0, comma);
-    list = comma == std::string_view::npos ? std::string_view() : list.substr(comma + 1);
-    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
-    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
-    if (item.empty() && list.empty() && count > 0) break;  // a trailing comma
+  for (const std::string_view item : detail::list_items(list.substr(1, list.size() - 2))) {
     auto value = scalar_default(f.type, item, true);
     if (!value) return value.error();
     out += (count++ > 0 ? ", " : "") + value.value();
