@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,13 +24,15 @@ std::vector<std::string> names(const ParameterTable& t) {
 TEST(ParameterTable, DeclaresTheRunsParametersWithForcesInFileOrder) {
   const Scene scene = test::control_scene();
   const ParameterTable t(scene, 200, RunSettings{2.0, 3, false});
-  const std::vector<std::string> expected = {
+  std::vector<std::string> expected = {
       "scene",         "dt",           "integrator",  "bodies",
       "springs",       "steps",        "rate",        "publish_every",
       "paused",        "use_sim_time", "forces.0.fx", "forces.0.fy",             // gravity
       "forces.1.beta", "forces.1.fx",  "forces.1.fy", "forces.1.pointsperedge",  // wind
       "forces.2.fx",   "forces.2.fy",                                            // gravity
       "springs.0.k",   "springs.0.l0", "springs.1.k", "springs.1.l0"};
+  // rclcpp's read-only node parameter, declared after use_sim_time.
+  expected.insert(expected.begin() + 10, "start_type_description_service");
   EXPECT_EQ(names(t), expected);
   const auto value = [&](const char* name) { return t.value(*t.find(name)); };
   EXPECT_EQ(value("scene"), V::of_string("control.xml"));
@@ -48,10 +51,16 @@ TEST(ParameterTable, DeclaresTheRunsParametersWithForcesInFileOrder) {
   EXPECT_EQ(value("forces.2.fx"), V::of_double(scene.world.gravity[1].acceleration.x()));
   EXPECT_EQ(value("springs.1.k"), V::of_double(scene.world.springs[1].stiffness));
   EXPECT_EQ(value("springs.0.l0"), V::of_double(scene.world.springs[0].rest_length));
-  for (const char* ro : {"scene", "dt", "integrator", "bodies", "springs", "steps"}) {
-    EXPECT_TRUE(t.descriptor(*t.find(ro)).read_only) << ro;
+  EXPECT_EQ(value("start_type_description_service"), V::of_bool(true));  // rclcpp's default
+  const auto read_only = {
+      "scene", "dt", "integrator", "bodies", "springs", "steps", "start_type_description_service"};
+  for (const char* ro : read_only) EXPECT_TRUE(t.descriptor(*t.find(ro)).read_only) << ro;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const std::string& name = t.descriptor(i).name;
+    if (std::find(read_only.begin(), read_only.end(), name) == read_only.end()) {
+      EXPECT_FALSE(t.descriptor(i).read_only) << name;
+    }
   }
-  for (std::size_t i = 6; i < t.size(); ++i) EXPECT_FALSE(t.descriptor(i).read_only) << t.descriptor(i).name;
 }
 
 // One row per read-write parameter: a value it takes, one of the wrong type, one out of range.
@@ -105,7 +114,8 @@ TEST(ParameterTableCheck, EveryReadWriteParameterTakesItsTypeInRangeAndRefusesTh
 
 TEST(ParameterTableCheck, RefusesReadOnlyUnknownAndNotSet) {
   const ParameterTable t(test::control_scene(), 200, RunSettings{});
-  for (const char* name : {"scene", "dt", "integrator", "bodies", "springs", "steps"}) {
+  for (const char* name :
+       {"scene", "dt", "integrator", "bodies", "springs", "steps", "start_type_description_service"}) {
     const SetParametersResult r = t.check({name, t.value(*t.find(name))});  // even its own value
     EXPECT_FALSE(r.successful) << name;
     EXPECT_NE(r.reason.find("read-only"), std::string::npos) << r.reason;
@@ -145,7 +155,7 @@ TEST(ParameterTableList, FollowsRclcppPrefixAndDepthRules) {
             (std::vector<std::string>{"forces.0", "forces.1", "forces.2", "springs.0", "springs.1"}));
   const ListParametersResult top = t.list({}, 1);  // names without a '.'
   for (const std::string& n : top.names) EXPECT_EQ(n.find('.'), std::string::npos) << n;
-  EXPECT_EQ(top.names.size(), 10u);
+  EXPECT_EQ(top.names.size(), 11u);  // start_type_description_service among them
   const ListParametersResult wind = t.list({"forces.1"}, kDepthRecursive);
   EXPECT_EQ(wind.names, (std::vector<std::string>{"forces.1.beta", "forces.1.fx", "forces.1.fy",
                                                   "forces.1.pointsperedge"}));
@@ -172,6 +182,27 @@ TEST(ApplyOverrides, EditsTheSceneAndSettingsAsOneBatch) {
   EXPECT_EQ(scene.world.winds[0].points_per_edge, 9);
   EXPECT_EQ(settings.rate, 4.0);
   EXPECT_TRUE(settings.paused);
+}
+
+// rclcpp's start_type_description_service is read-only and takes its value from an override
+// (-p start_type_description_service:=false); the scene's read-only parameters take none.
+TEST(ApplyOverrides, StartTypeDescriptionServiceIsGivenByAnOverrideOnly) {
+  Scene scene = test::control_scene();
+  RunSettings settings;
+  EXPECT_TRUE(settings.start_type_description_service);
+  ASSERT_TRUE(apply_overrides({{{"start_type_description_service", V::of_bool(false)}, "-p", false}}, scene,
+                              200, settings)
+                  .ok());
+  EXPECT_FALSE(settings.start_type_description_service);
+  const ParameterTable t(scene, 200, settings);
+  EXPECT_EQ(t.value(*t.find("start_type_description_service")), V::of_bool(false));
+  const Status wrong_type = apply_overrides(
+      {{{"start_type_description_service", V::of_integer(0)}, "-p", false}}, scene, 200, settings);
+  ASSERT_FALSE(wrong_type.ok());
+  EXPECT_NE(wrong_type.error().message.find("Wrong parameter type"), std::string::npos);
+  const Status dt = apply_overrides({{{"dt", V::of_double(0.5)}, "-p", false}}, scene, 200, settings);
+  ASSERT_FALSE(dt.ok());
+  EXPECT_NE(dt.error().message.find("read-only"), std::string::npos);
 }
 
 TEST(ApplyOverrides, TheFirstBadOneNamesOriginAndParameterAndNothingChanges) {

@@ -42,6 +42,7 @@
 #include "rbsim/interfaces.hpp"
 #include "rbsim/msgs.hpp"
 #include "rbsim/simulation_interfaces.hpp"
+#include "rbsim/type_hash.hpp"
 
 namespace {
 
@@ -832,6 +833,64 @@ TEST(CycloneCdrSimulationInterfaces, EncoderBytesEqualCycloneSerialisation) {
     auto* formats = alloc_seq(c.spawn_formats, m.spawn_formats.size());
     formats[0] = str(m.spawn_formats[0]);
     c.custom_info = str(m.custom_info);
+    check(desc, sample, ours);
+  }
+}
+
+// type_description_interfaces (~/get_type_description, rbsim/type_description.hpp): a whole
+// TypeDescription as msgs::type_description builds it (nested types, bounded names, default values,
+// sequences of sequences) and a TypeSource, msgs::encode's bytes against Cyclone's serialisation of
+// the idlc-generated types filled with the same values.
+TEST(CycloneCdrTypeDescription, EncoderBytesEqualCycloneSerialisation) {
+  namespace m = rbsim::msgs;
+  const auto check = [](const dds_topic_descriptor_t& desc, const Sample& sample, const Bytes& ours) {
+    Loopback dds;
+    ASSERT_NO_FATAL_FAILURE(dds.open(desc));
+    const SerdataPtr cyclone = dds.write_sample(sample.get());
+    ASSERT_NE(cyclone, nullptr);
+    EXPECT_TRUE(same_bytes(ours, serialized(*cyclone))) << desc.m_typename;
+  };
+  const auto fill = [](type_description_interfaces_msg_dds__IndividualTypeDescription_& c,
+                       const m::IndividualTypeDescription& d) {
+    std::snprintf(c.type_name, sizeof c.type_name, "%s", d.type_name.c_str());
+    auto* fields = alloc_seq(c.fields, d.fields.size());
+    for (std::size_t k = 0; k < d.fields.size(); ++k) {
+      const m::Field& f = d.fields[k];
+      fields[k].name = str(f.name);
+      fields[k].type.type_id = f.type.type_id;
+      fields[k].type.capacity = f.type.capacity;
+      fields[k].type.string_capacity = f.type.string_capacity;
+      std::snprintf(fields[k].type.nested_type_name, sizeof fields[k].type.nested_type_name, "%s",
+                    f.type.nested_type_name.c_str());
+      fields[k].default_value = str(f.default_value);
+    }
+  };
+  {
+    const auto td =
+        m::type_description("rcl_interfaces/msg/ParameterDescriptor");  // defaults, bounded sequences
+    ASSERT_TRUE(td.ok()) << td.error().message;
+    ASSERT_FALSE(td.value().referenced_type_descriptions.empty());
+    Bytes ours;
+    m::encode(td.value(), ours);
+    const dds_topic_descriptor_t& desc = type_description_interfaces_msg_dds__TypeDescription__desc;
+    Sample sample(desc);
+    auto& c = *static_cast<type_description_interfaces_msg_dds__TypeDescription_*>(sample.get());
+    fill(c.type_description, td.value().type_description);
+    const auto& refs = td.value().referenced_type_descriptions;
+    auto* r = alloc_seq(c.referenced_type_descriptions, refs.size());
+    for (std::size_t k = 0; k < refs.size(); ++k) fill(r[k], refs[k]);
+    check(desc, sample, ours);
+  }
+  {
+    const m::TypeSource source{"std_srvs/srv/Trigger", "srv", "---\nbool success\nstring message"};
+    Bytes ours;
+    m::encode(source, ours);
+    const dds_topic_descriptor_t& desc = type_description_interfaces_msg_dds__TypeSource__desc;
+    Sample sample(desc);
+    auto& c = *static_cast<type_description_interfaces_msg_dds__TypeSource_*>(sample.get());
+    c.type_name = str(source.type_name);
+    c.encoding = str(source.encoding);
+    c.raw_file_contents = str(source.raw_file_contents);
     check(desc, sample, ours);
   }
 }

@@ -1446,6 +1446,49 @@ def case_ros_graph(ctx):
                 f"USER_DATA {got['user_data']!r}, /rosout {log['name']}: {log['msg'][:40]}...")
 
 
+def case_type_description(ctx):
+    """rbsim node's ~/get_type_description as an independent client (Python cyclonedds,
+    type_description_client.py) calls it: asked for the hash the node's body_states writer
+    announces in its USER_DATA, it answers that type's description, whose REP 2011 hash computed in
+    Python is the announced one, with the .msg texts as sources; a hash no type has fails in rcl's
+    words; started with -p start_type_description_service:=false, the service is not there."""
+    env = ctx.env(uri="file://" + ctx.loopback_xml)
+    client = os.path.join(os.path.dirname(__file__), "type_description_client.py")
+    node_name, topic, type_name = f"/{ctx.ns}", f"/{ctx.ns}/body_states", "rbsim_msgs/msg/BodyStates"
+    args = [sys.executable, client, "--domain", str(ctx.domain), "--node", node_name, "--topic", topic,
+            "--type", type_name]
+    node = ctx.rb("node", "node", ctx.scene("chain.xml"), "--domain", ctx.domain, "--namespace", ctx.ns, "--loop",
+                  env=env)
+    rc, out, err = ctx.run("client", args + ["--timeout", "40"], timeout=90, env=env)
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 30)
+    if ctx.check(rc == 0, f"type description client exited with {rc}\n{out}{err}"):
+        got = json.loads(out.strip().splitlines()[-1])
+        with open(os.path.join(ctx.src, "tools", "msgs", "definitions", "rbsim_msgs", "msg",
+                               "BodyStates.msg"), encoding="utf-8") as f:
+            text = f.read()
+        ctx.check(got["announced"] and got["announced"].startswith("RIHS01_"), f"announced hash {got['announced']!r}")
+        ctx.check(got["successful"] and got["failure_reason"] == "", f"reply {got['successful']} {got['failure_reason']!r}")
+        ctx.check(got["type_name"] == type_name, f"described {got['type_name']!r}")
+        ctx.check(got["description_hash"] == got["announced"],
+                  f"the description hashes to {got['description_hash']}, the writer announces {got['announced']}")
+        ctx.check(got["sources"] and got["sources"][0] == [type_name, "msg", text.rstrip("\n")],
+                  f"first source {got['sources'][:1]}")
+        ctx.check([s[0] for s in got["sources"][1:]] == got["referenced"],
+                  f"sources {[s[0] for s in got['sources']]} for referenced {got['referenced']}")
+        ctx.check(got["unknown"] == [False, "Type not currently in use by this node"], f"unknown hash: {got['unknown']}")
+        ctx.log(f"{type_name}: {got['announced']} described ({len(got['referenced'])} referenced types, "
+                f"{len(got['sources'])} sources)")
+    node = ctx.rb("node-off", "node", ctx.scene("chain.xml"), "--domain", ctx.domain, "--namespace", ctx.ns, "--loop",
+                  "--ros-args", "-p", "start_type_description_service:=false", env=env)
+    rc, out, err = ctx.run("client-off", args + ["--timeout", "40", "--expect-none"], timeout=90, env=env)
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 30)
+    if ctx.check(rc == 0, f"type description client (off) exited with {rc}\n{out}{err}"):
+        ctx.check(json.loads(out.strip().splitlines()[-1]) == {"node_seen": True, "matched": False},
+                  f"start_type_description_service:=false still serves: {out}")
+
+
 def case_ros_env(ctx):
     """ROS 2's environment variables, on loopback only: ROS_DOMAIN_ID alone puts a node and a
     recorder on the same domain (the recorder gets everything), --domain wins over it, a recorder
@@ -2060,6 +2103,7 @@ CASES = {
     "record_services": case_record_services,
     "security": case_security,
     "disk_full": case_disk_full,
+    "type_description": case_type_description,
 }
 
 

@@ -4,7 +4,6 @@
 // middleware. The states are checked against a World stepped here, the codes against the
 // definitions' constants.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -24,6 +23,7 @@
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
 #include "rbsim/simulation_interfaces.hpp"
+#include "sim_test_util.hpp"
 
 namespace rbsim::node {
 namespace {
@@ -37,19 +37,12 @@ using SetRes = sim::SetSimulationStateResponse;
 constexpr std::uint32_t kDomain = 159;    // its own: test/dds has 143..157, test/middleware 158
 constexpr std::int64_t kSteps = 1000000;  // never reached: each test ends the run itself
 
-std::string node_name() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string test = info->name();
-  for (char& c : test) c = (c == '/') ? '_' : c;
-  return "sim_services_" + std::to_string(::getpid()) + "_" + test;
-}
-
 // A node of this process: paused at step 0 (STOPPED), the run loop on another thread at real
 // time, and a client participant.
 class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    node_ = node_name();
+    node_ = test::node_name("sim_services");
     server_.emplace(participant(node_));
     NodeServicesOptions options;
     options.node = "/" + node_;
@@ -83,11 +76,7 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
   }
 
   Participant participant(const std::string& name) {
-    const NodeName n{"/", name};
-    auto p =
-        GetParam() == "memory" ? create_memory_participant(network_, n) : create_dds_participant(kDomain, n);
-    if (!p) throw std::runtime_error(p.error().message);
-    return std::move(p.value());
+    return test::participant(GetParam(), network_, kDomain, name);
   }
 
   // Calls <node>/<service> with `req` and decodes the reply.

@@ -242,6 +242,7 @@ int node_command(const NodeArgs& a) {
     if (!quiet) RBSIM_LOG(Info, "rbsim node: quitting (set_simulation_state STATE_QUITTING)\n");
     request_stop();
   };
+  service_options.start_type_description_service = settings.start_type_description_service;
   auto services = node::NodeServices::create(participant.value(), controller, service_options);
   if (!services) return fail("node", services.error().message);
   publish_commands(controller, *services.value(), *sink.value(), foxglove, scene.world.dt);
@@ -314,7 +315,9 @@ Subcommand add_node_command(CLI::App& parent) {
       "--params-file FILE [--] (rcl's YAML: /NS: or /**: then ros__parameters:). Read-write: rate, "
       "publish_every, paused, forces.<i>.fx|fy (gravity), forces.<i>.beta|fx|fy|pointsperedge (wind), "
       "springs.<j>.k|l0; values typed as YAML types them (2.0 double, 2 integer, true bool). They apply "
-      "from step 0, and a reset returns to them.\n"
+      "from step 0, and a reset returns to them. Read-only, given only this way: "
+      "start_type_description_service (default true: the node serves <namespace>/get_type_description, "
+      "as an rclcpp node does).\n"
       "Exit status: 0 done, or stopped by Ctrl-C/SIGTERM (cleanly); 1 error (bad scene, DDS failure, "
       "divergence, --foxglove port in use); 2 usage error (also a bad --ros-args value or parameters file).");
   return {app, [a] { return node_command(*a); }};

@@ -35,7 +35,9 @@ Result<Publisher> Publisher::create(const Participant& participant, const msgs::
   const TopicRef topic{std::string(ros_topic), std::string(spec.type), &spec};
   auto impl = participant.impl().create_publisher(topic, qos, options);
   if (!impl) return impl.error();
-  return Publisher(std::move(impl.value()), topic.ros_name);
+  Publisher pub(std::move(impl.value()), topic.ros_name);
+  if (options.in_graph) pub.type_ = NodeTypeCache::register_type(participant.types(), topic.ros_type);
+  return pub;
 }
 
 Result<Publisher> Publisher::create(const Participant& participant, const RawTopic& raw, const QosSpec& qos,
@@ -43,7 +45,9 @@ Result<Publisher> Publisher::create(const Participant& participant, const RawTop
   auto impl =
       participant.impl().create_publisher(TopicRef{raw.ros_name, raw.ros_type, nullptr}, qos, options);
   if (!impl) return impl.error();
-  return Publisher(std::move(impl.value()), raw.ros_name);
+  Publisher pub(std::move(impl.value()), raw.ros_name);
+  if (options.in_graph) pub.type_ = NodeTypeCache::register_type(participant.types(), raw.ros_type);
+  return pub;
 }
 
 Publisher::Publisher(std::unique_ptr<PublisherImpl> impl, std::string ros_topic)
@@ -71,7 +75,9 @@ Result<Subscription> Subscription::create(const Participant& participant, const 
   const TopicRef topic{std::string(ros_topic), std::string(spec.type), &spec};
   auto impl = participant.impl().create_subscription(topic, qos, options);
   if (!impl) return impl.error();
-  return Subscription(std::move(impl.value()), topic.ros_name, &spec);
+  Subscription sub(std::move(impl.value()), topic.ros_name, &spec);
+  if (options.in_graph) sub.type_ = NodeTypeCache::register_type(participant.types(), topic.ros_type);
+  return sub;
 }
 
 Result<Subscription> Subscription::create(const Participant& participant, const RawTopic& raw,
@@ -79,7 +85,9 @@ Result<Subscription> Subscription::create(const Participant& participant, const 
   auto impl =
       participant.impl().create_subscription(TopicRef{raw.ros_name, raw.ros_type, nullptr}, qos, options);
   if (!impl) return impl.error();
-  return Subscription(std::move(impl.value()), raw.ros_name, nullptr);
+  Subscription sub(std::move(impl.value()), raw.ros_name, nullptr);
+  if (options.in_graph) sub.type_ = NodeTypeCache::register_type(participant.types(), raw.ros_type);
+  return sub;
 }
 
 Subscription::Subscription(std::unique_ptr<SubscriptionImpl> impl, std::string ros_topic,

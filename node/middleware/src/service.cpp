@@ -11,7 +11,9 @@ Result<ServiceServer> ServiceServer::create(const Participant& participant, std:
                                             std::string_view srv_type, const ServiceOptions& options) {
   auto impl = participant.impl().create_server(service, srv_type, options);
   if (!impl) return impl.error();
-  return ServiceServer(std::move(impl.value()), std::string(service));
+  ServiceServer server(std::move(impl.value()), std::string(service));
+  if (options.in_graph) server.type_ = NodeTypeCache::register_type(participant.types(), srv_type);
+  return server;
 }
 
 ServiceServer::ServiceServer(std::unique_ptr<ServiceServerImpl> impl, std::string service)
@@ -37,7 +39,9 @@ Result<ServiceClient> ServiceClient::create(const Participant& participant, std:
                                             std::string_view srv_type, const ClientOptions& options) {
   auto impl = participant.impl().create_client(service, srv_type, options);
   if (!impl) return impl.error();
-  return ServiceClient(std::move(impl.value()));
+  ServiceClient client(std::move(impl.value()));
+  if (options.in_graph) client.type_ = NodeTypeCache::register_type(participant.types(), srv_type);
+  return client;
 }
 
 ServiceClient::ServiceClient(std::unique_ptr<ServiceClientImpl> impl) : impl_(std::move(impl)) {}

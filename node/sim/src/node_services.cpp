@@ -33,6 +33,26 @@ QosSpec commands_qos() {
   return q;
 }
 
+using ServiceEntry = std::tuple<std::string, std::string, ServiceServer::Handler>;
+
+// rclcpp's ~/get_type_description, answered from the participant's node type cache: the types of
+// the endpoints the node created, this service's own among them, as rcl's cache holds them.
+void add_type_description(const Participant& participant, std::vector<ServiceEntry>& out) {
+  using msgs::GetTypeDescriptionRequest;
+  using msgs::GetTypeDescriptionResponse;
+  out.emplace_back(
+      "get_type_description", std::string(GetTypeDescriptionRequest::kService),
+      typed_handler<GetTypeDescriptionRequest, GetTypeDescriptionResponse>(
+          [types = participant.types()](const RequestHeader&, const GetTypeDescriptionRequest& req) {
+            return describe_node_type(*types, req);
+          },
+          [](const Error& e) {
+            GetTypeDescriptionResponse res;
+            res.failure_reason = e.message;
+            return std::optional<GetTypeDescriptionResponse>(std::move(res));
+          }));
+}
+
 }  // namespace
 
 struct NodeServices::Impl {
@@ -187,6 +207,7 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
       controller, [raw = impl.get()](Command c) { return raw->apply(std::move(c)); }, options.apply_timeout_s,
       options.dt, options.quit);
   impl->simulation->add(services);
+  if (options.start_type_description_service) add_type_description(participant, services);
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
       return st.error();

@@ -192,6 +192,10 @@ ParameterTable::ParameterTable(const Scene& scene, std::int64_t steps, const Run
       boolean("use_sim_time", "rbsim is the clock (it publishes /clock): always false");
   sim_time.additional_constraints = "false only";
   add(std::move(sim_time), V::of_bool(false), {K::UseSimTime});
+  // rclcpp's NodeTypeDescriptions declares it on every node, read-only, with these words.
+  add(read_only("start_type_description_service", ParameterType::Bool,
+                "Start the ~/get_type_description service for this node."),
+      V::of_bool(settings.start_type_description_service), {K::StartTypeDescriptionService});
   const std::vector<ForceRef> forces = force_order(scene);
   for (std::size_t i = 0; i < forces.size(); ++i) {
     const std::string p = "forces." + std::to_string(i) + ".";
@@ -230,12 +234,15 @@ std::optional<std::size_t> ParameterTable::find(std::string_view name) const {
   return it->second;
 }
 
-SetParametersResult ParameterTable::check(const Parameter& p) const {
+SetParametersResult ParameterTable::check(const Parameter& p, bool at_start) const {
   const auto fail = [](std::string reason) { return SetParametersResult{false, std::move(reason)}; };
   const std::optional<std::size_t> i = find(p.name);
   if (!i) return fail("parameter '" + p.name + "' is not declared");
   const ParameterDescriptor& d = entries_[*i].descriptor;
-  if (d.read_only) return fail("parameter '" + p.name + "' cannot be set because it is read-only");
+  const bool given_at_start =
+      at_start && entries_[*i].target.kind == ParameterTarget::Kind::StartTypeDescriptionService;
+  if (d.read_only && !given_at_start)
+    return fail("parameter '" + p.name + "' cannot be set because it is read-only");
   if (p.value.type != d.type) {
     std::string reason = "Wrong parameter type, parameter {" + p.name + "} is of type {" + to_string(d.type) +
                          "}, setting it to {" + to_string(p.value.type) + "} is not allowed.";
@@ -378,6 +385,7 @@ void apply(const ParameterTarget& t, const ParameterValue& v, RunSettings& setti
   if (t.kind == K::Rate) settings.rate = v.double_value;
   if (t.kind == K::PublishEvery) settings.publish_every = v.integer_value;
   if (t.kind == K::Paused) settings.paused = v.bool_value;
+  if (t.kind == K::StartTypeDescriptionService) settings.start_type_description_service = v.bool_value;
 }
 
 Status apply_overrides(const std::vector<ParameterOverride>& overrides, Scene& scene, std::int64_t steps,
@@ -391,7 +399,7 @@ Status apply_overrides(const std::vector<ParameterOverride>& overrides, Scene& s
       }
       continue;
     }
-    if (SetParametersResult r = table.check(o.parameter); !r.successful) {
+    if (SetParametersResult r = table.check(o.parameter, true); !r.successful) {
       return Error{o.origin + ": parameter '" + o.parameter.name + "': " + r.reason,
                    ErrorCode::InvalidArgument};
     }

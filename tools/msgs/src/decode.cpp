@@ -342,6 +342,13 @@ Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::strin
     if (words >> rest && rest.starts_with('=')) continue;  // constant "int32 X = 3"
     MsgField f;
     f.name = field;
+    if (!rest.empty()) {  // a default value: the rest of the line, trimmed ("[1, 2]" has spaces)
+      std::string tail;
+      std::getline(words, tail);
+      f.default_text = rest + tail;
+      while (!f.default_text.empty() && std::isspace(static_cast<unsigned char>(f.default_text.back())))
+        f.default_text.pop_back();
+    }
     if (const auto bracket = field_type.find('['); bracket != std::string::npos) {
       if (field_type.back() != ']') return Error{name + ": bad array type in " + line};
       const std::string inside = field_type.substr(bracket + 1, field_type.size() - bracket - 2);
@@ -373,7 +380,11 @@ Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::strin
   }
   // rosidl gives a message without fields one uint8 member, so every element has a size.
   if (fields.empty()) {
-    fields.push_back(MsgField{"structure_needs_at_least_one_member", "uint8", primitive_type("uint8")});
+    MsgField placeholder;
+    placeholder.name = "structure_needs_at_least_one_member";
+    placeholder.type = "uint8";
+    placeholder.primitive = primitive_type("uint8");
+    fields.push_back(std::move(placeholder));
   }
   return fields;
 }

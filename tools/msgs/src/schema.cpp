@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "definitions.hpp"
+#include "list_items.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
@@ -108,12 +109,7 @@ TopicSet default_topics() {
 
 Result<TopicSet> parse_topic_set(std::string_view list, std::string_view ns) {
   TopicFilter filter;
-  while (!list.empty()) {
-    const auto comma = list.find(',');
-    std::string_view name = list.substr(0, comma);
-    list = comma == std::string_view::npos ? std::string_view() : list.substr(comma + 1);
-    while (!name.empty() && name.front() == ' ') name.remove_prefix(1);
-    while (!name.empty() && name.back() == ' ') name.remove_suffix(1);
+  for (const std::string_view name : detail::list_items(list)) {
     if (!name.empty()) filter.topics.emplace_back(name);
   }
   if (filter.topics.empty()) return Error{"no topic given"};

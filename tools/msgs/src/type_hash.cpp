@@ -7,7 +7,11 @@
 #include <openssl/evp.h>
 
 #include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -15,6 +19,7 @@
 #include <set>
 #include <vector>
 
+#include "list_items.hpp"
 #include "rbsim/msgs.hpp"
 
 namespace rbsim::msgs {
@@ -66,18 +71,6 @@ std::optional<std::uint8_t> primitive_type_id(std::string_view t) {
   return std::nullopt;
 }
 
-struct FieldDescription {
-  std::string name;
-  std::uint8_t type_id = 0;
-  std::uint32_t capacity = 0;
-  std::uint32_t string_capacity = 0;
-  std::string nested_type_name;
-};
-struct IndividualDescription {
-  std::string type_name;
-  std::vector<FieldDescription> fields;
-};
-
 // ROS names are identifiers: [A-Za-z][A-Za-z0-9_]*. Checking them keeps the JSON what rosidl would
 // write (no escapes needed) and rejects garbage with a clear message.
 bool is_identifier(std::string_view s) {
@@ -106,45 +99,159 @@ std::optional<TypeName> split_type(std::string_view full) {
   return n;
 }
 
-FieldDescription nested_field(std::string name, std::string type, std::uint8_t id, std::uint32_t capacity) {
-  return FieldDescription{std::move(name), id, capacity, 0, std::move(type)};
+Field nested_field(std::string name, std::string type, std::uint8_t id, std::uint64_t capacity) {
+  return Field{std::move(name), FieldType{id, capacity, 0, std::move(type)}, ""};
+}
+// A field of a type rosidl derives (an action's service messages): a primitive, no default.
+Field primitive_field(std::string name, std::uint8_t id) {
+  return Field{std::move(name), FieldType{id, 0, 0, ""}, ""};
 }
 
-Result<FieldDescription> describe_field(std::string_view owner, const MsgField& f) {
+// ---------------------------------------------------------------------------------------------
+// Field.default_value as rosidl fills it: rosidl_adapter parses the .msg default into a Python
+// value, writes it into the IDL as an @default annotation, and rosidl_generator_type_description
+// stores str() of what rosidl_parser reads back. So a float is Python's repr (0 -> "0.0", 1e-05),
+// a bool "True"/"False", an integer in decimal, a string its text without the quotes, an array the
+// repr of a tuple ("(0.0, 1.0)", "(1,)"). REP 2011 leaves defaults out of the hash.
+
+// Python's repr of a float: the shortest round trip, in fixed notation for exponents in [-4, 16)
+// (with ".0" when integral), else d.ddde+XX, which std::to_chars' scientific form already is.
+std::string python_float_repr(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  const auto sci = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::scientific);
+  const std::string_view s(buf, static_cast<std::size_t>(sci.ptr - buf));
+  const int exponent = std::atoi(std::string(s.substr(s.find('e') + 1)).c_str());
+  if (exponent < -4 || exponent >= 16) return std::string(s);
+  const auto fixed = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed);
+  std::string out(buf, static_cast<std::size_t>(fixed.ptr - buf));
+  if (out.find('.') == std::string::npos) out += ".0";
+  return out;
+}
+
+// A whole number as Python's int(text) or int(text, 0) reads it (0x, 0o, 0b prefixes), in decimal
+// (uint64's whole range, and its negatives).
+std::optional<std::string> python_int(std::string_view text) {
+  bool negative = false;
+  if (!text.empty() && (text[0] == '-' || text[0] == '+')) {
+    negative = text[0] == '-';
+    text.remove_prefix(1);
+  }
+  int base = 10;
+  if (text.size() > 2 && text[0] == '0') {
+    const char p = static_cast<char>(std::tolower(static_cast<unsigned char>(text[1])));
+    base = p == 'x' ? 16 : p == 'o' ? 8 : p == 'b' ? 2 : 10;
+    if (base != 10) text.remove_prefix(2);
+  }
+  unsigned long long n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n, base);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return (negative && n != 0 ? "-" : "") + std::to_string(n);
+}
+
+// One scalar default of a primitive type (`quoted`: a string inside an array, as repr quotes it).
+Result<std::string> scalar_default(std::string_view type, std::string_view text, bool quoted) {
+  const auto bad = [&] {
+    return Error{"bad default value \"" + std::string(text) + "\" for " + std::string(type)};
+  };
+  if (type == "bool") {
+    std::string lower(text);
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower == "true" || lower == "1") return std::string("True");
+    if (lower == "false" || lower == "0") return std::string("False");
+    return bad();
+  }
+  if (type == "float32" || type == "float64") {
+    double v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size()) return bad();
+    return python_float_repr(v);
+  }
+  if (type == "string" || type.starts_with("string<=")) {
+    // rosidl_adapter drops one pair of outer quotes.
+    if (text.size() >= 2 && (text[0] == '"' || text[0] == '\'') && text.back() == text[0])
+      text = text.substr(1, text.size() - 2);
+    return quoted ? "'" + std::string(text) + "'" : std::string(text);
+  }
+  auto n = python_int(text);
+  if (!n) return bad();
+  return std::move(*n);
+}
+
+Result<std::string> rosidl_default_value(const MsgField& f) {
+  if (f.default_text.empty()) return std::string();
+  if (!f.primitive) return Error{"a nested type cannot have a default value"};
+  if (f.array == MsgField::Array::None) return scalar_default(f.type, f.default_text, false);
+  std::string_view list = f.default_text;
+  if (list.size() < 2 || list.front() != '[' || list.back() != ']')
+    return Error{"an array default must be written [a, b, ...]: " + f.default_text};
+  std::string out = "(";
+  std::size_t count = 0;
+  for (const std::string_view item : detail::list_items(list.substr(1, list.size() - 2))) {
+    auto value = scalar_default(f.type, item, true);
+    if (!value) return value.error();
+    out += (count++ > 0 ? ", " : "") + value.value();
+  }
+  return out + (count == 1 ? ",)" : ")");
+}
+
+// TypeSource.raw_file_contents as rosidl_generator_c embeds a definition file: its lines
+// (Python's splitlines: \n, \r\n or \r) joined by \n, so the final newline is dropped.
+std::string rosidl_source_text(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\r') {
+      if (i + 1 < text.size() && text[i + 1] == '\n') ++i;
+      out += '\n';
+    } else {
+      out += text[i];
+    }
+  }
+  if (!out.empty() && out.back() == '\n') out.pop_back();
+  return out;
+}
+
+Result<Field> describe_field(std::string_view owner, const MsgField& f) {
   if (!is_identifier(f.name)) return Error{std::string(owner) + ": bad field name \"" + f.name + "\""};
-  FieldDescription d;
+  Field d;
   d.name = f.name;
+  FieldType& t = d.type;
   if (f.primitive) {
     const auto id = primitive_type_id(f.type);
     if (!id) return Error{std::string(owner) + ": field " + f.name + " has unsupported type " + f.type};
-    d.type_id = *id;
-    d.string_capacity = f.string_capacity;
+    t.type_id = *id;
+    t.string_capacity = f.string_capacity;
   } else {
     if (!split_type(f.type))
       return Error{std::string(owner) + ": field " + f.name + " has bad type " + f.type};
-    d.type_id = kNestedType;
-    d.nested_type_name = f.type;
+    t.type_id = kNestedType;
+    t.nested_type_name = f.type;
   }
   switch (f.array) {
     case MsgField::Array::None:
       break;
     case MsgField::Array::Fixed:
-      d.type_id = static_cast<std::uint8_t>(d.type_id + kArrayOffset);
-      d.capacity = f.fixed_size;
+      t.type_id = static_cast<std::uint8_t>(t.type_id + kArrayOffset);
+      t.capacity = f.fixed_size;
       break;
     case MsgField::Array::Sequence:
-      d.type_id = static_cast<std::uint8_t>(
-          d.type_id + (f.sequence_bound > 0 ? kBoundedSequenceOffset : kUnboundedSequenceOffset));
-      d.capacity = f.sequence_bound;
+      t.type_id = static_cast<std::uint8_t>(
+          t.type_id + (f.sequence_bound > 0 ? kBoundedSequenceOffset : kUnboundedSequenceOffset));
+      t.capacity = f.sequence_bound;
       break;
   }
+  auto value = rosidl_default_value(f);
+  if (!value) return Error{std::string(owner) + ": field " + f.name + ": " + value.error().message};
+  d.default_value = std::move(value.value());
   return d;
 }
 
-Result<IndividualDescription> describe_msg_text(std::string_view type, std::string_view text) {
+Result<IndividualTypeDescription> describe_msg_text(std::string_view type, std::string_view text) {
   auto parsed = parse_msg_fields(type, text);
   if (!parsed) return parsed.error();
-  IndividualDescription d{std::string(type), {}};
+  IndividualTypeDescription d{std::string(type), {}};
   for (const MsgField& f : parsed.value()) {
     auto field = describe_field(type, f);
     if (!field) return field.error();
@@ -204,8 +311,8 @@ std::optional<std::string> service_origin(const TypeName& n, const DefinitionSou
 // The request or response of an action's generated service, as rosidl_parser's Action builds them:
 // _SendGoal_Request {UUID goal_id, _Goal goal}, _SendGoal_Response {bool accepted, Time stamp},
 // _GetResult_Request {UUID goal_id}, _GetResult_Response {int8 status, _Result result}.
-IndividualDescription action_service_message(const std::string& type, const std::string& service,
-                                             const std::string& action, bool request) {
+IndividualTypeDescription action_service_message(const std::string& type, const std::string& service,
+                                                 const std::string& action, bool request) {
   const std::string uuid(kUuid);
   if (service.ends_with(kSendGoal)) {
     if (request) {
@@ -214,23 +321,22 @@ IndividualDescription action_service_message(const std::string& type, const std:
                nested_field("goal", action + std::string(kGoal), kNestedType, 0)}};
     }
     return {type,
-            {FieldDescription{"accepted", kBool, 0, 0, ""},
-             nested_field("stamp", std::string(kTime), kNestedType, 0)}};
+            {primitive_field("accepted", kBool), nested_field("stamp", std::string(kTime), kNestedType, 0)}};
   }
   if (request) return {type, {nested_field("goal_id", uuid, kNestedType, 0)}};
   return {type,
-          {FieldDescription{"status", kInt8, 0, 0, ""},
+          {primitive_field("status", kInt8),
            nested_field("result", action + std::string(kResult), kNestedType, 0)}};
 }
 
 // A service's _Request, _Response or _Event message (`suffix`); `service` is a service_origin().
-Result<IndividualDescription> describe_service_message(std::string_view type, const std::string& service,
-                                                       const std::string& origin, std::string_view suffix,
-                                                       const DefinitionSource& source) {
+Result<IndividualTypeDescription> describe_service_message(std::string_view type, const std::string& service,
+                                                           const std::string& origin, std::string_view suffix,
+                                                           const DefinitionSource& source) {
   if (suffix == kEvent) {
     // rosidl_parser's Service.event_message: info, then the request and the response each as a
     // sequence of at most one.
-    return IndividualDescription{
+    return IndividualTypeDescription{
         std::string(type),
         {nested_field("info", std::string(kEventInfo), kNestedType, 0),
          nested_field("request", service + std::string(kRequest), kNestedType + kBoundedSequenceOffset, 1),
@@ -248,11 +354,11 @@ Result<IndividualDescription> describe_service_message(std::string_view type, co
 
 // A type rosidl derives from an action (`action` has a definition): the action itself, its goal,
 // result and feedback (the three parts of the .action text) or the feedback message.
-Result<IndividualDescription> describe_action_type(std::string_view type, const std::string& action,
-                                                   std::string_view suffix, std::string_view text) {
+Result<IndividualTypeDescription> describe_action_type(std::string_view type, const std::string& action,
+                                                       std::string_view suffix, std::string_view text) {
   if (suffix.empty()) {
     // rosidl_generator_type_description's add_action: the six types rosidl makes of it.
-    return IndividualDescription{
+    return IndividualTypeDescription{
         action,
         {nested_field("goal", action + std::string(kGoal), kNestedType, 0),
          nested_field("result", action + std::string(kResult), kNestedType, 0),
@@ -262,9 +368,10 @@ Result<IndividualDescription> describe_action_type(std::string_view type, const 
          nested_field("feedback_message", action + std::string(kFeedbackMessage), kNestedType, 0)}};
   }
   if (suffix == kFeedbackMessage) {
-    return IndividualDescription{std::string(type),
-                                 {nested_field("goal_id", std::string(kUuid), kNestedType, 0),
-                                  nested_field("feedback", action + std::string(kFeedback), kNestedType, 0)}};
+    return IndividualTypeDescription{
+        std::string(type),
+        {nested_field("goal_id", std::string(kUuid), kNestedType, 0),
+         nested_field("feedback", action + std::string(kFeedback), kNestedType, 0)}};
   }
   const int part = suffix == kGoal ? 0 : suffix == kResult ? 1 : 2;
   auto part_text = definition_part(action, text, part, 3);
@@ -274,8 +381,8 @@ Result<IndividualDescription> describe_action_type(std::string_view type, const 
 
 // The service (`type` is a service_origin()) as rosidl_generator_type_description's add_srv
 // describes it: its three messages.
-IndividualDescription service_description(const std::string& service) {
-  return IndividualDescription{
+IndividualTypeDescription service_description(const std::string& service) {
+  return IndividualTypeDescription{
       service,
       {nested_field("request_message", service + std::string(kRequest), kNestedType, 0),
        nested_field("response_message", service + std::string(kResponse), kNestedType, 0),
@@ -283,7 +390,7 @@ IndividualDescription service_description(const std::string& service) {
 }
 
 // The description of one type, without the types it refers to.
-Result<IndividualDescription> describe_type(std::string_view type, const DefinitionSource& source) {
+Result<IndividualTypeDescription> describe_type(std::string_view type, const DefinitionSource& source) {
   const auto name = split_type(type);
   if (!name)
     return Error{"\"" + std::string(type) +
@@ -318,19 +425,19 @@ Result<IndividualDescription> describe_type(std::string_view type, const Definit
   return Error{"no definition for " + std::string(type)};
 }
 
-void append_type(std::string& out, const IndividualDescription& d) {
+void append_type(std::string& out, const IndividualTypeDescription& d) {
   out += "{\"type_name\": ";
   append_json_string(out, d.type_name);
   out += ", \"fields\": [";
   for (std::size_t i = 0; i < d.fields.size(); ++i) {
-    const FieldDescription& f = d.fields[i];
+    const Field& f = d.fields[i];
     out += i == 0 ? "{\"name\": " : ", {\"name\": ";
     append_json_string(out, f.name);
-    out += ", \"type\": {\"type_id\": " + std::to_string(f.type_id);
-    out += ", \"capacity\": " + std::to_string(f.capacity);
-    out += ", \"string_capacity\": " + std::to_string(f.string_capacity);
+    out += ", \"type\": {\"type_id\": " + std::to_string(f.type.type_id);
+    out += ", \"capacity\": " + std::to_string(f.type.capacity);
+    out += ", \"string_capacity\": " + std::to_string(f.type.string_capacity);
     out += ", \"nested_type_name\": ";
-    append_json_string(out, f.nested_type_name);
+    append_json_string(out, f.type.nested_type_name);
     out += "}}";
   }
   out += "]}";
@@ -360,16 +467,16 @@ std::optional<std::string_view> shipped_definition(std::string_view type) {
   return text;
 }
 
-Result<std::string> type_description_json(std::string_view type, const DefinitionSource& source) {
+Result<TypeDescription> type_description(std::string_view type, const DefinitionSource& source) {
   const std::string root_name = canonical_type(type, "");
   auto root = describe_type(root_name, source);
   if (!root) return root.error();
   // Every type the root refers to, directly or not (rosidl's extract_full_type_description),
   // sorted by name.
-  std::map<std::string, IndividualDescription> referenced;
+  std::map<std::string, IndividualTypeDescription> referenced;
   std::deque<std::pair<std::string, std::string>> pending;  // (type, referenced by)
-  for (const FieldDescription& f : root.value().fields) {
-    if (!f.nested_type_name.empty()) pending.emplace_back(f.nested_type_name, root_name);
+  for (const Field& f : root.value().fields) {
+    if (!f.type.nested_type_name.empty()) pending.emplace_back(f.type.nested_type_name, root_name);
   }
   while (!pending.empty()) {
     auto [name, by] = std::move(pending.front());
@@ -378,16 +485,26 @@ Result<std::string> type_description_json(std::string_view type, const Definitio
     if (referenced.size() >= kMaxTypes) return Error{root_name + ": refers to more than 4096 types"};
     auto d = describe_type(name, source);
     if (!d) return Error{root_name + ": " + d.error().message + " (referenced by " + by + ")"};
-    for (const FieldDescription& f : d.value().fields) {
-      if (!f.nested_type_name.empty()) pending.emplace_back(f.nested_type_name, name);
+    for (const Field& f : d.value().fields) {
+      if (!f.type.nested_type_name.empty()) pending.emplace_back(f.type.nested_type_name, name);
     }
     referenced.emplace(name, std::move(d.value()));
   }
+  TypeDescription out{std::move(root.value()), {}};
+  for (auto& [name, d] : referenced) out.referenced_type_descriptions.push_back(std::move(d));
+  return out;
+}
+
+Result<TypeDescription> type_description(std::string_view type) {
+  return type_description(type, shipped_definition);
+}
+
+std::string type_description_json(const TypeDescription& description) {
   std::string out = "{\"type_description\": ";
-  append_type(out, root.value());
+  append_type(out, description.type_description);
   out += ", \"referenced_type_descriptions\": [";
   bool first = true;
-  for (const auto& [name, d] : referenced) {
+  for (const IndividualTypeDescription& d : description.referenced_type_descriptions) {
     if (!first) out += ", ";
     first = false;
     append_type(out, d);
@@ -396,12 +513,42 @@ Result<std::string> type_description_json(std::string_view type, const Definitio
   return out;
 }
 
-Result<std::string> type_hash(std::string_view type, const DefinitionSource& source) {
-  auto json = type_description_json(type, source);
-  if (!json) return json.error();
-  const auto hex = sha256_hex(json.value());
-  if (!hex) return Error{std::string(type) + ": SHA-256 failed (OpenSSL libcrypto)"};
+Result<std::string> type_description_json(std::string_view type, const DefinitionSource& source) {
+  auto description = type_description(type, source);
+  if (!description) return description.error();
+  return type_description_json(description.value());
+}
+
+Result<std::string> type_hash(const TypeDescription& description) {
+  const auto hex = sha256_hex(type_description_json(description));
+  if (!hex) {
+    return Error{description.type_description.type_name + ": SHA-256 failed (OpenSSL libcrypto)"};
+  }
   return "RIHS01_" + *hex;
+}
+
+Result<std::string> type_hash(std::string_view type, const DefinitionSource& source) {
+  auto description = type_description(type, source);
+  if (!description) return description.error();
+  return type_hash(description.value());
+}
+
+std::vector<TypeSource> type_sources(const TypeDescription& description, const DefinitionSource& source) {
+  std::vector<TypeSource> out;
+  const auto add = [&](const std::string& name) {
+    const auto text = source(name);
+    // A type with a definition of its own is a .msg, .srv or .action file (its kind is the
+    // encoding); one rosidl derives from a service or an action has none.
+    if (!text) {
+      out.push_back(TypeSource{name, "implicit", ""});
+      return;
+    }
+    out.push_back(TypeSource{name, split_type(name) ? std::string(split_type(name)->kind) : "msg",
+                             rosidl_source_text(*text)});
+  };
+  add(description.type_description.type_name);
+  for (const IndividualTypeDescription& d : description.referenced_type_descriptions) add(d.type_name);
+  return out;
 }
 
 Result<std::string> type_hash(std::string_view type) {

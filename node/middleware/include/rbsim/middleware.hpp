@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "rbsim/msgs.hpp"
+#include "rbsim/node_types.hpp"
 #include "rbsim/status.hpp"
 
 namespace rbsim::node {
@@ -51,10 +52,14 @@ class Participant {
   // How it was configured, for the start line: e.g. "domain 7 (LOCALHOST)".
   const std::string& description() const;
   const NodeName& node() const;
+  // The types of the node's endpoints while they live (rbsim/node_types.hpp): what its
+  // ~/get_type_description answers for.
+  const std::shared_ptr<NodeTypeCache>& types() const { return types_; }
   ParticipantImpl& impl() const { return *impl_; }  // for backends
 
  private:
   std::unique_ptr<ParticipantImpl> impl_;
+  std::shared_ptr<NodeTypeCache> types_ = std::make_shared<NodeTypeCache>();
 };
 
 using QosSpec = msgs::OfferedQos;
@@ -105,6 +110,7 @@ class Publisher {
  private:
   std::unique_ptr<PublisherImpl> impl_;
   std::string ros_topic_;
+  TypeRegistration type_;  // a node's endpoint: its type in the node's cache
 };
 
 // A sample's storage lent by the backend (no copy): released when the loan goes. Move-only.
@@ -171,6 +177,7 @@ class Subscription {
   std::unique_ptr<SubscriptionImpl> impl_;
   std::string ros_topic_;
   const msgs::TopicSpec* spec_ = nullptr;
+  TypeRegistration type_;  // a node's endpoint: its type in the node's cache
 };
 
 // Waits for samples on several subscriptions at once: the loop of the recorder and of the relay,

@@ -100,6 +100,7 @@ class ServiceServer {
  private:
   std::unique_ptr<ServiceServerImpl> impl_;
   std::string service_;
+  TypeRegistration type_;  // a node's endpoint: its service type in the node's cache
 };
 
 // A ServiceServer::Handler from a typed function: the request decoded as `Req` (a request struct of
@@ -159,6 +160,7 @@ class ServiceClient {
 
  private:
   std::unique_ptr<ServiceClientImpl> impl_;
+  TypeRegistration type_;  // a node's endpoint: its service type in the node's cache
 };
 
 }  // namespace rbsim::node

@@ -1,7 +1,8 @@
 // The node's services, the ROS 2 way: the six rcl_interfaces parameter services and rbsim's
 // controls (pause, resume, reset: std_srvs/srv/Trigger; step: rbsim_msgs/srv/Step; apply_impulse:
-// rbsim_msgs/srv/ApplyImpulse) under the node's name, on rmw_cyclonedds_cpp's wire format
-// (rbsim/service.hpp), /parameter_events and <node>/commands. Every request becomes a control::Command for
+// rbsim_msgs/srv/ApplyImpulse), simulation_interfaces' services and rclcpp's get_type_description
+// under the node's name, on rmw_cyclonedds_cpp's wire format (rbsim/service.hpp), /parameter_events
+// and <node>/commands. Every request becomes a control::Command for
 // the run loop (rbsim/control.hpp), answered once it applied at a step boundary; reads answer at once from
 // the table as of the last boundary. Requests are served on one thread of this class, woken by any server's
 // arrival, so a paused run loop (idling in the controller) still answers.
@@ -28,6 +29,10 @@ struct NodeServicesOptions {
   // reply goes out) to end the node as a SIGINT would, outputs finished, exit 0. Empty: QUITTING
   // answers RESULT_FEATURE_UNSUPPORTED.
   std::function<void()> quit = nullptr;
+  // <node>/get_type_description (type_description_interfaces/srv/GetTypeDescription): the
+  // description of every type the node's endpoints use (rbsim/node_types.hpp), as rclcpp serves it
+  // unless its read-only parameter start_type_description_service is false.
+  bool start_type_description_service = true;
 };
 
 // For the end line.

@@ -5,7 +5,9 @@
 //
 // The table of a run:
 //   read-only   scene (string: the path), dt (double), integrator (string), bodies, springs,
-//               steps (integers)
+//               steps (integers), start_type_description_service (bool, true: rclcpp's, whether
+//               the node serves ~/get_type_description; given only by an override, -p or
+//               --params-file, as rclcpp's read-only parameters are)
 //   read-write  rate (double >= 0), publish_every (integer >= 1), paused (bool),
 //               forces.<i>.fx|fy (gravity i, double), forces.<i>.beta (wind, double >= 0),
 //               forces.<i>.fx|fy (wind velocity, double), forces.<i>.pointsperedge (wind,
@@ -59,6 +61,8 @@ struct RunSettings {
   double rate = 1.0;               // real-time factor; 0: as fast as possible
   std::int64_t publish_every = 1;  // publish every k-th step
   bool paused = false;
+  // rclcpp's read-only start_type_description_service: the node serves ~/get_type_description.
+  bool start_type_description_service = true;
 };
 
 // What a parameter is bound to (the table's internal map from a name to the state it reads and
@@ -77,6 +81,8 @@ struct ParameterTarget {
     PublishEvery,
     Paused,
     UseSimTime,
+    // read-only, its value given at start by an override (rclcpp's node parameter)
+    StartTypeDescriptionService,
     // index: into WorldDef::gravity
     GravityX,
     GravityY,
@@ -110,7 +116,10 @@ class ParameterTable {
 
   // Why setting `p` would be refused, as rclcpp words it where rclcpp has a rule: unknown name,
   // read-only, wrong type, out of range, not finite, use_sim_time true. Successful if none.
-  SetParametersResult check(const Parameter& p) const;
+  // `at_start`: an override before the run (apply_overrides), which may give a read-only
+  // parameter that has no value of the scene's (start_type_description_service) its value, as
+  // rclcpp's overrides give read-only parameters theirs at declaration.
+  SetParametersResult check(const Parameter& p, bool at_start = false) const;
   // Records a value that check() accepted (the caller applied it to the state).
   void store(std::size_t i, const ParameterValue& value) { entries_[i].value = value; }
   // Values read again from a world and settings (after a reset, a new pass).

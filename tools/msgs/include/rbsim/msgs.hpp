@@ -447,9 +447,13 @@ struct MsgField {
   std::uint32_t fixed_size = 0;       // Array::Fixed
   std::uint32_t sequence_bound = 0;   // Array::Sequence written "[<=N]": N (0: unbounded)
   std::uint32_t string_capacity = 0;  // "string<=N": N (0: an unbounded string or not a string)
+  // The default value as written after the name ("1", "[0, 1]", "'text'"), comment cut off; empty
+  // when there is none. Kept as text: only the type description (REP 2011's Field.default_value)
+  // reads it, and rosidl writes it there in its own spelling (type_hash.cpp).
+  std::string default_text;
 };
 // The fields of the .msg text of `type` ("pkg/msg/Name"; bare nested names resolve in its package),
-// constants, default values and comments skipped. A message without fields gets rosidl's one uint8
+// constants and comments skipped, default values as text. A message without fields gets rosidl's one uint8
 // member. Fails on a malformed line, a bad array or string bound or a wstring.
 Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::string_view text);
 

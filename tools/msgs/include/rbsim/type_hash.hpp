@@ -3,10 +3,10 @@
 // endpoint's USER_DATA ("typehash=RIHS01_...;") and rosbag2 records per topic.
 //
 // The hash is rosidl's (rosidl_generator_type_description; rcl computes the same at run time): the
-// type_description_interfaces/TypeDescription of the type (its fields' type ids, array capacities,
-// string bounds and nested type names; default values left out) followed by every type it refers
-// to, directly or not, sorted by name, written as JSON with Python's json.dumps separators
-// (", " and ": ", no newlines) and hashed with SHA-256.
+// type_description_interfaces/TypeDescription of the type (rbsim/type_description.hpp: its fields'
+// type ids, array capacities, string bounds and nested type names; default values left out) and
+// of every type it refers to, directly or not, sorted by name, written as JSON with Python's
+// json.dumps separators (", " and ": ", no newlines) and hashed with SHA-256.
 //
 // Type names are fully qualified: "std_msgs/msg/String", a service "std_srvs/srv/Trigger", or one
 // of the messages rosidl makes of a service: "std_srvs/srv/Trigger_Request", "..._Response" and
@@ -28,8 +28,10 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "rbsim/status.hpp"
+#include "rbsim/type_description.hpp"
 
 namespace rbsim::msgs {
 
@@ -40,11 +42,20 @@ using DefinitionSource = std::function<std::optional<std::string_view>(std::stri
 // The definitions rbsim ships (msgs::definition(), none of them empty).
 std::optional<std::string_view> shipped_definition(std::string_view type);
 
-// The JSON the hash is taken over (default values left out). Fails, naming the type, on an unknown
-// type, a missing dependency, a malformed definition, a service without exactly one "---" or an
-// action without exactly two.
+// The type description of `type`: the one structured description both the hash and the
+// ~/get_type_description reply come from. Field.default_value is rosidl's spelling of the .msg
+// default (str() of the Python value rosidl_parser reads: "0.0", "1", "True", "(1, 2)", a string
+// without its quotes; empty when none), as rosidl_generator_type_description fills it and rclcpp's
+// service returns it. Fails, naming the type, on an unknown type, a missing dependency, a
+// malformed definition or default value, a service without exactly one "---" or an action
+// without exactly two.
+Result<TypeDescription> type_description(std::string_view type, const DefinitionSource& source);
+Result<TypeDescription> type_description(std::string_view type);  // over shipped_definition()
+// The JSON the hash is taken over: the description with its default values left out.
+std::string type_description_json(const TypeDescription& description);
 Result<std::string> type_description_json(std::string_view type, const DefinitionSource& source);
-// "RIHS01_" + the SHA-256 of type_description_json(type, source) in lower-case hex.
+// "RIHS01_" + the SHA-256 of type_description_json() in lower-case hex.
+Result<std::string> type_hash(const TypeDescription& description);
 Result<std::string> type_hash(std::string_view type, const DefinitionSource& source);
 // The same over shipped_definition(); each hash is computed once per
 // process and then served from a cache (thread-safe).
@@ -61,6 +72,14 @@ struct ServiceEndpointHashes {
   std::string reply;    // rr/<service name>Reply
 };
 Result<ServiceEndpointHashes> service_endpoint_type_hashes(std::string_view service);
+
+// The texts the types of `description` were defined in, as rosidl_generator_c embeds them (its
+// get_type_description_sources): the described type first, then each referenced type in the
+// description's order. A type with a definition of its own has encoding "msg", "srv" or
+// "action" and the file's text (its lines joined by "\n", without the final newline); one rosidl
+// derives from a service or an action (_Request, _Response, _Event, an action's parts) has
+// encoding "implicit" and no text.
+std::vector<TypeSource> type_sources(const TypeDescription& description, const DefinitionSource& source);
 
 // The USER_DATA entry of an endpoint as rmw_dds_common writes it: "typehash=" + hash + ";". An
 // endpoint's USER_DATA is rmw_cyclonedds's extra entries first ("serviceid=...;" or
