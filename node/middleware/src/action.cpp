@@ -105,7 +105,8 @@ struct ActionServer::Impl {
     wake.notify_one();
   }
   Goal* find(const GoalUuid& id) {
-    const auto it = std::find_if(goals.begin(), goals.end(), [&](const Goal& g) { return g.info.goal_id == id; });
+    const auto it =
+        std::find_if(goals.begin(), goals.end(), [&](const Goal& g) { return g.info.goal_id == id; });
     return it == goals.end() ? nullptr : &*it;
   }
 
@@ -201,7 +202,8 @@ void ActionServer::Impl::expire() {
 // held goal is active.
 bool ActionServer::Impl::make_room() {
   if (goals.size() < options.max_goals) return true;
-  const auto oldest = std::find_if(goals.begin(), goals.end(), [](const Goal& g) { return terminal(g.status); });
+  const auto oldest =
+      std::find_if(goals.begin(), goals.end(), [](const Goal& g) { return terminal(g.status); });
   if (oldest == goals.end()) return false;
   goals.erase(oldest);
   count(&ActionStats::expired);
@@ -209,7 +211,8 @@ bool ActionServer::Impl::make_room() {
   return true;
 }
 
-bool ActionServer::Impl::on_send_goal(const RequestHeader&, std::span<const std::byte> request, Bytes& reply) {
+bool ActionServer::Impl::on_send_goal(const RequestHeader&, std::span<const std::byte> request,
+                                      Bytes& reply) {
   const Result<GoalUuid> id = msgs::request_goal_id(request);
   if (!id) {
     count(&ActionStats::malformed);
@@ -329,7 +332,8 @@ ActionServer::~ActionServer() {
   if (impl_->thread.joinable()) impl_->thread.join();
 }
 
-Result<std::unique_ptr<ActionServer>> ActionServer::create(const Participant& participant, std::string_view action,
+Result<std::unique_ptr<ActionServer>> ActionServer::create(const Participant& participant,
+                                                           std::string_view action,
                                                            std::string_view action_type, Handlers handlers,
                                                            const ActionServerOptions& options) {
   RBSIM_ASSERT(handlers.goal && handlers.cancel && handlers.empty_result, "an action needs all its handlers");
@@ -351,7 +355,8 @@ Result<std::unique_ptr<ActionServer>> ActionServer::create(const Participant& pa
     return Ok{};
   };
   if (Status st = server("send_goal", type + "_SendGoal", impl->send_goal); !st) return st.error();
-  if (Status st = server("cancel_goal", std::string(msgs::CancelGoalRequest::kService), impl->cancel_goal); !st)
+  if (Status st = server("cancel_goal", std::string(msgs::CancelGoalRequest::kService), impl->cancel_goal);
+      !st)
     return st.error();
   if (Status st = server("get_result", type + "_GetResult", impl->get_result); !st) return st.error();
   EndpointOptions eo;
@@ -360,9 +365,8 @@ Result<std::unique_ptr<ActionServer>> ActionServer::create(const Participant& pa
                                     feedback_qos(), eo);
   if (!feedback) return with_context("action " + impl->name + ": ", feedback.error());
   impl->feedback_pub.emplace(std::move(feedback.value()));
-  auto status = Publisher::create(participant,
-                                  RawTopic{base + "status", std::string(msgs::GoalStatusArray::kType)},
-                                  status_qos(), eo);
+  auto status = Publisher::create(
+      participant, RawTopic{base + "status", std::string(msgs::GoalStatusArray::kType)}, status_qos(), eo);
   if (!status) return with_context("action " + impl->name + ": ", status.error());
   impl->status_pub.emplace(std::move(status.value()));
   Impl* raw = impl.get();

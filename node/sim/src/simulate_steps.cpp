@@ -74,7 +74,8 @@ bool SimulateSteps::State::on_goal(const GoalUuid& id, std::span<const std::byte
   c.kind = control::CommandKind::Step;
   c.steps = static_cast<std::int64_t>(req.steps);
   c.source = "ros2 action simulate_steps";
-  controller.submit(std::move(c), [self = shared_from_this()](const control::CommandResult& r) { self->started(r); });
+  controller.submit(std::move(c),
+                    [self = shared_from_this()](const control::CommandResult& r) { self->started(r); });
   return true;
 }
 
@@ -172,8 +173,8 @@ void SimulateSteps::State::progress(const World* world, std::int64_t at_step) {
 void SimulateSteps::State::end(std::int8_t status, std::uint8_t code, std::string message) {
   if (server != nullptr) {
     Bytes out;
-    msgs::simulation::encode(sim::SimulateStepsGetResultResponse{status, sim::Result{code, std::move(message)}},
-                             out);
+    msgs::simulation::encode(
+        sim::SimulateStepsGetResultResponse{status, sim::Result{code, std::move(message)}}, out);
     server->finish(goal->id, status, std::move(out));
   }
   goal.reset();
@@ -190,12 +191,15 @@ void SimulateSteps::State::send_feedback(std::int64_t completed) {
 }
 
 // ---------------------------------------------------------------------------------------------
-Result<std::unique_ptr<SimulateSteps>> SimulateSteps::create(const Participant& participant, const std::string& node,
+Result<std::unique_ptr<SimulateSteps>> SimulateSteps::create(const Participant& participant,
+                                                             const std::string& node,
                                                              control::Controller& controller) {
   auto state = std::make_shared<State>(controller);
   State* raw = state.get();  // the server's handlers end before the state can (the server goes first)
   ActionServer::Handlers h;
-  h.goal = [raw](const GoalUuid& id, std::span<const std::byte> request) { return raw->on_goal(id, request); };
+  h.goal = [raw](const GoalUuid& id, std::span<const std::byte> request) {
+    return raw->on_goal(id, request);
+  };
   h.cancel = [raw](const GoalUuid& id) { return raw->on_cancel(id); };
   h.empty_result = [](std::int8_t status, Bytes& out) {
     msgs::simulation::encode(sim::SimulateStepsGetResultResponse{status, {}}, out);

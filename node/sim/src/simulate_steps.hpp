@@ -20,7 +20,8 @@ namespace rbsim::node {
 class SimulateSteps {
  public:
   // `node` is the node's fully qualified name; the action is <node>/simulate_steps.
-  static Result<std::unique_ptr<SimulateSteps>> create(const Participant& participant, const std::string& node,
+  static Result<std::unique_ptr<SimulateSteps>> create(const Participant& participant,
+                                                       const std::string& node,
                                                        control::Controller& controller);
   ~SimulateSteps();  // the action server stops; reads still queued in the controller do nothing
   SimulateSteps(const SimulateSteps&) = delete;
