@@ -231,8 +231,9 @@ int node_command(const NodeArgs& a) {
   // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse)
   // answer through the controller; every parameter change also goes out on /parameter_events
   // (an observer beside the Foxglove server's parameter updates).
-  auto services =
-      node::NodeServices::create(participant.value(), controller, {name->fully_qualified(), scene.world.dt});
+  node::NodeServicesOptions services_options{name->fully_qualified(), scene.world.dt};
+  services_options.introspection = settings.service_introspection;  // -p service_configure_introspection:=...
+  auto services = node::NodeServices::create(participant.value(), controller, services_options);
   if (!services) return fail("node", services.error().message);
   publish_commands(controller, *services.value(), foxglove, scene.world.dt);
   DriverOptions options;
@@ -303,7 +304,9 @@ Subcommand add_node_command(CLI::App& parent) {
       "Parameters, as a ROS 2 node takes them, after the other options: --ros-args -p NAME:=VALUE "
       "--params-file FILE [--] (rcl's YAML: /NS: or /**: then ros__parameters:). Read-write: rate, "
       "publish_every, paused, forces.<i>.fx|fy (gravity), forces.<i>.beta|fx|fy|pointsperedge (wind), "
-      "springs.<j>.k|l0; values typed as YAML types them (2.0 double, 2 integer, true bool). They apply "
+      "springs.<j>.k|l0, service_configure_introspection (disabled, metadata or contents: REP 2012 events "
+      "of the node's services on <service>/_service_event, off by default, as ROS 2's introspection demos "
+      "switch theirs); values typed as YAML types them (2.0 double, 2 integer, true bool). They apply "
       "from step 0, and a reset returns to them.\n"
       "Exit status: 0 done, or stopped by Ctrl-C/SIGTERM (cleanly); 1 error (bad scene, DDS failure, "
       "divergence, --foxglove port in use); 2 usage error (also a bad --ros-args value or parameters file).");

@@ -9,6 +9,7 @@
 
 #include "rbsim/interfaces.hpp"
 #include "rbsim/parameter_events.hpp"
+#include "rbsim/print.hpp"
 #include "rbsim/service.hpp"
 #include "rbsim/service_set.hpp"
 #include "simulation_services.hpp"
@@ -32,9 +33,13 @@ QosSpec commands_qos() {
   return q;
 }
 
+// The parameter that switches service introspection (ROS 2's introspection demos' name).
+constexpr std::string_view kIntrospectionParameter = "service_configure_introspection";
+
 }  // namespace
 
 struct NodeServices::Impl {
+  const Participant* participant;  // null for catalogue()'s
   control::Controller& controller;
   NodeServicesOptions options;
   std::optional<Publisher> events;
@@ -47,7 +52,20 @@ struct NodeServices::Impl {
   std::unique_ptr<SimulationServices> simulation;  // simulation_interfaces' services
   ServiceSet services;  // last: stopped first, before the members its handlers use go
 
-  Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
+  Impl(const Participant* p, control::Controller& c, NodeServicesOptions o)
+      : participant(p), controller(c), options(std::move(o)) {}
+
+  // Every service of the node with its handler, in the order served: the one list, for create()
+  // and catalogue().
+  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> collect() {
+    std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> all;
+    add_controls(all);
+    add_parameters(all);
+    simulation = std::make_unique<SimulationServices>(
+        controller, [this](Command c) { return apply(std::move(c)); }, options.apply_timeout_s, options.dt);
+    simulation->add(all);
+    return all;
+  }
 
   // Submits `command` and waits (bounded) for the boundary that applies it.
   CommandResult apply(Command command) {
@@ -168,6 +186,17 @@ struct NodeServices::Impl {
   }
 };
 
+std::vector<NodeServices::Served> NodeServices::catalogue() {
+  // The same list create() serves, its handlers made and dropped uncalled: they only need a
+  // controller to refer to, and no participant is touched.
+  const Scene scene;
+  control::Controller controller(scene, 0, control::RunSettings{});
+  Impl impl(nullptr, controller, {});
+  std::vector<Served> out;
+  for (auto& [name, type, handler] : impl.collect()) out.push_back({name, type});
+  return out;
+}
+
 NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 NodeServices::~NodeServices() {
@@ -177,14 +206,8 @@ NodeServices::~NodeServices() {
 Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& participant,
                                                            control::Controller& controller,
                                                            const NodeServicesOptions& options) {
-  auto impl = std::make_unique<Impl>(controller, options);
-  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services;
-  impl->add_controls(services);
-  impl->add_parameters(services);
-  impl->simulation = std::make_unique<SimulationServices>(
-      controller, [raw = impl.get()](Command c) { return raw->apply(std::move(c)); }, options.apply_timeout_s,
-      options.dt);
-  impl->simulation->add(services);
+  auto impl = std::make_unique<Impl>(&participant, controller, options);
+  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services = impl->collect();
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
       return st.error();
@@ -197,6 +220,8 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
       participant, RawTopic{commands_topic, std::string(msgs::CommandMessage::kType)}, commands_qos());
   if (!commands) return commands.error();
   impl->commands.emplace(std::move(commands.value()));
+  if (Status st = impl->services.configure_introspection(participant, options.introspection); !st)
+    return st.error();
   impl->services.start(kBudgetPerServer);
   return std::unique_ptr<NodeServices>(new NodeServices(std::move(impl)));
 }
@@ -207,6 +232,15 @@ void NodeServices::command_applied(const Command& command, const CommandResult& 
   msgs::encode(control::to_message(command, result, impl_->next_sequence++, impl_->options.dt),
                impl_->command_cdr);
   if (impl_->commands->publish(impl_->command_cdr)) ++impl_->command_count;
+  for (const msgs::Parameter& p : result.changed) {
+    if (p.name != kIntrospectionParameter) continue;
+    const std::optional<IntrospectionState> state = msgs::parse_introspection_state(p.value.string_value);
+    if (!state) continue;  // the table accepts the three words only
+    if (Status st = impl_->services.configure_introspection(*impl_->participant, *state); !st)
+      RBSIM_LOG(Warn, "rbsim node: warning: service introspection stays %s: %s\n",
+                std::string(msgs::to_string(impl_->services.introspection())).c_str(),
+                st.error().message.c_str());
+  }
   if (result.changed.empty() || result.step < 0) return;
   msgs::ParameterEvent event;
   event.node = impl_->options.node;
@@ -231,6 +265,7 @@ NodeServiceCounters NodeServices::counters() const {
   }
   c.events = impl_->event_count.load();
   c.commands = impl_->command_count.load();
+  c.service_events = impl_->services.events_published();
   return c;
 }
 
