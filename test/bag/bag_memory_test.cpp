@@ -4,6 +4,7 @@
 // DDS; these pin down what the classes do with what they receive.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <string>
@@ -14,10 +15,12 @@
 #include "rbsim/interfaces.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/memory_middleware.hpp"
+#include "rbsim/node_services.hpp"
 #include "rbsim/player.hpp"
 #include "rbsim/recorder.hpp"
 #include "rbsim/recording.hpp"
 #include "rbsim/service.hpp"
+#include "rbsim/service_event.hpp"
 #include "rbsim/subprocess.hpp"
 
 namespace rbsim::bag {
@@ -206,6 +209,75 @@ TEST(Recorder, CountsTheStepsMissingFromATopicsSequenceAsLost) {
     EXPECT_EQ(c.lost, 3u);
   }
   EXPECT_TRUE(found);
+}
+
+// rbsim record --services: a node's service events (introspection on, contents) recorded like any
+// topic, under their _Event type and its schema, each decoding to the call that was made.
+TEST(Recorder, RecordsTheNodesServiceEvents) {
+  test::TempDir dir;
+  const Scene scene = test::control_scene();
+  auto network = std::make_shared<MemoryNetwork>();
+  Participant rec = participant(network, "rbsim_recorder");
+  Participant node_side = participant(network, "rbsim");
+  Participant client_side = participant(network, "client");
+  const std::string service(msgs::GetParametersRequest::kService);
+  RecorderOptions options;
+  options.path = (dir / "events.mcap").string();
+  options.topics = {"commands"};  // an event topic, so nothing waits for a scene description
+  options.raw_topics = {{"/rbsim/get_parameters/_service_event", msgs::service_event_type(service)}};
+  Result<std::unique_ptr<Recorder>> recorder = Recorder::create(rec, options);
+  ASSERT_TRUE(recorder.ok()) << recorder.error().message;
+
+  control::Controller controller(scene, kSteps, control::RunSettings{});
+  NodeServicesOptions so{"/rbsim", scene.world.dt};
+  so.introspection = IntrospectionState::Contents;
+  Result<std::unique_ptr<NodeServices>> services = NodeServices::create(node_side, controller, so);
+  ASSERT_TRUE(services.ok()) << services.error().message;
+  // The catalogue names the service as the node serves it.
+  const std::vector<NodeServices::Served> served = NodeServices::catalogue();
+  EXPECT_NE(std::find_if(served.begin(), served.end(),
+                         [&](const auto& s) { return s.name == "get_parameters" && s.type == service; }),
+            served.end());
+
+  auto client = ServiceClient::create(client_side, "/rbsim/get_parameters", service);
+  ASSERT_TRUE(client.ok());
+  ASSERT_TRUE(client->wait_for_server(10.0).ok());
+  msgs::GetParametersRequest req;
+  req.names = {"rate", "dt"};
+  Bytes req_cdr;
+  msgs::encode(req, req_cdr);
+  Result<Bytes> reply = client->call(req_cdr, 10.0);
+  ASSERT_TRUE(reply.ok()) << reply.error().message;
+  drain(*recorder.value(), 2);
+  ASSERT_TRUE(recorder.value()->close().ok());
+
+  Result<std::unique_ptr<recordings::Recording>> r =
+      recordings::Recording::open(options.path, recordings::raw_options());
+  ASSERT_TRUE(r.ok());
+  bool found = false;
+  for (const recordings::RecordedChannel& c : r.value()->channels()) {
+    if (c.channel->topic != "/rbsim/get_parameters/_service_event") continue;
+    found = true;
+    ASSERT_NE(c.schema, nullptr);
+    EXPECT_EQ(c.schema->name, "rcl_interfaces/srv/GetParameters_Event");
+    EXPECT_EQ(c.schema_text(), msgs::ros2msg_schema(c.schema->name).value());
+  }
+  EXPECT_TRUE(found);
+  const Payloads got = payloads_of(options.path);
+  const auto events = got.find("/rbsim/get_parameters/_service_event");
+  ASSERT_NE(events, got.end());
+  ASSERT_EQ(events->second.size(), 2u);
+  Result<msgs::ServiceEventCodec> codec = msgs::ServiceEventCodec::create(service);
+  ASSERT_TRUE(codec.ok());
+  msgs::ServiceEventInfo info;
+  Bytes request, response;
+  ASSERT_TRUE(codec.value().decode(events->second[0], info, request, response).ok());
+  EXPECT_EQ(info.event_type, msgs::ServiceEventType::RequestReceived);
+  EXPECT_EQ(request, req_cdr);
+  ASSERT_TRUE(codec.value().decode(events->second[1], info, request, response).ok());
+  EXPECT_EQ(info.event_type, msgs::ServiceEventType::ResponseSent);
+  EXPECT_EQ(response, reply.value());
+  EXPECT_EQ(services.value()->counters().service_events, 2u);
 }
 
 TEST(Recorder, TakesButDoesNotRecordWhilePaused) {

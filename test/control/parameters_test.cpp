@@ -24,13 +24,29 @@ std::vector<std::string> names(const ParameterTable& t) {
 TEST(ParameterTable, DeclaresTheRunsParametersWithForcesInFileOrder) {
   const Scene scene = test::control_scene();
   const ParameterTable t(scene, 200, RunSettings{2.0, 3, false});
-  std::vector<std::string> expected = {
-      "scene",         "dt",           "integrator",  "bodies",
-      "springs",       "steps",        "rate",        "publish_every",
-      "paused",        "use_sim_time", "forces.0.fx", "forces.0.fy",             // gravity
-      "forces.1.beta", "forces.1.fx",  "forces.1.fy", "forces.1.pointsperedge",  // wind
-      "forces.2.fx",   "forces.2.fy",                                            // gravity
-      "springs.0.k",   "springs.0.l0", "springs.1.k", "springs.1.l0"};
+  std::vector<std::string> expected = {"scene",
+                                       "dt",
+                                       "integrator",
+                                       "bodies",
+                                       "springs",
+                                       "steps",
+                                       "rate",
+                                       "publish_every",
+                                       "paused",
+                                       "use_sim_time",
+                                       "service_configure_introspection",
+                                       "forces.0.fx",
+                                       "forces.0.fy",  // gravity
+                                       "forces.1.beta",
+                                       "forces.1.fx",
+                                       "forces.1.fy",
+                                       "forces.1.pointsperedge",  // wind
+                                       "forces.2.fx",
+                                       "forces.2.fy",  // gravity
+                                       "springs.0.k",
+                                       "springs.0.l0",
+                                       "springs.1.k",
+                                       "springs.1.l0"};
   // rclcpp's read-only node parameter, declared after use_sim_time.
   expected.insert(expected.begin() + 10, "start_type_description_service");
   EXPECT_EQ(names(t), expected);
@@ -45,6 +61,7 @@ TEST(ParameterTable, DeclaresTheRunsParametersWithForcesInFileOrder) {
   EXPECT_EQ(value("publish_every"), V::of_integer(3));
   EXPECT_EQ(value("paused"), V::of_bool(false));
   EXPECT_EQ(value("use_sim_time"), V::of_bool(false));
+  EXPECT_EQ(value("service_configure_introspection"), V::of_string("disabled"));
   EXPECT_EQ(value("forces.0.fy"), V::of_double(scene.world.gravity[0].acceleration.y()));
   EXPECT_EQ(value("forces.1.beta"), V::of_double(scene.world.winds[0].beta));
   EXPECT_EQ(value("forces.1.pointsperedge"), V::of_integer(scene.world.winds[0].points_per_edge));
@@ -78,6 +95,7 @@ std::vector<Case> cases() {
       {"publish_every", V::of_integer(1), V::of_double(2.0), V::of_integer(0)},
       {"paused", V::of_bool(true), V::of_integer(1), std::nullopt},
       {"use_sim_time", V::of_bool(false), V::of_string("false"), V::of_bool(true)},
+      {"service_configure_introspection", V::of_string("contents"), V::of_bool(true), V::of_string("on")},
       {"forces.0.fx", V::of_double(-1e6), V::of_bool(true), V::of_double(nan)},
       {"forces.0.fy", V::of_double(3.7), V::of_integer(-3),
        V::of_double(-std::numeric_limits<double>::infinity())},
@@ -136,6 +154,22 @@ TEST(ParameterTableCheck, UseSimTimeTrueIsRefusedWithAReason) {
   EXPECT_NE(r.reason.find("rbsim is the clock"), std::string::npos) << r.reason;
 }
 
+// The introspection demos' three words, and nothing else (the node switches on them).
+TEST(ParameterTableCheck, ServiceIntrospectionTakesTheDemosWords) {
+  const ParameterTable t(test::control_scene(), 200, RunSettings{});
+  for (const char* word : {"disabled", "metadata", "contents"}) {
+    EXPECT_TRUE(t.check({"service_configure_introspection", V::of_string(word)}).successful) << word;
+  }
+  for (const char* word : {"", "off", "Contents", "contents "}) {
+    const SetParametersResult r = t.check({"service_configure_introspection", V::of_string(word)});
+    EXPECT_FALSE(r.successful) << word;
+    EXPECT_NE(r.reason.find("disabled, metadata or contents"), std::string::npos) << r.reason;
+  }
+  RunSettings settings;
+  apply(t.target(*t.find("service_configure_introspection")), V::of_string("metadata"), settings);
+  EXPECT_EQ(settings.service_introspection, msgs::IntrospectionState::Metadata);
+}
+
 TEST(ParameterTableCheck, AnIntegerForADoubleIsRefusedAsRclcppDoes) {
   const ParameterTable t(test::control_scene(), 200, RunSettings{});
   const SetParametersResult r = t.check({"rate", V::of_integer(2)});
@@ -155,7 +189,8 @@ TEST(ParameterTableList, FollowsRclcppPrefixAndDepthRules) {
             (std::vector<std::string>{"forces.0", "forces.1", "forces.2", "springs.0", "springs.1"}));
   const ListParametersResult top = t.list({}, 1);  // names without a '.'
   for (const std::string& n : top.names) EXPECT_EQ(n.find('.'), std::string::npos) << n;
-  EXPECT_EQ(top.names.size(), 11u);  // start_type_description_service among them
+  EXPECT_EQ(top.names.size(), 12u);  // the six read-only, rate, publish_every, paused, use_sim_time,
+                                     // start_type_description_service, introspection
   const ListParametersResult wind = t.list({"forces.1"}, kDepthRecursive);
   EXPECT_EQ(wind.names, (std::vector<std::string>{"forces.1.beta", "forces.1.fx", "forces.1.fy",
                                                   "forces.1.pointsperedge"}));

@@ -514,6 +514,81 @@ def case_node_record(ctx):
     rbsim_check(ctx, live, run, "check-live-run", live=True)
 
 
+def case_service_events(ctx):
+    """REP 2012 service introspection over DDS: a node started with -p
+    service_configure_introspection:=contents, `rbsim record --services pause,resume` beside it and an
+    independent Python client (player_client.py's, with std_srvs/srv/Trigger) calling pause and resume:
+    the recording holds /NS/pause/_service_event and /NS/resume/_service_event under the _Event types
+    with the ros2msg schema and type hash rosbag2 would write, and `rosbags`, given only the recorded
+    schema, decodes each event: REQUEST_RECEIVED then RESPONSE_SENT per call, the client's guid
+    (rmw_cyclonedds's first 8 bytes of client_gid) and sequence number, the reply the client got."""
+    import struct
+    from player_client import Player, trigger_types
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    scene = ctx.scene("cantilever.xml")
+    out = ctx.path("events.mcap")
+    node = ctx.rb("node", *node_args(ctx, scene, "--loop", "--ros-args", "-p",
+                                     "service_configure_introspection:=contents"))
+    node.wait_for_text("rbsim node:", 30, stream="stderr")
+    rec = ctx.rb("record", *record_args(ctx, out, "--services", "pause,resume", "--topics", "commands",
+                                        "--wall-duration", 90, "--chunk-size", 1024))
+    client = Player(ctx.domain, "/" + ctx.ns, "file://" + ctx.loopback_xml, names=("pause", "resume"),
+                    types=trigger_types())
+    ctx.require(client.wait_matched(20), "the Python client did not match the node's pause and resume in 20 s")
+    topics = {name: f"/{ctx.ns}/{name}/_service_event" for name in ("pause", "resume")}
+    replies = {}  # (service, seq) -> the reply the client got
+
+    # Calls until the recorder, whose readers match the node's event writers some time after it
+    # starts, has both events of a call on each topic (the calls before that are not recorded).
+    def enough(got):
+        for name in ("pause", "resume"):
+            r = client.call(name)
+            ctx.require(r is not None, f"no reply from {name} within 15 s\n{node.output()}")
+            replies[(name, client.clients[name]["seq"])] = r
+        counts = {t: sum(1 for m in got if m[0] == t) for t in topics.values()}
+        return all(c >= 4 for c in counts.values())
+    wait_recorded(ctx, rec, out, enough, 60, "two calls' events of pause and resume")
+    rec.signal(signal.SIGINT)
+    exited_ok(ctx, rec, 30)
+    node.signal(signal.SIGINT)
+    exited_ok(ctx, node, 30)
+
+    log = Log(out)
+    schemas = {ch.topic: log.summary.schemas[ch.schema_id] for ch in log.summary.channels.values()}
+    store = get_typestore(Stores.EMPTY)
+    for name, topic in topics.items():
+        ctx.require(topic in schemas, f"{topic} not recorded: {log.topics()}")
+        schema = schemas[topic]
+        ctx.check(schema.name == "std_srvs/srv/Trigger_Event", f"{topic}: schema {schema.name}")
+        ctx.check(schema.encoding == "ros2msg", f"{topic}: schema encoding {schema.encoding}")
+        # The recorded schema alone, split as rosbag2 writes it, registered with rosbags.
+        sections = schema.data.decode().split("\n" + "=" * 80 + "\n")
+        types = dict(get_types_from_msg(sections[0], schema.name))
+        for part in sections[1:]:
+            head, _, text = part.partition("\n")
+            types.update(get_types_from_msg(text, head.removeprefix("MSG: ")))
+        store.register(types)
+        events = [store.deserialize_cdr(p, "std_srvs/srv/msg/Trigger_Event") for p in log.payloads(topic)]
+        ctx.require(len(events) >= 4 and len(events) % 2 == 0, f"{topic}: {len(events)} events")
+        guid = client.clients[name]["guid"]
+        for request, response in zip(events[::2], events[1::2]):
+            info = request.info
+            ctx.check(info.event_type == 1 and response.info.event_type == 2,
+                      f"{topic}: event types {info.event_type}, {response.info.event_type} (want 1, 2)")
+            ctx.check(bytes(info.client_gid.tolist()) == struct.pack("<Q", guid) + bytes(8),
+                      f"{topic}: client_gid {info.client_gid.tolist()} (guid {guid:#x})")
+            ctx.check(response.info.sequence_number == info.sequence_number,
+                      f"{topic}: sequence numbers {info.sequence_number}, {response.info.sequence_number}")
+            ctx.check(len(request.request) == 1 and len(request.response) == 0, f"{topic}: request event's sequences")
+            got = response.response[0] if len(response.response) == 1 else None
+            want = replies.get((name, info.sequence_number))
+            ctx.check(got is not None and want is not None and (got.success, got.message) ==
+                      (want.success, want.message),
+                      f"{topic}: seq {info.sequence_number}: recorded reply {got}, the client got {want}")
+            ctx.check(abs(info.stamp.sec - time.time()) < 600, f"{topic}: stamp {info.stamp} not the system clock")
+
+
 def case_late_recorder(ctx):
     """A recorder started after the node still gets the scene description (transient local) and
     then every step, contiguous and byte-equal to the run; SIGTERM finishes a valid file."""
@@ -2101,6 +2176,7 @@ CASES = {
     "record_snapshot": case_record_snapshot,
     "player": case_player,
     "record_services": case_record_services,
+    "service_events": case_service_events,
     "security": case_security,
     "disk_full": case_disk_full,
     "type_description": case_type_description,

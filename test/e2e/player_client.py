@@ -103,13 +103,35 @@ def player_types():
     }, Time_
 
 
+def trigger_types(names=("pause", "resume")):
+    """std_srvs/srv/Trigger (rbsim node's pause, resume, reset) as rmw_cyclonedds_cpp puts it on the
+    wire: for Player(..., types=trigger_types())."""
+    from cyclonedds.idl import IdlStruct
+    import cyclonedds.idl.types as types
+
+    @dataclass
+    class Trigger_Request_(IdlStruct, typename="std_srvs::srv::dds_::Trigger_Request_"):
+        guid: types.uint64
+        seq: types.int64
+        structure_needs_at_least_one_member: types.uint8 = 0
+
+    @dataclass
+    class Trigger_Response_(IdlStruct, typename="std_srvs::srv::dds_::Trigger_Response_"):
+        guid: types.uint64
+        seq: types.int64
+        success: bool
+        message: str
+
+    return {name: (Trigger_Request_, Trigger_Response_) for name in names}
+
+
 class Player:
     """One rmw_cyclonedds-style client per service of the player node `node` ("/rbsim_player"), or
     of the services named in `names` (the recorder's: snapshot, split_bagfile, pause, resume, is_paused)."""
 
     PLAYER = ("pause", "resume", "toggle_paused", "is_paused", "get_rate", "set_rate", "seek", "play_next", "burst")
 
-    def __init__(self, domain, node, config_uri=None, names=PLAYER):
+    def __init__(self, domain, node, config_uri=None, names=PLAYER, types=None):
         import os
         if config_uri:  # read by Cyclone when the domain is created (rbsim's loopback configuration)
             os.environ["CYCLONEDDS_URI"] = config_uri
@@ -122,6 +144,8 @@ class Player:
 
         self.dp = DomainParticipant(domain)
         self.types, self.Time = player_types()
+        if types is not None:  # another node's services (rbsim node's Trigger services)
+            self.types = types
         self.clients = {}
         for name, (req, rep) in self.types.items():
             if name not in names:

@@ -22,6 +22,7 @@
 #include "rbsim/dds_sink.hpp"
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
+#include "rbsim/service_event.hpp"
 #include "rbsim/simulation_interfaces.hpp"
 #include "sim_test_util.hpp"
 
@@ -563,6 +564,88 @@ TEST_P(SimulationServicesTest, AMalformedRequestIsAnsweredAsFailed) {
   EXPECT_EQ(res.result.result, SimResult::kOperationFailed);
   EXPECT_NE(res.result.error_message.find("GetEntityState request"), std::string::npos)
       << res.result.error_message;
+}
+
+// Service introspection follows the parameter service_configure_introspection, set through the
+// node's own parameter service and applied at a step boundary: off (no publisher), contents (the
+// request and the response in the events), metadata (neither), off again (the publisher gone).
+TEST_P(SimulationServicesTest, IntrospectionFollowsItsParameter) {
+  const std::string service(sim::GetEntityStateRequest::kService);
+  auto sub = Subscription::create(
+      *client_, RawTopic{"/" + node_ + "/get_entity_state/_service_event", msgs::service_event_type(service)},
+      service_event_qos());
+  ASSERT_TRUE(sub.ok());
+  Result<msgs::ServiceEventCodec> codec = msgs::ServiceEventCodec::create(service);
+  ASSERT_TRUE(codec.ok());
+  const auto get = [&](const std::string& entity) {
+    sim::GetEntityStateRequest req;
+    req.entity = entity;
+    return call<sim::GetEntityStateResponse>("get_entity_state", req);
+  };
+  const auto introspection = [&](const char* word) {
+    msgs::SetParametersRequest req;
+    req.parameters = {{"service_configure_introspection", msgs::ParameterValue::of_string(word)}};
+    const auto res = call<msgs::SetParametersResponse>("set_parameters", req);
+    ASSERT_EQ(res.results.size(), 1u);
+    EXPECT_TRUE(res.results[0].successful) << res.results[0].reason;
+  };
+  // Events until `count` came (bounded), decoded.
+  const auto events = [&](std::size_t count) {
+    std::vector<std::pair<msgs::ServiceEventInfo, std::pair<Bytes, Bytes>>> out;
+    const auto end = std::chrono::steady_clock::now() + 20s;
+    Received r;
+    while (out.size() < count && std::chrono::steady_clock::now() < end) {
+      if (!sub->take(r)) {
+        std::this_thread::sleep_for(2ms);
+        continue;
+      }
+      msgs::ServiceEventInfo info;
+      Bytes req, res;
+      EXPECT_TRUE(codec.value().decode(r.cdr, info, req, res).ok());
+      out.push_back({info, {std::move(req), std::move(res)}});
+    }
+    return out;
+  };
+
+  const auto until = [](auto done) {  // bounded: DDS matching takes a moment
+    const auto end = std::chrono::steady_clock::now() + 20s;
+    while (!done() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(2ms);
+    return done();
+  };
+  get("body_0");  // off: no publisher, so no event of it can come later
+  EXPECT_EQ(sub->matched(), 0);
+  introspection("contents");
+  ASSERT_TRUE(until([&] { return sub->matched() == 1; }));
+  const sim::GetEntityStateResponse answered = get("body_1");
+  auto got = events(2);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].first.event_type, msgs::ServiceEventType::RequestReceived);
+  sim::GetEntityStateRequest req;
+  ASSERT_TRUE(decode(std::span<const std::byte>(got[0].second.first), req).ok());
+  EXPECT_EQ(req.entity, "body_1");
+  EXPECT_EQ(got[1].first.event_type, msgs::ServiceEventType::ResponseSent);
+  Bytes answered_cdr;
+  encode(answered, answered_cdr);
+  EXPECT_EQ(got[1].second.second, answered_cdr);
+
+  introspection("metadata");
+  get("body_0");
+  got = events(2);
+  ASSERT_EQ(got.size(), 2u);
+  for (const auto& [info, parts] : got) {
+    EXPECT_TRUE(parts.first.empty());
+    EXPECT_TRUE(parts.second.empty());
+  }
+  EXPECT_EQ(got[0].first.client_gid, got[1].first.client_gid);
+  EXPECT_EQ(got[0].first.sequence_number, got[1].first.sequence_number);
+
+  introspection("disabled");
+  EXPECT_TRUE(until([&] { return sub->matched() == 0; }));
+  // Every service's events: get_entity_state's four; set_parameters' two while it was on (the call
+  // to metadata) and the request of the call to disabled (its reply came after the switch); none
+  // of the call that turned it on (its request came while off, and a call's events follow the
+  // state it found).
+  EXPECT_EQ(services_->counters().service_events, 7u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, SimulationServicesTest, ::testing::Values("dds", "memory"),

@@ -243,6 +243,7 @@ int node_command(const NodeArgs& a) {
     request_stop();
   };
   service_options.start_type_description_service = settings.start_type_description_service;
+  service_options.introspection = settings.service_introspection;  // -p service_configure_introspection:=...
   auto services = node::NodeServices::create(participant.value(), controller, service_options);
   if (!services) return fail("node", services.error().message);
   publish_commands(controller, *services.value(), *sink.value(), foxglove, scene.world.dt);
@@ -314,7 +315,9 @@ Subcommand add_node_command(CLI::App& parent) {
       "Parameters, as a ROS 2 node takes them, after the other options: --ros-args -p NAME:=VALUE "
       "--params-file FILE [--] (rcl's YAML: /NS: or /**: then ros__parameters:). Read-write: rate, "
       "publish_every, paused, forces.<i>.fx|fy (gravity), forces.<i>.beta|fx|fy|pointsperedge (wind), "
-      "springs.<j>.k|l0; values typed as YAML types them (2.0 double, 2 integer, true bool). They apply "
+      "springs.<j>.k|l0, service_configure_introspection (disabled, metadata or contents: REP 2012 events "
+      "of the node's services on <service>/_service_event, off by default, as ROS 2's introspection demos "
+      "switch theirs); values typed as YAML types them (2.0 double, 2 integer, true bool). They apply "
       "from step 0, and a reset returns to them. Read-only, given only this way: "
       "start_type_description_service (default true: the node serves <namespace>/get_type_description, "
       "as an rclcpp node does).\n"

@@ -1,4 +1,5 @@
 // rbsim record: DDS topics to MCAP until Ctrl-C, --wall-duration or --max-messages.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -11,9 +12,11 @@
 #include "rbsim/bag.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/mcap_sink.hpp"
+#include "rbsim/node_services.hpp"
 #include "rbsim/outputs.hpp"
 #include "rbsim/recorder.hpp"
 #include "rbsim/rosout.hpp"
+#include "rbsim/service_event.hpp"
 #include "rbsim/time.hpp"
 #include "validators.hpp"
 
@@ -34,7 +37,41 @@ struct RecordArgs {
   bool overwrite = false;
   std::optional<double> wrong_duration;
   node::NodeName node{"/", "rbsim_recorder"};  // as rosbag2's recorder names its node
+  std::vector<std::string> services;           // --services
+  bool all_services = false;                   // --all-services
 };
+
+// --services and --all-services as topics: each service's <service>/_service_event with its
+// _Event type, the service looked up among the node's (a name under the node, "pause", or in full,
+// "/rbsim/pause"). Empty when neither was given; an unknown name is a usage error naming them.
+Result<std::vector<node::RawTopic>> service_event_topics(const RecordArgs& a) {
+  std::vector<node::RawTopic> out;
+  if (a.services.empty() && !a.all_services) return out;
+  const std::string node = "/" + (a.rec.ns.starts_with('/') ? a.rec.ns.substr(1) : a.rec.ns);
+  const std::vector<node::NodeServices::Served> served = node::NodeServices::catalogue();
+  const auto add = [&](const node::NodeServices::Served& s) {
+    out.push_back({node + "/" + s.name + std::string(msgs::kServiceEventTopicSuffix),
+                   msgs::service_event_type(s.type)});
+  };
+  if (a.all_services) {
+    for (const node::NodeServices::Served& s : served) add(s);
+    return out;
+  }
+  for (const std::string& name : a.services) {
+    const auto it = std::find_if(served.begin(), served.end(), [&](const node::NodeServices::Served& s) {
+      return name == s.name || name == node + "/" + s.name;
+    });
+    if (it == served.end()) {
+      std::string names;
+      for (const node::NodeServices::Served& s : served) names += (names.empty() ? "" : ", ") + s.name;
+      return Error{
+          "--services: \"" + name + "\" is not a service of the node " + node + " (services: " + names + ")",
+          ErrorCode::InvalidArgument};
+    }
+    add(*it);
+  }
+  return out;
+}
 
 // --max-file-duration, --snapshot-duration in ns (0 when not given), by base's one rule.
 Result<std::uint64_t> duration_ns(const std::optional<double>& seconds, const char* option) {
@@ -149,6 +186,9 @@ int record_command(RecordArgs a) {
   std::string bag;
   std::vector<OutputPath> outputs;
   if (std::optional<int> exit = choose_outputs(a, bag, outputs)) return *exit;
+  Result<std::vector<node::RawTopic>> events = service_event_topics(a);
+  if (!events) return fail("record", events.error().message, 2);
+  a.rec.raw_topics = std::move(events.value());
 
   if (Status st = check_outputs(outputs, {}, a.overwrite); !st) return fail("record", st.error().message);
   std::error_code ec;
@@ -213,6 +253,15 @@ Subcommand add_record_command(CLI::App& parent) {
       ->allow_extra_args(false);
   app->add_option("--exclude-regex", a->rec.exclude_regex,
                   "Do not record the topics whose full name matches this regular expression");
+  app->add_option("--services", a->services,
+                  "Also record these services' introspection events (<service>/_service_event, as rosbag2's "
+                  "--services), comma-separated or repeated (pause or /rbsim/pause); the node publishes them "
+                  "once its parameter service_configure_introspection is metadata or contents")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  app->add_flag(
+      "--all-services", a->all_services,
+      "Also record the introspection events of every service of the node (rosbag2's --all-services)");
   add_domain_option(app, a->domain);
   add_node_name_option(app, a->node);
   app->add_option("--namespace", a->rec.ns, "ROS namespace of the topics")

@@ -82,17 +82,31 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   auto waitset = WaitSet::create(participant);
   if (!waitset) return waitset.error();
   r->waitset_ = std::move(waitset.value());
+  // Before the topics of the table: the body states stay last (above).
+  for (const node::RawTopic& raw : r->options_.raw_topics) {
+    QosSpec qos;  // reliable, volatile (an event topic's writer offers no more), keep all
+    qos.keep_all = true;
+    auto sub = Subscription::create(participant, raw, qos);
+    if (!sub) return with_context(raw.ros_name + ": ", sub.error());
+    r->waitset_.attach(sub.value());
+    r->topics_.push_back(Topic{std::move(sub.value()), &raw, 0, 0, {}, {}, 0, Gaps{}});
+  }
   for (const msgs::TopicSpec* spec : wanted) {
     const std::string ros = msgs::topic_name(*spec, options.ns);
     auto sub = Subscription::create(participant, *spec, ros, qos_for(*spec));
     if (!sub) return sub.error();
     r->waitset_.attach(sub.value());
-    Topic topic{std::move(sub.value()), 0, 0, {}, {}, 0, Gaps{}};
+    Topic topic{std::move(sub.value()), nullptr, 0, 0, {}, {}, 0, Gaps{}};
     topic.latched_pending = spec->latched();
     r->topics_.push_back(std::move(topic));
     if (spec->latched()) r->holding_ = true;
   }
   return r;
+}
+
+Result<std::uint16_t> Recorder::add_channel(const Topic& t, const msgs::OfferedQos& offered) {
+  if (t.raw != nullptr) return recordings::add_topic(writer_, t.raw->ros_name, t.raw->ros_type, offered);
+  return recordings::add_topic(writer_, t.subscription.spec(), options_.ns, offered);
 }
 
 // The next file: options.path, or the bag's file files_.size().
@@ -127,7 +141,7 @@ Status Recorder::split(std::uint64_t log_time) {
   file_start_ = log_time;
   for (const std::size_t i : channel_order_) {
     Topic& t = topics_[i];
-    if (!t.subscription.spec().latched() || t.last.empty()) continue;
+    if (!is_latched(t) || t.last.empty()) continue;
     if (auto st = writer_.write_message(t.channel, t.received - 1, log_time, t.last_source, t.last); !st.ok())
       return with_context(options_.path + ": ", st.error());
   }
@@ -138,7 +152,7 @@ Status Recorder::split(std::uint64_t log_time) {
 Status Recorder::add_channels() {
   for (const std::size_t i : channel_order_) {
     Topic& t = topics_[i];
-    auto channel = recordings::add_topic(writer_, t.subscription.spec(), options_.ns, t.offered);
+    auto channel = add_channel(t, t.offered);
     if (!channel.ok()) return with_context(options_.path + ": ", channel.error());
     if (channel.value() != t.channel) {
       return Error{options_.path + ": channel of " + t.subscription.ros_topic() + " got id " +
@@ -184,7 +198,7 @@ Result<std::uint64_t> Recorder::snapshot() {
   const std::uint64_t first = kept_.front().log_time;
   for (const std::size_t i : channel_order_) {  // the latched topics' latest, at the first kept time
     Topic& t = topics_[i];
-    if (!t.subscription.spec().latched() || t.last.empty()) continue;
+    if (!is_latched(t) || t.last.empty()) continue;
     if (auto st = writer_.write_message(t.channel, t.received - 1, first, t.last_source, t.last); !st.ok())
       return with_context(options_.path + ": ", st.error());
     ++n;
@@ -231,11 +245,10 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       }
       const std::uint64_t now = wall_ns();
       const std::size_t index = static_cast<std::size_t>(&t - topics_.data());
-      const bool latched = t.subscription.spec().latched();
+      const bool latched = is_latched(t);
       // Held: per-step samples while a latched topic is outstanding, and the markers while the
       // scene description is (it goes first).
-      if (holding_ &&
-          (!latched || (t.subscription.spec().id != msgs::TopicId::SceneDescription && scene_pending()))) {
+      if (holding_ && (!latched || (!is_scene(t) && scene_pending()))) {
         held_bytes_ += sample.cdr.size();
         held_.push_back({index, std::move(sample), now});
         if (latched) t.latched_pending = false;  // it came: only its writing waits
@@ -266,7 +279,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
 }
 
 Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time) {
-  const bool latched = t.subscription.spec().latched();
+  const bool latched = is_latched(t);
   const bool snapshots = options_.snapshot_duration_ns > 0;
   if (options_.max_file_bytes > 0 && ++written_ % 16 == 0) {  // the size as chunks reached the file
     std::error_code ec;
@@ -285,7 +298,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
     if (snapshots) {  // no file open: the id add_channels() gives it (one schema and channel each, in order)
       t.channel = static_cast<std::uint16_t>(channel_order_.size());
     } else {
-      auto channel = recordings::add_topic(writer_, t.subscription.spec(), options_.ns, sample.offered);
+      auto channel = add_channel(t, sample.offered);
       if (!channel.ok()) return with_context(options_.path + ": ", channel.error());
       t.channel = channel.value();
     }
@@ -302,6 +315,7 @@ Status Recorder::write(Topic& t, const Received& sample, std::uint64_t log_time)
     return with_context(options_.path + ": ", st.error());
   }
   ++t.received;
+  if (t.raw != nullptr) return Ok{};  // an event topic: no step to check
   const msgs::TopicId id = t.subscription.spec().id;
   if (id == msgs::TopicId::SceneDescription) {
     if (auto scene = msgs::decode_scene(sample.cdr); scene && scene.value().dt > 0.0) dt_ = scene.value().dt;
@@ -319,17 +333,14 @@ bool Recorder::latched_outstanding() const {
     if (!t.latched_pending) continue;
     // The scene description is always waited for; other latched topics while a node offers them
     // (or until the scene description came, discovery of their writer having had that long).
-    if (t.subscription.spec().id == msgs::TopicId::SceneDescription || !scene_seen ||
-        t.subscription.matched() > 0)
-      return true;
+    if (is_scene(t) || !scene_seen || t.subscription.matched() > 0) return true;
   }
   return false;
 }
 
 bool Recorder::scene_pending() const {
-  return std::any_of(topics_.begin(), topics_.end(), [](const Topic& t) {
-    return t.latched_pending && t.subscription.spec().id == msgs::TopicId::SceneDescription;
-  });
+  return std::any_of(topics_.begin(), topics_.end(),
+                     [](const Topic& t) { return t.latched_pending && is_scene(t); });
 }
 
 Status Recorder::release_held() {
@@ -342,7 +353,7 @@ Status Recorder::release_held() {
   for (const bool latched : {true, false}) {
     for (Held& h : held_) {
       Topic& t = topics_[h.topic];
-      if (t.subscription.spec().latched() != latched) continue;
+      if (is_latched(t) != latched) continue;
       if (Status st = write(t, h.sample, latched ? first : h.log_time); !st) return st;
     }
   }

@@ -9,6 +9,7 @@
 
 #include "rbsim/interfaces.hpp"
 #include "rbsim/parameter_events.hpp"
+#include "rbsim/print.hpp"
 #include "rbsim/service.hpp"
 #include "rbsim/service_set.hpp"
 #include "simulate_steps.hpp"
@@ -37,13 +38,19 @@ using ServiceEntry = std::tuple<std::string, std::string, ServiceServer::Handler
 
 // rclcpp's ~/get_type_description, answered from the participant's node type cache: the types of
 // the endpoints the node created, this service's own among them, as rcl's cache holds them.
-void add_type_description(const Participant& participant, std::vector<ServiceEntry>& out) {
+// Without a participant (catalogue()), listed only: its handler answers nothing.
+void add_type_description(const Participant* participant, std::vector<ServiceEntry>& out) {
   using msgs::GetTypeDescriptionRequest;
   using msgs::GetTypeDescriptionResponse;
+  if (participant == nullptr) {
+    out.emplace_back("get_type_description", std::string(GetTypeDescriptionRequest::kService),
+                     [](const RequestHeader&, std::span<const std::byte>, Bytes&) { return false; });
+    return;
+  }
   out.emplace_back(
       "get_type_description", std::string(GetTypeDescriptionRequest::kService),
       typed_handler<GetTypeDescriptionRequest, GetTypeDescriptionResponse>(
-          [types = participant.types()](const RequestHeader&, const GetTypeDescriptionRequest& req) {
+          [types = participant->types()](const RequestHeader&, const GetTypeDescriptionRequest& req) {
             return describe_node_type(*types, req);
           },
           [](const Error& e) {
@@ -53,9 +60,13 @@ void add_type_description(const Participant& participant, std::vector<ServiceEnt
           }));
 }
 
+// The parameter that switches service introspection (ROS 2's introspection demos' name).
+constexpr std::string_view kIntrospectionParameter = "service_configure_introspection";
+
 }  // namespace
 
 struct NodeServices::Impl {
+  const Participant* participant;  // null for catalogue()'s
   control::Controller& controller;
   NodeServicesOptions options;
   std::optional<Publisher> events;
@@ -69,7 +80,22 @@ struct NodeServices::Impl {
   std::unique_ptr<SimulateSteps> simulate_steps;   // and its action
   ServiceSet services;  // last: stopped first, before the members its handlers use go
 
-  Impl(control::Controller& c, NodeServicesOptions o) : controller(c), options(std::move(o)) {}
+  Impl(const Participant* p, control::Controller& c, NodeServicesOptions o)
+      : participant(p), controller(c), options(std::move(o)) {}
+
+  // Every service of the node with its handler, in the order served: the one list, for create()
+  // and catalogue().
+  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> collect() {
+    std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> all;
+    add_controls(all);
+    add_parameters(all);
+    simulation = std::make_unique<SimulationServices>(
+        controller, [this](Command c) { return apply(std::move(c)); }, options.apply_timeout_s, options.dt,
+        options.quit);
+    simulation->add(all);
+    if (options.start_type_description_service) add_type_description(participant, all);
+    return all;
+  }
 
   // Submits `command` and waits (bounded) for the boundary that applies it.
   CommandResult apply(Command command) {
@@ -190,6 +216,17 @@ struct NodeServices::Impl {
   }
 };
 
+std::vector<NodeServices::Served> NodeServices::catalogue() {
+  // The same list create() serves, its handlers made and dropped uncalled: they only need a
+  // controller to refer to, and no participant is touched.
+  const Scene scene;
+  control::Controller controller(scene, 0, control::RunSettings{});
+  Impl impl(nullptr, controller, {});
+  std::vector<Served> out;
+  for (auto& [name, type, handler] : impl.collect()) out.push_back({name, type});
+  return out;
+}
+
 NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 NodeServices::~NodeServices() {
@@ -199,15 +236,8 @@ NodeServices::~NodeServices() {
 Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& participant,
                                                            control::Controller& controller,
                                                            const NodeServicesOptions& options) {
-  auto impl = std::make_unique<Impl>(controller, options);
-  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services;
-  impl->add_controls(services);
-  impl->add_parameters(services);
-  impl->simulation = std::make_unique<SimulationServices>(
-      controller, [raw = impl.get()](Command c) { return raw->apply(std::move(c)); }, options.apply_timeout_s,
-      options.dt, options.quit);
-  impl->simulation->add(services);
-  if (options.start_type_description_service) add_type_description(participant, services);
+  auto impl = std::make_unique<Impl>(&participant, controller, options);
+  std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services = impl->collect();
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
       return st.error();
@@ -223,6 +253,8 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
       participant, RawTopic{commands_topic, std::string(msgs::CommandMessage::kType)}, commands_qos());
   if (!commands) return commands.error();
   impl->commands.emplace(std::move(commands.value()));
+  if (Status st = impl->services.configure_introspection(participant, options.introspection); !st)
+    return st.error();
   impl->services.start(kBudgetPerServer);
   return std::unique_ptr<NodeServices>(new NodeServices(std::move(impl)));
 }
@@ -233,6 +265,15 @@ void NodeServices::command_applied(const Command& command, const CommandResult& 
   msgs::encode(control::to_message(command, result, impl_->next_sequence++, impl_->options.dt),
                impl_->command_cdr);
   if (impl_->commands->publish(impl_->command_cdr)) ++impl_->command_count;
+  for (const msgs::Parameter& p : result.changed) {
+    if (p.name != kIntrospectionParameter) continue;
+    const std::optional<IntrospectionState> state = msgs::parse_introspection_state(p.value.string_value);
+    if (!state) continue;  // the table accepts the three words only
+    if (Status st = impl_->services.configure_introspection(*impl_->participant, *state); !st)
+      RBSIM_LOG(Warn, "rbsim node: warning: service introspection stays %s: %s\n",
+                std::string(msgs::to_string(impl_->services.introspection())).c_str(),
+                st.error().message.c_str());
+  }
   if (result.changed.empty() || result.step < 0) return;
   msgs::ParameterEvent event;
   event.node = impl_->options.node;
@@ -249,17 +290,23 @@ std::span<const std::byte> NodeServices::last_command() const {
 
 NodeServiceCounters NodeServices::counters() const {
   NodeServiceCounters c;
-  std::vector<ServiceStats> all = impl_->services.stats();
-  const ActionStats action = impl_->simulate_steps->stats();
-  all.insert(all.end(), {action.send_goal, action.cancel_goal, action.get_result});
-  for (const ServiceStats& st : all) {
+  const auto add = [&c](const ServiceStats& st, std::uint64_t unanswered) {
     c.received += st.received;
     c.calls += st.answered;
     c.dropped += st.dropped_full + st.dropped_large + st.malformed + st.client_gone + st.client_unmatched +
-                 st.unanswered + st.write_failed;
-  }
+                 unanswered + st.write_failed;
+  };
+  for (const ServiceStats& st : impl_->services.stats()) add(st, st.unanswered);
+  // The action's handlers leave a get_result unanswered to answer it later: its own malformed
+  // count is what went unanswered for good.
+  const ActionStats action = impl_->simulate_steps->stats();
+  add(action.send_goal, 0);
+  add(action.cancel_goal, 0);
+  add(action.get_result, 0);
+  c.dropped += action.malformed;
   c.events = impl_->event_count.load();
   c.commands = impl_->command_count.load();
+  c.service_events = impl_->services.events_published();
   return c;
 }
 

@@ -57,6 +57,14 @@ ParameterDescriptor boolean(std::string name, std::string description) {
   return d;
 }
 
+ParameterDescriptor string(std::string name, std::string description) {
+  ParameterDescriptor d;
+  d.name = std::move(name);
+  d.type = ParameterType::String;
+  d.description = std::move(description);
+  return d;
+}
+
 // Forces in the parameters' numbering: the scene's file order, or gravity then wind for a scene
 // made in code.
 std::vector<ForceRef> force_order(const Scene& scene) {
@@ -82,6 +90,8 @@ ParameterValue read(const ParameterTarget& t, std::span<const GravityDef> gravit
       return ParameterValue::of_integer(settings.publish_every);
     case K::Paused:
       return ParameterValue::of_bool(settings.paused);
+    case K::ServiceIntrospection:
+      return ParameterValue::of_string(std::string(msgs::to_string(settings.service_introspection)));
     case K::GravityX:
       return ParameterValue::of_double(gravity[t.index].acceleration.x());
     case K::GravityY:
@@ -196,6 +206,13 @@ ParameterTable::ParameterTable(const Scene& scene, std::int64_t steps, const Run
   add(read_only("start_type_description_service", ParameterType::Bool,
                 "Start the ~/get_type_description service for this node."),
       V::of_bool(settings.start_type_description_service), {K::StartTypeDescriptionService});
+  ParameterDescriptor introspection =
+      string("service_configure_introspection",
+             "Service introspection (REP 2012) of the node's services: events on <service>/_service_event "
+             "without (metadata) or with (contents) the request and response");
+  introspection.additional_constraints = "disabled, metadata or contents";
+  add(std::move(introspection), V::of_string(std::string(msgs::to_string(settings.service_introspection))),
+      {K::ServiceIntrospection});
   const std::vector<ForceRef> forces = force_order(scene);
   for (std::size_t i = 0; i < forces.size(); ++i) {
     const std::string p = "forces." + std::to_string(i) + ".";
@@ -270,6 +287,11 @@ SetParametersResult ParameterTable::check(const Parameter& p, bool at_start) con
                   std::to_string(v) + ").");
     }
   }
+  if (entries_[*i].target.kind == ParameterTarget::Kind::ServiceIntrospection &&
+      !msgs::parse_introspection_state(p.value.string_value)) {
+    return fail("Parameter {" + p.name + "} must be disabled, metadata or contents (got '" +
+                p.value.string_value + "').");
+  }
   if (entries_[*i].target.kind == ParameterTarget::Kind::UseSimTime && p.value.bool_value) {
     return fail("parameter 'use_sim_time' cannot be true: rbsim is the clock (it publishes /clock)");
   }
@@ -314,7 +336,8 @@ ListParametersResult ParameterTable::list(const std::vector<std::string>& prefix
 
 bool is_setting(const ParameterTarget& t) {
   using K = ParameterTarget::Kind;
-  return t.kind == K::Rate || t.kind == K::PublishEvery || t.kind == K::Paused || t.kind == K::UseSimTime;
+  return t.kind == K::Rate || t.kind == K::PublishEvery || t.kind == K::Paused || t.kind == K::UseSimTime ||
+         t.kind == K::ServiceIntrospection;
 }
 
 void apply(const ParameterTarget& t, const ParameterValue& v, WorldDef& def) {
@@ -386,6 +409,10 @@ void apply(const ParameterTarget& t, const ParameterValue& v, RunSettings& setti
   if (t.kind == K::PublishEvery) settings.publish_every = v.integer_value;
   if (t.kind == K::Paused) settings.paused = v.bool_value;
   if (t.kind == K::StartTypeDescriptionService) settings.start_type_description_service = v.bool_value;
+  if (t.kind == K::ServiceIntrospection) {
+    settings.service_introspection =
+        msgs::parse_introspection_state(v.string_value).value_or(settings.service_introspection);
+  }
 }
 
 Status apply_overrides(const std::vector<ParameterOverride>& overrides, Scene& scene, std::int64_t steps,

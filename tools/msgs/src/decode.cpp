@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "cdr.hpp"
 #include "rbsim/cdr.hpp"
 #include "rbsim/msgs.hpp"
 
@@ -43,7 +44,17 @@ class Walker {
  public:
   Walker(const std::vector<MessageDecoder::Type>& types, std::span<const std::byte> cdr)
       : types_(types), cdr_(cdr), at_(cdr) {}
+  // A walk of one value starting where `at` stands (inside a message whose header was checked).
+  Walker(const std::vector<MessageDecoder::Type>& types, const CdrCursor& at)
+      : types_(types), cdr_(), at_(at) {}
   std::string error;
+
+  // The root type once, from the cursor, no header check: a value embedded in a larger message.
+  template <class Visit>
+  bool value(Visit&& visit) {
+    return type(0, visit);
+  }
+  const CdrCursor& cursor() const { return at_; }
 
   template <class Visit>
   bool message(Visit&& visit) {
@@ -102,6 +113,10 @@ class Walker {
     } else {
       std::byte raw[8] = {};
       if (!read(p.size, raw)) return false;
+      if constexpr (requires { visit.bits(raw, p.size); }) {
+        visit.bits(raw, p.size);  // the value's bytes as they were (a copy, bit for bit)
+        return true;
+      }
       s = load_scalar(raw, p.size, p.kind);
     }
     visit.scalar(s, false);
@@ -130,6 +145,37 @@ struct Collect {
   void index(std::uint64_t) {}
   void unindex() {}
   void scalar(const Scalar& s, bool) { out->push_back(s); }
+};
+
+// Writes each value as it is read, aligned where it lands in the writer's message (a value moved
+// to another offset, e.g. a request embedded in its service's _Event, keeps CDR's alignment rule
+// there: an 8-byte field after an odd-sized one gets the padding of its new place, not its old).
+struct Copy {
+  detail::CdrWriter* to;
+  void begin_object() {}
+  void end_object() {}
+  void enter(const MessageDecoder::Field&) {}
+  void leave(const MessageDecoder::Field&) {}
+  void index(std::uint64_t) {}
+  void unindex() {}
+  // Sequence lengths and strings (every other primitive comes through bits()).
+  void scalar(const Scalar& s, bool is_length) {
+    if (is_length) return to->sequence_length(static_cast<std::size_t>(s.u));
+    to->string(s.s);
+  }
+  // A primitive of `size` bytes, copied bit for bit (a NaN's payload, a float's -0 kept).
+  void bits(const std::byte* raw, std::uint8_t size) {
+    switch (size) {
+      case 1:
+        return to->u8(CdrCursor::load<std::uint8_t>(raw));
+      case 2:
+        return to->u16(CdrCursor::load<std::uint16_t>(raw));
+      case 4:
+        return to->u32(CdrCursor::load<std::uint32_t>(raw));
+      default:
+        return to->u64(CdrCursor::load<std::uint64_t>(raw));
+    }
+  }
 };
 
 // Builds the path of scalar number `target` while walking; stops the walk there. The path is
@@ -436,6 +482,14 @@ Status MessageDecoder::to_json(std::span<const std::byte> cdr, std::string& out)
     out.resize(start);
     return Error{"CDR: " + w.error};
   }
+  return Ok{};
+}
+
+Status MessageDecoder::copy(CdrCursor& from, detail::CdrWriter& to) const {
+  Walker w(types_, from);
+  Copy c{&to};
+  if (!w.value(c)) return Error{"CDR: " + types_[0].name + ": " + w.error};
+  from = w.cursor();
   return Ok{};
 }
 

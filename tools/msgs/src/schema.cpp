@@ -195,6 +195,33 @@ std::string offered_qos_yaml(const OfferedQos& qos) {
   return y;
 }
 
+namespace detail {
+Result<std::string> definition_part(std::string_view type, std::string_view text, int part, int parts) {
+  std::string texts[3];
+  int separators = 0;
+  while (!text.empty()) {
+    const auto nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text = nl == std::string_view::npos ? std::string_view() : text.substr(nl + 1);
+    std::string_view bare = line;
+    while (!bare.empty() && (bare.back() == '\r' || bare.back() == ' ' || bare.back() == '\t'))
+      bare.remove_suffix(1);
+    if (bare == "---") {
+      ++separators;
+      continue;
+    }
+    if (separators < 3) texts[separators] += std::string(line) + "\n";
+  }
+  if (separators != parts - 1) {
+    const char* what = parts == 2 ? "a service definition needs exactly one \"---\" line"
+                                  : "an action definition needs exactly two \"---\" lines";
+    return Error{std::string(type) + ": " + what + " (found " + std::to_string(separators) + ")"};
+  }
+  return std::move(texts[part]);
+}
+
+}  // namespace detail
+
 std::string_view definition(std::string_view type) {
   const std::string key = canonical(type);
   for (const detail::Definition& d : detail::definitions()) {
@@ -228,19 +255,49 @@ std::vector<std::string_view> action_types() {
 }
 
 namespace {
+// The .msg text rosidl makes of a service's messages (rosidl_parser's Service): "pkg/srv/Name_Request"
+// and "_Response" are the two parts of the .srv text (either may be empty: std_srvs/srv/Trigger's
+// request has no field), "_Event" is rosidl's event_message: the ServiceEventInfo, then the request
+// and the response each as a sequence of at most one (named in full: the parts have no .msg of their
+// own to be found by a bare name). nullopt for another name or a service we do not carry.
+std::optional<std::string> service_message_text(std::string_view type) {
+  for (const std::string_view suffix : {kServiceRequestSuffix, kServiceResponseSuffix, kServiceEventSuffix}) {
+    if (!type.ends_with(suffix) || type.find("/srv/") == std::string_view::npos) continue;
+    const std::string service(type.substr(0, type.size() - suffix.size()));
+    const std::string_view srv = definition(service);
+    if (srv.empty()) return std::nullopt;
+    if (suffix == kServiceEventSuffix) {
+      return "service_msgs/ServiceEventInfo info\n" + service + std::string(kServiceRequestSuffix) +
+             "[<=1] request\n" + service + std::string(kServiceResponseSuffix) + "[<=1] response\n";
+    }
+    Result<std::string> part =
+        detail::definition_part(service, srv, suffix == kServiceRequestSuffix ? 0 : 1, 2);
+    if (!part) return std::nullopt;
+    return std::move(part.value());
+  }
+  return std::nullopt;
+}
+
+// The text of a type: its shipped .msg, or a service message's (service_message_text).
+std::optional<std::string> text_of(std::string_view type) {
+  const std::string_view shipped = definition(type);
+  if (!shipped.empty()) return std::string(shipped);
+  return service_message_text(type);
+}
+
 // The rosbag2 schema of `root` whose own text is `root_text` (its dependencies from definitions).
-Result<std::string> schema_of(std::string_view root, std::string_view root_text) {
+Result<std::string> schema_of(std::string_view root, const std::optional<std::string>& root_text) {
   std::set<std::string> seen;
   std::string missing;
   std::function<std::string(std::string_view, int)> expand = [&](std::string_view type, int depth) {
-    const std::string_view text = depth == 0 ? root_text : definition(type);
-    if (text.empty() || depth > 50) {
+    const std::optional<std::string> text = depth == 0 ? root_text : text_of(type);
+    if (!text || depth > 50) {
       missing = std::string(type);
       return std::string();
     }
-    std::string out(text);
+    std::string out(*text);
     const std::string package = canonical(type).substr(0, canonical(type).find('/'));
-    for (const std::string& dep : dependencies(text, package)) {
+    for (const std::string& dep : dependencies(*text, package)) {
       if (!seen.insert(dep).second) continue;
       out += "\n" + std::string(80, '=') + "\nMSG: " + dep + "\n";
       out += expand(dep, depth + 1);
@@ -254,7 +311,7 @@ Result<std::string> schema_of(std::string_view root, std::string_view root_text)
 }  // namespace
 
 Result<std::string> ros2msg_schema(std::string_view root) {
-  return schema_of(root, definition(root));
+  return schema_of(root, text_of(root));
 }
 
 std::optional<EnergyTermsVersion> energy_terms_version(std::string_view schema) {
@@ -262,7 +319,8 @@ std::optional<EnergyTermsVersion> energy_terms_version(std::string_view schema) 
   if (Result<std::string> now = ros2msg_schema(type); now && now.value() == schema) {
     return EnergyTermsVersion::Current;
   }
-  if (Result<std::string> old = schema_of(type, kEnergyTermsWithoutSplit); old && old.value() == schema) {
+  if (Result<std::string> old = schema_of(type, std::string(kEnergyTermsWithoutSplit));
+      old && old.value() == schema) {
     return EnergyTermsVersion::WithoutSplit;
   }
   return std::nullopt;

@@ -19,6 +19,7 @@
 #include <set>
 #include <vector>
 
+#include "definitions.hpp"
 #include "list_items.hpp"
 #include "rbsim/msgs.hpp"
 
@@ -26,9 +27,11 @@ namespace rbsim::msgs {
 
 namespace {
 
-constexpr std::string_view kRequest = "_Request";
-constexpr std::string_view kResponse = "_Response";
-constexpr std::string_view kEvent = "_Event";
+using detail::definition_part;
+
+constexpr std::string_view kRequest = kServiceRequestSuffix;
+constexpr std::string_view kResponse = kServiceResponseSuffix;
+constexpr std::string_view kEvent = kServiceEventSuffix;
 constexpr std::string_view kEventInfo = "service_msgs/msg/ServiceEventInfo";
 // What rosidl_parser's Action makes of pkg/action/Name (definition.py: ACTION_*_SUFFIX).
 constexpr std::string_view kGoal = "_Goal";
@@ -258,32 +261,6 @@ Result<IndividualTypeDescription> describe_msg_text(std::string_view type, std::
     d.fields.push_back(std::move(field.value()));
   }
   return d;
-}
-
-// Part `part` of a .srv text (request, response: split by exactly one "---" line) or of an .action
-// text (goal, result, feedback: exactly two), as rosidl_adapter splits them.
-Result<std::string> definition_part(std::string_view type, std::string_view text, int part, int parts) {
-  std::string texts[3];
-  int separators = 0;
-  while (!text.empty()) {
-    const auto nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text = nl == std::string_view::npos ? std::string_view() : text.substr(nl + 1);
-    std::string_view bare = line;
-    while (!bare.empty() && (bare.back() == '\r' || bare.back() == ' ' || bare.back() == '\t'))
-      bare.remove_suffix(1);
-    if (bare == "---") {
-      ++separators;
-      continue;
-    }
-    if (separators < 3) texts[separators] += std::string(line) + "\n";
-  }
-  if (separators != parts - 1) {
-    const char* what = parts == 2 ? "a service definition needs exactly one \"---\" line"
-                                  : "an action definition needs exactly two \"---\" lines";
-    return Error{std::string(type) + ": " + what + " (found " + std::to_string(separators) + ")"};
-  }
-  return std::move(texts[part]);
 }
 
 // `name` without `suffix`, when it ends with it and something comes before.

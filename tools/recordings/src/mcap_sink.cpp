@@ -127,16 +127,21 @@ Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spe
 
 Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
                                 const msgs::OfferedQos& offered) {
-  Result<std::string> schema = msgs::ros2msg_schema(spec.type);
+  return add_topic(writer, msgs::topic_name(spec, ns), spec.type, offered);
+}
+
+Result<std::uint16_t> add_topic(mcap::Writer& writer, std::string_view ros_name, std::string_view ros_type,
+                                const msgs::OfferedQos& offered) {
+  Result<std::string> schema = msgs::ros2msg_schema(ros_type);
   if (!schema) return schema.error();
   const std::string& text = schema.value();
-  auto schema_id = writer.add_schema(spec.type, "ros2msg", std::as_bytes(std::span(text)));
+  auto schema_id = writer.add_schema(ros_type, "ros2msg", std::as_bytes(std::span(text)));
   if (!schema_id.ok()) return schema_id.error();
   // rosbag2_storage_mcap (Jazzy) writes the topic's type hash as channel metadata "topic_type_hash".
-  Result<std::string> hash = msgs::type_hash(spec.type);
+  Result<std::string> hash = msgs::type_hash(ros_type);
   if (!hash) return hash.error();
   return writer.add_channel(
-      schema_id.value(), msgs::topic_name(spec, ns), "cdr",
+      schema_id.value(), ros_name, "cdr",
       {{"offered_qos_profiles", msgs::offered_qos_yaml(offered)}, {"topic_type_hash", hash.value()}});
 }
 

@@ -54,6 +54,11 @@ struct RecorderOptions {
   std::string regex;
   std::vector<std::string> exclude_topics;
   std::string exclude_regex;
+  // Topics outside msgs::topics() by their ROS name and type, recorded as they arrive (after the
+  // latched topics, as the per-step ones; no step checks; subscribed volatile, so what was
+  // published before the recorder matched is not there): the _service_event topics of the node's
+  // services (rbsim record --services, --all-services), as rosbag2 records a service's events.
+  std::vector<node::RawTopic> raw_topics;
   mcap::Compression compression = mcap::Compression::Zstd;
   int compression_level = 0;  // 0: the codec's default
   std::uint64_t chunk_size = 1 << 20;
@@ -100,7 +105,8 @@ class Recorder {
   };
   struct Topic {
     node::Subscription subscription;
-    std::uint16_t channel;  // 0 until the first sample: its writer's QoS goes into the channel
+    const node::RawTopic* raw;  // one of options_.raw_topics, or null for one of msgs::topics()
+    std::uint16_t channel;      // 0 until the first sample: its writer's QoS goes into the channel
     std::uint32_t received;
     msgs::OfferedQos offered{};  // what its channel says (the first publisher's offer)
     // A latched topic's latest sample (payload and times), written again at the start of every
@@ -129,6 +135,11 @@ class Recorder {
   recordings::BagMetadata bag_metadata_;  // the bag's closed files
   [[nodiscard]] Status split(std::uint64_t log_time);
   [[nodiscard]] Status add_channels();
+  [[nodiscard]] Result<std::uint16_t> add_channel(const Topic& t, const msgs::OfferedQos& offered);
+  static bool is_latched(const Topic& t) { return t.raw == nullptr && t.subscription.spec().latched(); }
+  static bool is_scene(const Topic& t) {
+    return t.raw == nullptr && t.subscription.spec().id == msgs::TopicId::SceneDescription;
+  }
   // Snapshot mode's buffer: per-step and event messages in arrival order.
   struct Kept {
     std::size_t topic;

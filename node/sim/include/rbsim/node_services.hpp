@@ -5,7 +5,8 @@
 // and <node>/commands. Every request becomes a control::Command for
 // the run loop (rbsim/control.hpp), answered once it applied at a step boundary; reads answer at once from
 // the table as of the last boundary. Requests are served on one thread of this class, woken by any server's
-// arrival, so a paused run loop (idling in the controller) still answers.
+// arrival, so a paused run loop (idling in the controller) still answers. Service introspection (REP 2012,
+// rbsim/service_set.hpp) follows the parameter service_configure_introspection: off by default.
 #pragma once
 
 #include <cstdint>
@@ -13,9 +14,11 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "rbsim/control.hpp"
 #include "rbsim/middleware.hpp"
+#include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
 
@@ -33,15 +36,19 @@ struct NodeServicesOptions {
   // description of every type the node's endpoints use (rbsim/node_types.hpp), as rclcpp serves it
   // unless its read-only parameter start_type_description_service is false.
   bool start_type_description_service = true;
+  // REP 2012 introspection of the services from the start (the parameter
+  // service_configure_introspection as the run starts; later changes of it turn it on and off).
+  IntrospectionState introspection = IntrospectionState::Off;
 };
 
 // For the end line.
 struct NodeServiceCounters {
-  std::uint64_t received = 0;  // requests taken from DDS
-  std::uint64_t calls = 0;     // requests answered
-  std::uint64_t dropped = 0;   // not answered: queue full, too large, malformed, client gone
-  std::uint64_t events = 0;    // /parameter_events published
-  std::uint64_t commands = 0;  // /<ns>/commands published
+  std::uint64_t received = 0;        // requests taken from DDS
+  std::uint64_t calls = 0;           // requests answered
+  std::uint64_t dropped = 0;         // not answered: queue full, too large, malformed, client gone
+  std::uint64_t events = 0;          // /parameter_events published
+  std::uint64_t commands = 0;        // /<ns>/commands published
+  std::uint64_t service_events = 0;  // <service>/_service_event published
 };
 
 class NodeServices {
@@ -56,16 +63,24 @@ class NodeServices {
 
   // The controller's observer (Controller::on_command): publishes every command with its outcome
   // on <node>/commands (rbsim_msgs/msg/Command, numbered from 0 without gaps; reliable, transient
-  // local, keep all) and /parameter_events for every parameter a command changed. Called on the
-  // run loop's thread.
+  // local, keep all) and /parameter_events for every parameter a command changed, and turns
+  // service introspection on or off when service_configure_introspection changed (its publishers
+  // made or destroyed there: at that boundary only). Called on the run loop's thread.
   void command_applied(const control::Command& command, const control::CommandResult& result);
   // The rbsim_msgs/msg/Command command_applied() published last (the run loop's thread), for the
   // node's other outputs of /<ns>/commands (its Foxglove server).
   std::span<const std::byte> last_command() const;
   NodeServiceCounters counters() const;
+  // The node's services as create() serves them, in that order: name under the node ("pause") and
+  // type ("std_srvs/srv/Trigger"), for `rbsim record --services` to find an event topic's type.
+  struct Served {
+    std::string name, type;
+  };
+  static std::vector<Served> catalogue();
+
+  struct Impl;  // node_services.cpp
 
  private:
-  struct Impl;
   explicit NodeServices(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

@@ -12,7 +12,10 @@
 //               forces.<i>.fx|fy (gravity i, double), forces.<i>.beta (wind, double >= 0),
 //               forces.<i>.fx|fy (wind velocity, double), forces.<i>.pointsperedge (wind,
 //               integer in [2, 1000000]), springs.<j>.k, springs.<j>.l0 (doubles >= 0),
-//               use_sim_time (bool, false: true is refused, rbsim is the clock)
+//               use_sim_time (bool, false: true is refused, rbsim is the clock),
+//               service_configure_introspection (string: disabled, metadata or contents; the
+//               node's services' introspection, REP 2012, named as ROS 2's introspection demos
+//               name it)
 // Forces are the scene's gravity and wind forces numbered together in file order from 0
 // (Scene::forces); springs are numbered apart, in file order. Doubles must be finite.
 //
@@ -36,6 +39,7 @@
 #include "rbsim/core.hpp"
 #include "rbsim/interfaces.hpp"
 #include "rbsim/scene.hpp"
+#include "rbsim/service_event.hpp"
 
 namespace rbsim::control {
 
@@ -63,6 +67,9 @@ struct RunSettings {
   bool paused = false;
   // rclcpp's read-only start_type_description_service: the node serves ~/get_type_description.
   bool start_type_description_service = true;
+  // REP 2012 service introspection of the node's services (msgs::IntrospectionState's words);
+  // `rbsim node` turns it on and off, other runs carry it unused.
+  msgs::IntrospectionState service_introspection = msgs::IntrospectionState::Off;
 };
 
 // What a parameter is bound to (the table's internal map from a name to the state it reads and
@@ -83,6 +90,7 @@ struct ParameterTarget {
     UseSimTime,
     // read-only, its value given at start by an override (rclcpp's node parameter)
     StartTypeDescriptionService,
+    ServiceIntrospection,
     // index: into WorldDef::gravity
     GravityX,
     GravityY,

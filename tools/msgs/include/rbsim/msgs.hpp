@@ -155,8 +155,15 @@ std::vector<std::string_view> service_types();
 // from each are in rbsim/type_hash.hpp).
 std::vector<std::string_view> action_types();
 // The schema rosbag2 writes for a type with encoding "ros2msg": its .msg text followed by each
-// dependency, depth first, once, as "\n" + 80 '=' + "\nMSG: pkg/Name\n" + text.
+// dependency, depth first, once, as "\n" + 80 '=' + "\nMSG: pkg/Name\n" + text. Also for the
+// messages rosidl makes of a service we carry: "pkg/srv/Name_Request", "_Response" (the parts of
+// its .srv text) and "_Event" (service_msgs/ServiceEventInfo info, then the request and the
+// response as sequences of at most one, named in full: "pkg/srv/Name_Request[<=1] request").
 Result<std::string> ros2msg_schema(std::string_view type);
+// The suffixes of those messages' names.
+inline constexpr std::string_view kServiceRequestSuffix = "_Request";
+inline constexpr std::string_view kServiceResponseSuffix = "_Response";
+inline constexpr std::string_view kServiceEventSuffix = "_Event";
 // The EnergyTerms layouts this build reads: the current one, and the one before
 // potential_gravity / potential_spring were appended.
 enum class EnergyTermsVersion : std::uint8_t { Current, WithoutSplit };
@@ -460,6 +467,11 @@ Result<std::vector<MsgField>> parse_msg_fields(std::string_view type, std::strin
 // Appends `text` to `out` as a JSON string: quoted, with '"', '\\' and control characters escaped.
 void append_json_string(std::string& out, std::string_view text);
 
+class CdrCursor;  // rbsim/cdr.hpp
+namespace detail {
+class CdrWriter;  // tools/msgs/src/cdr.hpp: msgs's own writer
+}
+
 class MessageDecoder {
  public:
   // `type` names the root ("rbsim_msgs/msg/BodyStates"); `schema` is its ros2msg text with its
@@ -476,6 +488,13 @@ class MessageDecoder {
   [[nodiscard]] Status to_json(std::span<const std::byte> cdr, std::string& out) const;
   // The field path of scalar `index` of that message, e.g. "bodies[3].x" or "bodies.length".
   std::string path(std::span<const std::byte> cdr, std::size_t index) const;
+  // The one CDR re-aligner: reads one value of the root type where `from` stands (inside a
+  // message, its header already checked) and writes it to `to` at the writer's position, each
+  // primitive aligned for its new offset (bit for bit otherwise), so a message moved into another
+  // at a different offset (a request inside its service's _Event, rbsim/service_event.hpp) keeps
+  // CDR's rule. On success `from` is past the value; on malformed data it fails (every length
+  // checked against the bytes left) with `to` part-written, for the caller to discard.
+  [[nodiscard]] Status copy(CdrCursor& from, detail::CdrWriter& to) const;
 
   struct Field;
   struct Type;

@@ -44,6 +44,10 @@ std::unique_ptr<McapSink> make_mcap_sink(std::string path, McapSinkOptions optio
 Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns,
                                 const msgs::OfferedQos& offered);
 Result<std::uint16_t> add_topic(mcap::Writer& writer, const msgs::TopicSpec& spec, std::string_view ns);
+// The same for a topic by its ROS name and type ("/rbsim/pause/_service_event",
+// "std_srvs/srv/Trigger_Event": any type msgs::ros2msg_schema and msgs::type_hash know).
+Result<std::uint16_t> add_topic(mcap::Writer& writer, std::string_view ros_name, std::string_view ros_type,
+                                const msgs::OfferedQos& offered);
 // The writer options of every rbsim log (profile "ros2", library "rbsim <version>").
 mcap::WriterOptions writer_options(mcap::Compression compression, std::uint64_t chunk_size = 1 << 20,
                                    int compression_level = 0);
