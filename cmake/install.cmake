@@ -45,6 +45,43 @@ install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md
 # The Foxglove layout `rbsim node --foxglove` points to (tools/cli/foxglove.cpp looks here first).
 install(FILES ${PROJECT_SOURCE_DIR}/docs/foxglove-layout.json DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim)
 
+# A package of a ROS 2 workspace (package.xml, colcon.pkg; colcon builds it as plain CMake, no ament):
+# what ROS 2's tools look up through the ament index under an AMENT_PREFIX_PATH entry.
+#  - `ros2 run rbsim rbsim` runs lib/rbsim/rbsim: a relative link to bin/rbsim, so the binary is
+#    stored once and still finds share/rbsim beside its real path (/proc/self/exe).
+#  - The index's markers: packages/<pkg> (empty) for rbsim and rbsim_msgs, and rosidl_interfaces/
+#    rbsim_msgs listing its definitions one per line (msg/BodyStates.msg), as rosidl registers them.
+#  - share/rbsim_msgs: the .msg and .srv files rbsim defines, byte for byte (`ros2 interface show`
+#    reads them; no generated code), and a package.xml, as every indexed package has.
+#  - share/rbsim/hook: the environment hook colcon.pkg names, putting the prefix on
+#    AMENT_PREFIX_PATH when the workspace is sourced (colcon does that for ament packages only).
+# Only rbsim_msgs is installed of tools/msgs/definitions: the other packages there (std_msgs,
+# simulation_interfaces, ...) are copies of ROS 2's own, which a sourced ROS 2 already has; a
+# second share/std_msgs would shadow or clash with the real one.
+set(RBSIM_ROS_BUILD ${PROJECT_BINARY_DIR}/ros)
+file(RELATIVE_PATH RBSIM_EXE_FROM_LIB /prefix/lib/rbsim /prefix/${CMAKE_INSTALL_BINDIR}/rbsim)
+file(MAKE_DIRECTORY ${RBSIM_ROS_BUILD}/lib)
+file(CREATE_LINK ${RBSIM_EXE_FROM_LIB} ${RBSIM_ROS_BUILD}/lib/rbsim SYMBOLIC)
+install(FILES ${RBSIM_ROS_BUILD}/lib/rbsim DESTINATION lib/rbsim)
+set(RBSIM_MSGS_DIR ${PROJECT_SOURCE_DIR}/tools/msgs/definitions/rbsim_msgs)
+file(GLOB RBSIM_MSGS_FILES RELATIVE ${RBSIM_MSGS_DIR} CONFIGURE_DEPENDS ${RBSIM_MSGS_DIR}/msg/*.msg
+     ${RBSIM_MSGS_DIR}/srv/*.srv ${RBSIM_MSGS_DIR}/action/*.action)
+list(SORT RBSIM_MSGS_FILES)
+list(JOIN RBSIM_MSGS_FILES "\n" RBSIM_MSGS_INDEX)
+file(CONFIGURE OUTPUT ${RBSIM_ROS_BUILD}/rosidl_interfaces/rbsim_msgs CONTENT "${RBSIM_MSGS_INDEX}\n" @ONLY)
+file(CONFIGURE OUTPUT ${RBSIM_ROS_BUILD}/packages/rbsim CONTENT "")
+file(CONFIGURE OUTPUT ${RBSIM_ROS_BUILD}/packages/rbsim_msgs CONTENT "")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/ros/rbsim_msgs.package.xml.in ${RBSIM_ROS_BUILD}/rbsim_msgs/package.xml @ONLY)
+set(RBSIM_AMENT_INDEX ${CMAKE_INSTALL_DATADIR}/ament_index/resource_index)
+install(FILES ${RBSIM_ROS_BUILD}/packages/rbsim ${RBSIM_ROS_BUILD}/packages/rbsim_msgs
+        DESTINATION ${RBSIM_AMENT_INDEX}/packages)
+install(FILES ${RBSIM_ROS_BUILD}/rosidl_interfaces/rbsim_msgs DESTINATION ${RBSIM_AMENT_INDEX}/rosidl_interfaces)
+install(DIRECTORY ${RBSIM_MSGS_DIR}/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim_msgs)
+install(FILES ${RBSIM_ROS_BUILD}/rbsim_msgs/package.xml DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim_msgs)
+install(FILES ${PROJECT_SOURCE_DIR}/package.xml DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim)
+install(FILES ${PROJECT_SOURCE_DIR}/cmake/ros/ament_prefix_path.dsv ${PROJECT_SOURCE_DIR}/cmake/ros/ament_prefix_path.sh
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim/hook)
+
 install(EXPORT rbsimTargets NAMESPACE rbsim:: DESTINATION ${RBSIM_CMAKE_DIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rbsimConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/rbsimConfig.cmake INSTALL_DESTINATION ${RBSIM_CMAKE_DIR})
