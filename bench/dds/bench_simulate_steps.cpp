@@ -54,10 +54,14 @@ int main(int argc, char** argv) {
   std::uint32_t domain = 173;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--steps") steps = std::atoll(argv[i + 1]);
-    else if (flag == "--rounds") rounds = std::atoi(argv[i + 1]);
-    else if (flag == "--domain") domain = static_cast<std::uint32_t>(std::atoi(argv[i + 1]));
-    else return fail("unknown option " + flag);
+    if (flag == "--steps")
+      steps = std::atoll(argv[i + 1]);
+    else if (flag == "--rounds")
+      rounds = std::atoi(argv[i + 1]);
+    else if (flag == "--domain")
+      domain = static_cast<std::uint32_t>(std::atoi(argv[i + 1]));
+    else
+      return fail("unknown option " + flag);
   }
   Result<Scene> scene = load_scene(path);
   if (!scene) return fail(scene.error().message);
