@@ -191,9 +191,9 @@ void SimulateSteps::State::send_feedback(std::int64_t completed) {
 }
 
 // ---------------------------------------------------------------------------------------------
-Result<std::unique_ptr<SimulateSteps>> SimulateSteps::create(const Participant& participant,
-                                                             const std::string& node,
-                                                             control::Controller& controller) {
+rbsim::Result<std::unique_ptr<SimulateSteps>> SimulateSteps::create(const Participant& participant,
+                                                                    const std::string& node,
+                                                                    control::Controller& controller) {
   auto state = std::make_shared<State>(controller);
   State* raw = state.get();  // the server's handlers end before the state can (the server goes first)
   ActionServer::Handlers h;
