@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 
+#include "rbsim/counts.hpp"
 #include "rbsim/simulation_interfaces.hpp"
 
 namespace rbsim::node {
@@ -21,7 +22,7 @@ constexpr auto kFeedbackPeriod = std::chrono::milliseconds(50);  // at most 20 f
 constexpr double kReadPeriodS = 0.02;                            // progress read about every 20 ms
 
 std::string steps_text(std::int64_t n) {
-  return std::to_string(n) + (n == 1 ? " step" : " steps");
+  return std::to_string(n) + plural(n, " step", " steps");
 }
 
 }  // namespace
