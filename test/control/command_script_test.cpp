@@ -43,8 +43,12 @@ TEST(ParseCommandScript, ReadsEveryActionWithItsStepAndOrigin) {
       "- {step: 50, steps: 5}\n"
       "- {step: 55, resume: true}\n"
       "- {step: 60, pause: 0.25}\n"
-      "- {step: 70, reset: yes}\n");
-  ASSERT_EQ(c.size(), 8u);
+      "- {step: 70, reset: yes}\n"
+      "- {step: 80, set_entity_state: {body: 1, x: [1, -0.5], theta: 0.25}}\n"
+      "- {step: 81, set_entity_state: {body: 0, v: [0.5, 2], omega: -3, x: [0, 0], theta: 1}}\n"
+      "- {step: 90, pause: true}\n- {step: 90, steps: 9}\n- {step: 92, stop_stepping: true}\n"
+      "- {step: 92, resume: true}\n");
+  ASSERT_EQ(c.size(), 14u);
   EXPECT_EQ(c[0].kind, CommandKind::SetParameters);
   EXPECT_EQ(c[0].step, 5);
   EXPECT_TRUE(c[0].atomic);
@@ -66,6 +70,18 @@ TEST(ParseCommandScript, ReadsEveryActionWithItsStepAndOrigin) {
   EXPECT_EQ(c[5].kind, CommandKind::Resume);
   EXPECT_EQ(c[6].pause_seconds, 0.25);
   EXPECT_EQ(c[7].kind, CommandKind::Reset);
+  EXPECT_EQ(c[8].kind, CommandKind::SetState);
+  EXPECT_EQ(c[8].state.body, 1);
+  EXPECT_TRUE(c[8].state.set_pose);
+  EXPECT_FALSE(c[8].state.set_twist);  // a pose alone keeps the velocities
+  EXPECT_EQ(c[8].state.position, Vec2(1.0, -0.5));
+  EXPECT_EQ(c[8].state.theta, 0.25);
+  EXPECT_TRUE(c[9].state.set_pose);
+  EXPECT_TRUE(c[9].state.set_twist);
+  EXPECT_EQ(c[9].state.velocity, Vec2(0.5, 2.0));
+  EXPECT_EQ(c[9].state.omega, -3.0);
+  EXPECT_EQ(c[12].kind, CommandKind::StopStepping);
+  EXPECT_EQ(c[12].step, 92);
   EXPECT_TRUE(parse("").empty());
 }
 
@@ -98,6 +114,22 @@ TEST(ParseCommandScript, ErrorsNameTheFileLineAndField) {
        "c.yaml:2: impulse.j: must be two finite numbers"},
       {ok + "- {step: 1, impulse: {body: 0, j: [0]}}", "c.yaml:2: impulse.j: must be [x, y]"},
       {ok + "- {step: 1, impulse: {body: 0, j: [0, 1], q: 1}}", "c.yaml:2: impulse.q: unknown field"},
+      {ok + "- {step: 1, set_entity_state: {body: 2, x: [0, 0], theta: 0}}",
+       "c.yaml:2: set_entity_state.body: must be a body index in [0, 2)"},
+      {ok + "- {step: 1, set_entity_state: {body: 0, x: [0, 0]}}",
+       "c.yaml:2: set_entity_state.theta: missing (give x and theta together)"},
+      {ok + "- {step: 1, set_entity_state: {body: 0, omega: 1}}",
+       "c.yaml:2: set_entity_state.v: missing (give v and omega together)"},
+      {ok + "- {step: 1, set_entity_state: {body: 0, v: [0, 1], omega: .nan}}",
+       "c.yaml:2: set_entity_state.omega: must be a finite number"},
+      {ok + "- {step: 1, set_entity_state: {body: 0}}", "c.yaml:2: set_entity_state: sets nothing"},
+      {ok + "- {step: 1, set_entity_state: {body: 0, a: [0, 1]}}",
+       "c.yaml:2: set_entity_state.a: unknown field"},
+      {ok + "- {step: 1, stop_stepping: 1}", "c.yaml:2: stop_stepping: must be true"},
+      // A stop_stepping drops the steps still to take: the run stays paused where it stopped.
+      {ok + "- {step: 20, pause: true}\n- {step: 20, steps: 5}\n- {step: 22, stop_stepping: true}\n"
+            "- {step: 25, resume: true}",
+       "c.yaml:2: pause: no resume follows at or before step 22"},
       {ok + "- {step: 1, pause: -2}",
        "c.yaml:2: pause: must be true (until a resume) or wall-clock seconds > 0"},
       {ok + "- {step: 1, resume: false}", "c.yaml:2: resume: must be true"},
@@ -136,13 +168,18 @@ TEST(ParseCommandScript, AScriptedRunEqualsTheSameCommandsGivenLive) {
       "- {step: 50, steps: 4}\n"
       "- {step: 54, impulse: {body: 1, j: [0.5, 2.0], p: [0.1, 0.0]}}\n"
       "- {step: 54, resume: true}\n"
+      "- {step: 60, set_entity_state: {body: 0, v: [0.25, -1], omega: 0.5}}\n"
+      "- {step: 70, pause: true}\n"
+      "- {step: 70, steps: 20}\n"
+      "- {step: 73, stop_stepping: true}\n"
+      "- {step: 73, resume: true}\n"
       "- {step: 80, pause: 0.05}\n");
   Controller scripted(scene, kSteps, RunSettings{0.0, 1, false});
   for (const Command& c : script) scripted.submit(c, nullptr);
   const auto start = std::chrono::steady_clock::now();
   const std::vector<Snapshot> run = test::run(scene, kSteps, &scripted);
   EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(50));  // the timed pause
-  EXPECT_EQ(scripted.counters().commands, 7u);  // six and the timed pause's own resume
+  EXPECT_EQ(scripted.counters().commands, 12u);  // eleven and the timed pause's own resume
   EXPECT_FALSE(scripted.settings().paused);
 
   Controller live(scene, kSteps, RunSettings{0.0, 1, false});
@@ -154,8 +191,16 @@ TEST(ParseCommandScript, AScriptedRunEqualsTheSameCommandsGivenLive) {
   kick.step = 54;
   kick.kind = CommandKind::Impulse;
   kick.impulse = ImpulseArgs{1, Vec2(0.5, 2.0), Vec2(0.1, 0.0)};
+  Command state;  // the stepping 70..73 leaves no trace in the states: only wall time differs
+  state.step = 60;
+  state.kind = CommandKind::SetState;
+  state.state.body = 0;
+  state.state.set_twist = true;
+  state.state.velocity = Vec2(0.25, -1.0);
+  state.state.omega = 0.5;
   live.submit(set, nullptr);
   live.submit(kick, nullptr);
+  live.submit(state, nullptr);
   const std::vector<Snapshot> given = test::run(scene, kSteps, &live);
   ASSERT_EQ(run.size(), given.size());
   for (std::size_t i = 0; i < run.size(); ++i)

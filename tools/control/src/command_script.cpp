@@ -15,7 +15,8 @@ namespace rbsim::control {
 
 namespace {
 
-constexpr const char* kActions = "set, impulse, pause, resume, steps or reset";
+constexpr const char* kActions =
+    "set, impulse, set_entity_state, pause, resume, steps, stop_stepping or reset";
 
 // The entry being read: its place in the file for every message.
 struct Entry {
@@ -126,6 +127,53 @@ Status impulse(const Entry& e, const YAML::Node& n, std::int64_t bodies, Impulse
   return Ok{};
 }
 
+// {body: I, x: [x, y], theta: T, v: [vx, vy], omega: W}: the pose (x and theta) and/or the
+// twist (v and omega), each pair whole, as StateArgs sets them.
+Status set_entity_state(const Entry& e, const YAML::Node& n, std::int64_t bodies, StateArgs& out) {
+  const std::string rule = "must be a map {body: I, x: [x, y], theta: T, v: [vx, vy], omega: W}";
+  if (!n.IsMap()) return e.error(n, "set_entity_state", rule);
+  for (const auto& kv : n) {
+    const std::string key = kv.first.Scalar();
+    if (key != "body" && key != "x" && key != "theta" && key != "v" && key != "omega") {
+      return e.error(kv.first, "set_entity_state." + key,
+                     "unknown field (want body, x and theta, v and omega)");
+    }
+  }
+  const YAML::Node body = n["body"];
+  if (!body) return e.error(n, "set_entity_state.body", "missing");
+  const std::optional<std::int64_t> b = integer(body);
+  if (!b || *b < 0 || *b >= bodies) {
+    return e.error(body, "set_entity_state.body",
+                   "must be a body index in [0, " + std::to_string(bodies) + ")");
+  }
+  StateArgs s;
+  s.body = *b;
+  // One pair: both fields or neither; `vector_field` is [x, y], `scalar_field` a finite number.
+  const auto pair = [&](const char* vector_field, const char* scalar_field, bool& set, Vec2& v,
+                        double& a) -> Status {
+    const YAML::Node vn = n[vector_field], an = n[scalar_field];
+    if (!vn && !an) return Ok{};
+    const std::string both = std::string("give ") + vector_field + " and " + scalar_field + " together";
+    if (!vn) return e.error(n, std::string("set_entity_state.") + vector_field, "missing (" + both + ")");
+    if (!an) return e.error(n, std::string("set_entity_state.") + scalar_field, "missing (" + both + ")");
+    Result<Vec2> read = vector(e, vn, std::string("set_entity_state.") + vector_field);
+    if (!read) return read.error();
+    const std::optional<double> value = number(an);
+    if (!value || !std::isfinite(*value))
+      return e.error(an, std::string("set_entity_state.") + scalar_field, "must be a finite number");
+    set = true;
+    v = read.value();
+    a = *value;
+    return Ok{};
+  };
+  if (Status st = pair("x", "theta", s.set_pose, s.position, s.theta); !st) return st;
+  if (Status st = pair("v", "omega", s.set_twist, s.velocity, s.omega); !st) return st;
+  if (!s.set_pose && !s.set_twist)
+    return e.error(n, "set_entity_state", "sets nothing: give x and theta, v and omega, or both");
+  out = s;
+  return Ok{};
+}
+
 bool is_true(const YAML::Node& n) {
   if (!n.IsScalar()) return false;
   const ParameterValue v = yaml_scalar(n);
@@ -138,8 +186,8 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
   for (const auto& kv : e.node) {
     const std::string key = kv.first.Scalar();
     if (key == "step" || key == "t") continue;
-    if (key != "set" && key != "impulse" && key != "pause" && key != "resume" && key != "steps" &&
-        key != "reset") {
+    if (key != "set" && key != "impulse" && key != "set_entity_state" && key != "pause" && key != "resume" &&
+        key != "steps" && key != "stop_stepping" && key != "reset") {
       return e.error(kv.first, key,
                      std::string("unknown field (want step or t, and one of ") + kActions + ")");
     }
@@ -157,6 +205,10 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
   if (*name == "impulse") {
     c.kind = CommandKind::Impulse;
     return impulse(e, v, bodies, c.impulse);
+  }
+  if (*name == "set_entity_state") {
+    c.kind = CommandKind::SetState;
+    return set_entity_state(e, v, bodies, c.state);
   }
   if (*name == "steps") {
     const std::optional<std::int64_t> n = integer(v);
@@ -176,7 +228,9 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
     return Ok{};
   }
   if (!is_true(v)) return e.error(v, *name, "must be true");
-  c.kind = *name == "resume" ? CommandKind::Resume : CommandKind::Reset;
+  c.kind = *name == "resume"          ? CommandKind::Resume
+           : *name == "stop_stepping" ? CommandKind::StopStepping
+                                      : CommandKind::Reset;
   return Ok{};
 }
 
@@ -213,6 +267,7 @@ Status check_pauses(const std::vector<Command>& commands, const std::vector<YAML
       }
       reach += c.steps;
     }
+    if (c.kind == CommandKind::StopStepping && open) reach = c.step;  // the steps still to take are dropped
     if (c.kind == CommandKind::Reset && open) reach = 0;  // a reset keeps the run paused, at step 0
   }
   if (open) return stuck();

@@ -4,9 +4,13 @@
 //   - {step: 500, set: {forces.1.fx: 2.0, springs.0.k: 40.0}}     parameters, as one atomic batch
 //   - {t: 1.5, impulse: {body: 3, j: [0, 4], p: [0, 0]}}           J (N s, world axes) at p (m, body
 //                                                                  frame; optional, default [0, 0])
+//   - {step: 600, set_entity_state: {body: 2, x: [1, 0.5], theta: 0, v: [0, 0], omega: 0}}
+//                                  the pose (x: m, world frame; theta: rad) and/or the twist (v: m/s;
+//                                  omega: rad/s) of a body, each pair whole (SetEntityState)
 //   - {step: 900, pause: 0.5}      pause, resuming by itself after 0.5 s of wall time
 //   - {step: 900, pause: true}     pause until a later `resume` entry (one must follow)
 //   - {step: 900, steps: 5}        while paused: step 5 times, then pause again
+//   - {step: 902, stop_stepping: true}   end the `steps` under way there (SimulateSteps' cancel)
 //   - {step: 905, resume: true}
 //   - {step: 1000, reset: true}    back to step 0 with the run's initial parameters
 //
