@@ -146,6 +146,20 @@ def cyclone_use(name, text):
     return m and m.group(1).rstrip("( \t")
 
 
+# The clocks: base's time.hpp reads them (monotonic_ns paces and times out, wall_ns stamps); a
+# module reading the system clock itself is a second rule for how wall time becomes nanoseconds.
+CLOCK_MODULES = {"base"}
+SYSTEM_CLOCK = re.compile(r"\bsystem_clock\s*::\s*now\b|\bclock_gettime\s*\(\s*CLOCK_REALTIME\b")
+
+
+def clock_use(name, text):
+    """The system clock reading `text` makes, if module `name` may not."""
+    if name in CLOCK_MODULES:
+        return None
+    m = SYSTEM_CLOCK.search(check_common.strip(text))
+    return m and m.group(0)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("root", type=pathlib.Path)
@@ -185,6 +199,10 @@ def main():
             spelt = type_name_use(name, text)
             if spelt:
                 problems.append(f"{rel}: module {name} spells the type name {spelt}; take msgs's constant")
+            clock = clock_use(name, text)
+            if clock:
+                problems.append(f"{rel}: module {name} reads the wall clock itself ({clock}); "
+                                "take rbsim::wall_ns (rbsim/time.hpp)")
             framed = framing_use(name, text)
             if framed:
                 framers.add(rel)

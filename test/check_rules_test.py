@@ -120,6 +120,17 @@ class CheckModulesTest(CheckerTest):
         self.tree.write("node/bag/src/recorder.cpp", "struct ddsi_serdata* held;\n")
         self.assertFails("node/bag/src/recorder.cpp: module bag uses Cyclone DDS (ddsi_serdata)")
 
+    def test_wall_clock_outside_base_fails(self):
+        self.tree.write("sim_core/base/src/time.cpp", "long w() { timespec t; clock_gettime(CLOCK_REALTIME, &t); }\n")
+        self.tree.write("node/bag/src/recorder.cpp", "// not system_clock::now() in a comment\n"
+                        "auto t = rbsim::wall_ns(); auto m = std::chrono::steady_clock::now();\n")
+        self.assertPasses()
+        self.tree.write("node/bag/src/recorder.cpp", "auto t = std::chrono::system_clock::now();\n")
+        self.assertFails("node/bag/src/recorder.cpp: module bag reads the wall clock itself (system_clock::now); "
+                         "take rbsim::wall_ns")
+        self.tree.write("node/bag/src/recorder.cpp", "void f(timespec* t) { clock_gettime(CLOCK_REALTIME, t); }\n")
+        self.assertFails("module bag reads the wall clock itself (clock_gettime(CLOCK_REALTIME)")
+
     def test_type_name_outside_msgs_fails(self):
         self.tree.write("tools/msgs/include/rbsim/msgs.hpp",
                         'inline constexpr const char* kTrigger = "std_srvs/srv/Trigger";\n')

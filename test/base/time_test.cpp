@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -56,6 +57,22 @@ TEST(RbsimTime, TheMonotonicClockNeverGoesBack) {
     ASSERT_GE(now, last);
     last = now;
   }
+}
+
+// The wall clock is the system clock's epoch count (what stamps say): bracketed by two readings of
+// std::chrono::system_clock, an independent reader of the same clock.
+TEST(RbsimTime, WallNsIsTheSystemClockSinceTheEpoch) {
+  const auto system_ns = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::system_clock::now().time_since_epoch())
+        .count();
+  };
+  const std::int64_t before = system_ns();
+  const std::int64_t wall = wall_ns();
+  const std::int64_t after = system_ns();
+  EXPECT_LE(before, wall);
+  EXPECT_LE(wall, after);
+  EXPECT_GT(wall, std::int64_t{1'600'000'000} * 1'000'000'000);  // after 2020: an epoch count, not uptime
 }
 
 }  // namespace

@@ -30,6 +30,16 @@ rbsim::Scene spring_wind_scene() {
   return scene;
 }
 
+// builtin_interfaces/Time from a count of ns: whole seconds and the rest, at the edges.
+TEST(TimeFromNs, SplitsSecondsAndNanoseconds) {
+  EXPECT_EQ(rbsim::msgs::time_from_ns(0), (rbsim::msgs::Time{0, 0}));
+  EXPECT_EQ(rbsim::msgs::time_from_ns(999'999'999), (rbsim::msgs::Time{0, 999'999'999}));
+  EXPECT_EQ(rbsim::msgs::time_from_ns(1'000'000'000), (rbsim::msgs::Time{1, 0}));
+  EXPECT_EQ(rbsim::msgs::time_from_ns(1'765'000'000'123'456'789),
+            (rbsim::msgs::Time{1'765'000'000, 123'456'789}));
+  EXPECT_EQ(rbsim::msgs::sim_time(3, 0.5), rbsim::msgs::time_from_ns(1'500'000'000));  // one split for both
+}
+
 TEST(TopicNames, FollowRos2Conventions) {
   const auto& states = rbsim::msgs::topic(TopicId::BodyStates);
   EXPECT_EQ(rbsim::msgs::topic_name(states, "rbsim"), "/rbsim/body_states");

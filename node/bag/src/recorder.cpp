@@ -11,16 +11,16 @@
 #include "rbsim/bag.hpp"
 #include "rbsim/mcap_sink.hpp"
 #include "rbsim/recorder.hpp"
+#include "rbsim/time.hpp"
 
 namespace rbsim::bag {
 
 using namespace node;
 
 namespace {
-std::uint64_t wall_ns() {
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                        std::chrono::system_clock::now().time_since_epoch())
-                                        .count());
+// Log times: the wall clock, unsigned as MCAP's.
+std::uint64_t log_time_now() {
+  return static_cast<std::uint64_t>(wall_ns());
 }
 }  // namespace
 
@@ -168,7 +168,7 @@ Status Recorder::split_now() {
                  ErrorCode::InvalidArgument};
   }
   if (file_start_ == 0) return Ok{};  // nothing in the open file yet: it stays the new one
-  return split(std::max(file_start_, wall_ns()));
+  return split(std::max(file_start_, log_time_now()));
 }
 
 // Snapshot mode: the sample is kept (copied) instead of written; the oldest go once they are
@@ -243,7 +243,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
       } else {
         newest->second = sample.source_time_ns;
       }
-      const std::uint64_t now = wall_ns();
+      const std::uint64_t now = log_time_now();
       const std::size_t index = static_cast<std::size_t>(&t - topics_.data());
       const bool latched = is_latched(t);
       // Held: per-step samples while a latched topic is outstanding, and the markers while the
@@ -270,7 +270,7 @@ Result<bool> Recorder::poll(std::int64_t timeout_ns) {
   // (or kHoldBytes held): stop waiting (the readers find latched messages wherever they are).
   if (holding_ &&
       (!latched_outstanding() ||
-       (!held_.empty() && (wall_ns() - held_.front().log_time > kHoldNs || held_bytes_ > kHoldBytes)))) {
+       (!held_.empty() && (log_time_now() - held_.front().log_time > kHoldNs || held_bytes_ > kHoldBytes)))) {
     holding_ = false;
     if (Status st = release_held(); !st) return st.error();
   }

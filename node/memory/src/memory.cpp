@@ -6,6 +6,7 @@
 
 #include "memory_state.hpp"
 #include "rbsim/memory_middleware.hpp"
+#include "rbsim/time.hpp"
 
 namespace rbsim::node {
 
@@ -32,12 +33,6 @@ std::size_t history_limit(const QosSpec& qos) {
 }
 
 namespace {
-
-std::int64_t wall_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // Waits on `cv` until `done` holds or `stop` (looked at every 20 ms) turns true; bounded by
 // nothing else, as the DDS publisher's wait for subscribers.

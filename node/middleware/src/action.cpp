@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rbsim/assert.hpp"
+#include "rbsim/time.hpp"
 
 namespace rbsim::node {
 
@@ -36,11 +37,7 @@ bool at_or_before(const msgs::Time& a, const msgs::Time& b) {
 }
 // Goal stamps are wall time, as rcl_action's with the node's clock not on simulated time.
 msgs::Time wall_now() {
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                      std::chrono::system_clock::now().time_since_epoch())
-                      .count();
-  return msgs::Time{static_cast<std::int32_t>(ns / 1'000'000'000),
-                    static_cast<std::uint32_t>(ns % 1'000'000'000)};
+  return msgs::time_from_ns(static_cast<std::uint64_t>(wall_ns()));
 }
 
 // The status topic: late joiners get the last array (rcl_action_qos_profile_status_default).

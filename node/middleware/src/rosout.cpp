@@ -1,5 +1,6 @@
 // stderr and /rosout, one path (rbsim/rosout.hpp).
 #include "rbsim/rosout.hpp"
+#include "rbsim/time.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -13,11 +14,6 @@ namespace {
 std::mutex g_current_mutex;
 Rosout* g_current = nullptr;
 
-std::int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 }  // namespace
 
 std::string_view function_name(std::string_view pretty) {
@@ -69,9 +65,9 @@ void Rosout::set_clock(Clock clock) {
 
 Status Rosout::publish(LogLevel level, std::string_view text, const std::source_location& where) {
   std::lock_guard lock(mutex_);
-  const std::int64_t now = clock_ ? clock_() : system_now_ns();
+  const std::int64_t now = clock_ ? clock_() : wall_ns();
   msgs::LogMessage m;
-  m.stamp = {static_cast<std::int32_t>(now / 1'000'000'000), static_cast<std::uint32_t>(now % 1'000'000'000)};
+  m.stamp = msgs::time_from_ns(static_cast<std::uint64_t>(now));
   m.level = level;
   m.name = name_;
   m.msg = text;

@@ -1,5 +1,6 @@
 // Servers of one node on one serving thread, and their introspection events (service_set.hpp).
 #include "rbsim/service_set.hpp"
+#include "rbsim/time.hpp"
 
 #include <chrono>
 #include <cstring>
@@ -92,11 +93,7 @@ void ServiceSet::introspect(std::size_t k, msgs::ServiceEventType type, const Re
   if (state == IntrospectionState::Off || !e.publisher) return;  // turned off meanwhile
   msgs::ServiceEventInfo info;
   info.event_type = type;
-  const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                       std::chrono::system_clock::now().time_since_epoch())
-                       .count();
-  info.stamp = {static_cast<std::int32_t>(now / 1'000'000'000),
-                static_cast<std::uint32_t>(now % 1'000'000'000)};
+  info.stamp = msgs::time_from_ns(static_cast<std::uint64_t>(wall_ns()));
   info.client_gid = client_gid(header);
   info.sequence_number = header.seq;
   const bool contents = state == IntrospectionState::Contents;

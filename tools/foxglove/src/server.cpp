@@ -134,9 +134,7 @@ struct Server::Impl {
 
   void new_session_locked() {
     ++sessions;
-    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
-                        std::chrono::system_clock::now().time_since_epoch())
-                        .count();
+    const std::int64_t ms = wall_ns() / 1'000'000;
     server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions),
                                    options.steering != nullptr, !services.empty());
     for (Latched& l : latched) l.has = false;

@@ -166,14 +166,12 @@ std::uint64_t sim_time_ns(const World& world) {
   return sim_time_ns(world.step_index(), world.dt());
 }
 
-namespace {
-Time time_of(std::uint64_t ns) {
+Time time_from_ns(std::uint64_t ns) {
   return Time{static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
 }
-}  // namespace
 
 Time sim_time(std::int64_t step, double dt) {
-  return time_of(sim_time_ns(step, dt));
+  return time_from_ns(sim_time_ns(step, dt));
 }
 
 Time sim_time(const World& world) {
@@ -416,7 +414,7 @@ void Encoder::markers(const World& world, Bytes& out) const {
 const Bytes& encode_clock(std::uint64_t t_ns, Bytes& out) {
   {
     CdrWriter w(out);
-    w.time(time_of(t_ns));
+    w.time(time_from_ns(t_ns));
   }  // finished: padded
   return out;
 }

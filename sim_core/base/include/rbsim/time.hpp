@@ -1,6 +1,7 @@
-// Seconds to nanoseconds, and the monotonic clock: the one conversion of a time or duration given
-// in seconds (an option, a step's simulated time) to integer nanoseconds, and the one clock that
-// paces and times out (the node's pacer, the replay's player, the Foxglove server).
+// Seconds to nanoseconds, and the clocks: the one conversion of a time or duration given in
+// seconds (an option, a step's simulated time) to integer nanoseconds, the one clock that paces
+// and times out (the node's pacer, the replay's player, the Foxglove server), and the one reading
+// of wall time (stamps).
 #pragma once
 
 #include <cstdint>
@@ -25,5 +26,8 @@ std::int64_t seconds_to_ns_clamped(double seconds);
 // The monotonic clock (CLOCK_MONOTONIC, the clock std::chrono::steady_clock reads) in ns since an
 // unspecified start.
 std::int64_t monotonic_ns();
+// The wall clock (CLOCK_REALTIME, std::chrono::system_clock) in ns since the Unix epoch: what a
+// log time, a /rosout stamp, a goal stamp or a service event's stamp says, never what paces.
+std::int64_t wall_ns();
 
 }  // namespace rbsim

@@ -183,6 +183,9 @@ struct Time {
 // seconds_to_ns_clamped()).
 Time sim_time(const World& world);
 std::uint64_t sim_time_ns(const World& world);
+// A count of ns (since the epoch, or simulated) as builtin_interfaces/Time: the one split into
+// seconds and nanoseconds.
+Time time_from_ns(std::uint64_t ns);
 // The same for step `step` of a world stepping `dt` (t = step * dt, as World::time()).
 Time sim_time(std::int64_t step, double dt);
 std::uint64_t sim_time_ns(std::int64_t step, double dt);
