@@ -29,6 +29,18 @@
 namespace rbsim {
 namespace {
 
+// The services a node's Foxglove server (and a bridge to it) offers, in order: the controls, then
+// simulation_interfaces' (node/sim's list).
+std::vector<std::string> node_services(const std::string& node) {
+  std::vector<std::string> out;
+  for (const char* name :
+       {"pause", "resume", "reset", "step", "apply_impulse", "get_simulator_features", "get_simulation_state",
+        "set_simulation_state", "reset_simulation", "step_simulation", "get_entities", "get_entities_states",
+        "get_entity_info", "get_entity_state", "get_entity_bounds", "set_entity_state"})
+    out.push_back(node + "/" + name);
+  return out;
+}
+
 using test::rbsim;
 constexpr const char* kDomain = "61";
 
@@ -294,11 +306,10 @@ TEST(FoxgloveCli, NodeServesAClientEndToEnd) {
   EXPECT_LE(seen.max_time.at("/fox_e2e/body_states"), 3'000'000'000ull) << "log time is simulated time";
   EXPECT_NE(node.err().find("rbsim node: stopped after"), std::string::npos) << node.err();
   EXPECT_NE(node.err().find("foxglove: 1 client,"), std::string::npos) << node.err();
-  // Steered through its controller: parameters and the node's five services.
+  // Steered through its controller: parameters, the node's five services and simulation_interfaces'.
   EXPECT_EQ(seen.capabilities, nlohmann::json::array({"time", "parameters", "parametersSubscribe", "services",
                                                       "clientPublish"}));
-  EXPECT_EQ(seen.services, (std::vector<std::string>{"/fox_e2e/pause", "/fox_e2e/resume", "/fox_e2e/reset",
-                                                     "/fox_e2e/step", "/fox_e2e/apply_impulse"}));
+  EXPECT_EQ(seen.services, node_services("/fox_e2e"));
 }
 
 // Binding an address other hosts reach without a token refuses to start, saying how to add one.
@@ -488,8 +499,7 @@ TEST(FoxgloveCli, BridgeRelaysANodeOverDds) {
                 seen.capabilities.end())
         << capability << " in " << seen.capabilities.dump();
   }
-  EXPECT_EQ(seen.services, (std::vector<std::string>{"/fox_br/pause", "/fox_br/resume", "/fox_br/reset",
-                                                     "/fox_br/step", "/fox_br/apply_impulse"}));
+  EXPECT_EQ(seen.services, node_services("/fox_br"));  // simulation_interfaces' forwarded to the node
 }
 
 }  // namespace

@@ -70,6 +70,26 @@ TEST(FoxgloveControlProtocol, AdvertiseServicesGivesBothSchemaForms) {
   EXPECT_EQ(s["responseSchema"], "bool success\n");
 }
 
+// A service's schemas are rosbag2's of its _Request and _Response: the part of the .srv text, then
+// every type it uses, so a client decodes simulation_interfaces' nested replies on its own.
+TEST(FoxgloveServiceSpec, SchemasCarryTheTypesTheyUse) {
+  const ServiceSpec flat = service_spec("/ns", "step", "rbsim_msgs/srv/Step");
+  EXPECT_EQ(flat.name, "/ns/step");
+  EXPECT_EQ(flat.request_schema, msgs::ros2msg_schema("rbsim_msgs/srv/Step_Request").value());
+  EXPECT_NE(flat.request_schema.find("uint32 steps"), std::string::npos);
+  EXPECT_EQ(flat.request_schema.find("---"), std::string::npos);
+  const ServiceSpec nested =
+      service_spec("/ns", "get_entity_state", "simulation_interfaces/srv/GetEntityState");
+  EXPECT_EQ(nested.type, "simulation_interfaces/srv/GetEntityState");
+  EXPECT_NE(nested.request_schema.find("string entity"), std::string::npos);
+  for (const char* dep : {"MSG: simulation_interfaces/Result", "MSG: simulation_interfaces/EntityState",
+                          "MSG: std_msgs/Header", "MSG: geometry_msgs/Pose", "MSG: geometry_msgs/Quaternion",
+                          "MSG: geometry_msgs/Twist", "MSG: builtin_interfaces/Time"}) {
+    EXPECT_NE(nested.response_schema.find(dep), std::string::npos) << dep;
+  }
+  EXPECT_TRUE(service_spec("/ns", "x", "no_such/srv/Type").request_schema.empty());
+}
+
 TEST(FoxgloveControlProtocol, ParameterValuesTypeDoublesAsTheSdkDoes) {
   V bytes;
   bytes.type = msgs::ParameterType::ByteArray;

@@ -568,5 +568,42 @@ TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
   EXPECT_EQ(r->call, 10u);
 }
 
+// A hosted call that waits (rbsim node's step_simulation until its steps are done) counts against
+// its client's calls in flight until answered: more are refused, not queued behind it.
+TEST(FoxgloveHostedServices, CallsInFlightAreBoundedPerClient) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  ServerOptions o;
+  o.port = 0;
+  o.max_pending_commands = 2;
+  o.hosted_services.push_back({service_spec("/player", "pause", "rosbag2_interfaces/srv/Pause"),
+                               [released](std::string_view) -> Result<std::string> {
+                                 released.wait_for(10s);
+                                 return cdr(msgs::PauseResponse{});
+                               }});
+  auto server = Server::start(o, {});
+  ASSERT_TRUE(server) << server.error().message;
+  WsClient c;
+  connect(c, server.value()->port());
+  next_op(c, "advertiseServices");
+  for (std::uint32_t id = 1; id <= 3; ++id)
+    ASSERT_TRUE(c.send_binary(call_frame(1, id, "cdr", cdr(msgs::PauseRequest{}))));
+  const Json refused = next_op(c, "serviceCallFailure");
+  EXPECT_EQ(refused["callId"], 3);
+  EXPECT_NE(refused["message"].get<std::string>().find("too many requests in flight (2 per client)"),
+            std::string::npos)
+      << refused.dump();
+  release.set_value();
+  for (std::uint32_t id = 1; id <= 2; ++id) {
+    const auto r = next_response(c);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->call, id);
+  }
+  ASSERT_TRUE(c.send_binary(call_frame(1, 4, "cdr", cdr(msgs::PauseRequest{}))));  // answered: admitted again
+  const auto again = next_response(c);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->call, 4u);
+}
+
 }  // namespace
 }  // namespace rbsim::foxglove

@@ -5,6 +5,7 @@
 // definitions' constants.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "rbsim/command_script.hpp"
 #include "rbsim/dds.hpp"
 #include "rbsim/dds_sink.hpp"
+#include "rbsim/forwarded_service.hpp"
 #include "rbsim/memory_middleware.hpp"
 #include "rbsim/node_services.hpp"
 #include "rbsim/service_event.hpp"
@@ -646,6 +648,91 @@ TEST_P(SimulationServicesTest, IntrospectionFollowsItsParameter) {
   // of the call that turned it on (its request came while off, and a call's events follow the
   // state it found).
   EXPECT_EQ(services_->counters().service_events, 7u);
+}
+
+// The node's other front ends (its Foxglove server) run these very handlers: the catalogue's
+// simulation_interfaces part, answering as the DDS services do, their commands recorded with the
+// front end's source.
+TEST_P(SimulationServicesTest, SimulationHandlersAreTheServedOnesWithTheirSource) {
+  const std::vector<std::string> want = {
+      "get_simulator_features", "get_simulation_state", "set_simulation_state", "reset_simulation",
+      "step_simulation",        "get_entities",         "get_entities_states",  "get_entity_info",
+      "get_entity_state",       "get_entity_bounds",    "set_entity_state"};
+  std::vector<std::string> listed, handled, names;
+  for (const NodeServices::Served& s : NodeServices::simulation_catalogue()) {
+    listed.push_back(s.name + " " + s.type);
+    names.push_back(s.name);
+  }
+  const std::vector<NodeServices::Handled> handlers = services_->simulation_handlers("foxglove");
+  for (const NodeServices::Handled& h : handlers) handled.push_back(h.name + " " + h.type);
+  EXPECT_EQ(handled, listed);
+  std::vector<std::string> sorted_names = names, sorted_want = want;
+  std::sort(sorted_names.begin(), sorted_names.end());
+  std::sort(sorted_want.begin(), sorted_want.end());
+  EXPECT_EQ(sorted_names, sorted_want);
+  const auto handler = [&](std::string_view name) -> const ServiceServer::Handler& {
+    for (const NodeServices::Handled& h : handlers) {
+      if (h.name == name) return h.handler;
+    }
+    throw std::runtime_error("no handler " + std::string(name));
+  };
+
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);  // over DDS
+  sim::StepSimulationRequest step_req;
+  step_req.steps = 3;
+  Bytes body, reply;
+  encode(step_req, body);
+  ASSERT_TRUE(handler("step_simulation")(RequestHeader{}, body, reply));
+  sim::StepSimulationResponse stepped_res;
+  ASSERT_TRUE(decode(std::span<const std::byte>(reply), stepped_res).ok());
+  EXPECT_EQ(stepped_res.result.result, SimResult::kOk) << stepped_res.result.error_message;
+
+  sim::GetEntityStateRequest get;
+  get.entity = "body_1";
+  encode(get, body);
+  ASSERT_TRUE(handler("get_entity_state")(RequestHeader{}, body, reply));
+  sim::GetEntityStateResponse here;
+  ASSERT_TRUE(decode(std::span<const std::byte>(reply), here).ok());
+  const auto over_dds = call<sim::GetEntityStateResponse>("get_entity_state", get);
+  EXPECT_EQ(here.result.result, SimResult::kOk) << here.result.error_message;
+  EXPECT_EQ(here.state, over_dds.state);
+  const World w = stepped(scene_, 3);
+  EXPECT_EQ(here.state.position.x, w.x()[1]);
+  EXPECT_EQ(here.state.position.y, w.y()[1]);
+
+  const std::lock_guard lock(mu_);
+  ASSERT_EQ(recorded_.size(), 2u);
+  EXPECT_EQ(recorded_[0].source, "ros2 service");  // the pause, over DDS
+  EXPECT_EQ(recorded_[1].source, "foxglove");      // the step, through the handler
+  EXPECT_EQ(recorded_[1].steps, 3u);
+}
+
+// rbsim bridge's forward of a simulation service: the request's CDR to the node's service, the
+// reply's back as it came; a node that serves none fails the call naming the service, bounded.
+TEST_P(SimulationServicesTest, ForwardedServiceCallsTheNodesServiceWithRawCdr) {
+  const std::string type(sim::GetSimulationStateRequest::kService);
+  auto forward = bridge::ForwardedService::create(*client_, "/" + node_, "get_simulation_state", type);
+  ASSERT_TRUE(forward.ok()) << forward.error().message;
+  Bytes body;
+  encode(sim::GetSimulationStateRequest{}, body);
+  Result<Bytes> reply = forward.value()->call(body);
+  ASSERT_TRUE(reply.ok()) << reply.error().message;
+  sim::GetSimulationStateResponse res;
+  ASSERT_TRUE(decode(std::span<const std::byte>(reply.value()), res).ok());
+  EXPECT_EQ(res.result.result, SimResult::kOk);
+  EXPECT_EQ(res.state, static_cast<std::uint8_t>(State::Stopped));
+
+  bridge::ForwardOptions quick;
+  quick.match_timeout_s = 0.2;
+  auto absent = bridge::ForwardedService::create(*client_, "/" + node_ + "_absent", "get_simulation_state",
+                                                 type, quick);
+  ASSERT_TRUE(absent.ok()) << absent.error().message;
+  const auto t0 = std::chrono::steady_clock::now();
+  Result<Bytes> none = absent.value()->call(body);
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().message.find("/" + node_ + "_absent/get_simulation_state: "), std::string::npos)
+      << none.error().message;
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 5s);
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, SimulationServicesTest, ::testing::Values("dds", "memory"),

@@ -7,6 +7,8 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/dds.hpp"
+#include "rbsim/forwarded_service.hpp"
+#include "rbsim/node_services.hpp"
 #include "rbsim/relay.hpp"
 #include "rbsim/remote_steering.hpp"
 #include "rbsim/rosout.hpp"
@@ -58,8 +60,19 @@ int bridge_command(const BridgeArgs& a) {
   steer.node = target->fully_qualified();
   auto steering = bridge::RemoteSteering::create(participant.value(), steer);
   if (!steering) return fail("bridge", steering.error().message);
+  // simulation_interfaces' services, the node's own list of them: each call forwarded as raw CDR
+  // to the node's DDS service (bounded; a node that does not answer fails the call, saying so).
+  std::vector<foxglove::HostedService> hosted;
+  for (const node::NodeServices::Served& s : node::NodeServices::simulation_catalogue()) {
+    auto forward = bridge::ForwardedService::create(participant.value(), steer.node, s.name, s.type);
+    if (!forward) return fail("bridge", forward.error().message);
+    hosted.push_back(
+        hosted_service(steer.node, s.name, s.type,
+                       [f = std::shared_ptr<bridge::ForwardedService>(std::move(forward.value()))](
+                           std::span<const std::byte> request) { return f->call(request); }));
+  }
   auto started = start_foxglove("rbsim bridge", a.foxglove, std::move(channels.value()),
-                                steering.value().get(), steer.node);
+                                steering.value().get(), steer.node, std::move(hosted));
   if (!started) return fail("bridge", started.error().message, foxglove_exit_status(started.error()));
   foxglove::Server& server = *started.value();
   if (!a.quiet) {
@@ -129,7 +142,10 @@ Subcommand add_bridge_command(CLI::App& parent) {
       "commands published on /<namespace>/command_in reach the node /<namespace> through its ROS 2 services "
       "(rcl_interfaces' set_parameters, rbsim's controls), as any ROS 2 client's would: the node applies "
       "them "
-      "at its next step and records them on /<namespace>/commands (source \"ros2 service\"). The parameter "
+      "at its next step and records them on /<namespace>/commands (source \"ros2 service\"). "
+      "simulation_interfaces' services (get_simulation_state, step_simulation, get_entity_state, ...) are "
+      "offered too, each call forwarded in cdr to the node's service of that name (12 s at most). The "
+      "parameter "
       "table is read from the node when its scene description arrives and follows /parameter_events. A "
       "command for a given step or a timed pause cannot be relayed (the services have neither). Ctrl-C "
       "stops.\n"

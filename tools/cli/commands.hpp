@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,13 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
                                                          control::Steering* steering = nullptr,
                                                          const std::string& node = "/rbsim",
                                                          std::vector<foxglove::HostedService> hosted = {});
+// A service the Foxglove server hosts (cdr calls, on its service thread): spec <node>/<name> of ROS 2
+// type `type`, each call's request CDR handed to `call`, whose reply CDR answers it and whose error
+// fails it with its message. rbsim node's simulation_interfaces handlers, rbsim bridge's forwards
+// of them to the node, rbsim replay's player services.
+foxglove::HostedService hosted_service(const std::string& node, const std::string& name,
+                                       const std::string& type,
+                                       std::function<Result<Bytes>(std::span<const std::byte>)> call);
 // The exit status for start_foxglove's error: 2 for a usage error, else 1.
 int foxglove_exit_status(const Error& error);
 // "foxglove: 2 clients, 1200 messages queued, 0 dropped for slow clients" for a command's end line.

@@ -71,6 +71,19 @@ CLI::Option* add_foxglove_option(CLI::App* app, FoxgloveArgs& args, bool require
   return o;
 }
 
+foxglove::HostedService hosted_service(const std::string& node, const std::string& name,
+                                       const std::string& type,
+                                       std::function<Result<Bytes>(std::span<const std::byte>)> call) {
+  foxglove::HostedService h;
+  h.spec = foxglove::service_spec(node, name, type);
+  h.call = [call = std::move(call)](std::string_view request) -> Result<std::string> {
+    Result<Bytes> reply = call({reinterpret_cast<const std::byte*>(request.data()), request.size()});
+    if (!reply) return reply.error();
+    return std::string(reinterpret_cast<const char*>(reply.value().data()), reply.value().size());
+  };
+  return h;
+}
+
 int foxglove_exit_status(const Error& error) {
   return error.code == ErrorCode::InvalidArgument ? 2 : 1;
 }

@@ -70,7 +70,8 @@ struct NodeFoxglove {
 // /<ns>/commands; the exit status when it cannot.
 std::optional<int> serve_foxglove(const NodeArgs& a, const control::RunSettings& settings,
                                   const node::NodeOptions& node_options, control::Controller& controller,
-                                  const node::NodeName& name, NodeFoxglove& out) {
+                                  const node::NodeName& name, const node::NodeServices& services,
+                                  NodeFoxglove& out) {
   foxglove::SinkOptions fo;
   fo.publish_every = settings.publish_every;
   fo.topics = a.node.topics;
@@ -81,8 +82,21 @@ std::optional<int> serve_foxglove(const NodeArgs& a, const control::RunSettings&
   served.set(static_cast<std::size_t>(msgs::TopicId::Commands));
   auto channels = foxglove::ros2_channels(served, a.node.ns, &ids);
   if (!channels) return fail("node", channels.error().message);
+  // simulation_interfaces' services beside the controller's: the handlers the node's DDS services
+  // run (one implementation), their commands recorded with source "foxglove".
+  std::vector<foxglove::HostedService> hosted;
+  for (node::NodeServices::Handled& h : services.simulation_handlers("foxglove")) {
+    hosted.push_back(hosted_service(
+        name.fully_qualified(), h.name, h.type,
+        [handler = std::move(h.handler), type = h.type](std::span<const std::byte> request) -> Result<Bytes> {
+          Bytes reply;
+          if (!handler(node::RequestHeader{}, request, reply))
+            return Error{"a malformed " + type + " request", ErrorCode::InvalidArgument};
+          return reply;
+        }));
+  }
   auto started = start_foxglove("rbsim node", a.foxglove, std::move(channels.value()), &controller,
-                                name.fully_qualified());
+                                name.fully_qualified(), std::move(hosted));
   if (!started) return fail("node", started.error().message, foxglove_exit_status(started.error()));
   out.server = std::move(started.value());
   out.commands_channel = ids[static_cast<std::size_t>(msgs::TopicId::Commands)];
@@ -198,13 +212,30 @@ int node_command(const NodeArgs& a) {
   // Commands (parameters, pause, step, reset, impulses) apply at step boundaries. The controller
   // outlives every front end that submits to it (the Foxglove server, the node's services).
   control::Controller controller(scene, steps, settings);
+  // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse;
+  // simulation_interfaces') answer through the controller; every parameter change also goes out on
+  // /parameter_events (an observer beside the Foxglove server's parameter updates). They come
+  // before the Foxglove server, which offers simulation_interfaces' too by running their handlers,
+  // so the server stops (its calls answered or dropped) before the handlers go.
+  node::NodeServicesOptions service_options;
+  service_options.node = name->fully_qualified();
+  service_options.dt = scene.world.dt;
+  // STATE_QUITTING: the node ends as on SIGINT (outputs finished, the end line, exit 0).
+  service_options.quit = [quiet = a.quiet] {
+    if (!quiet) RBSIM_LOG(Info, "rbsim node: quitting (set_simulation_state STATE_QUITTING)\n");
+    request_stop();
+  };
+  service_options.start_type_description_service = settings.start_type_description_service;
+  service_options.introspection = settings.service_introspection;  // -p service_configure_introspection:=...
+  auto services = node::NodeServices::create(participant.value(), controller, service_options);
+  if (!services) return fail("node", services.error().message);
   // The Foxglove server serves beside DDS, steered through the controller. The pacer releases
   // each step when it is due; the Foxglove sink's hand-off to the server's thread (a copy and a
   // wake-up) goes first, so viewers do not wait for the DDS writes.
   NodeFoxglove foxglove;
   if (a.foxglove.address) {
     if (std::optional<int> exit =
-            serve_foxglove(a, settings, node_options, controller, name.value(), foxglove))
+            serve_foxglove(a, settings, node_options, controller, name.value(), *services.value(), foxglove))
       return *exit;
   }
   if (!a.quiet) {
@@ -231,21 +262,6 @@ int node_command(const NodeArgs& a) {
   if (foxglove.sink) driver.add(*foxglove.sink);
   driver.add(*sink.value());
   follow_settings(controller, pacer, *sink.value(), foxglove.sink.get());
-  // The node's services (the six parameter services; pause, resume, reset, step, apply_impulse)
-  // answer through the controller; every parameter change also goes out on /parameter_events
-  // (an observer beside the Foxglove server's parameter updates).
-  node::NodeServicesOptions service_options;
-  service_options.node = name->fully_qualified();
-  service_options.dt = scene.world.dt;
-  // STATE_QUITTING: the node ends as on SIGINT (outputs finished, the end line, exit 0).
-  service_options.quit = [quiet = a.quiet] {
-    if (!quiet) RBSIM_LOG(Info, "rbsim node: quitting (set_simulation_state STATE_QUITTING)\n");
-    request_stop();
-  };
-  service_options.start_type_description_service = settings.start_type_description_service;
-  service_options.introspection = settings.service_introspection;  // -p service_configure_introspection:=...
-  auto services = node::NodeServices::create(participant.value(), controller, service_options);
-  if (!services) return fail("node", services.error().message);
   publish_commands(controller, *services.value(), *sink.value(), foxglove, scene.world.dt);
   DriverOptions options;
   options.steps = steps;
@@ -311,7 +327,9 @@ Subcommand add_node_command(CLI::App& parent) {
       "--foxglove serves the same topics (and /<namespace>/commands) to Foxglove beside DDS: encoding cdr, "
       "ros2msg schemas as in MCAP, "
       "log time = simulated time; a client that falls behind loses the oldest per-step messages (never the "
-      "latched scene and markers), one that stops reading is disconnected.\n"
+      "latched scene and markers), one that stops reading is disconnected. Its services are the node's: "
+      "pause, resume, reset, step, apply_impulse (cdr or json) and simulation_interfaces' (cdr), each "
+      "answered as over DDS.\n"
       "Parameters, as a ROS 2 node takes them, after the other options: --ros-args -p NAME:=VALUE "
       "--params-file FILE [--] (rcl's YAML: /NS: or /**: then ros__parameters:). Read-write: rate, "
       "publish_every, paused, forces.<i>.fx|fy (gravity), forces.<i>.beta|fx|fy|pointsperedge (wind), "

@@ -81,15 +81,13 @@ class ProgressLine {
 std::vector<foxglove::HostedService> player_services(const bag::Player& replay, const std::string& node) {
   std::vector<foxglove::HostedService> hosted;
   for (bag::Player::PlayerService& s : replay.player_services()) {
-    foxglove::HostedService h;
-    h.spec = foxglove::service_spec(node, s.name, s.type);
-    h.call = [call = std::move(s.call), type = s.type](std::string_view request) -> Result<std::string> {
-      const std::optional<Bytes> reply =
-          call({reinterpret_cast<const std::byte*>(request.data()), request.size()});
-      if (!reply) return Error{"a malformed " + type + " request", ErrorCode::InvalidArgument};
-      return std::string(reinterpret_cast<const char*>(reply->data()), reply->size());
-    };
-    hosted.push_back(std::move(h));
+    hosted.push_back(hosted_service(
+        node, s.name, s.type,
+        [call = std::move(s.call), type = s.type](std::span<const std::byte> request) -> Result<Bytes> {
+          std::optional<Bytes> reply = call(request);
+          if (!reply) return Error{"a malformed " + type + " request", ErrorCode::InvalidArgument};
+          return std::move(*reply);
+        }));
   }
   return hosted;
 }

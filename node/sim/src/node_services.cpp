@@ -60,6 +60,11 @@ void add_type_description(const Participant* participant, std::vector<ServiceEnt
           }));
 }
 
+// The source apply() records a command with, when a handler runs for a front end other than DDS
+// (simulation_handlers()): set on the calling thread for the call's length, which is where the
+// handler submits its commands.
+thread_local const std::string* t_source = nullptr;
+
 // The parameter that switches service introspection (ROS 2's introspection demos' name).
 constexpr std::string_view kIntrospectionParameter = "service_configure_introspection";
 
@@ -78,6 +83,10 @@ struct NodeServices::Impl {
   std::atomic<std::uint64_t> command_count{0};
   std::unique_ptr<SimulationServices> simulation;  // simulation_interfaces' services
   std::unique_ptr<SimulateSteps> simulate_steps;   // and its action
+  // simulation_interfaces' services in collect()'s list: [first, end); their entries (handlers
+  // copied) kept by create() for simulation_handlers().
+  std::size_t simulation_first = 0, simulation_end = 0;
+  std::vector<ServiceEntry> simulation_entries;
   ServiceSet services;  // last: stopped first, before the members its handlers use go
 
   Impl(const Participant* p, control::Controller& c, NodeServicesOptions o)
@@ -92,14 +101,16 @@ struct NodeServices::Impl {
     simulation = std::make_unique<SimulationServices>(
         controller, [this](Command c) { return apply(std::move(c)); }, options.apply_timeout_s, options.dt,
         options.quit);
+    simulation_first = all.size();
     simulation->add(all);
+    simulation_end = all.size();
     if (options.start_type_description_service) add_type_description(participant, all);
     return all;
   }
 
   // Submits `command` and waits (bounded) for the boundary that applies it.
   CommandResult apply(Command command) {
-    command.source = "ros2 service";
+    command.source = t_source != nullptr ? *t_source : "ros2 service";
     std::future<CommandResult> done = controller.submit(std::move(command));
     if (done.wait_for(std::chrono::duration<double>(options.apply_timeout_s)) != std::future_status::ready) {
       CommandResult r;
@@ -227,6 +238,34 @@ std::vector<NodeServices::Served> NodeServices::catalogue() {
   return out;
 }
 
+std::vector<NodeServices::Served> NodeServices::simulation_catalogue() {
+  const Scene scene;
+  control::Controller controller(scene, 0, control::RunSettings{});
+  Impl impl(nullptr, controller, {});
+  std::vector<ServiceEntry> all = impl.collect();
+  std::vector<Served> out;
+  for (std::size_t i = impl.simulation_first; i < impl.simulation_end; ++i)
+    out.push_back({std::get<0>(all[i]), std::get<1>(all[i])});
+  return out;
+}
+
+std::vector<NodeServices::Handled> NodeServices::simulation_handlers(std::string source) const {
+  auto shared = std::make_shared<const std::string>(std::move(source));
+  std::vector<Handled> out;
+  for (const ServiceEntry& e : impl_->simulation_entries) {
+    out.push_back({std::get<0>(e), std::get<1>(e),
+                   [shared, handler = std::get<2>(e)](const RequestHeader& header,
+                                                      std::span<const std::byte> request, Bytes& reply) {
+                     const std::string* outer = t_source;
+                     t_source = shared.get();
+                     const bool answered = handler(header, request, reply);
+                     t_source = outer;
+                     return answered;
+                   }});
+  }
+  return out;
+}
+
 NodeServices::NodeServices(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 NodeServices::~NodeServices() {
@@ -238,6 +277,8 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
                                                            const NodeServicesOptions& options) {
   auto impl = std::make_unique<Impl>(&participant, controller, options);
   std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services = impl->collect();
+  impl->simulation_entries.assign(services.begin() + static_cast<std::ptrdiff_t>(impl->simulation_first),
+                                  services.begin() + static_cast<std::ptrdiff_t>(impl->simulation_end));
   for (auto& [name, type, handler] : services) {
     if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
       return st.error();

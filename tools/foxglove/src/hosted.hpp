@@ -1,4 +1,5 @@
-// The hosted services' calls (ServerOptions::hosted_services: rbsim replay's player), served one at
+// The hosted services' calls (ServerOptions::hosted_services: rbsim replay's player, rbsim node's
+// simulation_interfaces services, rbsim bridge's forwards of them), served one at
 // a time on a thread of their own, so a handler may block (a seek waits for the player) without
 // holding up the server's I/O thread. Each call's answer, a serviceCallResponse frame or a
 // serviceCallFailure, goes to `answer` from that thread.

@@ -10,17 +10,16 @@
 namespace rbsim::foxglove {
 
 ServiceSpec service_spec(std::string_view node, std::string_view name, std::string_view type) {
-  const std::string text(msgs::definition(type));
-  // The .srv text: the request, a line "---", the response.
-  const std::size_t split = text.rfind("---", 0) == 0 ? 0 : text.find("\n---");
   ServiceSpec spec;
   spec.name = std::string(node) + "/" + std::string(name);
   spec.type = std::string(type);
-  if (split != std::string::npos) {
-    spec.request_schema = text.substr(0, split == 0 ? 0 : split + 1);
-    const std::size_t response = text.find('\n', split == 0 ? 0 : split + 1);
-    spec.response_schema = response == std::string::npos ? std::string() : text.substr(response + 1);
-  }
+  // rosbag2's ros2msg schema of each half: its part of the .srv text, then every type it uses
+  // (simulation_interfaces' requests nest geometry_msgs and their own messages), so a client
+  // decodes the call without the types installed. A type we do not carry leaves them empty.
+  if (Result<std::string> r = msgs::ros2msg_schema(spec.type + std::string(msgs::kServiceRequestSuffix)))
+    spec.request_schema = std::move(r.value());
+  if (Result<std::string> r = msgs::ros2msg_schema(spec.type + std::string(msgs::kServiceResponseSuffix)))
+    spec.response_schema = std::move(r.value());
   return spec;
 }
 

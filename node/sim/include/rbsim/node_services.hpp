@@ -18,6 +18,7 @@
 
 #include "rbsim/control.hpp"
 #include "rbsim/middleware.hpp"
+#include "rbsim/service.hpp"
 #include "rbsim/service_set.hpp"
 
 namespace rbsim::node {
@@ -77,6 +78,19 @@ class NodeServices {
     std::string name, type;
   };
   static std::vector<Served> catalogue();
+  // simulation_interfaces' services, the part of catalogue() the node's other front ends offer too
+  // (its Foxglove server, and rbsim bridge's, which forwards them to the node's DDS services).
+  static std::vector<Served> simulation_catalogue();
+  // Those services as create() serves them, the very handlers DDS calls (one implementation of
+  // each): a handler takes a request's CDR and writes its reply's, blocking until the answer is
+  // ready (step_simulation until its steps are done; every wait bounded by apply_timeout_s, plus
+  // the steps' pace). The commands a call submits are recorded with `source` ("foxglove") where
+  // DDS's say "ros2 service". Callable from any thread while this object lives.
+  struct Handled {
+    std::string name, type;
+    ServiceServer::Handler handler;
+  };
+  std::vector<Handled> simulation_handlers(std::string source) const;
 
   struct Impl;  // node_services.cpp
 

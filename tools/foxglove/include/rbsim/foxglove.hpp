@@ -96,10 +96,12 @@ struct ServiceSpec {
   std::string request_schema;   // ros2msg text of <type>_Request
   std::string response_schema;  // ros2msg text of <type>_Response
 };
-// The spec of service <node>/<name> of ROS 2 type `type` (its .srv text from msgs::definition, split
-// into the request and response schemas).
+// The spec of service <node>/<name> of ROS 2 type `type`: the request and response schemas are
+// msgs::ros2msg_schema of <type>_Request and _Response (each half of the .srv text, then the types
+// it uses, as rosbag2 writes them).
 ServiceSpec service_spec(std::string_view node, std::string_view name, std::string_view type);
-// A service the server offers beside the steering's (rbsim replay's player services): its spec,
+// A service the server offers beside the steering's (rbsim replay's player services, rbsim node's
+// simulation_interfaces services, rbsim bridge's forwards of them to the node): its spec,
 // and its handler, given a request's CDR payload, returning the response's (an error: the call
 // fails with its message). Handlers run on the server's one service thread, one call at a time,
 // so one may block for a while (a seek waits for the player); a call only takes encoding cdr.
