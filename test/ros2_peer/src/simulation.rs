@@ -29,7 +29,7 @@ use std::{
 use futures::{FutureExt, StreamExt};
 use ros2_client::{
   ActionTypeName, Context, Message, Node, QosProfile, ServiceMapping,
-  action::{ActionClient, ActionClientQosPolicies, GoalStatusEnum},
+  action::{ActionClient, ActionClientQosPolicies, GoalStatusEnum, SendGoalRequest},
   builtin_interfaces::Time,
   qos::{Durability, History, Reliability, WhenFull},
 };
@@ -178,8 +178,27 @@ fn bounded<T>(deadline: Instant, what: &str, work: impl std::future::Future<Outp
   }))
 }
 
+/// Calls `make()`'s request until one is answered (each try bounded to 1 s), bounded by the
+/// deadline: a client's first call. Discovery says the server is there; whether our request writer
+/// is matched with its reader, and its reply writer with our reader, only an answer says (a
+/// volatile writer drops what it wrote before matching, and a request or a reply lost that way
+/// would never come). So the first request is one that changes nothing.
+async fn answered<T, E, F: std::future::Future<Output = Result<T, E>>>(call: impl Fn() -> F) -> Result<(), String> {
+  loop {
+    let reply = smol::future::or(async { call().await.ok().map(|_| ()) }, async {
+      smol::Timer::after(Duration::from_secs(1)).await;
+      None
+    });
+    if reply.await.is_some() {
+      return Ok(());
+    }
+  }
+}
+
 impl Session<'_> {
-  fn call<Req, Resp>(&mut self, service: &str, ty: &str, request: Req) -> Result<(Resp, Duration), String>
+  /// Calls `service` (type `ty`, pkg/Name) with `request`; a client made on first use is first
+  /// probed with `probe`, a request of the same type that changes nothing.
+  fn call_probed<Req, Resp>(&mut self, service: &str, ty: &str, request: Req, probe: Req) -> Result<(Resp, Duration), String>
   where
     Req: Message + Clone + 'static,
     Resp: Message + DeserializeOwned + 'static,
@@ -191,7 +210,7 @@ impl Session<'_> {
       let context = self.context;
       bounded(self.deadline, &full, async {
         wait_for_server(context, &full).await;
-        Ok(())
+        answered(|| c.async_call_service(probe.clone())).await
       })?;
       self.clients.insert(full.clone(), Box::new(c));
     }
@@ -203,6 +222,16 @@ impl Session<'_> {
       let r = c.async_call_service(request).await.map_err(|e| format!("{full}: {e:?}"))?;
       Ok((r, t0.elapsed()))
     })
+  }
+
+  /// A call that changes nothing (a read): its own request is the probe.
+  fn call<Req, Resp>(&mut self, service: &str, ty: &str, request: Req) -> Result<(Resp, Duration), String>
+  where
+    Req: Message + Clone + 'static,
+    Resp: Message + DeserializeOwned + 'static,
+  {
+    let probe = request.clone();
+    self.call_probed(service, ty, request, probe)
   }
 }
 
@@ -318,17 +347,26 @@ fn op(s: &mut Session, words: &[String]) -> Result<String, String> {
     }
     "set-state" => {
       let (r, d): (ResultResponse, _) =
-        s.call("set_simulation_state", &ty("SetSimulationState"), SetStateRequest { state: num(rest.first(), "state")? })?;
+        // The probe: NO_WORLD, refused (INCORRECT_TRANSITION) and changing nothing.
+        s.call_probed(
+          "set_simulation_state", &ty("SetSimulationState"), SetStateRequest { state: num(rest.first(), "state")? },
+          SetStateRequest { state: 4 })?;
       format!("{}, {}", result_json(&r.result), took(d))
     }
     "reset" => {
       let (r, d): (ResultResponse, _) =
-        s.call("reset_simulation", &ty("ResetSimulation"), ResetRequest { scope: num(rest.first(), "scope")? })?;
+        // The probe: SCOPE_SPAWNED, unsupported.
+        s.call_probed("reset_simulation", &ty("ResetSimulation"), ResetRequest { scope: num(rest.first(), "scope")? }, ResetRequest {
+          scope: 4,
+        })?;
       format!("{}, {}", result_json(&r.result), took(d))
     }
     "step" => {
       let (r, d): (ResultResponse, _) =
-        s.call("step_simulation", &ty("StepSimulation"), StepRequest { steps: num(rest.first(), "steps")? })?;
+        // The probe: 0 steps, refused.
+        s.call_probed("step_simulation", &ty("StepSimulation"), StepRequest { steps: num(rest.first(), "steps")? }, StepRequest {
+          steps: 0,
+        })?;
       format!("{}, {}", result_json(&r.result), took(d))
     }
     "entities" => {
@@ -364,7 +402,10 @@ fn op(s: &mut Session, words: &[String]) -> Result<String, String> {
       format!("{}, \"type\": {}, \"points\": [{}], {}", result_json(&r.result), r.bounds.r#type, points.join(", "), took(d))
     }
     "set-entity" => {
-      let (r, d): (ResultResponse, _) = s.call("set_entity_state", &ty("SetEntityState"), set_entity_request(rest)?)?;
+      // The probe: nothing to set (set_pose and set_twist false).
+      let probe = SetEntityRequest { set_pose: false, set_twist: false, set_acceleration: false, ..set_entity_request(rest)? };
+      let (r, d): (ResultResponse, _) =
+        s.call_probed("set_entity_state", &ty("SetEntityState"), set_entity_request(rest)?, probe)?;
       format!("{}, {}", result_json(&r.result), took(d))
     }
     "goal" => goal(s, rest)?,
@@ -576,6 +617,12 @@ fn action_client<'a>(s: &'a mut Session) -> Result<&'a StepsClient, String> {
       for service in ["send_goal", "cancel_goal", "get_result"] {
         wait_for_server(context, &format!("{base}/{service}")).await;
       }
+      // Each service answered once (see `answered`), with requests that change nothing: a goal
+      // of 0 steps (rejected), a cancel and a result of a goal that never was.
+      let none = ros2_client::unique_identifier_msgs::UUID::new_random();
+      answered(|| c.goal_client().async_call_service(SendGoalRequest { goal_id: none, goal: Goal { steps: 0 } })).await?;
+      answered(|| c.async_cancel_goal(none, Time::ZERO)).await?;
+      answered(|| c.async_request_result(none)).await?;
       let dds = context.domain_participant();
       for topic in ["feedback", "status"] {
         let name = format!("rt{base}/{topic}");
@@ -631,9 +678,18 @@ fn goal(s: &mut Session, words: &[String]) -> Result<String, String> {
         }
       };
       let (status, result) = outcome.map_err(|e| format!("get_result: {e:?}"))?;
-      // Feedback written before the result may still be on its way: what arrived by now.
-      while let Ok(Some(f)) = c.receive_feedback(id) {
-        feedback.push((f.completed_steps, f.remaining_steps));
+      // Feedback written before the result may still be on its way (another topic): what arrived
+      // by now, and for a goal that succeeded, up to the last one (none remaining), bounded.
+      let until = Instant::now() + Duration::from_secs(5);
+      loop {
+        while let Ok(Some(f)) = c.receive_feedback(id) {
+          feedback.push((f.completed_steps, f.remaining_steps));
+        }
+        let last_in = status != GoalStatusEnum::Succeeded || feedback.last().is_some_and(|f| f.1 == 0);
+        if last_in || Instant::now() >= until {
+          break;
+        }
+        smol::Timer::after(Duration::from_millis(10)).await;
       }
       let fb: Vec<String> = feedback.iter().map(|(a, b)| format!("[{a}, {b}]")).collect();
       // The status topic: the goal's status as the server last published it. rclcpp_action sends
