@@ -9,6 +9,7 @@ multicast). Cases share e2e.py's harness (processes, domains, cleanup) and its e
 0 pass, 1 fail, 77 skip (namespaces not permitted here).
 """
 import json
+import math
 import os
 import re
 import signal
@@ -527,10 +528,299 @@ def case_killed_client(ctx):
     return with_node(ctx, body)
 
 
+# ---------------------------------------------------------------------------------------------
+# simulation_interfaces 2.1.0 and get_type_description (issue 37), through ros2-client
+
+
+SIM_FEATURES = {5, 6, 8, 10, 11, 12, 20, 24, 25, 26, 31, 32, 33}  # the README's list, by value
+OK, UNSUPPORTED, NOT_FOUND, FAILED = 1, 0, 2, 4  # simulation_interfaces/msg/Result
+ALREADY, INCORRECT = 101, 103  # SetSimulationState's own codes
+STOPPED, PLAYING, PAUSED = 0, 1, 2
+DT_NS = 1_000_000  # chain.xml's dt, 0.001 s
+
+
+def sim(ctx, net, name, *ops, timeout=90):
+    """Runs the ops (lists of words) in one rbsim-ros2-peer `sim` process; its JSON lines, one per op."""
+    words = []
+    for k, o in enumerate(ops):
+        words += ([","] if k else []) + [str(w) for w in o]
+    got = {m["op"]: m for m in peer_json(ctx, net, name, "sim", f"/{ctx.ns}", *words, timeout=timeout) if "op" in m}
+    ctx.require(sorted(got) == list(range(len(ops))), f"sim {name}: {len(got)} answers to {len(ops)} ops: {got}")
+    return [got[k] for k in range(len(ops))]
+
+
+def csv_rows(ctx, name, scene, steps):
+    """`rbsim run --csv` of `scene` for `steps` steps: {(step, body): row} (step,t,body,x,y,theta,vx,vy,omega,...)."""
+    path = ctx.path(f"{name}.csv")
+    ctx.rbrun(name, "run", scene, "--steps", steps, "--csv", path)
+    with open(path) as f:
+        return {(int(r[0]), int(r[2])): r for r in (line.split(",") for line in f.read().splitlines()[1:])}
+
+
+def same_as_csv(ctx, what, reply, rows):
+    """Every entity state of a GetEntitiesStates reply equal, value for value, to the CSV row of its
+    body at the step its stamp names: pose (x, y, 0) and (0, 0, sin(theta/2), cos(theta/2)), twist
+    (vx, vy, 0; 0, 0, omega), frame world. The step it names."""
+    states = reply["states"]
+    ctx.require(reply["result"] == OK and states, f"{what}: {reply}")
+    step = states[0]["stamp_ns"] // DT_NS
+    bad = []
+    for name, st in zip(reply["entities"], states):
+        i = int(name.removeprefix("body_"))
+        r = rows.get((step, i))
+        if r is None:
+            bad.append(f"{name}: no CSV row at step {step}")
+            continue
+        x, y, theta, vx, vy, omega = (float(v) for v in r[3:9])
+        want = {"stamp_ns": round(float(r[1]) * 1e9), "frame": "world", "position": [x, y, 0.0],
+                "orientation": [0.0, 0.0, math.sin(0.5 * theta), math.cos(0.5 * theta)],
+                "linear": [vx, vy, 0.0], "angular": [0.0, 0.0, omega]}
+        got = {k: st[k] for k in want}
+        if got != want:
+            bad.append(f"{name} at step {step}: {got} != rbsim run --csv's {want}")
+    ctx.check(len(states) == len({b for (_, b) in rows}) and not bad,
+              f"{what}: {len(states)} states; differences: {bad[:3]}")
+    ctx.log(f"{what}: {len(states)} entity states at step {step} equal to rbsim run --csv's, value for value")
+    return step
+
+
+def expect(ctx, got, op, **want):
+    """Checks the fields of op `op`'s answer."""
+    m = got[op]
+    ctx.check(all(m.get(k) == v for k, v in want.items()), f"op {op} ({m.get('verb')}): want {want}, got {m}")
+    return m
+
+
+def case_simulation_state(ctx):
+    """simulation_interfaces through ros2-client: GetSimulatorFeatures lists exactly the README's
+    features, each listed interface answers and the unlisted ones (tags and convex-hull filters,
+    reset scopes TIME, STATE, SPAWNED alone, set_acceleration) answer RESULT_FEATURE_UNSUPPORTED;
+    pause, StepSimulation of N and of 1 (each answered at the step reached: the next state read
+    names it), play; STOPPED (step 0) then play starts the world again from step 0 (the states
+    equal `rbsim run --csv`'s at the step they name); reset scopes; every SetSimulationState code."""
+    def body(net, node):
+        box = ("box", -0.05, -0.05, 0, 0.05, 0.05, 0)  # around body_0's first vertex at step 0, no other body
+        ops = [("features",), ("state",), ("set-state", PLAYING), ("step", 5), ("set-state", PAUSED), ("state",),
+               ("entity", "body_0"), ("step", 25), ("entity", "body_0"), ("step", 1), ("entity", "body_0"),
+               ("step", 0), ("set-state", PLAYING), ("state",), ("set-state", STOPPED), ("state",),
+               ("states", "all"), ("set-state", STOPPED), ("set-state", PLAYING), ("set-state", PAUSED),
+               ("states", "all"),
+               ("reset", 1), ("reset", 2), ("reset", 4), ("step", 10), ("reset", 3), ("entity", "body_0"),
+               ("state",), ("step", 10), ("reset", 0), ("entity", "body_0"), ("step", 10), ("reset", 255),
+               ("entity", "body_0"),
+               ("set-state", 4), ("set-state", 5), ("set-state", 9),
+               ("bounds", "body_0"), ("info", "body_0"), ("entities", "all"), ("entities", "category", 4),
+               ("entities", "category", 1), ("entities", *box), ("entities", "regex", "^body_1$"),
+               ("entities", "tags", "x"), ("entities", "hull"), ("entity", "nobody"),
+               ("set-entity", "body_0", "accel"), ("set-state", PLAYING), ("state",)]
+        g = sim(ctx, net, "sim", *ops)
+        ctx.check(set(g[0]["features"]) == SIM_FEATURES and len(g[0]["features"]) == len(SIM_FEATURES),
+                  f"features {g[0]['features']}, want {sorted(SIM_FEATURES)}")
+        expect(ctx, g, 1, state=PLAYING, result=OK)
+        expect(ctx, g, 2, result=ALREADY)
+        expect(ctx, g, 3, result=FAILED)  # StepSimulation while playing
+        expect(ctx, g, 4, result=OK)
+        expect(ctx, g, 5, state=PAUSED)
+        s0 = g[6]["state"]["stamp_ns"] // DT_NS
+        expect(ctx, g, 7, result=OK)
+        ctx.check(g[8]["state"]["stamp_ns"] == (s0 + 25) * DT_NS, f"paused at step {s0}, stepped 25: {g[8]}")
+        expect(ctx, g, 9, result=OK)
+        ctx.check(g[10]["state"]["stamp_ns"] == (s0 + 26) * DT_NS, f"then 1 step more: {g[10]}")
+        expect(ctx, g, 11, result=FAILED)  # 0 steps
+        expect(ctx, g, 12, result=OK)
+        expect(ctx, g, 13, state=PLAYING)
+        expect(ctx, g, 14, result=OK)
+        expect(ctx, g, 15, state=STOPPED)
+        expect(ctx, g, 17, result=ALREADY)
+        expect(ctx, g, 18, result=OK)
+        expect(ctx, g, 19, result=OK)
+        stopped = [st["stamp_ns"] for st in g[16]["states"]]
+        ctx.check(stopped and set(stopped) == {0}, f"STOPPED: states stamped {set(stopped)}, want step 0 only")
+        s1 = g[20]["states"][0]["stamp_ns"] // DT_NS
+        rows = csv_rows(ctx, "csv", ctx.scene("chain.xml"), max(s1, 1))
+        same_as_csv(ctx, "STOPPED", g[16], rows)
+        # Played from step 0 after STOPPED: at the step it then paused at, the world is the one
+        # `rbsim run` reaches from the scene (it did not go on from where it had been).
+        same_as_csv(ctx, "STOPPED, played, paused", g[20], rows)
+        for k in (21, 22, 23):
+            expect(ctx, g, k, result=UNSUPPORTED)  # SCOPE_TIME, SCOPE_STATE alone, SCOPE_SPAWNED
+        expect(ctx, g, 24, result=OK)
+        for k in (25, 29, 32):
+            expect(ctx, g, k, result=OK)  # TIME | STATE, DEFAULT, ALL: a full reset
+            ctx.check(g[k + 1]["state"]["stamp_ns"] == 0, f"after reset scope {ops[k][1]}: {g[k + 1]}")
+        expect(ctx, g, 27, state=PAUSED)  # paused as before
+        for k in (34, 35, 36):
+            expect(ctx, g, k, result=INCORRECT)  # NO_WORLD, LOADING_WORLD, an unknown state
+        b = expect(ctx, g, 37, result=OK, type=1)
+        ctx.check(len(b.get("points", [])) == 2, f"bounds: {b}")
+        expect(ctx, g, 38, result=OK, category=4)
+        everyone = g[39]["entities"]
+        ctx.check(everyone == [f"body_{i}" for i in range(len(everyone))] and len(everyone) == len(g[16]["states"]),
+                  f"entities: {everyone}")
+        expect(ctx, g, 40, result=OK, entities=everyone)
+        expect(ctx, g, 41, result=OK, entities=[])
+        expect(ctx, g, 42, result=OK, entities=["body_0"])
+        expect(ctx, g, 43, result=OK, entities=["body_1"])
+        expect(ctx, g, 44, result=UNSUPPORTED)  # ENTITY_TAGS not listed
+        expect(ctx, g, 45, result=UNSUPPORTED)  # ENTITY_BOUNDS_CONVEX not listed
+        expect(ctx, g, 46, result=NOT_FOUND)
+        expect(ctx, g, 47, result=UNSUPPORTED)  # set_acceleration
+        expect(ctx, g, 48, result=OK)
+        expect(ctx, g, 49, state=PLAYING)
+    return with_node(ctx, body)
+
+
+def case_simulate_steps(ctx):
+    """The SimulateSteps action through ros2-client's ActionClient (rcl_action's protocol): a goal
+    while playing and one of 0 steps rejected; a goal accepted while paused, its feedback
+    (completed + remaining = steps, never going back, the last at the end), SUCCEEDED with
+    RESULT_OK, the world at the step reached; a goal cancelled mid-way ends CANCELED, its result's
+    message says how many steps ran, and the world is paused exactly that many steps on."""
+    def body(net, node):
+        g = sim(ctx, net, "sim", ("goal", 100), ("set-state", PAUSED), ("entity", "body_0"), ("goal", 0),
+                ("goal", 300), ("entity", "body_0"), ("goal", 50000, "cancel-after", 150), ("entity", "body_0"),
+                ("state",), ("set-state", PLAYING))
+        expect(ctx, g, 0, accepted=False)  # not paused
+        s0 = g[2]["state"]["stamp_ns"] // DT_NS
+        expect(ctx, g, 3, accepted=False)  # 0 steps
+        done = expect(ctx, g, 4, accepted=True, status="SUCCEEDED", result=OK)
+        fb = done.get("feedback", [])
+        ctx.check(fb and fb[-1] == [300, 0] and all(a + b == 300 for a, b in fb)
+                  and all(x[0] <= y[0] for x, y in zip(fb, fb[1:])), f"feedback of a 300-step goal: {fb}")
+        ctx.check(g[5]["state"]["stamp_ns"] == (s0 + 300) * DT_NS, f"at step {s0}, 300 steps: {g[5]}")
+        cut = expect(ctx, g, 6, accepted=True, status="CANCELED", result=OK)
+        ran = re.search(r"(\d+) steps?", cut.get("message", ""))
+        ctx.check(ran is not None and cut.get("cancel", {}).get("return_code") == 0
+                  and cut["cancel"]["canceling"] == 1, f"cancelled goal: {cut}")
+        if ran and "cancel" in cut:
+            n = int(ran.group(1))
+            ctx.check(cut["cancel"]["after"] <= n < 50000, f"{n} steps ran, cancelled after {cut['cancel']['after']}")
+            ctx.check(g[7]["state"]["stamp_ns"] == (s0 + 300 + n) * DT_NS and f"step {s0 + 300 + n}" in cut["message"],
+                      f"the result says {n} steps ran from step {s0 + 300}: {g[7]}")
+            ctx.log(f"cancelled after {cut['cancel']['after']} steps reported: {cut['message']!r}, "
+                    f"{len(cut['feedback'])} feedback messages")
+        ctx.check(cut.get("feedback") and all(a + b == 50000 for a, b in cut["feedback"]), f"feedback: {cut}")
+        ctx.check(done.get("status_topic") == "SUCCEEDED" and cut.get("status_topic") == "CANCELED",
+                  f"status topic: {done.get('status_topic')}, {cut.get('status_topic')}")
+        expect(ctx, g, 8, state=PAUSED)
+        expect(ctx, g, 9, result=OK)
+    return with_node(ctx, body)
+
+
+def case_entities(ctx):
+    """GetEntitiesStates equal, value for value, to `rbsim run --csv` at the step the reply names;
+    SetEntityState on a moving body while paused (read back at once; refusals INVALID_POSE,
+    NOT_FOUND, FEATURE_UNSUPPORTED change nothing), step, play; the session `rbsim record` recorded
+    re-simulated by `rbsim run --commands` equals it, every message, and differs from the run
+    without the set from the step after it."""
+    if not PEER or not os.access(PEER, os.X_OK):
+        raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
+    scene, duration = ctx.scene("chain.xml"), 8.0  # the peer pauses it well before its end
+    steps = round(duration * 1e9 / DT_NS)
+    commands = 4  # pause, set_entity_state, step, resume (the refused sets are no commands)
+    expected = len(e2e.LATCHED) + len(e2e.PER_STEP) * (steps + 1) + commands
+    live = ctx.path("live.mcap")
+    theta = 0.3
+    q = (0, 0, math.sin(0.5 * theta), math.cos(0.5 * theta))
+    with PeerNet(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return e2e.SKIP
+        rec = net.rb("record", "a", *e2e.record_args(ctx, live, "--max-messages", expected, "--wall-duration", 120))
+        node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1))
+        try:
+            g = sim(ctx, net, "sim", ("set-state", PAUSED), ("states", "all"), ("entity", "body_3"),
+                    ("set-entity", "body_3", "pose", 3.5, -0.1, *q, "twist", 0.75, -0.5, 1.5), ("entity", "body_3"),
+                    ("set-entity", "body_3", "pose", 0, 0, 0, 0, 0.6, 0.6),
+                    ("set-entity", "body_3", "pose", 0, 0, 0.6, 0, 0, 0.8),
+                    ("set-entity", "body_3", "pose", 0, 0, 0, 0, 0, "nan"),
+                    ("set-entity", "nobody", "twist", 0, 0, 0), ("set-entity", "body_3", "twist", 0, 0, 0, "accel"),
+                    ("entity", "body_3"), ("step", 5), ("entity", "body_3"), ("set-state", PLAYING))
+        finally:
+            e2e.exited_ok(ctx, node, 60, "rbsim node")
+            e2e.exited_ok(ctx, rec, 60, "rbsim record")
+    expect(ctx, g, 0, result=OK)
+    s0 = g[1]["states"][0]["stamp_ns"] // DT_NS if g[1].get("states") else 0
+    rows = csv_rows(ctx, "csv", scene, max(s0, 1))
+    same_as_csv(ctx, "paused", g[1], rows)
+    moving = g[2]["state"]
+    ctx.check(moving["stamp_ns"] == s0 * DT_NS and any(v != 0 for v in moving["linear"]), f"body_3 moving: {moving}")
+    expect(ctx, g, 3, result=OK)
+    got = g[4]["state"]
+    ctx.check(got["stamp_ns"] == s0 * DT_NS and got["position"] == [3.5, -0.1, 0.0] and got["linear"] == [0.75, -0.5, 0.0]
+              and got["angular"] == [0.0, 0.0, 1.5] and all(abs(a - b) < 1e-15 for a, b in zip(got["orientation"], q)),
+              f"body_3 read right after the set: {got}")
+    for k in (5, 6, 7):
+        expect(ctx, g, k, result=101)  # INVALID_POSE: not unit, not about z, not finite
+    expect(ctx, g, 8, result=NOT_FOUND)
+    expect(ctx, g, 9, result=UNSUPPORTED)
+    ctx.check(g[10]["state"] == got, f"a refused set changed body_3: {g[10]['state']} != {got}")
+    expect(ctx, g, 11, result=OK)
+    ctx.check(g[12]["state"]["stamp_ns"] == (s0 + 5) * DT_NS, f"5 steps from {s0}: {g[12]}")
+    expect(ctx, g, 13, result=OK)
+    # The recording re-simulated from its own commands: every message equal, commands included.
+    again, plain = ctx.path("again.mcap"), ctx.path("plain.mcap")
+    ctx.rbrun("again", "run", scene, "--duration", duration, "--commands", live, "--record", again, "--namespace", ctx.ns)
+    e2e.rbsim_check(ctx, live, again, "check-again", live=True)
+    ctx.rbrun("plain", "run", scene, "--duration", duration, "--record", plain, "--namespace", ctx.ns)
+    rc, out, err = ctx.rbrun("check-states", "check", live, plain, "--ignore-log-time", "--topics", "body_states",
+                             ok=False)
+    ctx.check(rc == 1 and f"body_states, step {s0 + 1}," in out,
+              f"the states without the set do not first differ at step {s0 + 1}\n{out}{err}")
+    return 0
+
+
+def rosbags_hash(ctx, type_name):
+    """The RIHS01 hash `rosbags` computes for `type_name` (test/msgs/data/rihs01_rosbags.txt, the
+    table test/python/check_type_hashes.py checks against rosbags on every run)."""
+    with open(os.path.join(ctx.src, "test", "msgs", "data", "rihs01_rosbags.txt")) as f:
+        for line in f:
+            words = line.split()
+            if len(words) == 2 and words[0] == type_name:
+                return words[1]
+    raise e2e.Failure(f"{type_name}: not in rihs01_rosbags.txt")
+
+
+def case_type_description(ctx):
+    """~/get_type_description called by ros2-client. A topic's type, asked for by the hash the
+    node's writer announces in its USER_DATA as RustDDS's discovery reports it: the description it
+    returns hashes (REP 2011, SHA-256, computed in the peer) to that very hash. A service's type
+    (simulation_interfaces/srv/GetEntitiesStates, asked for by the hash rosbags computes: a
+    service's endpoints announce their _Request and _Response types, which rcl's node type cache
+    does not hold, so the node answers for those as rcl does, "not currently in use"): its
+    description hashes to rosbags' hash, and its _Request and _Response parts, cut out of it, to
+    what the request reader and the reply writer announce. Sources come with both; a hash of no
+    type the node uses is refused in rcl's words."""
+    def body(net, node):
+        ns, srv = ctx.ns, "simulation_interfaces/srv/GetEntitiesStates"
+        g = sim(ctx, net, "sim", ("typedesc", f"rt/{ns}/body_states", "rbsim_msgs/msg/BodyStates"),
+                ("typedesc-hash", rosbags_hash(ctx, srv), srv),
+                ("announced", f"rq/{ns}/get_entities_statesRequest"), ("announced", f"rr/{ns}/get_entities_statesReply"),
+                ("typedesc", f"rr/{ns}/get_entities_statesReply", f"{srv}_Response"),
+                ("typedesc-hash", "RIHS01_" + "0" * 64, "rbsim_msgs/msg/BodyStates"))
+        for m, want, hash_ in ((g[0], "rbsim_msgs/msg/BodyStates", g[0]["announced"]), (g[1], srv, rosbags_hash(ctx, srv))):
+            ctx.check(m["successful"] and hash_.startswith("RIHS01_") and m["description_hash"] == hash_
+                      and m["type_name"] == want and m["sources"],
+                      f"type description of {want}: want its hash {hash_}, got {m}")
+            ctx.log(f"{want}: asked for {hash_}, described ({m['fields']} fields, {len(m['referenced'])} referenced "
+                    f"types) hashing to {m['description_hash']}")
+        parts = g[1].get("part_hashes", {})
+        for op, part in ((2, "_Request"), (3, "_Response")):
+            ctx.check(parts.get(srv + part) == g[op]["announced"] and g[op]["announced"] == rosbags_hash(ctx, srv + part),
+                      f"{srv}{part}: its description in the service's hashes to {parts.get(srv + part)}, the endpoint "
+                      f"announces {g[op]['announced']}, rosbags says {rosbags_hash(ctx, srv + part)}")
+        ctx.check(not g[4]["successful"] and "not currently in use" in g[4]["failure_reason"],
+                  f"{srv}_Response (announced, not in the node type cache, as rcl): {g[4]}")
+        ctx.check(not g[5]["successful"] and "not currently in use" in g[5]["failure_reason"], f"unknown hash: {g[5]}")
+    return with_node(ctx, body)
+
+
 e2e.CASES.clear()
 e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "killed_peer": case_killed_peer,
                   "parameters": case_parameters, "services": case_services, "flood": case_flood,
-                  "bad_requests": case_bad_requests, "killed_client": case_killed_client, "steered": case_steered})
+                  "bad_requests": case_bad_requests, "killed_client": case_killed_client, "steered": case_steered,
+                  "simulation_state": case_simulation_state, "simulate_steps": case_simulate_steps,
+                  "entities": case_entities, "type_description": case_type_description})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

@@ -4,8 +4,9 @@
 //! Both first make one call and wait for its reply (a probe, not counted in N): requests written
 //! before our writer matched the server's reader would never reach it (volatile), and a test could
 //! not tell that loss from the server's.
-//!   serve SERVICE          a std_srvs/srv/Trigger server answering at once, until the timeout
-//!   bench SERVICE N W      W warm-up calls, then N sequential Trigger calls timed
+//!   serve SERVICE [states N]  a std_srvs/srv/Trigger server (or GetEntitiesStates, a canned reply of N
+//!                             entities) answering at once, until the timeout
+//!   bench SERVICE N W [states]  W warm-up calls, then N sequential Trigger (GetEntitiesStates) calls timed
 //! KIND: trigger (std_srvs/srv/Trigger), get (rcl_interfaces/srv/GetParameters of "rate"), step
 //! (rbsim_msgs/srv/Step of 1 step). Every request goes out with ServiceMapping::Cyclone.
 use std::{
@@ -24,6 +25,7 @@ use serde::de::DeserializeOwned;
 
 use crate::{
   json_string,
+  simulation::{self, FiltersRequest, StatesResponse},
   services::{StepReply, StepRequest, TriggerRequest, TriggerResponse, client, service_qos, wait_for_server},
 };
 
@@ -165,12 +167,37 @@ pub fn flood(context: &Context, node: &mut Node, service: &str, words: &[String]
   }
 }
 
-/// `serve SERVICE`: answers every Trigger request at once ("served N" on stdout), until the timeout.
-pub fn serve(node: &mut Node, service: &str, timeout: Duration) -> Result<(), String> {
+/// `serve SERVICE [states N]`: answers every request at once ("served N" on stdout), until the
+/// timeout: a std_srvs/srv/Trigger server, or with `states N` a simulation_interfaces/srv/
+/// GetEntitiesStates server whose reply is a canned one of N entities (named body_<i>, frame world:
+/// byte for byte the size of rbsim's reply for N bodies), made once.
+pub fn serve(node: &mut Node, service: &str, words: &[String], timeout: Duration) -> Result<(), String> {
+  match words {
+    [] => serve_with(node, service, ("std_srvs", "Trigger"), timeout, |_: TriggerRequest| TriggerResponse {
+      success: true,
+      message: "ok".into(),
+    }),
+    [kind, n] if kind == "states" => {
+      let n: usize = n.parse().ok().filter(|&n| n <= 1_000_000).ok_or(format!("states N: 0..1000000 (got {n})"))?;
+      let reply = simulation::canned_states(n);
+      serve_with(node, service, ("simulation_interfaces", "GetEntitiesStates"), timeout, move |_: FiltersRequest| {
+        reply.clone()
+      })
+    }
+    _ => Err("serve SERVICE [states N]".into()),
+  }
+}
+
+fn serve_with<Req, Resp>(
+  node: &mut Node, service: &str, (pkg, ty): (&str, &str), timeout: Duration, answer: impl Fn(Req) -> Resp,
+) -> Result<(), String>
+where
+  Req: Message + Clone + DeserializeOwned + 'static,
+  Resp: Message + 'static,
+{
   let name = crate::services::service_name(service)?;
   let server = node
-    .create_server::<TriggerRequest, TriggerResponse>(
-      ServiceMapping::Cyclone, &name, &ServiceTypeName::new("std_srvs", "Trigger"), service_qos(), service_qos())
+    .create_server::<Req, Resp>(ServiceMapping::Cyclone, &name, &ServiceTypeName::new(pkg, ty), service_qos(), service_qos())
     .map_err(|e| format!("server {service}: {e:?}"))?;
   println!("{{\"serving\": {}}}", json_string(service));
   let _ = std::io::stdout().flush();
@@ -179,9 +206,8 @@ pub fn serve(node: &mut Node, service: &str, timeout: Duration) -> Result<(), St
     async {
       let mut requests = Box::pin(server.receive_request_stream());
       while let Some(r) = requests.next().await {
-        let Ok((id, _)) = r else { continue };
-        let reply = TriggerResponse { success: true, message: "ok".into() };
-        if server.async_send_response(id, reply).await.is_ok() {
+        let Ok((id, request)) = r else { continue };
+        if server.async_send_response(id, answer(request)).await.is_ok() {
           served += 1;
         }
       }
@@ -194,13 +220,38 @@ pub fn serve(node: &mut Node, service: &str, timeout: Duration) -> Result<(), St
   Ok(())
 }
 
-/// `bench SERVICE N W`: W warm-up calls, then N calls one after the other, each timed from
-/// sending the request to taking its reply.
+/// `bench SERVICE N W [states]`: W warm-up calls, then N calls one after the other, each timed
+/// from sending the request to taking its reply: std_srvs/srv/Trigger, or with `states`
+/// simulation_interfaces/srv/GetEntitiesStates without filters (every entity).
 pub fn bench(context: &Context, node: &mut Node, service: &str, words: &[String], timeout: Duration) -> Result<(), String> {
-  let [n, warmup] = words else { return Err("bench SERVICE N WARMUP".into()) };
+  let (n, warmup, kind) = match words {
+    [n, w] => (n, w, "trigger"),
+    [n, w, k] if k == "states" => (n, w, "states"),
+    _ => return Err("bench SERVICE N WARMUP [states]".into()),
+  };
   let n: usize = n.parse().ok().filter(|&n| n > 0 && n <= 1_000_000).ok_or(format!("N: 1..1000000 (got {n})"))?;
   let warmup: usize = warmup.parse().map_err(|_| format!("WARMUP: not a count: {warmup}"))?;
-  let client = client::<TriggerRequest, TriggerResponse>(node, service, "std_srvs", "Trigger", service_qos())?;
+  if kind == "states" {
+    bench_with(
+      context, node, service, ("simulation_interfaces", "GetEntitiesStates"), || FiltersRequest { filters: Default::default() },
+      |r: &StatesResponse| format!("{} entities, result {}", r.states.len(), r.result.result), n, warmup, timeout)
+  } else {
+    bench_with(
+      context, node, service, ("std_srvs", "Trigger"), || TriggerRequest { structure_needs_at_least_one_member: 0 },
+      |r: &TriggerResponse| r.message.clone(), n, warmup, timeout)
+  }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn bench_with<Req, Resp>(
+  context: &Context, node: &mut Node, service: &str, (pkg, ty): (&str, &str), request: impl Fn() -> Req,
+  describe: impl Fn(&Resp) -> String, n: usize, warmup: usize, timeout: Duration,
+) -> Result<(), String>
+where
+  Req: Message + Clone + 'static,
+  Resp: Message + DeserializeOwned + 'static,
+{
+  let client = client::<Req, Resp>(node, service, pkg, ty, service_qos())?;
   let deadline = Instant::now() + timeout;
   let mut times = Vec::with_capacity(n);
   let mut message = String::new();
@@ -209,13 +260,13 @@ pub fn bench(context: &Context, node: &mut Node, service: &str, words: &[String]
       wait_for_server(context, service).await;
       for k in 0..warmup + n {
         let t0 = Instant::now();
-        let r = client.async_call_service(TriggerRequest { structure_needs_at_least_one_member: 0 }).await;
+        let r = client.async_call_service(request()).await;
         let took = t0.elapsed();
         let Ok(r) = r else { return false };
         if k >= warmup {
           times.push(took.as_secs_f64() * 1e6);
         }
-        message = r.message;
+        message = describe(&r);
         if Instant::now() >= deadline {
           return false;
         }

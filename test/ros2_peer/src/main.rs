@@ -13,8 +13,10 @@
 //!   rbsim-ros2-peer flood SERVICE trigger|get|step N    one call answered, then N requests without waiting;
 //!                                                       count the replies (one JSON line: sent, answered, ...)
 //!   rbsim-ros2-peer send SERVICE trigger|get|step N     the same N requests, "sent", then sleep unread (to be killed)
-//!   rbsim-ros2-peer serve SERVICE                       a Trigger server of our own, answering at once
-//!   rbsim-ros2-peer bench SERVICE N WARMUP              N sequential Trigger calls timed: median, p99
+//!   rbsim-ros2-peer serve SERVICE [states N]            a Trigger server of our own, answering at once (or a
+//!                                                       GetEntitiesStates server with a canned reply of N entities)
+//!   rbsim-ros2-peer bench SERVICE N WARMUP [states]     N sequential Trigger (GetEntitiesStates) calls timed: median, p99
+//!   rbsim-ros2-peer sim /NS OP ARGS [, OP ARGS]...      simulation_interfaces and get_type_description (simulation.rs)
 //! /tf lines carry the wall time of their arrival (wall_ns); flood prints the wall times of its
 //! start, last send, last reply and end, so a test can line them up.
 use std::{process::ExitCode, time::Duration};
@@ -30,6 +32,7 @@ use serde::{Deserialize, Serialize};
 mod commands;
 mod hostile;
 mod services;
+mod simulation;
 
 mod tf {
   //! tf2_msgs/msg/TFMessage, field for field (serde's CDR follows declaration order).
@@ -92,7 +95,7 @@ fn parse_args() -> Result<Args, String> {
   if words.len() < 2 {
     return Err(
       "usage: rbsim-ros2-peer graph NODE | tf COUNT | rosout TEXT | events NAME | params NODE ... | call SERVICE ... \
-       | flood|send SERVICE KIND N | serve SERVICE | bench SERVICE N WARMUP [--timeout S]"
+       | flood|send SERVICE KIND N | serve SERVICE [states N] | bench SERVICE N WARMUP [states] | sim /NS OP ... [--timeout S]"
         .into(),
     );
   }
@@ -293,13 +296,14 @@ fn main() -> ExitCode {
         }
       }
     }
-    "params" | "call" | "flood" | "send" | "serve" | "bench" => {
+    "params" | "call" | "flood" | "send" | "serve" | "bench" | "sim" => {
       let (target, rest, timeout) = (&args.operand, &args.rest, args.timeout);
       let result = match args.verb.as_str() {
         "params" => services::params(&context, &mut node, target, rest, timeout),
         "call" => services::call_service(&context, &mut node, target, rest, timeout),
         "flood" | "send" => hostile::flood(&context, &mut node, target, rest, args.verb == "send", timeout),
-        "serve" => hostile::serve(&mut node, target, timeout),
+        "serve" => hostile::serve(&mut node, target, rest, timeout),
+        "sim" => simulation::sim(&context, &mut node, target, rest, timeout),
         _ => hostile::bench(&context, &mut node, target, rest, timeout),
       };
       if let Err(e) = &result {
@@ -308,7 +312,7 @@ fn main() -> ExitCode {
       result.is_ok()
     }
     other => {
-      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, commands, params, call, flood, send, serve, bench)");
+      eprintln!("rbsim-ros2-peer: unknown verb {other} (graph, tf, rosout, events, commands, params, call, flood, send, serve, bench, sim)");
       return ExitCode::from(2);
     }
   };
