@@ -47,7 +47,7 @@ TEST(FoxgloveControlProtocol, ServerInfoOffersSteeringOnlyWithAController) {
   EXPECT_FALSE(without.contains("supportedEncodings"));
   const Json hosted = Json::parse(server_info_json("rbsim", "1-1", false, true));
   EXPECT_EQ(hosted["capabilities"], Json::array({"time", "services"}));
-  EXPECT_EQ(hosted["supportedEncodings"], Json::array({"cdr"}));
+  EXPECT_EQ(hosted["supportedEncodings"], Json::array({"cdr", "json"}));
 }
 
 TEST(FoxgloveControlProtocol, AdvertiseServicesGivesBothSchemaForms) {

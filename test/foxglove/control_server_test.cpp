@@ -14,6 +14,7 @@
 
 #include "../control/control_test_util.hpp"
 #include "rbsim/foxglove.hpp"
+#include "rbsim/simulation_interfaces.hpp"
 #include "ws_client.hpp"
 
 namespace rbsim::foxglove {
@@ -505,8 +506,8 @@ namespace rbsim::foxglove {
 namespace {
 
 // Hosted services (rbsim replay's player): offered with no steering, the services capability in
-// cdr; each call answered by its handler on the server's service thread (one that blocks holds
-// up no other client's connection), a json request or a handler's error a serviceCallFailure.
+// cdr and json; each call answered by its handler on the server's service thread (one that blocks
+// holds up no other client's connection), a handler's error a serviceCallFailure.
 TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
   std::promise<void> release;
   std::shared_future<void> released = release.get_future().share();
@@ -533,6 +534,7 @@ TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
   WsClient c;
   const Json info = connect(c, server.value()->port());
   EXPECT_EQ(info["capabilities"], Json::array({"time", "services"}));
+  EXPECT_EQ(info["supportedEncodings"], Json::array({"cdr", "json"}));
   const Json services = next_op(c, "advertiseServices")["services"];
   ASSERT_EQ(services.size(), 2u);
   EXPECT_EQ(services[0]["name"], "/player/set_rate");
@@ -552,10 +554,10 @@ TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
   Json f = next_op(c, "serviceCallFailure");
   EXPECT_EQ(f["callId"], 8);
   EXPECT_EQ(f["message"], "rate must be > 0");
-  ASSERT_TRUE(c.send_binary(call_frame(1, 9, "json", R"({"rate":2.0})")));
+  ASSERT_TRUE(c.send_binary(call_frame(1, 9, "json", R"({"rate":-1})")));
   f = next_op(c, "serviceCallFailure");
   EXPECT_EQ(f["callId"], 9);
-  EXPECT_EQ(f["message"], "/player/set_rate takes its request in cdr only");
+  EXPECT_EQ(f["message"], "rate must be > 0");  // converted, then the handler's own refusal
 
   // A handler that blocks: the server still serves a new client meanwhile, then the answer comes.
   ASSERT_TRUE(c.send_binary(call_frame(2, 10, "cdr", cdr(msgs::PauseRequest{}))));
@@ -566,6 +568,89 @@ TEST(FoxgloveHostedServices, AnswerCdrCallsOnTheirOwnThread) {
   ASSERT_TRUE(r);
   EXPECT_EQ(r->service, 2u);
   EXPECT_EQ(r->call, 10u);
+}
+
+// A hosted call in json: converted to CDR by the request's schema (msgs::MessageDecoder::from_json),
+// handed to the same CDR handler, its CDR reply converted back by the response's (to_json) and sent
+// in json; a request that does not convert is refused with the converter's words, naming the field.
+TEST(FoxgloveHostedServices, ConvertJsonCallsByTheServiceSchemas) {
+  ServerOptions o;
+  o.port = 0;
+  o.hosted_services.push_back(
+      {service_spec("/sim", "set_entity_state", msgs::simulation::SetEntityStateRequest::kService),
+       [](std::string_view request) -> Result<std::string> {
+         msgs::simulation::SetEntityStateRequest req;
+         if (Status st = msgs::simulation::decode(
+                 {reinterpret_cast<const std::byte*>(request.data()), request.size()}, req);
+             !st)
+           return st.error();
+         // The reply says what arrived, so the test sees the conversion field by field.
+         msgs::simulation::SetEntityStateResponse reply;
+         reply.result.result = req.set_pose && !req.set_twist ? 1 : 2;
+         reply.result.error_message = req.entity + " x=" + std::to_string(req.state.position.x) +
+                                      " w=" + std::to_string(req.state.orientation.w) + " " +
+                                      req.state.frame_id;
+         Bytes out;
+         msgs::simulation::encode(reply, out);
+         return std::string(reinterpret_cast<const char*>(out.data()), out.size());
+       }});
+  auto server = Server::start(o, {});
+  ASSERT_TRUE(server) << server.error().message;
+  WsClient c;
+  connect(c, server.value()->port());
+  next_op(c, "advertiseServices");
+  ASSERT_TRUE(c.send_binary(call_frame(
+      1, 1, "json",
+      R"({"entity":"body_2","state":{"header":{"frame_id":"world"},"pose":{"position":{"x":1.5}}},"set_pose":true})")));
+  auto r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->call, 1u);
+  EXPECT_EQ(r->encoding, "json");
+  const Json reply = Json::parse(r->payload);
+  EXPECT_EQ(reply,
+            Json::parse(R"({"result":{"result":1,"error_message":"body_2 x=1.500000 w=0.000000 world"}})"))
+      << r->payload;
+  // The same request in cdr: the same handler, the reply in cdr.
+  msgs::simulation::SetEntityStateRequest req;
+  req.entity = "body_2";
+  req.state.frame_id = "world";
+  req.state.position.x = 1.5;
+  req.state.orientation.w = 0.0;
+  req.set_pose = true;
+  Bytes bytes;
+  msgs::simulation::encode(req, bytes);
+  ASSERT_TRUE(c.send_binary(
+      call_frame(1, 2, "cdr", std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()))));
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->encoding, "cdr");
+  msgs::simulation::SetEntityStateResponse got;
+  ASSERT_TRUE(msgs::simulation::decode(
+                  {reinterpret_cast<const std::byte*>(r->payload.data()), r->payload.size()}, got)
+                  .ok());
+  EXPECT_EQ(got.result.result, 1);
+  EXPECT_EQ(got.result.error_message, reply["result"]["error_message"]);
+  // Requests that do not convert: the converter's message, with the service's name.
+  ASSERT_TRUE(c.send_binary(call_frame(1, 3, "json", R"({"state":{"pose":{"position":{"x":"far"}}}})")));
+  Json f = next_op(c, "serviceCallFailure");
+  EXPECT_EQ(f["callId"], 3);
+  EXPECT_EQ(f["message"],
+            "/sim/set_entity_state: json request: state.pose.position.x: must be a number (or null for NaN)");
+  ASSERT_TRUE(c.send_binary(call_frame(1, 4, "json", R"({"entity":"body_2","speed":3})")));
+  f = next_op(c, "serviceCallFailure");
+  EXPECT_EQ(f["message"],
+            "/sim/set_entity_state: json request: speed: no such field in "
+            "simulation_interfaces/srv/SetEntityState_Request");
+  ASSERT_TRUE(c.send_binary(call_frame(1, 5, "json", "{not json")));
+  f = next_op(c, "serviceCallFailure");
+  EXPECT_NE(f["message"].get<std::string>().find("/sim/set_entity_state: json request: not JSON: "),
+            std::string::npos)
+      << f;
+  // Still serving after them.
+  ASSERT_TRUE(c.send_binary(call_frame(1, 6, "json", R"({"set_twist":true})")));
+  r = next_response(c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(Json::parse(r->payload)["result"]["result"], 2);
 }
 
 // A hosted call that waits (rbsim node's step_simulation until its steps are done) counts against

@@ -9,7 +9,8 @@
 //
 // paused: nothing per step arrives; play_next: exactly one message; burst 5: five; set_rate and
 // get_rate; seek to 2 s then play_next: the message of step 2000; toggle_paused: the replay plays on
-// from there; pause: it stops again. A json request and an unknown service are refused.
+// from there; pause: it stops again. A json request is answered in json, equal to cdr's reply; one
+// with an unknown field and an unknown service are refused.
 // Only 127.0.0.1 and its own DDS domain; every wait bounded.
 const path = require("path");
 const lib = require("./lib");
@@ -106,10 +107,18 @@ async function main(check) {
   const after = steps().slice(6);
   check(after.every((s, i) => i === 0 || s === after[i - 1] + 10), `steps after the seek not contiguous: ${after}`);
 
-  // Refusals: a json request, an unknown service id.
+  // A json request, converted by the service's schemas: the reply in json, equal to the cdr one's.
   const [, jsonId] = send("get_rate", {}, "json");
-  const refused = await until("the json refusal", 5000, () => failures.get(jsonId));
-  check(/cdr only/.test(refused.message), `json request: ${refused.message}`);
+  const jsonReply = await until("the json reply", 5000, () => responses.get(jsonId) ?? failures.get(jsonId));
+  check(jsonReply.encoding === "json" && jsonReply.data, `json request: ${JSON.stringify(jsonReply)}`);
+  const jsonRate = JSON.parse(new TextDecoder().decode(jsonReply.data));
+  const cdrRate = await call("get_rate");
+  check(JSON.stringify(jsonRate) === JSON.stringify({ rate: cdrRate.rate }),
+    `get_rate in json ${JSON.stringify(jsonRate)}, in cdr ${cdrRate.rate}`);
+  // Refusals: a json request with a field its type lacks, an unknown service id.
+  const [, badId] = send("set_rate", { speed: 3 }, "json");
+  const refused = await until("the json refusal", 5000, () => failures.get(badId));
+  check(/speed: no such field/.test(refused.message), `json request: ${refused.message}`);
   const [, unknownId] = send("nope", {});
   const unknown = await until("the unknown service's refusal", 5000, () => failures.get(unknownId));
   check(/unknown service/.test(unknown.message), `unknown service: ${unknown.message}`);

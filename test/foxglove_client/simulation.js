@@ -1,7 +1,8 @@
 #!/usr/bin/env node
 "use strict";
 // simulation_interfaces' services called from Foxglove's own client (npm @foxglove/ws-protocol,
-// requests and replies in cdr through @foxglove/rosmsg2-serialization from the advertised schemas):
+// requests and replies in cdr through @foxglove/rosmsg2-serialization from the advertised schemas,
+// and in json, which the server converts by the same schemas):
 //
 //   simulation.js --rbsim BUILD/rbsim --source-dir SRC --workdir DIR --npm BUILD/npm --index N [--via bridge]
 //
@@ -10,9 +11,11 @@
 // CDR to the node's DDS service of that name. The client reads PLAYING, pauses through
 // set_simulation_state and reads PAUSED, steps 300 while a second client keeps receiving
 // body_states (the call's wait holds up no one's data), reads body_1's state and checks it against
-// the body_states of the step reached, and ends the node with STATE_QUITTING (exit 0). A json
-// call is refused (these services take cdr); through the bridge, a call after the node is gone
-// fails with a serviceCallFailure naming the service.
+// the body_states of the step reached, and ends the node with STATE_QUITTING (exit 0). The pause
+// goes in json, and get_simulation_state and get_entity_state are called in json too, their json
+// replies equal to the cdr calls'; a json request with a field its type lacks is refused naming
+// it. Through the bridge, a call after the node is gone fails with a serviceCallFailure naming
+// the service.
 // Only 127.0.0.1 and its own DDS domain; every wait bounded.
 const path = require("path");
 const lib = require("./lib");
@@ -100,12 +103,25 @@ async function main(check) {
     check(reply.result?.result === RESULT_OK, `${name}: ${JSON.stringify(reply, bigint)}`);
     return reply;
   };
+  // The same in json: the reply comes in the request's encoding, as the JSON the server writes.
+  const callJson = async (name, request) => {
+    const id = send(name, request, "json");
+    const r = await until(`the json answer to ${name}`, 10000, () => responses.get(id) || failures.get(id));
+    if (failures.has(id)) throw new Failure(`${name} (json): serviceCallFailure ${failures.get(id).message}`);
+    check(r.encoding === "json", `${name}: a json call answered in ${r.encoding}`);
+    const reply = JSON.parse(new TextDecoder().decode(r.data));
+    check(reply.result?.result === RESULT_OK, `${name} (json): ${JSON.stringify(reply)}`);
+    return reply;
+  };
+  const same = (name, fromJson, fromCdr) => check(JSON.stringify(fromJson) === JSON.stringify(fromCdr, bigint),
+    `${name}: json reply ${JSON.stringify(fromJson)}, cdr reply ${JSON.stringify(fromCdr, bigint)}`);
 
   const playing = await call("get_simulation_state", {});
   check(playing.state.state === PLAYING, `state ${playing.state.state}, want PLAYING (${PLAYING})`);
-  await call("set_simulation_state", { state: { state: PAUSED } });
+  await callJson("set_simulation_state", { state: { state: PAUSED } });
   const paused = await call("get_simulation_state", {});
   check(paused.state.state === PAUSED, `state ${paused.state.state}, want PAUSED (${PAUSED})`);
+  same("get_simulation_state", await callJson("get_simulation_state", {}), paused);
   // Paused: the step the world stands at, from a read's stamp; body_states reaches it and stops.
   const before = (await call("get_entity_state", { entity: "body_1" })).state.header.stamp;
   const at = Math.round((before.sec + before.nanosec * 1e-9) / dt);
@@ -127,6 +143,7 @@ async function main(check) {
   check(Number(last().step) === at + steps, `body_states at step ${last().step}, want ${at + steps}`);
 
   const got = await call("get_entity_state", { entity: "body_1" });
+  same("get_entity_state", await callJson("get_entity_state", { entity: "body_1" }), got);
   const body = last().bodies.find((b) => b.id === 1);
   const st = got.state;
   const stamp = st.header.stamp.sec + st.header.stamp.nanosec * 1e-9;
@@ -141,10 +158,10 @@ async function main(check) {
     `twist ${JSON.stringify(st.twist)}, body_states (${body.vx}, ${body.omega})`);
   const missing = await answer("get_entity_state", send("get_entity_state", { entity: "body_99" }));
   check(missing.result.result === 2, `body_99: ${JSON.stringify(missing.result)}, want RESULT_NOT_FOUND (2)`);
-  // These services take cdr: a json call is refused, saying so.
-  const jsonId = send("get_simulation_state", {}, "json");
+  // A json request that does not convert is refused, naming the field.
+  const jsonId = send("get_entity_state", { entity: "body_1", name: "body_1" }, "json");
   const refused = await until("the json call's failure", 5000, () => failures.get(jsonId) || responses.get(jsonId));
-  check(failures.has(jsonId) && /cdr/.test(refused.message), `json call: ${JSON.stringify(refused)}`);
+  check(failures.has(jsonId) && refused.message.includes("name: no such field"), `json call: ${JSON.stringify(refused)}`);
   log(`PLAYING, paused at ${at}, stepped ${steps} to ${last().step}; body_1 at (${body.x}, ${body.y})`);
 
   const quit = await call("set_simulation_state", { state: { state: QUITTING } });

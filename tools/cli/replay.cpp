@@ -76,8 +76,9 @@ class ProgressLine {
   std::thread thread_;
 };
 
-// The player's services for Foxglove's Service Call panel, <node>/pause ... burst in cdr: the same
-// handlers as the player's DDS services. A request too malformed to answer fails the call.
+// The player's services for Foxglove's Service Call panel, <node>/pause ... burst (cdr, or json the
+// server converts by their schemas): the same handlers as the player's DDS services. A request too
+// malformed to answer fails the call.
 std::vector<foxglove::HostedService> player_services(const bag::Player& replay, const std::string& node) {
   std::vector<foxglove::HostedService> hosted;
   for (bag::Player::PlayerService& s : replay.player_services()) {

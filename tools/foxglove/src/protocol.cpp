@@ -29,11 +29,12 @@ std::string server_info_json(std::string_view name, std::string_view session_id,
   if (control) {
     for (const char* c : {"parameters", "parametersSubscribe", "services", "clientPublish"})
       j["capabilities"].push_back(c);
-    j["supportedEncodings"] = nlohmann::json::array();
-    for (std::string_view e : kServiceEncodings) j["supportedEncodings"].push_back(std::string(e));
   } else if (services) {
     j["capabilities"].push_back("services");
-    j["supportedEncodings"] = nlohmann::json::array({"cdr"});
+  }
+  if (control || services) {
+    j["supportedEncodings"] = nlohmann::json::array();
+    for (std::string_view e : kServiceEncodings) j["supportedEncodings"].push_back(std::string(e));
   }
   return j.dump();
 }

@@ -454,6 +454,9 @@ Result<MessageDecoder> MessageDecoder::create(std::string_view root, std::string
       f.name = std::move(m.name);
       f.array = m.array;
       f.fixed_size = m.fixed_size;
+      f.sequence_bound = m.sequence_bound;
+      f.string_capacity = m.string_capacity;
+      if (m.primitive) f.scalar = *m.primitive;
       f.primitive = m.primitive ? primitive_index(m.type) : -1;
       if (!m.primitive) {
         auto [pos, fresh] = index.try_emplace(m.type, d.types_.size());

@@ -79,7 +79,8 @@ using CallId = std::uint32_t;
 inline constexpr std::string_view kServiceEncodings[] = {"cdr", "json"};
 
 // `control`: the capabilities above and supportedEncodings; else `time`, and with `services` alone
-// (rbsim replay's player) the services capability, in cdr.
+// (rbsim replay's player) the services capability, in the same encodings (hosted services convert
+// json by their schemas).
 std::string server_info_json(std::string_view name, std::string_view session_id, bool control = false,
                              bool services = false);
 // Every channel of `channels`, channel i (0-based) with id i + 1.
@@ -104,7 +105,9 @@ ServiceSpec service_spec(std::string_view node, std::string_view name, std::stri
 // simulation_interfaces services, rbsim bridge's forwards of them to the node): its spec,
 // and its handler, given a request's CDR payload, returning the response's (an error: the call
 // fails with its message). Handlers run on the server's one service thread, one call at a time,
-// so one may block for a while (a seek waits for the player); a call only takes encoding cdr.
+// so one may block for a while (a seek waits for the player). A handler sees CDR only: a call in
+// json is converted to it and its reply back by the spec's schemas (msgs::MessageDecoder's from_json
+// and to_json; src/hosted.hpp).
 struct HostedService {
   ServiceSpec spec;
   std::function<Result<std::string>(std::string_view request)> call;

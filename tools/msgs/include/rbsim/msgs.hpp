@@ -489,6 +489,26 @@ class MessageDecoder {
   // shortest round-trip (float32 as float32), non-finite floats as null (JSON has no NaN or
   // infinity), bool as true/false, strings escaped. On malformed data `out` is left as it was.
   [[nodiscard]] Status to_json(std::span<const std::byte> cdr, std::string& out) const;
+  // The inverse: one message given as a JSON object (as to_json writes it, as Foxglove Studio's
+  // Service Call panel and rosbridge send it) encoded as CDR into `cdr` (replaced: the
+  // encapsulation header and padding as CdrWriter writes them, so cdr -> to_json -> from_json gives
+  // the same bytes). The rules, rosbridge's where it has one:
+  //  - a missing field takes its zero value (0, false, "", an empty sequence, a fixed array of
+  //    zeros, a nested message of zeros; not a default the .msg text gives, such as
+  //    geometry_msgs/Quaternion's w 1); a field the type lacks is an error;
+  //  - an integer field takes a JSON integer (or a number with an integral value, 2.0, 1e3) within
+  //    its primitive's range; bool takes true or false; a string field a JSON string;
+  //  - a float field takes any JSON number (float32 rounded to nearest, but not beyond float32's
+  //    range) or null, which is NaN (to_json writes every non-finite value as null);
+  //  - a fixed array takes exactly its size of elements, a bounded sequence or string at most its
+  //    bound; a uint8, byte or char array or sequence also takes a base64 string (rosbridge's
+  //    form for bytes; to_json writes them as numbers);
+  //  - every error names the field's path ("entities[2].pose.position.x: must be a number"), and
+  //    any input is refused cleanly: JSON nested deeper than 100 levels is refused before parsing,
+  //    and what is written is bounded by the input's size (each element of a sequence at least
+  //    one JSON value) times the type's size with its fields at zero.
+  // On failure `cdr` is left as it was.
+  [[nodiscard]] Status from_json(std::string_view json, Bytes& cdr) const;
   // The field path of scalar `index` of that message, e.g. "bodies[3].x" or "bodies.length".
   std::string path(std::span<const std::byte> cdr, std::size_t index) const;
   // The one CDR re-aligner: reads one value of the root type where `from` stands (inside a
@@ -513,6 +533,9 @@ struct MessageDecoder::Field {
   using Array = MsgField::Array;
   Array array = Array::None;
   std::uint32_t fixed_size = 0;
+  std::uint32_t sequence_bound = 0;   // Array::Sequence "[<=N]": N (0: unbounded)
+  std::uint32_t string_capacity = 0;  // "string<=N": N (0: unbounded)
+  PrimitiveType scalar;               // the primitive's kind and size when primitive >= 0
 };
 struct MessageDecoder::Type {
   std::string name;  // "pkg/msg/Name"
