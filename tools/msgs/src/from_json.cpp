@@ -13,7 +13,7 @@ namespace rbsim::msgs {
 
 namespace {
 
-using Json = nlohmann::json;
+using JsonValue = nlohmann::json;
 
 // nlohmann's parser is iterative, but a value nested this deep is no message of ours either way:
 // refusing it before parsing keeps every later step (destruction included) shallow.
@@ -82,7 +82,7 @@ class Writer {
   std::string error;
 
   // Message type `t` from `v` (null: absent, every field its zero value).
-  bool message(std::size_t t, const Json* v, std::string& path) {
+  bool message(std::size_t t, const JsonValue* v, std::string& path) {
     const MessageDecoder::Type& type = types_[t];
     if (v != nullptr) {
       if (!v->is_object()) return fail(path, "must be a JSON object (a " + type.name + ")");
@@ -96,7 +96,7 @@ class Writer {
       }
     }
     for (const MessageDecoder::Field& f : type.fields) {
-      const Json* fv = nullptr;
+      const JsonValue* fv = nullptr;
       if (v != nullptr) {
         if (const auto it = v->find(f.name); it != v->end()) fv = &*it;
       }
@@ -114,7 +114,7 @@ class Writer {
     path += name;
   }
 
-  bool field(const MessageDecoder::Field& f, const Json* v, std::string& path) {
+  bool field(const MessageDecoder::Field& f, const JsonValue* v, std::string& path) {
     using Array = MessageDecoder::Field::Array;
     if (f.array == Array::None) return element(f, v, path);
     const bool bytes = f.primitive >= 0 && f.scalar.kind == Scalar::Kind::UInt && f.scalar.size == 1;
@@ -161,7 +161,7 @@ class Writer {
     return true;
   }
 
-  bool element(const MessageDecoder::Field& f, const Json* v, std::string& path) {
+  bool element(const MessageDecoder::Field& f, const JsonValue* v, std::string& path) {
     if (f.primitive < 0) {
       if (++depth_ > 64) return fail(path, "types nest deeper than 64");
       const bool ok = message(f.nested, v, path);
@@ -196,7 +196,7 @@ class Writer {
     return fail(path, "unsupported type");
   }
 
-  bool real(std::uint8_t size, const Json* v, const std::string& path) {
+  bool real(std::uint8_t size, const JsonValue* v, const std::string& path) {
     double d = 0.0;
     if (v != nullptr) {
       if (v->is_null()) {
@@ -221,7 +221,7 @@ class Writer {
     return true;
   }
 
-  bool integer(const PrimitiveType& p, const Json* v, const std::string& path) {
+  bool integer(const PrimitiveType& p, const JsonValue* v, const std::string& path) {
     const bool is_signed = p.kind == Scalar::Kind::Int;
     const unsigned bits = 8u * p.size;
     // The range as what the JSON can hold: min and max of an int64 / uint64 view.
@@ -287,10 +287,10 @@ class Writer {
 
 Status MessageDecoder::from_json(std::string_view json, Bytes& cdr) const {
   if (too_deep(json)) return Error{"JSON nests deeper than " + std::to_string(kMaxJsonDepth) + " levels"};
-  Json value;
+  JsonValue value;
   try {
-    value = Json::parse(json);
-  } catch (const Json::exception& e) {
+    value = JsonValue::parse(json);
+  } catch (const JsonValue::exception& e) {
     return Error{std::string("not JSON: ") + e.what()};
   }
   Bytes out;
