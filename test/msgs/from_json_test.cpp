@@ -66,7 +66,7 @@ TEST(MessageDecoderFromJson, RoundTripsNestedSequences) {
     s.frame_id = "world";
     s.position = {0.1 * i, -2.5e-300, 1e300};
     s.orientation = {0.0, 0.0, 0.38268343236508978, 0.92387953251128674};
-    s.linear_velocity = {1.0 / 3.0, -0.0 + i, 7.0};
+    s.linear_velocity = {1.0 / 3.0, i == 1 ? -0.0 : 1.0 * i, 7.0};  // -0.0 comes back with its sign
     r.states.push_back(s);
   }
   Bytes cdr;

@@ -262,6 +262,12 @@ struct Json {
           *out += "null";  // JSON has no NaN or infinity
           return;
         }
+        if (s.f == 0.0 && std::signbit(s.f)) {
+          // to_chars writes "-0", which JSON readers may take for the integer 0 (nlohmann does):
+          // the fraction keeps it a float, so -0.0 reads back as itself.
+          *out += "-0.0";
+          return;
+        }
         const auto r = float32 ? std::to_chars(buf, buf + sizeof buf, static_cast<float>(s.f))
                                : std::to_chars(buf, buf + sizeof buf, s.f);
         out->append(buf, r.ptr);

@@ -202,8 +202,7 @@ class Writer {
       if (v->is_null()) {
         d = std::numeric_limits<double>::quiet_NaN();  // to_json's null: not finite
       } else if (v->is_number()) {
-        // One value does not come back bit for bit: to_json writes -0.0 as "-0", which nlohmann
-        // reads as the integer 0 (JavaScript's JSON.parse keeps -0), so it returns as +0.0.
+        // A bare "-0" is nlohmann's integer 0 and comes in as +0.0; to_json writes -0.0 as "-0.0".
         d = v->get<double>();
       } else {
         return fail(path, "must be a number (or null for NaN)");
