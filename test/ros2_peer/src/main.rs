@@ -24,7 +24,6 @@ use std::{process::ExitCode, time::Duration};
 use futures::StreamExt;
 use ros2_client::{
   Context, ContextOptions, MessageTypeName, Name, NodeEvent, NodeName, NodeOptions, QosProfile,
-  builtin_interfaces::Time,
   qos::{Durability, History, Reliability, WhenFull},
 };
 use serde::{Deserialize, Serialize};
@@ -37,24 +36,8 @@ mod simulation;
 mod tf {
   //! tf2_msgs/msg/TFMessage, field for field (serde's CDR follows declaration order).
   use super::*;
-  #[derive(Debug, Clone, Serialize, Deserialize)]
-  pub struct Header {
-    pub stamp: Time,
-    pub frame_id: String,
-  }
-  #[derive(Debug, Clone, Serialize, Deserialize)]
-  pub struct Vector3 {
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
-  }
-  #[derive(Debug, Clone, Serialize, Deserialize)]
-  pub struct Quaternion {
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
-    pub w: f64,
-  }
+  // geometry_msgs' and std_msgs' types, as simulation_interfaces' states use them too.
+  pub use crate::simulation::{Header, Quaternion, Vector3};
   #[derive(Debug, Clone, Serialize, Deserialize)]
   pub struct Transform {
     pub translation: Vector3,
