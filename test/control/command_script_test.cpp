@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <string>
@@ -209,6 +210,66 @@ TEST(ParseCommandScript, AScriptedRunEqualsTheSameCommandsGivenLive) {
   const std::vector<Snapshot> plain = test::run(scene, kSteps);
   EXPECT_TRUE(test::same_bits(run[30].state, plain[30].state));
   EXPECT_FALSE(test::same_bits(run[31].state, plain[31].state));
+}
+
+// A recorded session with a reset: the commands after it (a later epoch) name steps of the pass
+// the reset began, so they apply after it even where their steps are lower than its own (as
+// STOPPED then PLAYING records pause@30, reset@30, resume@0), at the reset's own boundary for step
+// 0. The run is the first pass to the reset and then a pass with the later commands alone.
+TEST(ScriptedRun, CommandsAfterAResetApplyInThePassItBegins) {
+  const Scene scene = test::control_scene();
+  const auto command = [](std::int64_t step, CommandKind kind, std::uint32_t epoch) {
+    ScriptedCommand s;
+    s.command.step = step;
+    s.command.kind = kind;
+    s.epoch = epoch;
+    s.origin = "command at " + std::to_string(step);
+    return s;
+  };
+  std::vector<ScriptedCommand> session;
+  session.push_back(command(20, CommandKind::Impulse, 0));
+  session.back().command.impulse = ImpulseArgs{1, Vec2(0.5, 2.0), Vec2(0.0, 0.0)};
+  session.push_back(command(30, CommandKind::Pause, 0));
+  session.push_back(command(30, CommandKind::Reset, 0));
+  session.push_back(command(0, CommandKind::Resume, 1));
+  session.push_back(command(10, CommandKind::Impulse, 1));
+  session.back().command.impulse = ImpulseArgs{0, Vec2(-1.0, 0.25), Vec2(0.0, 0.0)};
+  ScriptedRun scripted(scene, kSteps, session);
+  const std::vector<Snapshot> run = test::run(scene, kSteps, &scripted.controller());
+  EXPECT_TRUE(scripted.finish("session").ok())
+      << (scripted.mismatches().empty() ? "" : scripted.mismatches()[0]);
+  EXPECT_FALSE(scripted.ended_paused());
+
+  // The two passes, each by itself.
+  Controller first(scene, kSteps, RunSettings{0.0, 1, false});
+  Command kick;
+  kick.step = 20;
+  kick.kind = CommandKind::Impulse;
+  kick.impulse = session[0].command.impulse;
+  first.submit(kick, nullptr);
+  const std::vector<Snapshot> a = test::run(scene, kSteps, &first);
+  Controller second(scene, kSteps, RunSettings{0.0, 1, false});
+  kick.step = 10;
+  kick.impulse = session[4].command.impulse;
+  second.submit(kick, nullptr);
+  const std::vector<Snapshot> b = test::run(scene, kSteps, &second);
+
+  const auto back = std::adjacent_find(run.begin(), run.end(),
+                                       [](const Snapshot& x, const Snapshot& y) { return y.step < x.step; });
+  ASSERT_NE(back, run.end()) << "no reset in the run";
+  const std::size_t reset_at = static_cast<std::size_t>(back - run.begin()) + 1;
+  ASSERT_EQ(run[reset_at - 1].step, 30);
+  for (std::size_t i = 0; i < reset_at; ++i) EXPECT_TRUE(test::same_bits(run[i].state, a[i].state)) << i;
+  // After the reset, every step the sinks were given up to the run's end, each equal to that
+  // step of the second pass alone.
+  EXPECT_EQ(run.back().step, kSteps);
+  EXPECT_GE(run.size() - reset_at, static_cast<std::size_t>(kSteps));
+  for (std::size_t i = reset_at; i < run.size(); ++i) {
+    const auto k = static_cast<std::size_t>(run[i].step);
+    ASSERT_LT(k, b.size());
+    ASSERT_EQ(b[k].step, run[i].step);
+    EXPECT_TRUE(test::same_bits(run[i].state, b[k].state)) << "second pass, step " << k;
+  }
 }
 
 // Commands as rbsim_msgs/msg/Command and back: every kind keeps what a re-run applies.

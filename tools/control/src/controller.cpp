@@ -245,13 +245,19 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     return b;
   bool idled = false;
   for (;;) {
-    if (has_incoming_.load(std::memory_order_acquire)) take_incoming();
     bool applied = false;
-    while (due(world.step_index())) {
-      Pending p = std::move(schedule_.front());
-      schedule_.erase(schedule_.begin());
-      apply_now(p, world, b);
-      applied = true;
+    // What a command's `done` submits as it applies (a re-run's next epoch after its reset) is
+    // taken at this same boundary: due now, it applies here, before the world steps on.
+    for (bool more = true; more;) {
+      if (has_incoming_.load(std::memory_order_acquire)) take_incoming();
+      more = false;
+      while (due(world.step_index())) {
+        Pending p = std::move(schedule_.front());
+        schedule_.erase(schedule_.begin());
+        apply_now(p, world, b);
+        applied = more = true;
+      }
+      more = more && has_incoming_.load(std::memory_order_acquire);
     }
     if (resume_at_ && std::chrono::steady_clock::now() >= *resume_at_) {
       Pending p;

@@ -31,10 +31,13 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
   }
   Result<std::vector<msgs::CommandMessage>> recorded = recordings::read_commands(*recording.value());
   if (!recorded) return recorded.error();
+  std::uint32_t epoch = 0;  // resets applied so far, in the order the node applied its commands
   for (const msgs::CommandMessage& m : recorded.value()) {
     Result<Command> c = from_message(m);
     if (!c) return with_context(path + ": ", c.error());
-    out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq)});
+    const bool reset = c.value().kind == CommandKind::Reset && m.success;
+    out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq), epoch});
+    if (reset) ++epoch;
   }
   return out;
 }
@@ -44,14 +47,27 @@ ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<Scr
   controller_.end_when_idle(true);
   submitted_ = commands.size();
   for (ScriptedCommand& s : commands) {
-    controller_.submit(
-        std::move(s.command), [this, origin = s.origin, expect = s.expect_success](const CommandResult& r) {
-          ++answered_;
-          if (r.successful == expect) return;
-          mismatches_.push_back(origin + ": " +
-                                (r.successful ? "applied here but refused in the recording" : "refused") +
-                                ": " + r.message);
-        });
+    if (s.epoch >= epochs_.size()) epochs_.resize(s.epoch + 1);
+    epochs_[s.epoch].push_back(std::move(s));
+  }
+  if (!epochs_.empty()) submit_epoch(0);
+}
+
+// Submits the commands of epoch `e`; the reset that ends it submits the next one from its
+// boundary, where the controller applies those due at once (a resume at step 0 right after it).
+void ScriptedRun::submit_epoch(std::size_t e) {
+  for (ScriptedCommand& s : epochs_[e]) {
+    const bool ends_epoch =
+        s.command.kind == CommandKind::Reset && s.expect_success && e + 1 < epochs_.size();
+    controller_.submit(std::move(s.command), [this, origin = s.origin, expect = s.expect_success, ends_epoch,
+                                              e](const CommandResult& r) {
+      ++answered_;
+      if (ends_epoch && r.successful) submit_epoch(e + 1);
+      if (r.successful == expect) return;
+      mismatches_.push_back(origin + ": " +
+                            (r.successful ? "applied here but refused in the recording" : "refused") + ": " +
+                            r.message);
+    });
   }
 }
 

@@ -50,6 +50,10 @@ struct ScriptedCommand {
   Command command;
   bool expect_success = true;
   std::string origin;  // "steer.yaml:3", "live.mcap: command 4"
+  // A recording's: how many resets applied before it. A reset starts the steps again from 0, so
+  // a command of a later epoch names a step of the pass that reset began and is submitted once
+  // that reset applied (a script's commands are all epoch 0: their steps are the first pass's).
+  std::uint32_t epoch = 0;
 };
 // The commands of `path`: a script (above), or a recording (recordings::is_recording: an MCAP file or a bag
 // directory: its
@@ -75,7 +79,10 @@ class ScriptedRun {
   std::optional<std::int64_t> ended_paused() const { return controller_.ended_paused(); }
 
  private:
+  void submit_epoch(std::size_t e);
+
   const Scene& scene_;
+  std::vector<std::vector<ScriptedCommand>> epochs_;  // by ScriptedCommand::epoch
   std::vector<std::string> mismatches_;
   Status recorded_ = Ok{};
   Bytes cdr_;
