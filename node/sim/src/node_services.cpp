@@ -227,26 +227,29 @@ struct NodeServices::Impl {
   }
 };
 
-std::vector<NodeServices::Served> NodeServices::catalogue() {
-  // The same list create() serves, its handlers made and dropped uncalled: they only need a
-  // controller to refer to, and no participant is touched.
+namespace {
+// The node's services as create() serves them, names and types, [first, end) of them: the one
+// list, its handlers made and dropped uncalled (they only need a controller to refer to, and no
+// participant is touched). `simulation` keeps simulation_interfaces' alone.
+std::vector<NodeServices::Served> served(bool simulation) {
   const Scene scene;
   control::Controller controller(scene, 0, control::RunSettings{});
-  Impl impl(nullptr, controller, {});
-  std::vector<Served> out;
-  for (auto& [name, type, handler] : impl.collect()) out.push_back({name, type});
+  NodeServices::Impl impl(nullptr, controller, {});
+  std::vector<ServiceEntry> all = impl.collect();
+  const std::size_t first = simulation ? impl.simulation_first : 0;
+  const std::size_t end = simulation ? impl.simulation_end : all.size();
+  std::vector<NodeServices::Served> out;
+  for (std::size_t i = first; i < end; ++i) out.push_back({std::get<0>(all[i]), std::get<1>(all[i])});
   return out;
+}
+}  // namespace
+
+std::vector<NodeServices::Served> NodeServices::catalogue() {
+  return served(false);
 }
 
 std::vector<NodeServices::Served> NodeServices::simulation_catalogue() {
-  const Scene scene;
-  control::Controller controller(scene, 0, control::RunSettings{});
-  Impl impl(nullptr, controller, {});
-  std::vector<ServiceEntry> all = impl.collect();
-  std::vector<Served> out;
-  for (std::size_t i = impl.simulation_first; i < impl.simulation_end; ++i)
-    out.push_back({std::get<0>(all[i]), std::get<1>(all[i])});
-  return out;
+  return served(true);
 }
 
 std::vector<NodeServices::Handled> NodeServices::simulation_handlers(std::string source) const {
