@@ -11,6 +11,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "body_constants.hpp"
 #include "finite.hpp"
 #include "rbsim/core.hpp"
 #include "wind_moments.hpp"
@@ -50,27 +51,10 @@ Status validate_definition(const WorldDef& def) {
   if (!(std::isfinite(def.dt) && def.dt > 0)) return invalid("dt must be finite and > 0");
   const auto n = static_cast<std::int32_t>(def.bodies.size());
   for (std::int32_t b = 0; b < n; ++b) {
-    const BodyDef& body = def.bodies[b];
-    const std::string who = "body " + std::to_string(b) + ": ";
-    if (body.hull.size() < 2) return invalid(who + "needs at least 2 hull vertices");
-    if (body.masses.size() != body.hull.size()) return invalid(who + "one mass per hull vertex");
-    for (std::size_t v = 0; v < body.hull.size(); ++v) {
-      if (!finite(body.hull[v])) return invalid(who + "vertex position not finite");
-      if (!(std::isfinite(body.masses[v]) && body.masses[v] > 0))
-        return invalid(who + "vertex mass must be > 0");
-    }
-    if (!finite(body.velocity) || !std::isfinite(body.omega)) return invalid(who + "velocity not finite");
-    if (!(std::isfinite(body.radius) && body.radius > 0)) return invalid(who + "radius must be > 0");
+    if (Status st = detail::validate_body(def.bodies[b], b); !st) return st;
   }
   for (std::size_t s = 0; s < def.springs.size(); ++s) {
-    const SpringDef& sp = def.springs[s];
-    const std::string who = "spring " + std::to_string(s) + ": ";
-    for (std::int32_t end : {sp.body_i, sp.body_j}) {
-      if (end != kFixed && (end < 0 || end >= n)) return invalid(who + "body index out of range");
-    }
-    if (!finite(sp.anchor_i) || !finite(sp.anchor_j)) return invalid(who + "anchor not finite");
-    if (!(std::isfinite(sp.stiffness) && sp.stiffness >= 0)) return invalid(who + "k must be >= 0");
-    if (!(std::isfinite(sp.rest_length) && sp.rest_length >= 0)) return invalid(who + "l0 must be >= 0");
+    if (Status st = detail::validate_spring(def.springs[s], n, static_cast<std::int32_t>(s)); !st) return st;
   }
   for (const GravityDef& g : def.gravity) {
     if (!finite(g.acceleration)) return invalid("gravity not finite");
@@ -84,6 +68,64 @@ Status validate_definition(const WorldDef& def) {
 }
 
 }  // namespace
+
+namespace detail {
+
+Status validate_body(const BodyDef& body, std::int32_t index) {
+  const auto who = [index](const char* what) {
+    return invalid((index < 0 ? std::string("added body: ") : "body " + std::to_string(index) + ": ") + what);
+  };
+  if (body.hull.size() < 2) return who("needs at least 2 hull vertices");
+  if (body.masses.size() != body.hull.size()) return who("one mass per hull vertex");
+  for (std::size_t v = 0; v < body.hull.size(); ++v) {
+    if (!finite(body.hull[v])) return who("vertex position not finite");
+    if (!(std::isfinite(body.masses[v]) && body.masses[v] > 0)) return who("vertex mass must be > 0");
+  }
+  if (!finite(body.velocity) || !std::isfinite(body.omega)) return who("velocity not finite");
+  if (!(std::isfinite(body.radius) && body.radius > 0)) return who("radius must be > 0");
+  return Ok{};
+}
+
+Status validate_spring(const SpringDef& sp, std::int32_t bodies, std::int32_t index) {
+  const auto who = [index](const char* what) {
+    return invalid((index < 0 ? std::string("added spring: ") : "spring " + std::to_string(index) + ": ") +
+                   what);
+  };
+  for (std::int32_t end : {sp.body_i, sp.body_j}) {
+    if (end != kFixed && (end < 0 || end >= bodies)) return who("body index out of range");
+  }
+  if (!finite(sp.anchor_i) || !finite(sp.anchor_j)) return who("anchor not finite");
+  if (!(std::isfinite(sp.stiffness) && sp.stiffness >= 0)) return who("k must be >= 0");
+  if (!(std::isfinite(sp.rest_length) && sp.rest_length >= 0)) return who("l0 must be >= 0");
+  return Ok{};
+}
+
+Result<MassProperties> mass_properties(const BodyDef& body, std::int32_t index, std::vector<Vec2>& local) {
+  // M = sum m_i;  X = sum m_i r_i / M;  I = sum m_i |r_i - X|^2  (docs/rigid-body-milestone.md 3.1, 3.3.2)
+  double m = 0.0;
+  Vec2 mx(0.0, 0.0);
+  for (std::size_t v = 0; v < body.hull.size(); ++v) {
+    m += body.masses[v];
+    mx += body.masses[v] * body.hull[v];
+  }
+  const Vec2 com = mx / m;
+  double inertia = 0.0;
+  local.clear();
+  for (std::size_t v = 0; v < body.hull.size(); ++v) {
+    local.push_back(body.hull[v] - com);
+    inertia += body.masses[v] * local.back().squaredNorm();
+  }
+  const auto who = [index](const char* what) {
+    return invalid((index < 0 ? std::string("added body: ") : "body " + std::to_string(index) + ": ") + what);
+  };
+  if (!std::isfinite(inertia) || !std::isfinite(com.x()) || !std::isfinite(com.y())) {
+    return who("mass, centre of mass or moment of inertia overflows");
+  }
+  if (!(inertia > 0.0)) return who("all vertices coincide (moment of inertia is 0)");
+  return MassProperties{m, com, inertia};
+}
+
+}  // namespace detail
 
 Result<World> World::create(const WorldDef& def) {
   if (Status st = validate_definition(def); !st) return st.error();
@@ -106,26 +148,10 @@ Result<World> World::create(const WorldDef& def) {
   std::vector<Vec2> local;
   for (std::size_t b = 0; b < n; ++b) {
     const BodyDef& body = def.bodies[b];
-    // M = sum m_i;  X = sum m_i r_i / M;  I = sum m_i |r_i - X|^2  (docs/rigid-body-milestone.md 3.1, 3.3.2)
-    double m = 0.0;
-    Vec2 mx(0.0, 0.0);
-    for (std::size_t v = 0; v < body.hull.size(); ++v) {
-      m += body.masses[v];
-      mx += body.masses[v] * body.hull[v];
-    }
-    const Vec2 com = mx / m;
-    double inertia = 0.0;
-    local.clear();
-    for (std::size_t v = 0; v < body.hull.size(); ++v) {
-      local.push_back(body.hull[v] - com);
-      inertia += body.masses[v] * local.back().squaredNorm();
-    }
-    if (!std::isfinite(inertia) || !std::isfinite(com.x()) || !std::isfinite(com.y())) {
-      return invalid("body " + std::to_string(b) + ": mass, centre of mass or moment of inertia overflows");
-    }
-    if (!(inertia > 0.0)) {
-      return invalid("body " + std::to_string(b) + ": all vertices coincide (moment of inertia is 0)");
-    }
+    Result<detail::MassProperties> props = detail::mass_properties(body, static_cast<std::int32_t>(b), local);
+    if (!props) return props.error();
+    const double m = props.value().mass, inertia = props.value().inertia;
+    const Vec2 com = props.value().com;
     w.mass_[b] = m;
     w.inertia_[b] = inertia;
     w.radius_[b] = body.radius;
@@ -146,6 +172,9 @@ Result<World> World::create(const WorldDef& def) {
   }
   w.shape_vertices_.shrink_to_fit();
   w.shapes_.shrink_to_fit();
+  w.shape_refs_.assign(w.shapes_.size(), 0);
+  for (const std::int32_t shape : w.shape_) ++w.shape_refs_[shape];
+  w.init_identity();
 
   w.wind_moments_.reserve(w.winds_.size() * w.shapes_.size());
   for (const WindDef& wind : w.winds_) {
@@ -358,7 +387,10 @@ std::size_t World::memory_bytes() const {
   bytes += shape_.capacity() * sizeof(std::int32_t) + shapes_.capacity() * sizeof(Shape) +
            shape_vertices_.capacity() * sizeof(Vec2) + wind_moments_.capacity() * sizeof(WindMoments) +
            springs_.capacity() * sizeof(SpringDef) + gravity_.capacity() * sizeof(GravityDef) +
-           winds_.capacity() * sizeof(WindDef);
+           winds_.capacity() * sizeof(WindDef) + slots_.capacity() * sizeof(Slot);
+  for (const auto* column : {&shape_refs_, &body_ids_, &body_slot_, &spring_ids_, &free_slots_}) {
+    bytes += column->capacity() * sizeof(std::int32_t);
+  }
   return bytes;
 }
 

@@ -79,12 +79,24 @@ struct WorldDef {
   std::vector<WindDef> winds;
 };
 
-// Handles instead of pointers or raw indices in the public API.
+// A body's or spring's position in the world's dense arrays, valid until the next structural
+// change (add_body, remove_body, add_spring, remove_spring): the index every per-body column, and
+// every message built from them, uses at this step.
 struct BodyId {
   std::int32_t index = -1;
 };
 struct SpringId {
   std::int32_t index = -1;
+};
+
+// A body's handle, valid across structural changes (Box2D's b2BodyId): the body's slot plus one
+// (0 is the null handle) and the generation the slot had when the body was made. The generation
+// is the body's id plus one, and ids are never reused within a world's lineage (see
+// World::continue_ids), so a handle to a removed body never finds another one: find() refuses it.
+struct BodyHandle {
+  std::int32_t index1 = 0;
+  std::uint32_t generation = 0;
+  bool operator==(const BodyHandle&) const = default;
 };
 
 struct BodyState {
@@ -149,6 +161,50 @@ class World {
   // Advances one time step of dt: clears forces, accumulates gravity, springs and wind (each
   // in definition order), integrates. Does not allocate.
   void step();
+
+  // -- Structure: bodies and springs added and removed between steps (src/structure.cpp) --
+  //
+  // The arrays stay dense and in a stable order: a new body or spring is appended, a removal
+  // closes the gap by moving the later entries down one (O(n) at that boundary). Order is kept
+  // because it fixes every sum (a body's spring forces add up in spring order, the totals in body
+  // order), so a world edited this way steps bit for bit as a world created from the edited
+  // definition: a body added at step k with state s is the definition's last body, set to s at k.
+  //
+  // Ids: the scene's bodies and springs get their file index; each body or spring added later gets
+  // the next unused id, never one given before (removed or not). ids are what messages carry, so a
+  // body's identity survives the removal of bodies before it; body_ids() and spring_ids() are
+  // strictly increasing in dense order, so find_body_id() and find_spring_id() are binary searches.
+
+  // Reserves every per-body and per-spring array (no allocation until a change goes past it); a
+  // change beyond the reserve grows the arrays at that boundary, never inside step().
+  void reserve(std::int32_t bodies, std::int32_t springs);
+  // Continues the ids of an earlier world of the same session (a reset or reload creates a new
+  // World): the next added body and spring take ids at least these.
+  void continue_ids(std::int32_t next_body_id, std::int32_t next_spring_id);
+  std::int32_t next_body_id() const { return next_body_id_; }
+  std::int32_t next_spring_id() const { return next_spring_id_; }
+
+  // Adds a body whose hull and masses are `def`'s (in any frame: the body space is the hull about
+  // its centre of mass, as create() makes it, and def.velocity/omega are ignored) in `state`: the
+  // centre of mass at state.position, rotated by state.theta from that frame, moving with
+  // state.velocity and state.omega. Refuses what create() refuses, and a non-finite state.
+  [[nodiscard]] Result<BodyHandle> add_body(const BodyDef& def, const BodyState& state);
+  // Adds a spring between bodies of this world (body_i/j are dense indices or kFixed); returns
+  // its id. Refuses what create() refuses.
+  [[nodiscard]] Result<std::int32_t> add_spring(const SpringDef& def);
+  // Removes a body and, first, every spring attached to it (their ids, in spring order, appended
+  // to `removed_springs` if given). A stale or null handle is refused and changes nothing.
+  [[nodiscard]] Status remove_body(BodyHandle body, std::vector<std::int32_t>* removed_springs = nullptr);
+  [[nodiscard]] Status remove_spring(std::int32_t spring_id);
+
+  BodyHandle handle(BodyId b) const;
+  std::optional<BodyId> find(BodyHandle h) const;  // nullopt: null, removed or never made
+  std::int32_t body_id(BodyId b) const { return body_ids_[b.index]; }
+  std::int32_t spring_id(SpringId s) const { return spring_ids_[s.index]; }
+  std::span<const std::int32_t> body_ids() const { return body_ids_; }
+  std::span<const std::int32_t> spring_ids() const { return spring_ids_; }
+  std::optional<BodyId> find_body_id(std::int32_t id) const;
+  std::optional<SpringId> find_spring_id(std::int32_t id) const;
 
   std::int32_t body_count() const { return static_cast<std::int32_t>(x_.size()); }
   std::int32_t spring_count() const { return static_cast<std::int32_t>(springs_.size()); }
@@ -263,7 +319,20 @@ class World {
   using WindMoments = detail::WindMoments;
   World() = default;
 
+  // A slot of the handle table: the body's dense index (-1 while free) and the generation of the
+  // body that holds or last held it.
+  struct Slot {
+    std::int32_t dense = -1;
+    std::uint32_t generation = 0;
+  };
+
   double compute_finite_bound() const;
+  std::int32_t add_shape(std::span<const Vec2> local);
+  void release_shape(std::int32_t shape);
+  void compact_shapes();
+  void erase_body_columns(std::int32_t dense);
+  void init_identity();
+  Status validate_identity() const;
   void update_rotations();
   bool uses_rotations() const { return !springs_.empty() || !winds_.empty(); }
   void accumulate_gravity();
@@ -288,6 +357,15 @@ class World {
   std::vector<Shape> shapes_;
   std::vector<Vec2> shape_vertices_;       // all hulls, body space, concatenated
   std::vector<WindMoments> wind_moments_;  // [wind * shapes + shape]
+  std::vector<std::int32_t> shape_refs_;   // bodies using each shape; 0: garbage until compacted
+  std::int32_t dead_shapes_ = 0;
+
+  // Identity (cold): per body its id and slot, per spring its id; the slot table and its free
+  // list (last freed, first reused, so handles are deterministic).
+  std::vector<std::int32_t> body_ids_, body_slot_, spring_ids_;
+  std::vector<Slot> slots_;
+  std::vector<std::int32_t> free_slots_;
+  std::int32_t next_body_id_ = 0, next_spring_id_ = 0;
 
   std::vector<SpringDef> springs_;
   std::vector<GravityDef> gravity_;
