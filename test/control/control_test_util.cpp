@@ -49,15 +49,18 @@ Status RecordingSink::write(const World& world) {
   return Ok{};
 }
 
-std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller) {
+std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller,
+                          std::vector<Entities>* entities, bool follows) {
   Result<Driver> driver = Driver::create(scene);
   if (!driver) throw std::runtime_error(driver.error().message);
   RecordingSink sink;
+  sink.follows = follows;
   driver.value().add(sink);
   DriverOptions options;
   options.steps = steps;
   options.control = controller;
   if (Status st = driver.value().run_pass(options); !st) throw std::runtime_error(st.error().message);
+  if (entities != nullptr) *entities = std::move(sink.entities);
   return std::move(sink.snapshots);
 }
 

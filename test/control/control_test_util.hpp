@@ -34,12 +34,22 @@ class RecordingSink final : public Sink {
   Status write(const World& world) override;
   Status finish() override { return Ok{}; }
   void rebase(const World&) override { ++rebases; }
+  bool follows_structure() const override { return follows; }
+  Status restructure(const World&, const Entities& e) override {
+    entities.push_back(e);
+    return Ok{};
+  }
   std::vector<Snapshot> snapshots;
   int rebases = 0;
+  bool follows = true;
+  std::vector<Entities> entities;  // at each restructure()
 };
 
 // One pass of `scene` for `steps` steps with an optional controller; the snapshots of every step.
-std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller = nullptr);
+// `entities`, when given, receives the sink's restructure() calls; `follows` says whether the sink
+// follows structural changes.
+std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller = nullptr,
+                          std::vector<Entities>* entities = nullptr, bool follows = true);
 
 // Bit-for-bit equality of two doubles (memcmp: -0.0 differs from 0.0).
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b);

@@ -101,6 +101,11 @@ Result<Request> request_for(const Command& command, const RemoteSteeringOptions&
       return Error{"set_entity_state is not relayed: call the node's set_entity_state service"};
     case CommandKind::StopStepping:
       return Error{"stop_stepping is not relayed: cancel the node's simulate_steps goal"};
+    case CommandKind::Spawn:
+    case CommandKind::Delete:
+    case CommandKind::ResetSpawned:
+      return Error{std::string(control::to_string(command.kind)) +
+                   " is not relayed: call the node's simulation_interfaces service"};
   }
   return Error{"unknown command"};
 }
@@ -186,6 +191,9 @@ CommandResult result_of(const Command& command, std::span<const std::byte> reply
       return control_result(decode_reply<msgs::ApplyImpulseResponse>(reply, o));
     case CommandKind::SetState:
     case CommandKind::StopStepping:
+    case CommandKind::Spawn:
+    case CommandKind::Delete:
+    case CommandKind::ResetSpawned:
       break;  // never sent (make_request refuses them)
   }
   return failed("unknown command");

@@ -1,6 +1,10 @@
 // Commands as rbsim_msgs/msg/Command (rbsim/control.hpp): what the node publishes on
 // /<ns>/commands and a re-simulation reads back.
+#include <algorithm>
+#include <initializer_list>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "rbsim/control.hpp"
@@ -18,6 +22,9 @@ static_assert(static_cast<int>(CommandKind::Reset) == msgs::CommandMessage::Rese
 static_assert(static_cast<int>(CommandKind::Impulse) == msgs::CommandMessage::ApplyImpulse);
 static_assert(static_cast<int>(CommandKind::SetState) == msgs::CommandMessage::SetEntityState);
 static_assert(static_cast<int>(CommandKind::StopStepping) == msgs::CommandMessage::StopStepping);
+static_assert(static_cast<int>(CommandKind::Spawn) == msgs::CommandMessage::SpawnEntity);
+static_assert(static_cast<int>(CommandKind::Delete) == msgs::CommandMessage::DeleteEntity);
+static_assert(static_cast<int>(CommandKind::ResetSpawned) == msgs::CommandMessage::ResetSpawned);
 
 // SetEntityState's values travel as named float64 parameters (the message's layout predates the
 // kind, and recordings made before it stay readable): x, y, theta for a pose, vx, vy, omega for a
@@ -68,6 +75,72 @@ Status state_args(const std::vector<Parameter>& parameters, const std::string& w
   return Ok{};
 }
 
+// spawn_entity's and delete_entity's arguments as named parameters (see interfaces.hpp).
+std::vector<Parameter> spawn_parameters(const SpawnArgs& a) {
+  return {{"resource", ParameterValue::of_string(a.resource)},
+          {"uri", ParameterValue::of_string(a.uri)},
+          {"name", ParameterValue::of_string(a.name)},
+          {"allow_renaming", ParameterValue::of_bool(a.allow_renaming)},
+          {"x", ParameterValue::of_double(a.position.x())},
+          {"y", ParameterValue::of_double(a.position.y())},
+          {"theta", ParameterValue::of_double(a.theta)}};
+}
+
+// Each named parameter exactly once with its type: anything else is a malformed record.
+class NamedParameters {
+ public:
+  NamedParameters(const std::vector<Parameter>& parameters, std::string which)
+      : parameters_(parameters), which_(std::move(which)) {}
+  Status take(const char* name, ParameterType type, ParameterValue& out) const {
+    const Parameter* found = nullptr;
+    for (const Parameter& p : parameters_) {
+      if (p.name != name) continue;
+      if (found != nullptr) return Error{which_ + ": parameter '" + name + "' given twice", ErrorCode::Malformed};
+      found = &p;
+    }
+    if (found == nullptr) return Error{which_ + ": parameter '" + name + "' missing", ErrorCode::Malformed};
+    if (found->value.type != type) {
+      return Error{which_ + ": parameter '" + std::string(name) + "' is not a " + to_string(type),
+                   ErrorCode::Malformed};
+    }
+    out = found->value;
+    return Ok{};
+  }
+  Status only(std::initializer_list<const char*> names) const {
+    for (const Parameter& p : parameters_) {
+      if (std::none_of(names.begin(), names.end(), [&](const char* n) { return p.name == n; }))
+        return Error{which_ + ": unknown parameter '" + p.name + "'", ErrorCode::Malformed};
+    }
+    return Ok{};
+  }
+
+ private:
+  const std::vector<Parameter>& parameters_;
+  std::string which_;
+};
+
+Status spawn_args(const std::vector<Parameter>& parameters, const std::string& which, SpawnArgs& a) {
+  const NamedParameters named(parameters, which + ": spawn_entity");
+  ParameterValue resource, uri, name, renaming, x, y, theta;
+  for (auto [key, type, out] : {std::tuple{"resource", ParameterType::String, &resource},
+                                {"uri", ParameterType::String, &uri},
+                                {"name", ParameterType::String, &name},
+                                {"allow_renaming", ParameterType::Bool, &renaming},
+                                {"x", ParameterType::Double, &x},
+                                {"y", ParameterType::Double, &y},
+                                {"theta", ParameterType::Double, &theta}}) {
+    if (Status st = named.take(key, type, *out); !st) return st;
+  }
+  if (Status st = named.only({"resource", "uri", "name", "allow_renaming", "x", "y", "theta"}); !st) return st;
+  a.resource = resource.string_value;
+  a.uri = uri.string_value;
+  a.name = name.string_value;
+  a.allow_renaming = renaming.bool_value;
+  a.position = Vec2(x.double_value, y.double_value);
+  a.theta = theta.double_value;
+  return Ok{};
+}
+
 }  // namespace
 
 msgs::CommandMessage to_message(const Command& command, const CommandResult& result, std::uint64_t sequence,
@@ -79,12 +152,28 @@ msgs::CommandMessage to_message(const Command& command, const CommandResult& res
   m.stamp = msgs::sim_time(step, dt);
   m.kind = static_cast<std::uint8_t>(command.kind);
   m.source = command.source;
-  m.parameters = command.kind == CommandKind::SetState ? state_parameters(command.state) : command.parameters;
+  switch (command.kind) {
+    case CommandKind::SetState:
+      m.parameters = state_parameters(command.state);
+      break;
+    case CommandKind::Spawn:
+      m.parameters = spawn_parameters(command.spawn);
+      break;
+    case CommandKind::Delete:
+      m.parameters = {{"name", ParameterValue::of_string(command.entity)}};
+      break;
+    default:
+      m.parameters = command.parameters;
+  }
   m.atomic = command.atomic;
   m.steps = command.steps > 0 ? static_cast<std::uint64_t>(command.steps) : 0;
   m.pause_seconds = command.pause_seconds;
   // A body index the controller refused may not fit the field: the message says so in its text.
-  const std::int64_t body = command.kind == CommandKind::SetState ? command.state.body : command.impulse.body;
+  // Spawn and delete_entity: the body's id, as the result names it.
+  const bool entity = command.kind == CommandKind::Spawn || command.kind == CommandKind::Delete;
+  const std::int64_t body = entity                                 ? result.body_id
+                            : command.kind == CommandKind::SetState ? command.state.body
+                                                                    : command.impulse.body;
   m.body = body >= 0 && body <= 0xffffffffLL ? static_cast<std::uint32_t>(body) : 0xffffffffU;
   m.jx = command.impulse.impulse.x();
   m.jy = command.impulse.impulse.y();
@@ -97,8 +186,8 @@ msgs::CommandMessage to_message(const Command& command, const CommandResult& res
 
 Result<Command> from_message(const msgs::CommandMessage& m) {
   const std::string which = "command " + std::to_string(m.seq);
-  if (m.kind > msgs::CommandMessage::StopStepping) {
-    return Error{which + ": unknown kind " + std::to_string(m.kind) + " (rbsim_msgs/msg/Command has 0..7)",
+  if (m.kind > msgs::CommandMessage::ResetSpawned) {
+    return Error{which + ": unknown kind " + std::to_string(m.kind) + " (rbsim_msgs/msg/Command has 0..10)",
                  ErrorCode::Malformed};
   }
   if (m.step > static_cast<std::uint64_t>(INT64_MAX) || m.steps > static_cast<std::uint64_t>(INT64_MAX)) {
@@ -116,6 +205,21 @@ Result<Command> from_message(const msgs::CommandMessage& m) {
     c.parameters.clear();
     c.state.body = m.body;
     if (Status st = state_args(m.parameters, which, c.state); !st) return st.error();
+  }
+  if (c.kind == CommandKind::Spawn) {
+    c.parameters.clear();
+    if (Status st = spawn_args(m.parameters, which, c.spawn); !st) return st.error();
+  }
+  if (c.kind == CommandKind::Delete) {
+    c.parameters.clear();
+    ParameterValue name;
+    const NamedParameters named(m.parameters, which + ": delete_entity");
+    if (Status st = named.take("name", ParameterType::String, name); !st) return st.error();
+    if (Status st = named.only({"name"}); !st) return st.error();
+    c.entity = name.string_value;
+  }
+  if (c.kind == CommandKind::ResetSpawned && !m.parameters.empty()) {
+    return Error{which + ": reset_spawned takes no parameters", ErrorCode::Malformed};
   }
   c.source = m.source;
   return c;

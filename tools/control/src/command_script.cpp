@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <optional>
 #include <utility>
 
@@ -16,7 +18,8 @@ namespace rbsim::control {
 namespace {
 
 constexpr const char* kActions =
-    "set, impulse, set_entity_state, pause, resume, steps, stop_stepping or reset";
+    "set, impulse, set_entity_state, pause, resume, steps, stop_stepping, reset, spawn, delete or "
+    "reset_spawned";
 
 // The entry being read: its place in the file for every message.
 struct Entry {
@@ -174,6 +177,60 @@ Status set_entity_state(const Entry& e, const YAML::Node& n, std::int64_t bodies
   return Ok{};
 }
 
+// spawn: {file: FRAGMENT | resource: TEXT, name: NAME, x: [X, Y], theta: RAD, allow_renaming: BOOL};
+// a file is read now (relative to the script's folder) and its text kept in the command, so the
+// run, and its recording, depend on no file after this.
+Status spawn(const Entry& e, const YAML::Node& n, SpawnArgs& out) {
+  if (!n.IsMap()) return e.error(n, "spawn", "must be a map {file: FRAGMENT or resource: TEXT, name, x, theta}");
+  for (const auto& kv : n) {
+    const std::string key = kv.first.Scalar();
+    if (key != "file" && key != "resource" && key != "name" && key != "x" && key != "theta" &&
+        key != "allow_renaming") {
+      return e.error(kv.first, "spawn." + key, "unknown field (want file or resource, name, x, theta, allow_renaming)");
+    }
+  }
+  SpawnArgs a;
+  const YAML::Node file = n["file"], resource = n["resource"];
+  if ((file && resource) || (!file && !resource)) return e.error(n, "spawn", "give file or resource, one of them");
+  if (file) {
+    if (!file.IsScalar() || file.Scalar().empty()) return e.error(file, "spawn.file", "must be a path");
+    std::filesystem::path where(file.Scalar());
+    if (where.is_relative()) where = std::filesystem::path(e.path).parent_path() / where;
+    Result<std::string> text = read_text_file(where.string(), "the fragment");
+    if (!text) return e.error(file, "spawn.file", text.error().message);
+    a.resource = std::move(text.value());
+    a.uri = where.string();
+  } else {
+    if (!resource.IsScalar()) return e.error(resource, "spawn.resource", "must be the fragment's XML text");
+    a.resource = resource.Scalar();
+  }
+  if (const YAML::Node name = n["name"]) {
+    if (!name.IsScalar()) return e.error(name, "spawn.name", "must be a name");
+    a.name = name.Scalar();
+  }
+  if (const YAML::Node x = n["x"]) {
+    Result<Vec2> read = vector(e, x, "spawn.x");
+    if (!read) return read.error();
+    a.position = read.value();
+  }
+  if (const YAML::Node theta = n["theta"]) {
+    const std::optional<double> value = number(theta);
+    if (!value || !std::isfinite(*value)) return e.error(theta, "spawn.theta", "must be a finite number");
+    a.theta = *value;
+  }
+  if (const YAML::Node renaming = n["allow_renaming"]) {
+    const ParameterValue v = renaming.IsScalar() ? yaml_scalar(renaming) : ParameterValue{};
+    if (v.type != ParameterType::Bool) return e.error(renaming, "spawn.allow_renaming", "must be true or false");
+    a.allow_renaming = v.bool_value;
+  }
+  // The fragment is checked now: its errors name the file (or the script) and line.
+  Result<Fragment> parsed = parse_fragment(a.resource, a.uri.empty() ? yaml_line(e.path, resource) : a.uri);
+  if (!parsed) return e.error(file ? file : resource, file ? "spawn.file" : "spawn.resource", parsed.error().message);
+  a.fragment = std::make_shared<const Fragment>(std::move(parsed.value()));
+  out = std::move(a);
+  return Ok{};
+}
+
 bool is_true(const YAML::Node& n) {
   if (!n.IsScalar()) return false;
   const ParameterValue v = yaml_scalar(n);
@@ -187,7 +244,8 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
     const std::string key = kv.first.Scalar();
     if (key == "step" || key == "t") continue;
     if (key != "set" && key != "impulse" && key != "set_entity_state" && key != "pause" && key != "resume" &&
-        key != "steps" && key != "stop_stepping" && key != "reset") {
+        key != "steps" && key != "stop_stepping" && key != "reset" && key != "spawn" && key != "delete" &&
+        key != "reset_spawned") {
       return e.error(kv.first, key,
                      std::string("unknown field (want step or t, and one of ") + kActions + ")");
     }
@@ -210,6 +268,16 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
     c.kind = CommandKind::SetState;
     return set_entity_state(e, v, bodies, c.state);
   }
+  if (*name == "spawn") {
+    c.kind = CommandKind::Spawn;
+    return spawn(e, v, c.spawn);
+  }
+  if (*name == "delete") {
+    if (!v.IsScalar() || v.Scalar().empty()) return e.error(v, "delete", "must be the name of a body");
+    c.kind = CommandKind::Delete;
+    c.entity = v.Scalar();
+    return Ok{};
+  }
   if (*name == "steps") {
     const std::optional<std::int64_t> n = integer(v);
     if (!n || *n < 1) return e.error(v, "steps", "must be an integer >= 1");
@@ -230,6 +298,7 @@ Status action(const Entry& e, const ParameterTable& table, std::int64_t bodies, 
   if (!is_true(v)) return e.error(v, *name, "must be true");
   c.kind = *name == "resume"          ? CommandKind::Resume
            : *name == "stop_stepping" ? CommandKind::StopStepping
+           : *name == "reset_spawned" ? CommandKind::ResetSpawned
                                       : CommandKind::Reset;
   return Ok{};
 }

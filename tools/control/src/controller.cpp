@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <memory>
 #include <utility>
 
@@ -34,6 +35,18 @@ bool reportable(std::initializer_list<double> values, double bound) {
     return std::isfinite(v) && (bound <= 0.0 || std::abs(v) <= bound);
   });
 }
+// A command's body: its id (a scene's bodies have their file index), found where it is now.
+std::optional<BodyId> find_body(const World& world, std::int64_t id) {
+  if (id < 0 || id > std::numeric_limits<std::int32_t>::max()) return std::nullopt;
+  return world.find_body_id(static_cast<std::int32_t>(id));
+}
+
+std::string bodies_text(const World& world) {
+  return "(the world has " + std::to_string(world.body_count()) + " bodies" +
+         (world.next_body_id() > world.body_count() ? ", ids from 0 to " + std::to_string(world.next_body_id() - 1)
+                                                     : std::string()) +
+         ")";
+}
 }  // namespace
 
 const char* to_string(CommandKind kind) {
@@ -54,6 +67,12 @@ const char* to_string(CommandKind kind) {
       return "set_entity_state";
     case CommandKind::StopStepping:
       return "stop_stepping";
+    case CommandKind::Spawn:
+      return "spawn_entity";
+    case CommandKind::Delete:
+      return "delete_entity";
+    case CommandKind::ResetSpawned:
+      return "reset_spawned";
   }
   return "?";
 }
@@ -209,6 +228,10 @@ void Controller::publish_values(const World& world) {
 }
 
 void Controller::start(World& world) {
+  // A pass (again, with --loop) starts from the scene: what was spawned in an earlier one is gone,
+  // but the session's ids and names go on.
+  renew(world, next_body_id_, next_spring_id_);
+  follow_structure(world, nullptr);
   table_.refresh(world, settings_);
   publish_values(world);
 }
@@ -386,12 +409,22 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
     case CommandKind::Reset: {
       Result<World> fresh = World::create(scene_.world);
       if (!fresh) return failed("reset: " + fresh.error().message);
+      // Bodies spawned or deleted since the world was made: the outputs follow it back.
+      const bool edited = structure_edited_;
+      const std::int32_t bodies = world.next_body_id(), springs = world.next_spring_id();
       world = std::move(fresh.value());
+      renew(world, bodies, springs);
       step_budget_ = 0;
       const ParameterTable before = table_;
+      follow_structure(world, &r);
+      if (edited) {
+        ++entities_.epoch;
+        boundary.structure_changed = true;
+      }
       table_.refresh(world, settings_);
       for (std::size_t i = 0; i < table_.size(); ++i) {
-        if (!(table_.value(i) == before.value(i)))
+        const std::optional<std::size_t> was = before.find(table_.descriptor(i).name);
+        if (was && !(table_.value(i) == before.value(*was)))
           r.changed.push_back({table_.descriptor(i).name, table_.value(i)});
       }
       boundary.state_changed = true;
@@ -413,6 +446,21 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
     case CommandKind::SetState: {
       CommandResult applied = set_state(command, world);
       boundary.state_changed |= applied.successful;
+      return applied;
+    }
+    case CommandKind::Spawn:
+    case CommandKind::Delete:
+    case CommandKind::ResetSpawned: {
+      if (!structure_allowed_) {
+        return failed(std::string(to_string(command.kind)) +
+                      ": this run's outputs cannot follow a world whose bodies change");
+      }
+      const std::uint32_t epoch = entities_.epoch;
+      CommandResult applied = command.kind == CommandKind::Spawn    ? spawn(command, world)
+                              : command.kind == CommandKind::Delete ? remove(command, world)
+                                                                    : reset_spawned(world);
+      boundary.state_changed |= applied.successful;
+      boundary.structure_changed |= entities_.epoch != epoch;
       return applied;
     }
   }
@@ -476,14 +524,12 @@ CommandResult Controller::set_parameters(const Command& command, World& world, B
 CommandResult Controller::impulse(const Command& command, World& world) {
   const ImpulseArgs& a = command.impulse;
   const std::int64_t now = world.step_index();
-  if (a.body < 0 || a.body >= world.body_count()) {
-    return failed("apply_impulse: no body " + std::to_string(a.body) + " (the scene has " +
-                  std::to_string(world.body_count()) + " bodies)");
-  }
+  const std::optional<BodyId> found = find_body(world, a.body);
+  if (!found) return failed("apply_impulse: no body " + std::to_string(a.body) + " " + bodies_text(world));
   for (double v : {a.impulse.x(), a.impulse.y(), a.point.x(), a.point.y()}) {
     if (!std::isfinite(v)) return failed("apply_impulse: the impulse and its point must be finite");
   }
-  const BodyId body{static_cast<std::int32_t>(a.body)};
+  const BodyId body = *found;
   const BodyState before = world.state(body);
   if (Status st = world.apply_impulse(body, a.impulse, a.point); !st) {
     return failed("apply_impulse: " + st.error().message);
@@ -504,17 +550,15 @@ CommandResult Controller::impulse(const Command& command, World& world) {
 
 CommandResult Controller::set_state(const Command& command, World& world) {
   const StateArgs& a = command.state;
-  if (a.body < 0 || a.body >= world.body_count()) {
-    return failed("set_entity_state: no body " + std::to_string(a.body) + " (the scene has " +
-                  std::to_string(world.body_count()) + " bodies)");
-  }
+  const std::optional<BodyId> found = find_body(world, a.body);
+  if (!found) return failed("set_entity_state: no body " + std::to_string(a.body) + " " + bodies_text(world));
   if (!a.set_pose && !a.set_twist) return failed("set_entity_state: neither the pose nor the twist is set");
   if (!reportable({a.position.x(), a.position.y(), a.theta, a.velocity.x(), a.velocity.y(), a.omega},
                   world.finite_bound())) {
     return failed("set_entity_state: body " + std::to_string(a.body) +
                   ": every value must be finite and within the range the run can report");
   }
-  const BodyId body{static_cast<std::int32_t>(a.body)};
+  const BodyId body = *found;
   BodyState s = world.state(body);
   if (a.set_pose) {
     s.position = a.position;

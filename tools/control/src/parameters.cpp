@@ -1,7 +1,11 @@
 // The parameter table: declarations, rclcpp's checks, and applying a value to the state it names.
 #include "rbsim/parameters.hpp"
 
+#include "rbsim/assert.hpp"
+
 #include <algorithm>
+#include <set>
+#include <string_view>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -235,13 +239,46 @@ ParameterTable::ParameterTable(const Scene& scene, std::int64_t steps, const Run
           V::of_integer(wind.points_per_edge), {K::WindPoints, k});
     }
   }
-  for (std::size_t j = 0; j < w.springs.size(); ++j) {
-    const std::string p = "springs." + std::to_string(j) + ".";
-    const auto s = static_cast<std::int32_t>(j);
-    add(real(p + "k", "Spring: stiffness (N/m)", 0.0, kMaxDouble), V::of_double(w.springs[j].stiffness),
-        {K::SpringK, s});
-    add(real(p + "l0", "Spring: rest length (m)", 0.0, kMaxDouble), V::of_double(w.springs[j].rest_length),
-        {K::SpringL0, s});
+  for (std::size_t j = 0; j < w.springs.size(); ++j) add_spring(static_cast<std::int32_t>(j), j, w.springs[j]);
+}
+
+void ParameterTable::add_spring(std::int32_t id, std::size_t index, const SpringDef& spring) {
+  using K = ParameterTarget::Kind;
+  const std::string p = "springs." + std::to_string(id) + ".";
+  const auto s = static_cast<std::int32_t>(index);
+  add(real(p + "k", "Spring: stiffness (N/m)", 0.0, kMaxDouble), ParameterValue::of_double(spring.stiffness),
+      {K::SpringK, s});
+  add(real(p + "l0", "Spring: rest length (m)", 0.0, kMaxDouble), ParameterValue::of_double(spring.rest_length),
+      {K::SpringL0, s});
+}
+
+void ParameterTable::follow_structure(const World& world, std::vector<Parameter>* added,
+                                      std::vector<std::string>* removed) {
+  using K = ParameterTarget::Kind;
+  const auto is_spring = [](const Entry& e) { return e.target.kind == K::SpringK || e.target.kind == K::SpringL0; };
+  const auto first = std::find_if(entries_.begin(), entries_.end(), is_spring);
+  RBSIM_ASSERT(std::all_of(first, entries_.end(), is_spring), "the springs' parameters come last");
+  std::vector<std::string> before;  // in table order
+  for (auto it = first; it != entries_.end(); ++it) {
+    before.push_back(it->descriptor.name);
+    index_.erase(it->descriptor.name);
+  }
+  entries_.erase(first, entries_.end());
+  for (Entry& e : entries_) {
+    if (e.target.kind == K::Bodies) e.value = ParameterValue::of_integer(world.body_count());
+    if (e.target.kind == K::Springs) e.value = ParameterValue::of_integer(world.spring_count());
+  }
+  const std::size_t start = entries_.size();
+  for (std::int32_t s = 0; s < world.spring_count(); ++s) {
+    add_spring(world.spring_id(SpringId{s}), static_cast<std::size_t>(s), world.spring(SpringId{s}));
+  }
+  const std::set<std::string_view> old_names(before.begin(), before.end());
+  for (std::size_t i = start; added != nullptr && i < entries_.size(); ++i) {
+    if (!old_names.contains(entries_[i].descriptor.name))
+      added->push_back({entries_[i].descriptor.name, entries_[i].value});
+  }
+  for (const std::string& name : before) {
+    if (removed != nullptr && !index_.contains(name)) removed->push_back(name);
   }
 }
 

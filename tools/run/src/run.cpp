@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "rbsim/assert.hpp"
+
 namespace rbsim {
 
 std::string describe_divergence(const Divergence& d) {
@@ -44,7 +46,11 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
   double bound = world.finite_bound();
   double position = world.peak_position();
   double limit = std::min(bound, std::max(1.0, 2.0 * world.peak_velocity()));
-  if (options.control != nullptr) options.control->start(world);
+  if (options.control != nullptr) {
+    options.control->outputs_follow_structure(
+        std::all_of(sinks_.begin(), sinks_.end(), [](const Sink* sink) { return sink->follows_structure(); }));
+    options.control->start(world);
+  }
   while (world.step_index() < options.steps) {
     if (options.pace) options.pace(world);
     if (options.stop != nullptr && options.stop()) return PassEnd::Stopped;
@@ -57,6 +63,13 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
         bound = world.finite_bound();
         position = world.peak_position();
         limit = std::min(bound, std::max(1.0, 2.0 * world.peak_velocity()));
+      }
+      if (boundary.structure_changed) {
+        const Entities* entities = options.control->entities();
+        RBSIM_ASSERT(entities != nullptr, "a hook that changes the structure names what it holds");
+        for (Sink* sink : sinks_) {
+          if (Status st = sink->restructure(world, *entities); !st) return st.error();
+        }
       }
       if (boundary.timeline_changed) {
         for (Sink* sink : sinks_) sink->rebase(world);

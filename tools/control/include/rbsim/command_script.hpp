@@ -13,6 +13,13 @@
 //   - {step: 902, stop_stepping: true}   end the `steps` under way there (SimulateSteps' cancel)
 //   - {step: 905, resume: true}
 //   - {step: 1000, reset: true}    back to step 0 with the run's initial parameters
+//   - {step: 200, spawn: {file: crate.xml, name: crate, x: [1, 2], theta: 0.5}}
+//                                  a body from a fragment (rbsim/scene.hpp's parse_fragment; `file`
+//                                  relative to the script's folder and read now, or its text as
+//                                  `resource`), its centre of mass at x, rotated by theta;
+//                                  allow_renaming: true takes crate_1, ... when the name was used
+//   - {step: 300, delete: crate}   a body by name (a scene's: body_<index>) and its springs
+//   - {step: 400, reset_spawned: true}   every spawned body and spring removed
 //
 // Each entry names its boundary by `step` (an integer in [0, run steps): a command at step k acts
 // on the steps after k) or `t` (seconds >= 0: the first step whose time is at or after t, as

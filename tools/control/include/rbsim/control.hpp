@@ -17,6 +17,9 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
+#include <set>
 #include <future>
 #include <mutex>
 #include <optional>
@@ -35,6 +38,8 @@ namespace rbsim::control {
 
 // StopStepping ends a `step N` in progress at its boundary, the run staying paused there (the
 // SimulateSteps action's cancel; a Pause leaves the stepping alone); not stepping, it does nothing.
+// Spawn, Delete and ResetSpawned change the world's structure (simulation_interfaces' SpawnEntity,
+// DeleteEntity and ResetSimulation with SCOPE_SPAWNED); see SpawnArgs.
 enum class CommandKind : std::uint8_t {
   SetParameters,
   Pause,
@@ -43,10 +48,13 @@ enum class CommandKind : std::uint8_t {
   Reset,
   Impulse,
   SetState,
-  StopStepping
+  StopStepping,
+  Spawn,
+  Delete,
+  ResetSpawned
 };
 // "set_parameters", "pause", "resume", "step", "reset", "apply_impulse", "set_entity_state",
-// "stop_stepping"
+// "stop_stepping", "spawn_entity", "delete_entity", "reset_spawned"
 const char* to_string(CommandKind kind);
 
 // A linear impulse J (N s, world axes) at the point p (m, body frame, relative to the centre of
@@ -70,6 +78,33 @@ struct StateArgs {
   double omega = 0.0;
 };
 
+// A body spawned from a fragment (rbsim/scene.hpp's parse_fragment; its text is what a recording
+// keeps, so a re-run needs no file). The body's centre of mass goes to `position` with theta =
+// `theta` (the fragment's own frame rotated by theta), moving with the fragment's velocity and
+// spin as written (world axes); its springs join it to the bodies they name. The name is `name`
+// when given and never used before in the session; otherwise, with `allow_renaming` (or when
+// empty), the first of name_1, name_2, ... ("entity" when empty) never used before. A name once
+// used, even by a deleted body, is never given again.
+struct SpawnArgs {
+  std::string resource;  // the fragment's XML text
+  std::string uri;       // where the text came from, as the request gave it (for messages only)
+  std::string name;      // the full name asked for ("ns/name"), checked by the caller's rules
+  bool allow_renaming = false;
+  Vec2 position{0.0, 0.0};
+  double theta = 0.0;
+  // The fragment already parsed off the loop's thread (a service's), from `resource`; null: the
+  // controller parses `resource` when the command applies (a re-run).
+  std::shared_ptr<const Fragment> fragment;
+};
+
+// Why a command was refused, where a caller answers differently (simulation_interfaces' codes).
+enum class Refusal : std::uint8_t {
+  Other,
+  NameTaken,     // spawn: the name is in use or was used, and renaming is not allowed
+  NoSuchEntity,  // delete, or a spring naming a body: no body of that name
+  BadResource,   // spawn: the fragment does not parse
+};
+
 // One control input as data (issue 23 records these as rbsim_msgs/msg/Command).
 struct Command {
   static constexpr std::int64_t kNextStep = -1;
@@ -85,6 +120,8 @@ struct Command {
                                       // paused until a Resume); wall time only, never the run
   ImpulseArgs impulse;                // Impulse
   StateArgs state;                    // SetState
+  SpawnArgs spawn;                    // Spawn
+  std::string entity;                 // Delete: the body's name
   std::string source;                 // "ros2 service", "foxglove", "script", ...
 };
 
@@ -110,6 +147,14 @@ struct CommandResult {
   // returns parameters to their initial values) and request order otherwise; `paused` for a pause
   // or resume that changed it. What /parameter_events and Foxglove's parameter updates report.
   std::vector<Parameter> changed;
+  // Parameters that came or went with a structural change (a spawned body's springs): what
+  /// /parameter_events reports as new and deleted.
+  std::vector<Parameter> added;
+  std::vector<std::string> removed;
+  Refusal refusal = Refusal::Other;  // when not successful
+  std::string entity;                // Spawn: the name given; Delete: the name deleted
+  std::int32_t body_id = -1;         // Spawn, Delete: the body's id (msgs' BodyState.id)
+  std::vector<std::int32_t> removed_springs;  // Delete, ResetSpawned: the ids of the springs that went
 };
 
 // For the end line: calls answered (commands applied or refused, and reads) and parameters
@@ -153,6 +198,10 @@ class Controller final : public StepHook, public Steering {
   std::future<CommandResult> submit(Command command);
   // Same; `done` runs on the run loop's thread (or the closing one) and must not block.
   void submit(Command command, std::function<void(const CommandResult&)> done) override;
+  // The body names (spawned bodies' own, "body_<id>" for the scene's), on the loop's thread only:
+  // inside a read(). A body's id, or nullopt.
+  std::optional<std::int32_t> find_entity(std::string_view name) const;
+  std::string entity_name(std::int32_t id) const;
   // Reads as of the last boundary (rcl_interfaces' get, describe, get_types, list). An unknown
   // name gives nullopt or NotSet; rclcpp's services answer an empty list when any name is
   // undeclared. list() keeps the table's order (rclcpp's is alphabetical, from its std::map).
@@ -194,6 +243,10 @@ class Controller final : public StepHook, public Steering {
 
   // ---- The run loop's thread (StepHook).
   void start(World& world) override;
+  // Spawn, delete and reset_spawned apply only where every output follows (refused otherwise,
+  // naming why).
+  void outputs_follow_structure(bool yes) override { structure_allowed_ = yes; }
+  const Entities* entities() const override { return &entities_; }
   Boundary boundary(World& world, bool (*stop)()) override;
 
  private:
@@ -210,6 +263,16 @@ class Controller final : public StepHook, public Steering {
   CommandResult set_parameters(const Command& command, World& world, Boundary& boundary);
   CommandResult impulse(const Command& command, World& world);
   CommandResult set_state(const Command& command, World& world);
+  // The living world (src/living_world.cpp).
+  CommandResult spawn(const Command& command, World& world);
+  CommandResult remove(const Command& command, World& world);
+  CommandResult reset_spawned(World& world);
+  // Removes body `dense` and its springs from the world and from entities_.
+  Status remove_dense(World& world, std::int32_t dense, std::vector<std::int32_t>& removed_springs);
+  // The session's state after a new world (a reset, a pass's start): ids continued, spawned
+  // bodies forgotten (their names stay used).
+  void renew(World& world, std::int32_t next_body_id, std::int32_t next_spring_id);
+  void follow_structure(const World& world, CommandResult* r);
   void settings_changed(Boundary& boundary);
   // Applies one command now (from the schedule, or a timed pause's own resume): result, counters,
   // observer and callback.
@@ -250,7 +313,16 @@ class Controller final : public StepHook, public Steering {
   std::optional<std::chrono::steady_clock::time_point> resume_at_;  // a timed pause's end
   std::function<void(const RunSettings&)> settings_listener_;
   std::vector<std::function<void(const Command&, const CommandResult&)>> observers_;
+  // Spawned bodies and springs by id, and every name ever given in the session.
+  std::map<std::int32_t, std::string> spawned_names_;
+  std::map<std::string, std::int32_t, std::less<>> spawned_ids_;
+  std::set<std::int32_t> spawned_springs_;
+  std::set<std::string, std::less<>> used_names_;
+  Entities entities_;  // the world's names and colours, in its dense order
+  bool structure_edited_ = false;  // a spawn or delete since the world was made
+  std::int32_t next_body_id_ = 0, next_spring_id_ = 0;  // the session's, across worlds
   bool end_when_idle_ = false;
+  bool structure_allowed_ = false;
   std::optional<std::int64_t> ended_paused_;
 };
 

@@ -132,6 +132,11 @@ class ParameterTable {
   void store(std::size_t i, const ParameterValue& value) { entries_[i].value = value; }
   // Values read again from a world and settings (after a reset, a new pass).
   void refresh(const World& world, const RunSettings& settings);
+  // After bodies or springs were added or removed (or the world made again): the `bodies` and
+  // `springs` counts read again, and one `springs.<id>.k|l0` pair per spring the world now has,
+  // named by its id (a scene's springs keep their file index), in spring order, last in the table.
+  // The names that appeared go to `added` (with their values), the ones that went to `removed`.
+  void follow_structure(const World& world, std::vector<Parameter>* added, std::vector<std::string>* removed);
   // rclcpp's list_parameters: names under any of `prefixes` (all when empty), at most `depth`
   // levels of '.' below the prefix (kDepthRecursive: any), and the prefixes of those names.
   ListParametersResult list(const std::vector<std::string>& prefixes, std::uint64_t depth) const;
@@ -143,6 +148,7 @@ class ParameterTable {
     ParameterTarget target;
   };
   void add(ParameterDescriptor descriptor, ParameterValue value, ParameterTarget target);
+  void add_spring(std::int32_t id, std::size_t index, const SpringDef& spring);
   std::vector<Entry> entries_;
   // Name -> index: a lookup stays O(log n) however many names a request (or a client) sends.
   std::map<std::string, std::size_t, std::less<>> index_;

@@ -121,7 +121,13 @@ struct CommandMessage {
     // its values in `parameters` (x, y, theta; vx, vy, omega) and its body in `body`.
     SetEntityState = 6,
     // Not a constant of Command.msg either: stop_stepping (a SimulateSteps cancel), no arguments.
-    StopStepping = 7
+    StopStepping = 7,
+    // Nor these, the living world's: spawn_entity (its arguments as named parameters: the
+    // fragment's text `resource`, `uri`, `name`, `allow_renaming`, the pose `x`, `y`, `theta`),
+    // delete_entity (`name`) and reset_spawned (none).
+    SpawnEntity = 8,
+    DeleteEntity = 9,
+    ResetSpawned = 10
   };
   std::uint64_t seq = 0;  // the sequence number (`sequence` is an IDL keyword)
   std::uint64_t step = 0;

@@ -37,10 +37,17 @@ class StepHook {
     bool state_changed = false;     // parameters, velocities or the whole world changed: the
                                     // divergence check's cached bounds are read again
     bool timeline_changed = false;  // resumed, reset or re-paced: every sink's rebase() is called
+    bool structure_changed = false;  // bodies or springs came or went (World::add_body, remove_body)
     bool stop = false;              // a stop request arrived while paused: the pass ends (Stopped)
   };
   // A pass starts (Driver::run), on the world it will step.
   virtual void start(World& world) = 0;
+  // Told before start(): whether every output of the run follows a world whose bodies and springs
+  // change (Sink::follows_structure). A hook that changes them refuses to where they do not.
+  virtual void outputs_follow_structure(bool yes) { (void)yes; }
+  // The names and colours of the world's bodies and springs as they stand, after a boundary that
+  // changed them (Boundary::structure_changed); nullptr from a hook that never does.
+  virtual const Entities* entities() const { return nullptr; }
   // Before `world` takes its next step. May change the world between steps (a parameter, an
   // impulse, a reset to step 0) and may block while the run is paused, in bounded waits that
   // poll `stop` (may be null).

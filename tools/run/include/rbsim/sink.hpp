@@ -23,6 +23,16 @@ class Sink {
   // resumed after a pause, was reset to step 0, or its pace changed. A sink that paces to wall time
   // starts afresh from `world`'s step (node::Pacer); the others ignore it.
   virtual void rebase(const World& world) { (void)world; }
+  // Bodies or springs came or went at this boundary (a spawn or delete, rbsim/control.hpp): the
+  // world's dense arrays now hold `entities`' bodies and springs, in that order. A sink whose
+  // output follows says so in follows_structure() and, in restructure(), writes what the changed
+  // world needs before its next step; a run whose sinks do not all follow refuses such changes.
+  virtual bool follows_structure() const { return false; }
+  [[nodiscard]] virtual Status restructure(const World& world, const Entities& entities) {
+    (void)world;
+    (void)entities;
+    return Error{"this output cannot follow a world whose bodies change"};
+  }
 };
 
 // One row per body per step, columns kBodyCsvColumns (rbsim/csv.hpp), every value printed in

@@ -1,0 +1,26 @@
+// The cold data of a world's bodies and springs: names and colours (rbsim/scene.hpp's Entities).
+#include <string>
+
+#include "rbsim/scene.hpp"
+
+namespace rbsim {
+
+Color default_spring_color() {
+  return {0.25, 0.25, 0.25};
+}
+
+std::string scene_body_name(std::int32_t id) {
+  return "body_" + std::to_string(id);
+}
+
+Entities entities_of(const Scene& scene) {
+  Entities e;
+  const auto n = static_cast<std::int32_t>(scene.world.bodies.size());
+  e.body_names.reserve(static_cast<std::size_t>(n));
+  for (std::int32_t b = 0; b < n; ++b) e.body_names.push_back(scene_body_name(b));
+  e.body_colors = scene.body_colors;
+  e.spring_colors = scene.spring_colors;
+  return e;
+}
+
+}  // namespace rbsim
