@@ -1,7 +1,9 @@
 // FOSSSim-style XML scenes: loading, validation with located errors, and the scene's cold data
-// (names, colours, viewport) that the dynamics never touch.
+// (names, colours, viewport) that the dynamics never touch; and spawnable fragments, one body in
+// the same dialect.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -63,5 +65,56 @@ Result<Scene> parse_scene(std::string_view text, const std::string& path);
 
 // The default colour of body `index` when the scene gives none (a fixed palette).
 Color default_body_color(std::int32_t index);
+
+// A spawnable fragment: FOSSSim scene XML describing ONE body to add to a running world
+// (simulation_interfaces' SpawnEntity resource). Read by the scene loader's own element and
+// attribute rules, with errors worded as load_scene's ("<file>:<line>: <node> attribute 'a': rule").
+//   - The root is <scene> (another: "<robot>: a fragment's root must be <scene>").
+//   - <rigidbodyvertex x y m>: indices local to the fragment, from 0; each vertex on the body's hull.
+//   - Exactly one <rigidbody p... vx vy omega r> (none, or a second, refused at its line).
+//   - <rigidbodyspringforce pix piy pjx pjy k l0> with each end either `i`/`j` (0 = the fragment's
+//     body, -1 = fixed in space, nothing else) or `ibody`/`jbody`, the name (not blank) of a body of
+//     the running world (never both; the parser records the name, the world resolves it).
+//   - <rigidbodycolor body="0" r g b>, <rigidbodyspringcolor spring="k" r g b> (k indexes the
+//     fragment's springs), <description text> (once).
+//   - Scene-wide elements (simtype, duration, maxsimfreq, viewport, backgroundcolor, scenetag,
+//     rigidbodyintegrator, rigidbodygravityforce, rigidbodywindforce) refused at their line;
+//     unknown nodes and attributes are warnings, as in scenes.
+//   - FragmentLimits: text over max_bytes refused before parsing; the first vertex or spring over
+//     its limit refused at its line. Degenerate bodies are refused as in scenes.
+// Any text gives a Fragment or an Error (it is network input).
+struct FragmentLimits {
+  std::size_t max_bytes = 1 << 20;  // text size
+  std::int32_t max_vertices = 10000;
+  std::int32_t max_springs = 1000;
+};
+
+struct FragmentSpringEnd {
+  enum class Kind : std::uint8_t { Self, Fixed, Named };
+  Kind kind = Kind::Fixed;
+  std::string body;       // Kind::Named: the name of an existing body of the running world
+  Vec2 anchor{0.0, 0.0};  // body space (relative to that body's centre of mass), or a world point if Fixed
+};
+
+struct FragmentSpring {
+  FragmentSpringEnd end_i, end_j;
+  double stiffness = 0, rest_length = 0;
+  std::optional<Color> color;  // <rigidbodyspringcolor>
+};
+
+struct Fragment {
+  std::string path;         // as given (names the source in messages)
+  std::string description;  // <description text=...>, optional
+  // hull = the fragment's vertex positions as written (fragment-local coordinates), in the
+  // <rigidbody>'s p order, with their masses; velocity, omega, radius
+  BodyDef body;
+  std::optional<Color> color;           // <rigidbodycolor body="0">
+  std::vector<FragmentSpring> springs;  // in file order
+  std::vector<std::string> warnings;    // as Scene::warnings
+};
+
+// Parses and validates a fragment; `path` only names the source in messages.
+Result<Fragment> parse_fragment(std::string_view text, const std::string& path,
+                                const FragmentLimits& limits = {});
 
 }  // namespace rbsim
