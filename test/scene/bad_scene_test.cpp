@@ -163,6 +163,8 @@ const InlineBad kInline[] = {
      "inline.xml:5: <rigidbodyvertex> attribute 'x': must be a number (got \"1\\n2\")"},
     {"negative_value_after_newline", HEAD "<rigidbodyvertex x=\"1\" y=\"0\" m=\"\n\t-1\"/>\n</scene>",
      "inline.xml:5: <rigidbodyvertex> attribute 'm': must be > 0 (got \\n\\t-1)"},
+    {"xml_declaration_spanning_lines", "<scene>\n<?xml a\nb?>\n</scene>",
+     "inline.xml:2: not well-formed XML: XML_ERROR_PARSING_DECLARATION (XMLDeclaration value=xml a\\nb)"},
     {"simtype_twice", "<scene>\n<simtype type=\"rigid-body\"/>\n<simtype type=\"rigid-body\"/>\n</scene>",
      "inline.xml:3: <simtype>: node may appear only once (first at line 2)"},
 };

@@ -1,7 +1,9 @@
 // FOSSSim-style XML scenes: loading, validation with located errors, and the scene's cold data
-// (names, colours, viewport) that the dynamics never touch.
+// (names, colours, viewport) that the dynamics never touch; and spawnable fragments, one body in
+// the same dialect.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -71,7 +73,7 @@ Color default_body_color(std::int32_t index);
 //   - <rigidbodyvertex x y m>: indices local to the fragment, from 0; each vertex on the body's hull.
 //   - Exactly one <rigidbody p... vx vy omega r> (none, or a second, refused at its line).
 //   - <rigidbodyspringforce pix piy pjx pjy k l0> with each end either `i`/`j` (0 = the fragment's
-//     body, -1 = fixed in space, nothing else) or `ibody`/`jbody`, the non-empty name of a body of
+//     body, -1 = fixed in space, nothing else) or `ibody`/`jbody`, the name (not blank) of a body of
 //     the running world (never both; the parser records the name, the world resolves it).
 //   - <rigidbodycolor body="0" r g b>, <rigidbodyspringcolor spring="k" r g b> (k indexes the
 //     fragment's springs), <description text> (once).
@@ -106,13 +108,14 @@ struct Fragment {
   // hull = the fragment's vertex positions as written (fragment-local coordinates), in the
   // <rigidbody>'s p order, with their masses; velocity, omega, radius
   BodyDef body;
-  std::optional<Color> color;            // <rigidbodycolor body="0">
-  std::vector<FragmentSpring> springs;   // in file order
-  std::vector<std::string> warnings;     // as Scene::warnings
+  std::optional<Color> color;           // <rigidbodycolor body="0">
+  std::vector<FragmentSpring> springs;  // in file order
+  std::vector<std::string> warnings;    // as Scene::warnings
 };
 
 // Parses and validates a fragment; `path` only names the source in messages.
-Result<Fragment> parse_fragment(std::string_view text, const std::string& path, const FragmentLimits& limits = {});
+Result<Fragment> parse_fragment(std::string_view text, const std::string& path,
+                                const FragmentLimits& limits = {});
 
 // The spring colour of a scene that gives none.
 Color default_spring_color();
