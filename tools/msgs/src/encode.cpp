@@ -49,8 +49,8 @@ void pose(CdrWriter& w, double x, double y, double theta) {
   quaternion(w, theta);
 }
 
-// The fields of a visualization_msgs/Marker up to its points (action ADD, identity pose,
-// lifetime 0 = forever).
+// The fields of a visualization_msgs/Marker up to its points (action ADD unless said, identity
+// pose, lifetime 0 = forever).
 struct MarkerHead {
   Time stamp;
   std::string_view frame, ns;
@@ -58,13 +58,15 @@ struct MarkerHead {
   double sx = 1.0, sy = 1.0, sz = 1.0;  // scale: line width in x for lines, diameter for spheres
   Color color;
   bool frame_locked = false;
+  std::int32_t action = 0;  // ADD
 };
+constexpr std::int32_t kMarkerDeleteAll = 3;
 void marker_head(CdrWriter& w, const MarkerHead& m) {
   w.header(m.stamp, m.frame);
   w.string(m.ns);
   w.i32(m.id);
   w.i32(m.type);
-  w.i32(0);  // ADD
+  w.i32(m.action);
   pose(w, 0.0, 0.0, 0.0);
   w.f64(m.sx);
   w.f64(m.sy);
@@ -97,10 +99,14 @@ Quaternion quaternion_z(double theta) {
   return Quaternion{0.0, 0.0, std::sin(0.5 * theta), std::cos(0.5 * theta)};
 }
 
-std::string body_frame(std::string_view ns, std::int32_t index) {
+std::string body_frame(std::string_view ns, std::string_view name) {
   while (ns.starts_with('/')) ns.remove_prefix(1);
   while (ns.ends_with('/')) ns.remove_suffix(1);
-  return (ns.empty() ? std::string() : std::string(ns) + "/") + "body_" + std::to_string(index);
+  return (ns.empty() ? std::string() : std::string(ns) + "/") + std::string(name);
+}
+
+std::string body_frame(std::string_view ns, std::int32_t index) {
+  return body_frame(ns, scene_body_name(index));
 }
 
 // Ear clipping on the counter-clockwise vertex order: cut off a convex corner whose triangle
@@ -178,12 +184,17 @@ Time sim_time(const World& world) {
   return sim_time(world.step_index(), world.dt());
 }
 
-Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene) {
-  frames_.reserve(scene.world.bodies.size());
-  for (std::size_t b = 0; b < scene.world.bodies.size(); ++b) {
-    frames_.push_back(body_frame(ns, static_cast<std::int32_t>(b)));
-  }
-  const auto& colors = scene.spring_colors;
+Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene), ns_(ns) {
+  restructure(entities_of(scene));
+}
+
+void Encoder::restructure(const Entities& entities) {
+  entities_ = entities;
+  frames_.clear();
+  frames_.reserve(entities.body_names.size());
+  for (const std::string& name : entities.body_names) frames_.push_back(body_frame(ns_, name));
+  const auto& colors = entities.spring_colors;
+  spring_color_.reset();
   if (!colors.empty() &&
       std::all_of(colors.begin(), colors.end(), [&](const Color& c) { return c == colors.front(); })) {
     spring_color_ = colors.front();
@@ -206,7 +217,7 @@ void Encoder::scene(const World& world, Bytes& out) const {
     w.f64(world.mass(id));
     w.f64(world.inertia(id));
     w.f64(world.radius(id));
-    color(w, s.body_colors[b]);
+    color(w, entities_.body_colors[b]);
     const auto hull = world.hull(id);
     w.sequence_length(hull.size());
     for (const Vec2& v : hull) vector2(w, v);
@@ -220,7 +231,7 @@ void Encoder::scene(const World& world, Bytes& out) const {
     vector2(w, sp.anchor_j);
     w.f64(sp.stiffness);
     w.f64(sp.rest_length);
-    color(w, s.spring_colors[k]);
+    color(w, entities_.spring_colors[k]);
   }
   w.sequence_length(world.gravity().size());
   for (const GravityDef& g : world.gravity()) vector2(w, g.acceleration);
@@ -244,7 +255,7 @@ void Encoder::body_states(const World& world, Bytes& out) const {
   w.u64(static_cast<std::uint64_t>(world.step_index()));
   w.sequence_length(static_cast<std::size_t>(world.body_count()));
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
-    w.i32(b);
+    w.i32(world.body_id(BodyId{b}));
     for (double v :
          {world.x()[b], world.y()[b], world.theta()[b], world.vx()[b], world.vy()[b], world.omega()[b]}) {
       w.f64(v);
@@ -259,7 +270,7 @@ void Encoder::spring_states(const World& world, Bytes& out) const {
   w.sequence_length(static_cast<std::size_t>(world.spring_count()));
   for (std::int32_t k = 0; k < world.spring_count(); ++k) {
     const SpringState st = world.spring_state(SpringId{k});
-    w.i32(k);
+    w.i32(world.spring_id(SpringId{k}));
     vector2(w, st.end_i);
     vector2(w, st.end_j);
     w.f64(st.length);
@@ -276,7 +287,7 @@ void Encoder::energy(const World& world, Bytes& out) const {
   w.sequence_length(static_cast<std::size_t>(world.body_count()));
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     const BodyQuantities q = world.quantities(BodyId{b});
-    w.i32(b);
+    w.i32(world.body_id(BodyId{b}));
     vector2(w, q.momentum);
     w.f64(q.l_point);
     w.f64(q.l_spin);
@@ -302,7 +313,7 @@ void Encoder::energy(const World& world, Bytes& out) const {
   for (std::int32_t k = 0; k < world.spring_count(); ++k) {
     const double u = world.spring_state(SpringId{k}).potential;
     w.u8(1);
-    w.i32(k);
+    w.i32(world.spring_id(SpringId{k}));
     w.f64(u);
     potential += u;
   }
@@ -342,7 +353,6 @@ void Encoder::tf(const World& world, Bytes& out) const {
 // has the same colour, it is the marker's `color` and `colors` is empty (viewers then draw every
 // vertex in `color`): 32 bytes less per spring and step.
 void Encoder::springs(const World& world, Bytes& out) const {
-  const Scene& s = *scene_;
   CdrWriter w(out);
   marker_head(w, {sim_time(world), kFrame, "springs", 0, kMarkerLineList, kSpringWidth, 0.0, 0.0,
                   spring_color_.value_or(kSpringGrey), false});
@@ -355,8 +365,8 @@ void Encoder::springs(const World& world, Bytes& out) const {
   }
   w.sequence_length(spring_color_ ? 0 : 2 * n);
   for (std::int32_t k = 0; !spring_color_ && k < world.spring_count(); ++k) {
-    color(w, s.spring_colors[k]);
-    color(w, s.spring_colors[k]);
+    color(w, entities_.spring_colors[k]);
+    color(w, entities_.spring_colors[k]);
   }
   marker_rest(w);
 }
@@ -366,7 +376,6 @@ void Encoder::springs(const World& world, Bytes& out) const {
 // the same colour, which together cover the hull grown by the radius r as tools/render draws it.
 // Then one SPHERE_LIST in "world" marking the springs' fixed anchors, in the springs' colours.
 void Encoder::markers(const World& world, Bytes& out) const {
-  const Scene& s = *scene_;
   const Time stamp = sim_time(world);
   std::vector<Vec2> anchors;
   std::vector<Color> anchor_colors;
@@ -376,24 +385,35 @@ void Encoder::markers(const World& world, Bytes& out) const {
          {std::pair{sp.body_i, sp.anchor_i}, std::pair{sp.body_j, sp.anchor_j}}) {
       if (body != kFixed) continue;
       anchors.push_back(anchor);
-      anchor_colors.push_back(s.spring_colors[k]);
+      anchor_colors.push_back(entities_.spring_colors[k]);
     }
   }
   CdrWriter w(out);
-  w.sequence_length(2 * static_cast<std::size_t>(world.body_count()) + (anchors.empty() ? 0 : 1));
+  // After a change the array starts with a DELETEALL (action 3), which drops every marker a viewer
+  // holds from this topic before the world's markers as they now stand.
+  const bool delete_all = entities_.epoch > 0;
+  w.sequence_length((delete_all ? 1 : 0) + 2 * static_cast<std::size_t>(world.body_count()) +
+                    (anchors.empty() ? 0 : 1));
+  if (delete_all) {
+    marker_head(w, {stamp, kFrame, "", 0, kMarkerLineStrip, 1.0, 1.0, 1.0, kSpringGrey, false, kMarkerDeleteAll});
+    w.sequence_length(0);
+    w.sequence_length(0);
+    marker_rest(w);
+  }
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     const BodyId id{b};
+    const std::int32_t marker = world.body_id(id);  // a body keeps its markers' ids across changes
     const std::string& frame = frames_[static_cast<std::size_t>(b)];
     const auto hull = world.hull(id);
-    const Color c = s.body_colors[b];
-    marker_head(w, {stamp, frame, "hulls", b, kMarkerTriangleList, 1.0, 1.0, 1.0, c, true});
+    const Color c = entities_.body_colors[b];
+    marker_head(w, {stamp, frame, "hulls", marker, kMarkerTriangleList, 1.0, 1.0, 1.0, c, true});
     const std::vector<std::uint32_t> triangles = triangulate(hull);
     w.sequence_length(triangles.size());
     for (const std::uint32_t i : triangles) point(w, hull[i]);
     w.sequence_length(0);  // colors: the marker's
     marker_rest(w);
-    marker_head(w,
-                {stamp, frame, "outlines", b, kMarkerLineStrip, 2.0 * world.radius(id), 0.0, 0.0, c, true});
+    marker_head(w, {stamp, frame, "outlines", marker, kMarkerLineStrip, 2.0 * world.radius(id), 0.0, 0.0, c,
+                    true});
     w.sequence_length(hull.size() + 1);
     for (const Vec2& v : hull) point(w, v);
     point(w, hull.front());
@@ -461,6 +481,11 @@ const Bytes& StepMessages::get(TopicId id, const World& world) {
     step_[i] = world.step_index();
   }
   return bytes_[i];
+}
+
+void StepMessages::restructure(const Entities& entities) {
+  encoder_.restructure(entities);
+  step_.fill(-1);
 }
 
 }  // namespace rbsim::msgs

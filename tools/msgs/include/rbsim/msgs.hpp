@@ -207,6 +207,8 @@ std::vector<std::uint32_t> triangulate(std::span<const Vec2> polygon);
 
 // The TF frame of body `index` in namespace `ns`: "rbsim/body_3" (no leading slash, as tf2 wants).
 std::string body_frame(std::string_view ns, std::int32_t index);
+// The frame of a body by name (a spawned body's own, scene_body_name(id) for a scene's): ns/name.
+std::string body_frame(std::string_view ns, std::string_view name);
 
 // Encodes the messages of one step into reused buffers: after the first step of a world, no
 // per-step call allocates. The frame id of every header is "world", but for the body shapes,
@@ -227,10 +229,16 @@ class Encoder {
   void markers(const World& world, Bytes& out) const;
   void clock(const World& world, Bytes& out) const;  // rosgraph_msgs/msg/Clock: encode_clock
   void encode(TopicId id, const World& world, Bytes& out) const;
+  // The world's bodies or springs changed (Sink::restructure): their names and colours from now on.
+  // The ids messages carry are the world's (World::body_id); after a change (epoch > 0) the
+  // markers start with a DELETEALL, so a viewer drops the bodies that went.
+  void restructure(const Entities& entities);
 
  private:
   const Scene* scene_;
-  std::vector<std::string> frames_;  // body_frame(ns, i) per body
+  std::string ns_;
+  Entities entities_;
+  std::vector<std::string> frames_;  // body_frame(ns, name) per body
   // Every spring's colour when they all share one: the springs marker then carries it once.
   std::optional<Color> spring_color_;
 };
@@ -246,6 +254,8 @@ class StepMessages {
  public:
   explicit StepMessages(const Scene& scene, std::string_view ns = "rbsim");
   const Bytes& get(TopicId id, const World& world);
+  // The world's bodies or springs changed at this step: what was encoded for it is stale.
+  void restructure(const Entities& entities);
 
  private:
   Encoder encoder_;
