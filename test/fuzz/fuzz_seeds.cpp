@@ -19,14 +19,15 @@ int fail(const std::string& m) {
   return 1;
 }
 
-// Each interface type empty, and the parameter messages with every kind of field filled.
+// Each interface type empty, the parameter messages with every kind of field filled, and
+// simulation_interfaces' spawning and world types with sequences of nested messages.
 void interface_seeds(const std::filesystem::path& dir) {
   namespace m = rbsim::msgs;
   std::filesystem::create_directories(dir);
   int n = 0;
   const auto write = [&](std::size_t index, const auto& message) {
     rbsim::Bytes bytes;
-    m::encode(message, bytes);
+    encode(message, bytes);  // msgs' or simulation's: argument-dependent lookup
     std::ofstream f(dir / (std::to_string(n++) + "-" + std::to_string(index)), std::ios::binary);
     f.put(static_cast<char>(index));
     f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
@@ -52,6 +53,23 @@ void interface_seeds(const std::filesystem::path& dir) {
   write(5, e);
   write(10, m::SetParametersRequest{{{"rate", v}, {"paused", {}}}});
   write(15, m::DescribeParametersResponse{{d}});
+  // simulation_interfaces' nested sequences, filled.
+  namespace sim = m::simulation;
+  using rbsim::fuzz::interface_index;
+  const sim::Resource resource{"file:///models/cart.sdf", "<sdf/>"};
+  const sim::WorldResource world{"warehouse", resource, "indoor", {"indoor", "small"}};
+  const sim::PoseStamped pose{{1, 2}, "map", {1.0, 2.0, 0.0}, m::quaternion_z(0.5)};
+  write(interface_index<sim::SpawnEntitiesRequest>(),
+        sim::SpawnEntitiesRequest{{{"cart", true, resource, "/fleet", pose}, {}}});
+  write(interface_index<sim::SpawnEntitiesResponse>(),
+        sim::SpawnEntitiesResponse{{150, "one failed"}, {{{101, "taken"}, "cart"}, {}}});
+  write(interface_index<sim::GetSpawnablesResponse>(),
+        sim::GetSpawnablesResponse{{1, ""}, {{resource, "cart", {1, {{1, 1, 1}, {-1, -1, 0}}}}}});
+  write(interface_index<sim::GetAvailableWorldsRequest>(),
+        sim::GetAvailableWorldsRequest{{"https://worlds"}, {{"indoor"}, 1}, true, true});
+  write(interface_index<sim::GetAvailableWorldsResponse>(),
+        sim::GetAvailableWorldsResponse{{1, ""}, {world, {}}});
+  write(interface_index<sim::LoadWorldResponse>(), sim::LoadWorldResponse{{1, ""}, world});
 }
 }  // namespace
 

@@ -6,6 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+
+#include "rbsim/type_hash.hpp"
+#include "spawn_world_samples.hpp"
 
 namespace rbsim::msgs::simulation {
 namespace {
@@ -141,6 +149,178 @@ TEST(SimulationInterfacesCodec, TruncatedOrHostileBytesAreErrorsNamingTheType) {
            std::byte{1}, std::byte{0}, std::byte{0}, std::byte{0}};
   StepSimulationRequest step;
   EXPECT_FALSE(decode(be, step).ok());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spawning, deleting and worlds: every type filled (spawn_world_samples.hpp).
+
+TEST(SimulationInterfacesCodec, SpawnAndWorldTypesRoundTripEveryField) {
+  std::size_t n = 0;
+  for_each_spawn_and_world_type([&]<class T>(const T& m, std::string_view half) {
+    SCOPED_TRACE(rosidl_name<T>(half));
+    EXPECT_EQ(round_trip(m), m);
+    EXPECT_EQ(round_trip(T{}), T{});
+    ++n;
+  });
+  EXPECT_EQ(n, 6u + 8u * 2u);
+  // The fields a whole comparison could hide: the bools apart, the pose's every value.
+  const LoadWorldRequest load = round_trip(LoadWorldRequest{{"u", "s"}, true, false});
+  EXPECT_TRUE(load.fail_on_unsupported_element);
+  EXPECT_FALSE(load.ignore_missing_or_unsupported_assets);
+  const SpawnEntitiesRequest spawns = round_trip(SpawnEntitiesRequest{{some_spawn()}});
+  ASSERT_EQ(spawns.spawn_requests.size(), 1u);
+  EXPECT_EQ(spawns.spawn_requests[0].initial_pose.frame_id, "map");
+  EXPECT_EQ(spawns.spawn_requests[0].initial_pose.orientation, quaternion_z(0.5));
+  EXPECT_TRUE(spawns.spawn_requests[0].allow_renaming);
+}
+
+// The names kType and kService are definitions rbsim ships, and each type's REP 2011 hash is the
+// one rosbags computes (test/msgs/data/rihs01_rosbags.txt, checked against rosbags itself by
+// test/python/check_type_hashes.py); a service's endpoints carry its halves' hashes.
+TEST(SimulationInterfacesCodec, SpawnAndWorldTypeHashesMatchRosbags) {
+  std::ifstream in(std::filesystem::path(RBSIM_TEST_MSG_DATA) / "rihs01_rosbags.txt");
+  ASSERT_TRUE(in) << "test/msgs/data/rihs01_rosbags.txt";
+  std::map<std::string, std::string, std::less<>> table;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string type, hash;
+    if (words >> type >> hash) table[type] = hash;
+  }
+  const auto expect_hash = [&](const std::string& type) {
+    SCOPED_TRACE(type);
+    const auto it = table.find(type);
+    ASSERT_NE(it, table.end());
+    EXPECT_TRUE(it->second.starts_with("RIHS01_"));
+    const auto h = type_hash(type);
+    ASSERT_TRUE(h.ok()) << h.error().message;
+    EXPECT_EQ(h.value(), it->second);
+  };
+  for_each_spawn_and_world_type([&]<class T>(const T&, std::string_view half) {
+    expect_hash(rosidl_name<T>(half));
+    if constexpr (requires { T::kService; }) {
+      expect_hash(std::string(T::kService));
+      expect_hash(std::string(T::kService) + "_Event");
+      const auto endpoints = service_endpoint_type_hashes(T::kService);
+      ASSERT_TRUE(endpoints.ok());
+      EXPECT_EQ(half == "_Request" ? endpoints.value().request : endpoints.value().reply,
+                table.find(rosidl_name<T>(half))->second);
+    }
+  });
+  expect_hash("simulation_interfaces/msg/Bounds");      // Spawnable's
+  expect_hash("simulation_interfaces/msg/TagsFilter");  // GetAvailableWorlds'
+}
+
+// Each code is the definition's constant of that name, and every constant of those definitions
+// has its code ("uint8 NAME = value" lines, comments cut off).
+TEST(SimulationInterfacesCodec, SpawnAndWorldCodesAreTheDefinitions) {
+  const auto constants = [](std::string_view type) {
+    std::map<std::string, int, std::less<>> out;
+    std::istringstream lines{std::string(definition(type))};
+    for (std::string line; std::getline(lines, line);) {
+      std::istringstream words(line.substr(0, line.find('#')));
+      std::string kind, name, equals;
+      int value = 0;
+      if (words >> kind >> name >> equals >> value && equals == "=") {
+        EXPECT_EQ(kind, "uint8") << type << ": " << line;
+        out[name] = value;
+      }
+    }
+    return out;
+  };
+  using Codes = std::map<std::string, int, std::less<>>;
+  const auto spawn_codes = [](auto t) {
+    using T = decltype(t);
+    return Codes{{"NAME_NOT_UNIQUE", T::kNameNotUnique},
+                 {"NAME_INVALID", T::kNameInvalid},
+                 {"UNSUPPORTED_FORMAT", T::kUnsupportedFormat},
+                 {"NO_RESOURCE", T::kNoResource},
+                 {"NAMESPACE_INVALID", T::kNamespaceInvalid},
+                 {"RESOURCE_PARSE_ERROR", T::kResourceParseError},
+                 {"MISSING_ASSETS", T::kMissingAssets},
+                 {"UNSUPPORTED_ASSETS", T::kUnsupportedAssets},
+                 {"INVALID_POSE", T::kInvalidPose}};
+  };
+  using L = LoadWorldResponse;
+  const std::vector<std::pair<std::string_view, Codes>> expected = {
+      {SpawnResult::kType, spawn_codes(SpawnResult{})},
+      {SpawnEntityRequest::kService, spawn_codes(SpawnEntityResponse{})},
+      {SpawnEntitiesRequest::kService,
+       {{"ENTITIES_SPAWN_FAILED", SpawnEntitiesResponse::kEntitiesSpawnFailed}}},
+      {DeleteEntityRequest::kService, {}},
+      {GetSpawnablesRequest::kService, {}},
+      {LoadWorldRequest::kService,
+       {{"UNSUPPORTED_FORMAT", L::kUnsupportedFormat},
+        {"NO_RESOURCE", L::kNoResource},
+        {"RESOURCE_PARSE_ERROR", L::kResourceParseError},
+        {"MISSING_ASSETS", L::kMissingAssets},
+        {"UNSUPPORTED_ASSETS", L::kUnsupportedAssets},
+        {"UNSUPPORTED_ELEMENTS", L::kUnsupportedElements}}},
+      {UnloadWorldRequest::kService, {{"NO_WORLD_LOADED", UnloadWorldResponse::kNoWorldLoaded}}},
+      {GetCurrentWorldRequest::kService, {{"NO_WORLD_LOADED", GetCurrentWorldResponse::kNoWorldLoaded}}},
+      {GetAvailableWorldsRequest::kService,
+       {{"DEFAULT_SOURCES_FAILED", GetAvailableWorldsResponse::kDefaultSourcesFailed}}},
+      {"simulation_interfaces/msg/TagsFilter",
+       {{"FILTER_MODE_ANY", TagsFilter::kFilterModeAny}, {"FILTER_MODE_ALL", TagsFilter::kFilterModeAll}}},
+  };
+  for (const auto& [type, codes] : expected) {
+    SCOPED_TRACE(type);
+    ASSERT_FALSE(definition(type).empty());
+    EXPECT_EQ(constants(type), codes);
+  }
+}
+
+// Every prefix short of the data (the final padding aside) is refused naming the type; a length
+// past the data, wherever it lands, is refused or read, never a crash or a huge allocation.
+TEST(SimulationInterfacesCodec, SpawnAndWorldTruncatedOrHostileBytesAreRefused) {
+  for_each_spawn_and_world_type([&]<class T>(const T& m, std::string_view half) {
+    const std::string name = rosidl_name<T>(half);
+    SCOPED_TRACE(name);
+    Bytes cdr;
+    encode(m, cdr);
+    const std::size_t data = cdr.size() - static_cast<std::size_t>(cdr[3]);
+    // "pkg/msg/Name", or "pkg/srv/Name request" as errors name a service's half.
+    std::string named = name;
+    if constexpr (requires { T::kService; }) {
+      named = std::string(T::kService) + (half == "_Request" ? " request" : " response");
+    }
+    for (std::size_t n = 0; n < data; ++n) {
+      T out;
+      const Status st = decode(std::span<const std::byte>(cdr.data(), n), out);
+      ASSERT_FALSE(st.ok()) << n << " of " << cdr.size() << " bytes decoded";
+      EXPECT_NE(st.error().message.find(named), std::string::npos) << st.error().message;
+    }
+    for (std::size_t at = 4; at + 4 <= cdr.size(); at += 4) {
+      Bytes hostile = cdr;
+      for (std::size_t i = 0; i < 4; ++i)
+        hostile[at + i] = std::byte{i == 3 ? std::uint8_t{0x7f} : std::uint8_t{0xff}};
+      T out;
+      (void)decode(hostile, out);
+    }
+  });
+  // A count of two billion spawn requests in a short message fails before anything is allocated.
+  Bytes hostile{std::byte{0},    std::byte{1},    std::byte{0},    std::byte{0},
+                std::byte{0xff}, std::byte{0xff}, std::byte{0xff}, std::byte{0x7f}};
+  SpawnEntitiesRequest spawns;
+  const Status st = decode(hostile, spawns);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("simulation_interfaces/srv/SpawnEntities request"), std::string::npos)
+      << st.error().message;
+  EXPECT_TRUE(spawns.spawn_requests.empty());
+}
+
+// The wire layout of LoadWorld's request: two strings, then the two bools in definition order.
+TEST(SimulationInterfacesCodec, LoadWorldBytesFollowTheDefinition) {
+  Bytes cdr;
+  encode(LoadWorldRequest{{"a", ""}, false, true}, cdr);
+  // header, u32 2 "a\0" (padded to 8), u32 1 "\0", then the bools at offsets 13 and 14 of the body
+  ASSERT_EQ(cdr.size(), 4u + 16u);
+  std::uint32_t n = 0;
+  std::memcpy(&n, cdr.data() + 4, 4);
+  EXPECT_EQ(n, 2u);
+  std::memcpy(&n, cdr.data() + 12, 4);
+  EXPECT_EQ(n, 1u);
+  EXPECT_EQ(cdr[4 + 13], std::byte{0});  // fail_on_unsupported_element
+  EXPECT_EQ(cdr[4 + 14], std::byte{1});  // ignore_missing_or_unsupported_assets
 }
 
 }  // namespace

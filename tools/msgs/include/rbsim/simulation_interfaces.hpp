@@ -1,10 +1,11 @@
 // simulation_interfaces 2.1.0 (ros-simulation/simulation_interfaces, the ROS 2 standard simulator
 // interfaces Gazebo, Isaac Sim and O3DE serve) as plain structs with CDR codecs: the messages and
-// the services rbsim node serves (tools/msgs/definitions/simulation_interfaces has the .msg/.srv
-// text, their type hashes come from there). Field order and types follow those definitions; the
-// bytes are msgs.hpp's CDR, as rbsim/interfaces.hpp's codecs write them, and decode() reads
-// untrusted bytes with the same checks (every length against the bytes left before anything is
-// allocated; an error names the type and the byte offset).
+// the services rbsim node serves, and those of spawning, deleting and worlds (the .msg/.srv text
+// is in tools/msgs/definitions/simulation_interfaces, their type hashes come from there; the
+// names are kType and kService). Field order and types follow those definitions; the bytes are
+// msgs.hpp's CDR, as rbsim/interfaces.hpp's codecs write them, and decode() reads untrusted bytes
+// with the same checks (every length against the bytes left before anything is allocated; an
+// error names the type and the byte offset).
 #pragma once
 
 #include <cstddef>
@@ -109,8 +110,10 @@ struct Bounds {
 
 // simulation_interfaces/msg/TagsFilter.
 struct TagsFilter {
+  static constexpr std::uint8_t kFilterModeAny = 0;
+  static constexpr std::uint8_t kFilterModeAll = 1;
   std::vector<std::string> tags;
-  std::uint8_t filter_mode = 0;  // 0: any, 1: all
+  std::uint8_t filter_mode = kFilterModeAny;  // as received
   bool operator==(const TagsFilter&) const = default;
 };
 
@@ -143,6 +146,73 @@ struct EntityState {
   Vector3 linear_velocity, angular_velocity;
   Vector3 linear_acceleration, angular_acceleration;
   bool operator==(const EntityState&) const = default;
+};
+
+// geometry_msgs/msg/PoseStamped: header, then the pose (Point position, Quaternion orientation).
+struct PoseStamped {
+  static constexpr std::string_view kType = "geometry_msgs/msg/PoseStamped";
+  Time stamp;
+  std::string frame_id;
+  Vector3 position;
+  Quaternion orientation;
+  bool operator==(const PoseStamped&) const = default;
+};
+
+// simulation_interfaces/msg/Resource: a URI, or (uri empty) the resource's text itself.
+struct Resource {
+  static constexpr std::string_view kType = "simulation_interfaces/msg/Resource";
+  std::string uri;
+  std::string resource_string;
+  bool operator==(const Resource&) const = default;
+};
+
+// simulation_interfaces/msg/WorldResource: a world LoadWorld loads or GetAvailableWorlds lists.
+struct WorldResource {
+  static constexpr std::string_view kType = "simulation_interfaces/msg/WorldResource";
+  std::string name;
+  Resource world_resource;
+  std::string description;
+  std::vector<std::string> tags;
+  bool operator==(const WorldResource&) const = default;
+};
+
+// simulation_interfaces/msg/Spawnable: what GetSpawnables lists.
+struct Spawnable {
+  static constexpr std::string_view kType = "simulation_interfaces/msg/Spawnable";
+  Resource entity_resource;
+  std::string description;
+  Bounds spawn_bounds;
+  bool operator==(const Spawnable&) const = default;
+};
+
+// simulation_interfaces/msg/SpawnEntity: one entity of a SpawnEntities request (the fields of
+// SpawnEntity.srv's request).
+struct SpawnEntity {
+  static constexpr std::string_view kType = "simulation_interfaces/msg/SpawnEntity";
+  std::string name;
+  bool allow_renaming = false;
+  Resource entity_resource;
+  std::string entity_namespace;
+  PoseStamped initial_pose;
+  bool operator==(const SpawnEntity&) const = default;
+};
+
+// simulation_interfaces/msg/SpawnResult: one entity's result in a SpawnEntities response;
+// `result.result` one of Result's codes or these (SpawnEntity.srv's response has the same).
+struct SpawnResult {
+  static constexpr std::string_view kType = "simulation_interfaces/msg/SpawnResult";
+  static constexpr std::uint8_t kNameNotUnique = 101;
+  static constexpr std::uint8_t kNameInvalid = 102;
+  static constexpr std::uint8_t kUnsupportedFormat = 103;
+  static constexpr std::uint8_t kNoResource = 104;
+  static constexpr std::uint8_t kNamespaceInvalid = 105;
+  static constexpr std::uint8_t kResourceParseError = 106;
+  static constexpr std::uint8_t kMissingAssets = 107;
+  static constexpr std::uint8_t kUnsupportedAssets = 108;
+  static constexpr std::uint8_t kInvalidPose = 109;
+  Result result;
+  std::string entity_name;
+  bool operator==(const SpawnResult&) const = default;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -253,6 +323,121 @@ struct GetEntityBoundsResponse {
   Bounds bounds;
 };
 
+// Spawning, deleting and worlds (the halves compare whole: operator==).
+struct SpawnEntityRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/SpawnEntity";
+  std::string name;
+  bool allow_renaming = false;
+  Resource entity_resource;
+  std::string entity_namespace;
+  PoseStamped initial_pose;
+  bool operator==(const SpawnEntityRequest&) const = default;
+};
+struct SpawnEntityResponse {
+  static constexpr std::string_view kService = SpawnEntityRequest::kService;
+  // The .srv's codes, the values of SpawnResult's.
+  static constexpr std::uint8_t kNameNotUnique = SpawnResult::kNameNotUnique;
+  static constexpr std::uint8_t kNameInvalid = SpawnResult::kNameInvalid;
+  static constexpr std::uint8_t kUnsupportedFormat = SpawnResult::kUnsupportedFormat;
+  static constexpr std::uint8_t kNoResource = SpawnResult::kNoResource;
+  static constexpr std::uint8_t kNamespaceInvalid = SpawnResult::kNamespaceInvalid;
+  static constexpr std::uint8_t kResourceParseError = SpawnResult::kResourceParseError;
+  static constexpr std::uint8_t kMissingAssets = SpawnResult::kMissingAssets;
+  static constexpr std::uint8_t kUnsupportedAssets = SpawnResult::kUnsupportedAssets;
+  static constexpr std::uint8_t kInvalidPose = SpawnResult::kInvalidPose;
+  Result result;
+  std::string entity_name;
+  bool operator==(const SpawnEntityResponse&) const = default;
+};
+struct SpawnEntitiesRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/SpawnEntities";
+  std::vector<SpawnEntity> spawn_requests;
+  bool operator==(const SpawnEntitiesRequest&) const = default;
+};
+struct SpawnEntitiesResponse {
+  static constexpr std::string_view kService = SpawnEntitiesRequest::kService;
+  static constexpr std::uint8_t kEntitiesSpawnFailed = 150;
+  Result result;
+  std::vector<SpawnResult> results;  // one per request, in order
+  bool operator==(const SpawnEntitiesResponse&) const = default;
+};
+struct DeleteEntityRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/DeleteEntity";
+  std::string entity;
+  bool operator==(const DeleteEntityRequest&) const = default;
+};
+struct DeleteEntityResponse {  // no codes of its own
+  static constexpr std::string_view kService = DeleteEntityRequest::kService;
+  Result result;
+  bool operator==(const DeleteEntityResponse&) const = default;
+};
+struct GetSpawnablesRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/GetSpawnables";
+  std::vector<std::string> sources;
+  bool operator==(const GetSpawnablesRequest&) const = default;
+};
+struct GetSpawnablesResponse {  // no codes of its own
+  static constexpr std::string_view kService = GetSpawnablesRequest::kService;
+  Result result;
+  std::vector<Spawnable> spawnables;
+  bool operator==(const GetSpawnablesResponse&) const = default;
+};
+struct LoadWorldRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/LoadWorld";
+  Resource world_resource;
+  bool fail_on_unsupported_element = false;
+  bool ignore_missing_or_unsupported_assets = false;
+  bool operator==(const LoadWorldRequest&) const = default;
+};
+struct LoadWorldResponse {
+  static constexpr std::string_view kService = LoadWorldRequest::kService;
+  static constexpr std::uint8_t kUnsupportedFormat = 101;
+  static constexpr std::uint8_t kNoResource = 102;
+  static constexpr std::uint8_t kResourceParseError = 103;
+  static constexpr std::uint8_t kMissingAssets = 104;
+  static constexpr std::uint8_t kUnsupportedAssets = 105;
+  static constexpr std::uint8_t kUnsupportedElements = 106;
+  Result result;
+  WorldResource world;
+  bool operator==(const LoadWorldResponse&) const = default;
+};
+struct UnloadWorldRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/UnloadWorld";
+  bool operator==(const UnloadWorldRequest&) const = default;
+};
+struct UnloadWorldResponse {
+  static constexpr std::string_view kService = UnloadWorldRequest::kService;
+  static constexpr std::uint8_t kNoWorldLoaded = 101;
+  Result result;
+  bool operator==(const UnloadWorldResponse&) const = default;
+};
+struct GetCurrentWorldRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/GetCurrentWorld";
+  bool operator==(const GetCurrentWorldRequest&) const = default;
+};
+struct GetCurrentWorldResponse {
+  static constexpr std::string_view kService = GetCurrentWorldRequest::kService;
+  static constexpr std::uint8_t kNoWorldLoaded = 101;
+  Result result;
+  WorldResource world;
+  bool operator==(const GetCurrentWorldResponse&) const = default;
+};
+struct GetAvailableWorldsRequest {
+  static constexpr std::string_view kService = "simulation_interfaces/srv/GetAvailableWorlds";
+  std::vector<std::string> additional_sources;
+  TagsFilter filter;
+  bool offline_only = false;
+  bool continue_on_error = false;
+  bool operator==(const GetAvailableWorldsRequest&) const = default;
+};
+struct GetAvailableWorldsResponse {
+  static constexpr std::string_view kService = GetAvailableWorldsRequest::kService;
+  static constexpr std::uint8_t kDefaultSourcesFailed = 101;
+  Result result;
+  std::vector<WorldResource> worlds;
+  bool operator==(const GetAvailableWorldsResponse&) const = default;
+};
+
 // ---------------------------------------------------------------------------------------------
 // The SimulateSteps action: its goal request, result response and feedback message (the halves
 // every action shares are rbsim/interfaces.hpp's SendGoalResponse and GetResultRequest, its cancel
@@ -290,6 +475,12 @@ RBSIM_SIMULATION_CODEC(SimulatorFeatures)
 RBSIM_SIMULATION_CODEC(Bounds)
 RBSIM_SIMULATION_CODEC(EntityFilters)
 RBSIM_SIMULATION_CODEC(EntityState)
+RBSIM_SIMULATION_CODEC(PoseStamped)
+RBSIM_SIMULATION_CODEC(Resource)
+RBSIM_SIMULATION_CODEC(WorldResource)
+RBSIM_SIMULATION_CODEC(Spawnable)
+RBSIM_SIMULATION_CODEC(SpawnEntity)
+RBSIM_SIMULATION_CODEC(SpawnResult)
 RBSIM_SIMULATION_CODEC(GetSimulatorFeaturesRequest)
 RBSIM_SIMULATION_CODEC(GetSimulatorFeaturesResponse)
 RBSIM_SIMULATION_CODEC(GetSimulationStateRequest)
@@ -312,6 +503,22 @@ RBSIM_SIMULATION_CODEC(SetEntityStateRequest)
 RBSIM_SIMULATION_CODEC(SetEntityStateResponse)
 RBSIM_SIMULATION_CODEC(GetEntityBoundsRequest)
 RBSIM_SIMULATION_CODEC(GetEntityBoundsResponse)
+RBSIM_SIMULATION_CODEC(SpawnEntityRequest)
+RBSIM_SIMULATION_CODEC(SpawnEntityResponse)
+RBSIM_SIMULATION_CODEC(SpawnEntitiesRequest)
+RBSIM_SIMULATION_CODEC(SpawnEntitiesResponse)
+RBSIM_SIMULATION_CODEC(DeleteEntityRequest)
+RBSIM_SIMULATION_CODEC(DeleteEntityResponse)
+RBSIM_SIMULATION_CODEC(GetSpawnablesRequest)
+RBSIM_SIMULATION_CODEC(GetSpawnablesResponse)
+RBSIM_SIMULATION_CODEC(LoadWorldRequest)
+RBSIM_SIMULATION_CODEC(LoadWorldResponse)
+RBSIM_SIMULATION_CODEC(UnloadWorldRequest)
+RBSIM_SIMULATION_CODEC(UnloadWorldResponse)
+RBSIM_SIMULATION_CODEC(GetCurrentWorldRequest)
+RBSIM_SIMULATION_CODEC(GetCurrentWorldResponse)
+RBSIM_SIMULATION_CODEC(GetAvailableWorldsRequest)
+RBSIM_SIMULATION_CODEC(GetAvailableWorldsResponse)
 RBSIM_SIMULATION_CODEC(SimulateStepsSendGoalRequest)
 RBSIM_SIMULATION_CODEC(SimulateStepsGetResultResponse)
 RBSIM_SIMULATION_CODEC(SimulateStepsFeedbackMessage)
