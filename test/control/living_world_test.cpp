@@ -134,8 +134,9 @@ TEST(ControllerSpawn, AtStepKStepsAsTheEditedSceneFromThatState) {
   const std::vector<Snapshot> expected = run_from(test::scene_from(edited_scene_text()), start);
   expect_same_runs(after, from_step(expected, 41));
   // And the spawn mattered to the scene's bodies (the spring to body_1 pulls it).
-  EXPECT_FALSE(test::same_bits(test::run(scene, kSteps).back().state,
-                               std::vector<double>(live.back().state.begin(), live.back().state.begin() + 2)));
+  EXPECT_FALSE(
+      test::same_bits(test::run(scene, kSteps).back().state,
+                      std::vector<double>(live.back().state.begin(), live.back().state.begin() + 2)));
 }
 
 TEST(ControllerDelete, RemovesTheBodyAndNamesTheSpringsAttachedToIt) {
@@ -153,7 +154,8 @@ TEST(ControllerDelete, RemovesTheBodyAndNamesTheSpringsAttachedToIt) {
   // body_1 held scene spring 0 (to body_0) and spawned spring 2 (from the triangle).
   EXPECT_EQ(r.removed_springs, (std::vector<std::int32_t>{0, 2}));
   EXPECT_NE(r.message.find("the springs attached to it: 0, 2"), std::string::npos) << r.message;
-  EXPECT_EQ(r.removed, (std::vector<std::string>{"springs.0.k", "springs.0.l0", "springs.2.k", "springs.2.l0"}));
+  EXPECT_EQ(r.removed,
+            (std::vector<std::string>{"springs.0.k", "springs.0.l0", "springs.2.k", "springs.2.l0"}));
   const CommandResult twice = wait(again), none = wait(nobody);
   EXPECT_FALSE(twice.successful);
   EXPECT_EQ(twice.refusal, Refusal::NoSuchEntity);
@@ -301,7 +303,8 @@ TEST(ControllerImpulse, NamesABodyByItsIdAfterEarlierOnesWereDeleted) {
   CommandResult r;
   const std::vector<Snapshot> kicked = deleted_then(true, &r), still = deleted_then(false, &r);
   EXPECT_FALSE(r.successful);
-  EXPECT_NE(r.message.find("no body 0 (the world has 1 bodies, ids from 0 to 1)"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("no body 0 (the world has 1 bodies, ids from 0 to 1)"), std::string::npos)
+      << r.message;
   // body_1 is the world's only body: the impulse of 3 N s gave it vy + 3 / M, M = 5, at step 20
   // (one step of wind drag later, within a few parts in a thousand).
   ASSERT_TRUE(test::same_bits(from_step(kicked, 20).front().state, from_step(still, 20).front().state));

@@ -42,7 +42,6 @@ using scene_detail::ColorRead;
 using scene_detail::Deferred;
 using scene_detail::VertexRead;
 
-
 // A whole scene: the scene-wide elements here, the body elements through the shared readers.
 class SceneLoader : public scene_detail::Reader {
  public:

@@ -95,7 +95,8 @@ class NamedParameters {
     const Parameter* found = nullptr;
     for (const Parameter& p : parameters_) {
       if (p.name != name) continue;
-      if (found != nullptr) return Error{which_ + ": parameter '" + name + "' given twice", ErrorCode::Malformed};
+      if (found != nullptr)
+        return Error{which_ + ": parameter '" + name + "' given twice", ErrorCode::Malformed};
       found = &p;
     }
     if (found == nullptr) return Error{which_ + ": parameter '" + name + "' missing", ErrorCode::Malformed};
@@ -131,7 +132,8 @@ Status spawn_args(const std::vector<Parameter>& parameters, const std::string& w
                                 {"theta", ParameterType::Double, &theta}}) {
     if (Status st = named.take(key, type, *out); !st) return st;
   }
-  if (Status st = named.only({"resource", "uri", "name", "allow_renaming", "x", "y", "theta"}); !st) return st;
+  if (Status st = named.only({"resource", "uri", "name", "allow_renaming", "x", "y", "theta"}); !st)
+    return st;
   a.resource = resource.string_value;
   a.uri = uri.string_value;
   a.name = name.string_value;
@@ -171,7 +173,7 @@ msgs::CommandMessage to_message(const Command& command, const CommandResult& res
   // A body index the controller refused may not fit the field: the message says so in its text.
   // Spawn and delete_entity: the body's id, as the result names it.
   const bool entity = command.kind == CommandKind::Spawn || command.kind == CommandKind::Delete;
-  const std::int64_t body = entity                                 ? result.body_id
+  const std::int64_t body = entity                                  ? result.body_id
                             : command.kind == CommandKind::SetState ? command.state.body
                                                                     : command.impulse.body;
   m.body = body >= 0 && body <= 0xffffffffLL ? static_cast<std::uint32_t>(body) : 0xffffffffU;

@@ -181,17 +181,20 @@ Status set_entity_state(const Entry& e, const YAML::Node& n, std::int64_t bodies
 // a file is read now (relative to the script's folder) and its text kept in the command, so the
 // run, and its recording, depend on no file after this.
 Status spawn(const Entry& e, const YAML::Node& n, SpawnArgs& out) {
-  if (!n.IsMap()) return e.error(n, "spawn", "must be a map {file: FRAGMENT or resource: TEXT, name, x, theta}");
+  if (!n.IsMap())
+    return e.error(n, "spawn", "must be a map {file: FRAGMENT or resource: TEXT, name, x, theta}");
   for (const auto& kv : n) {
     const std::string key = kv.first.Scalar();
     if (key != "file" && key != "resource" && key != "name" && key != "x" && key != "theta" &&
         key != "allow_renaming") {
-      return e.error(kv.first, "spawn." + key, "unknown field (want file or resource, name, x, theta, allow_renaming)");
+      return e.error(kv.first, "spawn." + key,
+                     "unknown field (want file or resource, name, x, theta, allow_renaming)");
     }
   }
   SpawnArgs a;
   const YAML::Node file = n["file"], resource = n["resource"];
-  if ((file && resource) || (!file && !resource)) return e.error(n, "spawn", "give file or resource, one of them");
+  if ((file && resource) || (!file && !resource))
+    return e.error(n, "spawn", "give file or resource, one of them");
   if (file) {
     if (!file.IsScalar() || file.Scalar().empty()) return e.error(file, "spawn.file", "must be a path");
     std::filesystem::path where(file.Scalar());
@@ -220,12 +223,14 @@ Status spawn(const Entry& e, const YAML::Node& n, SpawnArgs& out) {
   }
   if (const YAML::Node renaming = n["allow_renaming"]) {
     const ParameterValue v = renaming.IsScalar() ? yaml_scalar(renaming) : ParameterValue{};
-    if (v.type != ParameterType::Bool) return e.error(renaming, "spawn.allow_renaming", "must be true or false");
+    if (v.type != ParameterType::Bool)
+      return e.error(renaming, "spawn.allow_renaming", "must be true or false");
     a.allow_renaming = v.bool_value;
   }
   // The fragment is checked now: its errors name the file (or the script) and line.
   Result<Fragment> parsed = parse_fragment(a.resource, a.uri.empty() ? yaml_line(e.path, resource) : a.uri);
-  if (!parsed) return e.error(file ? file : resource, file ? "spawn.file" : "spawn.resource", parsed.error().message);
+  if (!parsed)
+    return e.error(file ? file : resource, file ? "spawn.file" : "spawn.resource", parsed.error().message);
   a.fragment = std::make_shared<const Fragment>(std::move(parsed.value()));
   out = std::move(a);
   return Ok{};

@@ -43,8 +43,9 @@ std::optional<BodyId> find_body(const World& world, std::int64_t id) {
 
 std::string bodies_text(const World& world) {
   return "(the world has " + std::to_string(world.body_count()) + " bodies" +
-         (world.next_body_id() > world.body_count() ? ", ids from 0 to " + std::to_string(world.next_body_id() - 1)
-                                                     : std::string()) +
+         (world.next_body_id() > world.body_count()
+              ? ", ids from 0 to " + std::to_string(world.next_body_id() - 1)
+              : std::string()) +
          ")";
 }
 }  // namespace

@@ -76,7 +76,8 @@ void Controller::renew(World& world, std::int32_t next_body_id, std::int32_t nex
   entities_.epoch = epoch;
 }
 
-Status Controller::remove_dense(World& world, std::int32_t dense, std::vector<std::int32_t>& removed_springs) {
+Status Controller::remove_dense(World& world, std::int32_t dense,
+                                std::vector<std::int32_t>& removed_springs) {
   // The springs attached to it, by dense index, so their colours go with them.
   std::vector<std::int32_t> attached;
   for (std::int32_t k = 0; k < world.spring_count(); ++k) {
@@ -106,14 +107,16 @@ CommandResult Controller::spawn(const Command& command, World& world) {
   // The name: as asked if never used; else (renaming allowed, or none asked) the first unused
   // of <name>_1, <name>_2, ...
   if (scene_body_id(a.name)) {
-    return refuse(Refusal::Other, "spawn_entity: '" + a.name + "' is reserved for the scene's bodies (body_<id>)");
+    return refuse(Refusal::Other,
+                  "spawn_entity: '" + a.name + "' is reserved for the scene's bodies (body_<id>)");
   }
   std::string name = a.name;
   if (name.empty() || used_names_.contains(name)) {
     if (!name.empty() && !a.allow_renaming) {
-      return refuse(Refusal::NameTaken, "spawn_entity: the name '" + name + "' is " +
-                                            (spawned_ids_.contains(name) ? "taken" : "used earlier in the session") +
-                                            " and renaming is not allowed");
+      return refuse(Refusal::NameTaken,
+                    "spawn_entity: the name '" + name + "' is " +
+                        (spawned_ids_.contains(name) ? "taken" : "used earlier in the session") +
+                        " and renaming is not allowed");
     }
     const std::string stem = name.empty() ? "entity" : name;
     for (std::uint64_t k = 1;; ++k) {
@@ -139,8 +142,9 @@ CommandResult Controller::spawn(const Command& command, World& world) {
       const std::optional<std::int32_t> id = find_entity(end->body);
       const std::optional<BodyId> dense = id ? world.find_body_id(*id) : std::nullopt;
       if (!dense) {
-        return refuse(Refusal::NoSuchEntity, "spawn_entity: spring " + std::to_string(k) + " names '" + end->body +
-                                                 "', which is no body of the world at " + step_text(now));
+        return refuse(Refusal::NoSuchEntity, "spawn_entity: spring " + std::to_string(k) + " names '" +
+                                                 end->body + "', which is no body of the world at " +
+                                                 step_text(now));
       }
       *body = dense->index;
     }
@@ -149,11 +153,12 @@ CommandResult Controller::spawn(const Command& command, World& world) {
 
   const BodyState state{a.position, a.theta, fragment->body.velocity, fragment->body.omega};
   const double bound = world.finite_bound();
-  for (double v : {state.position.x(), state.position.y(), state.theta, state.velocity.x(), state.velocity.y(),
-                   state.omega}) {
+  for (double v : {state.position.x(), state.position.y(), state.theta, state.velocity.x(),
+                   state.velocity.y(), state.omega}) {
     if (!std::isfinite(v) || (bound > 0.0 && std::abs(v) > bound)) {
-      return refuse(Refusal::Other, "spawn_entity: the pose and the fragment's velocities must be finite and "
-                                    "within the range the run can report");
+      return refuse(Refusal::Other,
+                    "spawn_entity: the pose and the fragment's velocities must be finite and "
+                    "within the range the run can report");
     }
   }
   Result<BodyHandle> added = world.add_body(fragment->body, state);
@@ -187,7 +192,8 @@ CommandResult Controller::spawn(const Command& command, World& world) {
   r.entity = name;
   r.body_id = body_id;
   r.message = "spawned '" + name + "' (body " + std::to_string(body_id) + ")" +
-              (spring_ids.empty() ? std::string() : " with springs " + id_list(spring_ids)) + " at " + step_text(now);
+              (spring_ids.empty() ? std::string() : " with springs " + id_list(spring_ids)) + " at " +
+              step_text(now);
   follow_structure(world, &r);
   return r;
 }
@@ -197,7 +203,8 @@ CommandResult Controller::remove(const Command& command, World& world) {
   const std::optional<std::int32_t> id = find_entity(command.entity);
   const std::optional<BodyId> dense = id ? world.find_body_id(*id) : std::nullopt;
   if (!dense) {
-    return refuse(Refusal::NoSuchEntity, "delete_entity: no body named '" + command.entity + "' at " + step_text(now));
+    return refuse(Refusal::NoSuchEntity,
+                  "delete_entity: no body named '" + command.entity + "' at " + step_text(now));
   }
   CommandResult r;
   const Status st = remove_dense(world, dense->index, r.removed_springs);

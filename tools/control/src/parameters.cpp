@@ -4,11 +4,11 @@
 #include "rbsim/assert.hpp"
 
 #include <algorithm>
-#include <set>
-#include <string_view>
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <set>
+#include <string_view>
 #include <utility>
 
 namespace rbsim::control {
@@ -239,7 +239,8 @@ ParameterTable::ParameterTable(const Scene& scene, std::int64_t steps, const Run
           V::of_integer(wind.points_per_edge), {K::WindPoints, k});
     }
   }
-  for (std::size_t j = 0; j < w.springs.size(); ++j) add_spring(static_cast<std::int32_t>(j), j, w.springs[j]);
+  for (std::size_t j = 0; j < w.springs.size(); ++j)
+    add_spring(static_cast<std::int32_t>(j), j, w.springs[j]);
 }
 
 void ParameterTable::add_spring(std::int32_t id, std::size_t index, const SpringDef& spring) {
@@ -248,14 +249,16 @@ void ParameterTable::add_spring(std::int32_t id, std::size_t index, const Spring
   const auto s = static_cast<std::int32_t>(index);
   add(real(p + "k", "Spring: stiffness (N/m)", 0.0, kMaxDouble), ParameterValue::of_double(spring.stiffness),
       {K::SpringK, s});
-  add(real(p + "l0", "Spring: rest length (m)", 0.0, kMaxDouble), ParameterValue::of_double(spring.rest_length),
-      {K::SpringL0, s});
+  add(real(p + "l0", "Spring: rest length (m)", 0.0, kMaxDouble),
+      ParameterValue::of_double(spring.rest_length), {K::SpringL0, s});
 }
 
 void ParameterTable::follow_structure(const World& world, std::vector<Parameter>* added,
                                       std::vector<std::string>* removed) {
   using K = ParameterTarget::Kind;
-  const auto is_spring = [](const Entry& e) { return e.target.kind == K::SpringK || e.target.kind == K::SpringL0; };
+  const auto is_spring = [](const Entry& e) {
+    return e.target.kind == K::SpringK || e.target.kind == K::SpringL0;
+  };
   const auto first = std::find_if(entries_.begin(), entries_.end(), is_spring);
   RBSIM_ASSERT(std::all_of(first, entries_.end(), is_spring), "the springs' parameters come last");
   std::vector<std::string> before;  // in table order

@@ -395,7 +395,8 @@ void Encoder::markers(const World& world, Bytes& out) const {
   w.sequence_length((delete_all ? 1 : 0) + 2 * static_cast<std::size_t>(world.body_count()) +
                     (anchors.empty() ? 0 : 1));
   if (delete_all) {
-    marker_head(w, {stamp, kFrame, "", 0, kMarkerLineStrip, 1.0, 1.0, 1.0, kSpringGrey, false, kMarkerDeleteAll});
+    marker_head(
+        w, {stamp, kFrame, "", 0, kMarkerLineStrip, 1.0, 1.0, 1.0, kSpringGrey, false, kMarkerDeleteAll});
     w.sequence_length(0);
     w.sequence_length(0);
     marker_rest(w);
@@ -412,8 +413,8 @@ void Encoder::markers(const World& world, Bytes& out) const {
     for (const std::uint32_t i : triangles) point(w, hull[i]);
     w.sequence_length(0);  // colors: the marker's
     marker_rest(w);
-    marker_head(w, {stamp, frame, "outlines", marker, kMarkerLineStrip, 2.0 * world.radius(id), 0.0, 0.0, c,
-                    true});
+    marker_head(
+        w, {stamp, frame, "outlines", marker, kMarkerLineStrip, 2.0 * world.radius(id), 0.0, 0.0, c, true});
     w.sequence_length(hull.size() + 1);
     for (const Vec2& v : hull) point(w, v);
     point(w, hull.front());

@@ -47,8 +47,8 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
   double position = world.peak_position();
   double limit = std::min(bound, std::max(1.0, 2.0 * world.peak_velocity()));
   if (options.control != nullptr) {
-    options.control->outputs_follow_structure(
-        std::all_of(sinks_.begin(), sinks_.end(), [](const Sink* sink) { return sink->follows_structure(); }));
+    options.control->outputs_follow_structure(std::all_of(
+        sinks_.begin(), sinks_.end(), [](const Sink* sink) { return sink->follows_structure(); }));
     options.control->start(world);
   }
   while (world.step_index() < options.steps) {

@@ -17,12 +17,12 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
-#include <set>
-#include <future>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -151,9 +151,9 @@ struct CommandResult {
   /// /parameter_events reports as new and deleted.
   std::vector<Parameter> added;
   std::vector<std::string> removed;
-  Refusal refusal = Refusal::Other;  // when not successful
-  std::string entity;                // Spawn: the name given; Delete: the name deleted
-  std::int32_t body_id = -1;         // Spawn, Delete: the body's id (msgs' BodyState.id)
+  Refusal refusal = Refusal::Other;           // when not successful
+  std::string entity;                         // Spawn: the name given; Delete: the name deleted
+  std::int32_t body_id = -1;                  // Spawn, Delete: the body's id (msgs' BodyState.id)
   std::vector<std::int32_t> removed_springs;  // Delete, ResetSpawned: the ids of the springs that went
 };
 
@@ -318,8 +318,8 @@ class Controller final : public StepHook, public Steering {
   std::map<std::string, std::int32_t, std::less<>> spawned_ids_;
   std::set<std::int32_t> spawned_springs_;
   std::set<std::string, std::less<>> used_names_;
-  Entities entities_;  // the world's names and colours, in its dense order
-  bool structure_edited_ = false;  // a spawn or delete since the world was made
+  Entities entities_;                                   // the world's names and colours, in its dense order
+  bool structure_edited_ = false;                       // a spawn or delete since the world was made
   std::int32_t next_body_id_ = 0, next_spring_id_ = 0;  // the session's, across worlds
   bool end_when_idle_ = false;
   bool structure_allowed_ = false;

@@ -34,11 +34,11 @@ class StepHook {
   virtual ~StepHook() = default;
   // What a boundary did, for the driver to follow.
   struct Boundary {
-    bool state_changed = false;     // parameters, velocities or the whole world changed: the
-                                    // divergence check's cached bounds are read again
-    bool timeline_changed = false;  // resumed, reset or re-paced: every sink's rebase() is called
+    bool state_changed = false;      // parameters, velocities or the whole world changed: the
+                                     // divergence check's cached bounds are read again
+    bool timeline_changed = false;   // resumed, reset or re-paced: every sink's rebase() is called
     bool structure_changed = false;  // bodies or springs came or went (World::add_body, remove_body)
-    bool stop = false;              // a stop request arrived while paused: the pass ends (Stopped)
+    bool stop = false;               // a stop request arrived while paused: the pass ends (Stopped)
   };
   // A pass starts (Driver::run), on the world it will step.
   virtual void start(World& world) = 0;
