@@ -88,5 +88,53 @@ TEST(RbsimRunCommands, ABadScriptIsAUsageErrorBeforeAnyOutput) {
   EXPECT_EQ(read_text(dir / "ok.yaml"), "- {step: 1, resume: true}\n");
 }
 
+// A script's spawn and delete: the CSV rows hold the bodies the world has at each step, each named
+// by its id (the spawned body the next id, 5; a deleted body's rows end), and the scene's bodies
+// step as the plain run's until the spawn's springs reach them.
+TEST(RbsimRunCommands, SpawnAndDeleteChangeTheCsvRowsFromTheNextStep) {
+  const TempDir dir;
+  write_text(dir / "ball.xml",
+             "<scene>\n  <rigidbodyvertex x=\"-0.1\" y=\"0\" m=\"1\"/>\n"
+             "  <rigidbodyvertex x=\"0.1\" y=\"0\" m=\"1\"/>\n"
+             "  <rigidbody p=\"0\" p=\"1\" vx=\"0.5\" vy=\"0\" omega=\"0\" r=\"0.05\"/>\n</scene>\n");
+  write_text(dir / "c.yaml",
+             "- {step: 10, spawn: {file: ball.xml, name: ball, x: [0.5, 2.0], theta: 0.25}}\n"
+             "- {step: 20, delete: body_4}\n");
+  const test::Outcome plain = rbsim({"run", kScene, "--steps", "30", "--csv", (dir / "plain.csv").string()});
+  ASSERT_EQ(plain.exit_code, 0) << describe(plain);
+  const test::Outcome o = rbsim({"run", kScene, "--steps", "30", "--csv", (dir / "out.csv").string(),
+                                 "--commands", (dir / "c.yaml").string()});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  const std::vector<std::string> a = lines_of(read_text(dir / "plain.csv"));
+  const std::vector<std::string> b = lines_of(read_text(dir / "out.csv"));
+  ASSERT_EQ(b.size(), 1 + 11 * 5 + 10 * 6 + 10 * 5);
+  for (std::size_t step = 0; step <= 10; ++step) EXPECT_EQ(rows_at(a, step), rows_at(b, step)) << step;
+  const auto body_of = [](const std::string& row) {
+    const std::size_t c1 = row.find(',');
+    const std::size_t c2 = row.find(',', c1 + 1);
+    return row.substr(c2 + 1, row.find(',', c2 + 1) - c2 - 1);
+  };
+  for (std::size_t step = 11; step <= 20; ++step) {
+    for (std::size_t k = 0; k < 6; ++k) {
+      const std::string& row = b[1 + 11 * 5 + (step - 11) * 6 + k];
+      EXPECT_EQ(body_of(row), std::to_string(k)) << row;
+      EXPECT_TRUE(row.starts_with(std::to_string(step) + ",")) << row;
+    }
+  }
+  for (std::size_t step = 21; step <= 30; ++step) {
+    const std::vector<std::string> ids = {"0", "1", "2", "3", "5"};
+    for (std::size_t k = 0; k < 5; ++k) {
+      EXPECT_EQ(body_of(b[1 + 11 * 5 + 10 * 6 + (step - 21) * 5 + k]), ids[k]) << step;
+    }
+  }
+  // An output that cannot follow a changed world (the FOSSSim binary): the run is refused,
+  // naming the command, and writes nothing.
+  const test::Outcome refused = rbsim({"run", kScene, "--steps", "30", "--fosssim-out",
+                                       (dir / "out.bin").string(), "--commands", (dir / "c.yaml").string()});
+  EXPECT_NE(refused.exit_code, 0) << describe(refused);
+  EXPECT_NE(refused.err.find("spawn_entity"), std::string::npos) << describe(refused);
+  EXPECT_FALSE(fs::exists(dir / "out.bin"));
+}
+
 }  // namespace
 }  // namespace rbsim

@@ -10,6 +10,7 @@
 #include <optional>
 #include <regex>
 
+#include "rbsim/scene.hpp"
 #include "rbsim/simulation_interfaces.hpp"
 
 namespace rbsim::node {
@@ -44,19 +45,11 @@ Result failure(std::uint8_t code, std::string message) {
   return Result{code, std::move(message)};
 }
 
-// The entity's body index, when `name` is body_<i> of a body of the world (no sign, no leading
-// zero: each body has one name).
+// The entity's body index, when `name` is body_<i> of a body of the world (scene_body_id's rule).
 std::optional<std::int32_t> body_of(const std::string& name, std::int32_t bodies) {
-  const std::string prefix = msgs::body_frame("", 0).substr(0, 5);  // "body_"
-  if (!name.starts_with(prefix) || name.size() == prefix.size() || name.size() > prefix.size() + 10)
-    return std::nullopt;
-  const std::string digits = name.substr(prefix.size());
-  if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
-      (digits.size() > 1 && digits[0] == '0'))
-    return std::nullopt;
-  const long long i = std::stoll(digits);
-  if (i >= bodies) return std::nullopt;
-  return static_cast<std::int32_t>(i);
+  const std::optional<std::int32_t> i = scene_body_id(name);
+  if (!i || *i >= bodies) return std::nullopt;
+  return i;
 }
 
 sim::Vector3 planar(double x, double y) {

@@ -361,6 +361,37 @@ void Controller::settings_changed(Boundary& boundary) {
   if (settings_listener_) settings_listener_(settings_);
 }
 
+// Back to step 0 of the scene as loaded; ids continue (a spawned body's id is never reused).
+CommandResult Controller::reset(World& world, Boundary& boundary) {
+  const std::int64_t now = world.step_index();
+  CommandResult r;
+  r.successful = true;
+  Result<World> fresh = World::create(scene_.world);
+  if (!fresh) return failed("reset: " + fresh.error().message);
+  // Bodies spawned or deleted since the world was made: the outputs follow it back.
+  const bool edited = structure_edited_;
+  const std::int32_t bodies = world.next_body_id(), springs = world.next_spring_id();
+  world = std::move(fresh.value());
+  renew(world, bodies, springs);
+  step_budget_ = 0;
+  const ParameterTable before = table_;
+  follow_structure(world, &r);
+  if (edited) {
+    ++entities_.epoch;
+    boundary.structure_changed = true;
+  }
+  table_.refresh(world, settings_);
+  for (std::size_t i = 0; i < table_.size(); ++i) {
+    const std::optional<std::size_t> was = before.find(table_.descriptor(i).name);
+    if (was && !(table_.value(i) == before.value(*was)))
+      r.changed.push_back({table_.descriptor(i).name, table_.value(i)});
+  }
+  boundary.state_changed = true;
+  boundary.timeline_changed = true;
+  r.message = "reset at " + at(now) + " to step 0";
+  return r;
+}
+
 CommandResult Controller::execute(Command& command, World& world, Boundary& boundary) {
   const std::int64_t now = world.step_index();
   CommandResult r;
@@ -407,32 +438,8 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
       r.ends_at = now + step_budget_;
       r.message = "stepping from " + at(now) + " to " + at(now + step_budget_) + ", then paused";
       return r;
-    case CommandKind::Reset: {
-      Result<World> fresh = World::create(scene_.world);
-      if (!fresh) return failed("reset: " + fresh.error().message);
-      // Bodies spawned or deleted since the world was made: the outputs follow it back.
-      const bool edited = structure_edited_;
-      const std::int32_t bodies = world.next_body_id(), springs = world.next_spring_id();
-      world = std::move(fresh.value());
-      renew(world, bodies, springs);
-      step_budget_ = 0;
-      const ParameterTable before = table_;
-      follow_structure(world, &r);
-      if (edited) {
-        ++entities_.epoch;
-        boundary.structure_changed = true;
-      }
-      table_.refresh(world, settings_);
-      for (std::size_t i = 0; i < table_.size(); ++i) {
-        const std::optional<std::size_t> was = before.find(table_.descriptor(i).name);
-        if (was && !(table_.value(i) == before.value(*was)))
-          r.changed.push_back({table_.descriptor(i).name, table_.value(i)});
-      }
-      boundary.state_changed = true;
-      boundary.timeline_changed = true;
-      r.message = "reset at " + at(now) + " to step 0";
-      return r;
-    }
+    case CommandKind::Reset:
+      return reset(world, boundary);
     case CommandKind::Impulse: {
       CommandResult applied = impulse(command, world);
       boundary.state_changed |= applied.successful;

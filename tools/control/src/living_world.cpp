@@ -5,8 +5,9 @@
 // these commands steps bit for bit as a run of the scene edited the same way, set to the same
 // state at the same step. Names: the scene's bodies are body_<id>; a spawned body has its own
 // name, and no name is given twice in a session (the ids are never reused either).
-#include <charconv>
 #include <cmath>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -27,15 +28,28 @@ std::string step_text(std::int64_t step) {
   return "step " + std::to_string(step);
 }
 
-// "body_<digits>": a scene body's name, and its id.
-std::optional<std::int32_t> scene_body_id(std::string_view name) {
-  constexpr std::string_view kPrefix = "body_";
-  if (!name.starts_with(kPrefix) || name.size() == kPrefix.size()) return std::nullopt;
-  std::int32_t id = 0;
-  const char* end = name.data() + name.size();
-  const auto [ptr, ec] = std::from_chars(name.data() + kPrefix.size(), end, id);
-  if (ec != std::errc{} || ptr != end || id < 0) return std::nullopt;
-  return id;
+// The name a spawn takes: as asked if never used in the session; else (renaming allowed, or none
+// asked) the first unused of <name>_1, <name>_2, ... A scene body's name (body_<id>) is never
+// given. `refused` is set when no name is.
+std::string spawn_name(const SpawnArgs& a, const std::set<std::string, std::less<>>& used, bool taken_now,
+                       std::optional<CommandResult>& refused) {
+  if (scene_body_id(a.name)) {
+    refused = refuse(Refusal::Other,
+                     "spawn_entity: '" + a.name + "' is reserved for the scene's bodies (body_<id>)");
+    return {};
+  }
+  if (!a.name.empty() && !used.contains(a.name)) return a.name;
+  if (!a.name.empty() && !a.allow_renaming) {
+    refused = refuse(Refusal::NameTaken, "spawn_entity: the name '" + a.name + "' is " +
+                                             (taken_now ? "taken" : "used earlier in the session") +
+                                             " and renaming is not allowed");
+    return {};
+  }
+  const std::string stem = a.name.empty() ? "entity" : a.name;
+  for (std::uint64_t k = 1;; ++k) {
+    std::string name = stem + "_" + std::to_string(k);
+    if (!used.contains(name) && !scene_body_id(name)) return name;
+  }
 }
 
 std::string id_list(const std::vector<std::int32_t>& ids) {
@@ -104,26 +118,9 @@ CommandResult Controller::spawn(const Command& command, World& world) {
     fragment = std::make_shared<const Fragment>(std::move(parsed.value()));
   }
 
-  // The name: as asked if never used; else (renaming allowed, or none asked) the first unused
-  // of <name>_1, <name>_2, ...
-  if (scene_body_id(a.name)) {
-    return refuse(Refusal::Other,
-                  "spawn_entity: '" + a.name + "' is reserved for the scene's bodies (body_<id>)");
-  }
-  std::string name = a.name;
-  if (name.empty() || used_names_.contains(name)) {
-    if (!name.empty() && !a.allow_renaming) {
-      return refuse(Refusal::NameTaken,
-                    "spawn_entity: the name '" + name + "' is " +
-                        (spawned_ids_.contains(name) ? "taken" : "used earlier in the session") +
-                        " and renaming is not allowed");
-    }
-    const std::string stem = name.empty() ? "entity" : name;
-    for (std::uint64_t k = 1;; ++k) {
-      name = stem + "_" + std::to_string(k);
-      if (!used_names_.contains(name) && !scene_body_id(name)) break;
-    }
-  }
+  std::optional<CommandResult> refused;
+  const std::string name = spawn_name(a, used_names_, spawned_ids_.contains(a.name), refused);
+  if (refused) return *refused;
 
   // Every spring end named must be a body of the world now.
   std::vector<SpringDef> springs;

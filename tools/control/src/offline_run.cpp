@@ -63,27 +63,49 @@ Result<std::unique_ptr<OfflineRun>> OfflineRun::prepare(const OfflineRunDef& def
     if (!read) return read.error();
     commands = std::move(read.value());
   }
+  std::optional<ScriptedCommand> structural;
+  for (const ScriptedCommand& c : commands) {
+    if (c.expect_success && changes_structure(c.command.kind)) {
+      structural = c;
+      break;
+    }
+  }
   Result<Driver> driver = Driver::create(run->scene_);
   if (!driver) return with_context(run->scene_.path + ": ", driver.error());
   run->driver_.emplace(std::move(driver.value()));
   if (!def.commands.empty()) run->script_.emplace(run->scene_, run->steps_, std::move(commands));
   run->commands_ = def.commands;
-  run->make_sinks(def);
+  if (Status st = run->make_sinks(def, structural); !st) return st.error();
   return run;
 }
 
-void OfflineRun::make_sinks(const OfflineRunDef& def) {
-  if (!def.csv.path.empty()) sinks_.push_back(make_csv_sink(def.csv.path));
-  if (!def.energy_csv.path.empty()) sinks_.push_back(make_energy_csv_sink(def.energy_csv.path));
-  if (!def.fosssim_out.path.empty()) sinks_.push_back(make_fosssim_sink(def.fosssim_out.path));
+Status OfflineRun::make_sinks(const OfflineRunDef& def, const std::optional<ScriptedCommand>& structural) {
+  std::vector<std::string> paths;
+  const auto add = [&](std::unique_ptr<Sink> sink, const std::string& path) {
+    sinks_.push_back(std::move(sink));
+    paths.push_back(path);
+  };
+  if (!def.csv.path.empty()) add(make_csv_sink(def.csv.path), def.csv.path);
+  if (!def.energy_csv.path.empty()) add(make_energy_csv_sink(def.energy_csv.path), def.energy_csv.path);
+  if (!def.fosssim_out.path.empty()) add(make_fosssim_sink(def.fosssim_out.path), def.fosssim_out.path);
   if (!def.record.path.empty()) {
     std::unique_ptr<recordings::McapSink> mcap = recordings::make_mcap_sink(def.record.path, def.recording);
     // A steered run records its commands as the node publishes them (/<ns>/commands), so it can
     // be re-run in turn.
     if (script_) script_->record_to(*mcap);
-    sinks_.push_back(std::move(mcap));
+    add(std::move(mcap), def.record.path);
+  }
+  // A script that spawns or deletes needs outputs that follow the changed world: refused here,
+  // before any output is opened, rather than at its step.
+  for (std::size_t k = 0; structural && k < sinks_.size(); ++k) {
+    if (sinks_[k]->follows_structure()) continue;
+    return Error{structural->origin + ": " + to_string(structural->command.kind) + ": the output " +
+                     paths[k] +
+                     " cannot follow a world whose bodies change (the per-body and energy CSVs can)",
+                 ErrorCode::InvalidArgument};
   }
   for (auto& sink : sinks_) driver_->add(*sink);
+  return Ok{};
 }
 
 Result<PassEnd> OfflineRun::run(DriverOptions options) {

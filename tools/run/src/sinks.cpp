@@ -24,6 +24,10 @@ class CsvSink : public Sink {
     return csv_.flush_if_full();
   }
   Status finish() override { return csv_.commit(); }
+  // Rows name bodies by id (World::body_id), so a changed world needs no new header: the rows of
+  // later steps hold the bodies it then has.
+  bool follows_structure() const override { return true; }
+  Status restructure(const World&, const Entities&) override { return Ok{}; }
 
  private:
   virtual void rows(const World& world, std::string& out) const = 0;
@@ -40,7 +44,8 @@ class BodyCsvSink final : public CsvSink {
   void rows(const World& world, std::string& out) const override {
     const double t = world.time();
     for (std::int32_t b = 0; b < world.body_count(); ++b) {
-      append_body_row(out, world.step_index(), t, b, world.state(BodyId{b}), world.quantities(BodyId{b}));
+      append_body_row(out, world.step_index(), t, world.body_id(BodyId{b}), world.state(BodyId{b}),
+                      world.quantities(BodyId{b}));
     }
   }
 };

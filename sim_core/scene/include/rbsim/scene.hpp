@@ -135,5 +135,8 @@ struct Entities {
 Entities entities_of(const Scene& scene);
 // The one rule for a scene body's name: body_<id>.
 std::string scene_body_name(std::int32_t id);
+// Its inverse: the id when `name` is body_<digits> (no sign, no leading zero, so each id has one
+// name), else nullopt.
+std::optional<std::int32_t> scene_body_id(std::string_view name);
 
 }  // namespace rbsim

@@ -56,6 +56,10 @@ enum class CommandKind : std::uint8_t {
 // "set_parameters", "pause", "resume", "step", "reset", "apply_impulse", "set_entity_state",
 // "stop_stepping", "spawn_entity", "delete_entity", "reset_spawned"
 const char* to_string(CommandKind kind);
+// Spawn, Delete or ResetSpawned: the kinds only a run whose outputs follow may apply.
+constexpr bool changes_structure(CommandKind kind) {
+  return kind == CommandKind::Spawn || kind == CommandKind::Delete || kind == CommandKind::ResetSpawned;
+}
 
 // A linear impulse J (N s, world axes) at the point p (m, body frame, relative to the centre of
 // mass) of body `body`: V += J / M, omega += ((R(theta) p) x J) / I (World::apply_impulse).
@@ -261,6 +265,7 @@ class Controller final : public StepHook, public Steering {
   bool due(std::int64_t step) const;
   CommandResult execute(Command& command, World& world, Boundary& boundary);
   CommandResult set_parameters(const Command& command, World& world, Boundary& boundary);
+  CommandResult reset(World& world, Boundary& boundary);
   CommandResult impulse(const Command& command, World& world);
   CommandResult set_state(const Command& command, World& world);
   // The living world (src/living_world.cpp).

@@ -63,7 +63,7 @@ class OfflineRun {
 
  private:
   OfflineRun(Scene scene, std::int64_t steps) : scene_(std::move(scene)), steps_(steps) {}
-  void make_sinks(const OfflineRunDef& def);
+  [[nodiscard]] Status make_sinks(const OfflineRunDef& def, const std::optional<ScriptedCommand>& structural);
 
   Scene scene_;
   std::int64_t steps_ = 0;

@@ -12,7 +12,8 @@
 
 namespace rbsim {
 
-// Per-body CSV: one row per body per step.
+// Per-body CSV: one row per body per step; `body` is its id (a scene body's index in the file, a
+// spawned body's id given at its spawn, never reused).
 inline constexpr char kBodyCsvColumns[] =
     "step,t,body,x,y,theta,vx,vy,omega,px,py,L_point,L_spin,T_point,T_spin";
 // Scene-wide CSV: one row per step, the energies and the scene totals.
