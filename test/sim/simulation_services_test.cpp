@@ -242,15 +242,17 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
     return std::find(listed.begin(), listed.end(), static_cast<std::uint16_t>(f)) != listed.end();
   };
   for (const sim::Feature f :
-       {sim::Feature::EntityBounds, sim::Feature::EntityBoundsBox, sim::Feature::EntityCategories,
-        sim::Feature::EntityStateGetting, sim::Feature::EntityStateSetting, sim::Feature::EntityInfoGetting,
-        sim::Feature::SimulationReset, sim::Feature::SimulationStateGetting,
+       {sim::Feature::Spawning, sim::Feature::Deleting, sim::Feature::SpawningResourceString,
+        sim::Feature::SimulationResetSpawned, sim::Feature::EntityBounds, sim::Feature::EntityBoundsBox,
+        sim::Feature::EntityCategories, sim::Feature::EntityStateGetting, sim::Feature::EntityStateSetting,
+        sim::Feature::EntityInfoGetting, sim::Feature::SimulationReset, sim::Feature::SimulationStateGetting,
         sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
         sim::Feature::StepSimulationSingle, sim::Feature::StepSimulationMultiple,
         sim::Feature::StepSimulationAction}) {
     EXPECT_TRUE(has(f)) << static_cast<int>(f);
   }
-  EXPECT_EQ(listed.size(), 13u);
+  EXPECT_EQ(listed.size(), 17u);
+  EXPECT_EQ(features.features.spawn_formats, std::vector<std::string>{"fosssim-fragment"});
 
   // What is not listed answers RESULT_FEATURE_UNSUPPORTED.
   sim::SetEntityStateRequest set;
@@ -267,10 +269,10 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
             SimResult::kFeatureUnsupported);
   EXPECT_FALSE(has(sim::Feature::SimulationResetTime));
   EXPECT_FALSE(has(sim::Feature::SimulationResetState));
-  EXPECT_FALSE(has(sim::Feature::SimulationResetSpawned));
+  EXPECT_FALSE(has(sim::Feature::Spawnables));
+  EXPECT_FALSE(has(sim::Feature::SpawningEntities));
   for (const std::uint8_t scope :
-       {sim::ResetSimulationRequest::kScopeTime, sim::ResetSimulationRequest::kScopeState,
-        sim::ResetSimulationRequest::kScopeSpawned}) {
+       {sim::ResetSimulationRequest::kScopeTime, sim::ResetSimulationRequest::kScopeState}) {
     sim::ResetSimulationRequest reset;
     reset.scope = scope;
     EXPECT_EQ(call<sim::ResetSimulationResponse>("reset_simulation", reset).result.result,
@@ -500,6 +502,115 @@ TEST_P(SimulationServicesTest, SetEntityStateIsACommandAndReSimulatesExactly) {
       << "without the set, the run differs";
 }
 
+// A triangle in its own frame, spinning, with a spring to the scene's body_1 and one to a fixed
+// point (the control tests' fragment).
+constexpr const char* kTriangle = R"(<scene>
+  <rigidbodyvertex x="-1" y="-1" m="1"/><rigidbodyvertex x="-1" y="1" m="1"/>
+  <rigidbodyvertex x="3" y="0" m="1"/>
+  <rigidbody p="0" p="1" p="2" vx="0.25" vy="-0.5" omega="0.75" r="0.2"/>
+  <rigidbodyspringforce i="0" pix="0.5" piy="0.25" jbody="body_1" pjx="0.0" pjy="0.5" k="7.0" l0="1.5"/>
+  <rigidbodyspringforce i="-1" pix="2.0" piy="6.0" j="0" pjx="0.0" pjy="0.0" k="3.0" l0="0.5"/>
+</scene>)";
+
+sim::SpawnEntityRequest spawn_request(std::string name, std::string resource, double x, double y,
+                                      double theta) {
+  sim::SpawnEntityRequest req;
+  req.name = std::move(name);
+  req.entity_resource.resource_string = std::move(resource);
+  req.initial_pose.position = {x, y, 0.0};
+  req.initial_pose.orientation = msgs::quaternion_z(theta);
+  return req;
+}
+
+TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  ASSERT_EQ(step(10).result, SimResult::kOk);
+  const auto spawn = [&](const sim::SpawnEntityRequest& req) {
+    return call<sim::SpawnEntityResponse>("spawn_entity", req);
+  };
+  using Spawn = sim::SpawnEntityResponse;
+  const Spawn first = spawn(spawn_request("ball", kTriangle, 1.5, 6.0, 0.4));
+  ASSERT_EQ(first.result.result, SimResult::kOk) << first.result.error_message;
+  EXPECT_EQ(first.entity_name, "ball");
+  // While paused the spawn shows at once: its pose as asked, its velocities the fragment's.
+  sim::GetEntityStateRequest get;
+  get.entity = "ball";
+  const auto placed = call<sim::GetEntityStateResponse>("get_entity_state", get);
+  ASSERT_EQ(placed.result.result, SimResult::kOk) << placed.result.error_message;
+  EXPECT_EQ(placed.state.position, (sim::Vector3{1.5, 6.0, 0.0}));
+  EXPECT_NEAR(placed.state.orientation.z, msgs::quaternion_z(0.4).z, 1e-15);
+  EXPECT_EQ(placed.state.linear_velocity, (sim::Vector3{0.25, -0.5, 0.0}));
+  EXPECT_EQ(placed.state.angular_velocity, (sim::Vector3{0.0, 0.0, 0.75}));
+  EXPECT_EQ(placed.state.stamp.nanosec, msgs::sim_time(10, scene_.world.dt).nanosec);
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1", "ball"}));
+
+  // Names: unique, renamed when allowed, in a namespace; each refusal with its code.
+  EXPECT_EQ(spawn(spawn_request("ball", kTriangle, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
+  sim::SpawnEntityRequest again = spawn_request("ball", kTriangle, -3.0, 1.0, 0.0);
+  again.allow_renaming = true;
+  EXPECT_EQ(spawn(again).entity_name, "ball_1");
+  sim::SpawnEntityRequest in_ns = spawn_request("bot", kTriangle, 3.0, 1.0, 0.0);
+  in_ns.entity_namespace = "/team";
+  EXPECT_EQ(spawn(in_ns).entity_name, "team/bot");
+  for (const char* bad : {"body_7", "9lives", "a b", "a//b"}) {
+    EXPECT_EQ(spawn(spawn_request(bad, kTriangle, 0, 0, 0)).result.result, Spawn::kNameInvalid) << bad;
+  }
+  in_ns.entity_namespace = "team ns";
+  EXPECT_EQ(spawn(in_ns).result.result, Spawn::kNamespaceInvalid);
+  sim::SpawnEntityRequest by_uri = spawn_request("u", "", 0, 0, 0);
+  by_uri.entity_resource.uri = "file:///etc/passwd";
+  EXPECT_EQ(spawn(by_uri).result.result, Spawn::kNoResource);
+  EXPECT_EQ(spawn(spawn_request("e", "", 0, 0, 0)).result.result, Spawn::kNoResource);
+  const Spawn unparsed = spawn(spawn_request("p", "<scene>\n<rigidbodyvertex x=\"0\"/>\n</scene>", 0, 0, 0));
+  EXPECT_EQ(unparsed.result.result, Spawn::kResourceParseError);
+  EXPECT_NE(unparsed.result.error_message.find("resource_string:2"), std::string::npos)
+      << unparsed.result.error_message;
+  std::string missing = kTriangle;
+  missing.replace(missing.find("body_1"), 6, "nobody");
+  EXPECT_EQ(spawn(spawn_request("m", missing, 0, 0, 0)).result.result, Spawn::kMissingAssets);
+  sim::SpawnEntityRequest off_plane = spawn_request("z", kTriangle, 0, 0, 0);
+  off_plane.initial_pose.position.z = 1.0;
+  EXPECT_EQ(spawn(off_plane).result.result, Spawn::kInvalidPose);
+  off_plane.initial_pose.position.z = 0.0;
+  off_plane.initial_pose.frame_id = "map";
+  EXPECT_EQ(spawn(off_plane).result.result, Spawn::kInvalidPose);
+
+  // Deleting a scene body takes its springs with it, and the reply says which.
+  sim::DeleteEntityRequest del;
+  del.entity = "body_0";
+  const auto deleted = call<sim::DeleteEntityResponse>("delete_entity", del);
+  ASSERT_EQ(deleted.result.result, SimResult::kOk) << deleted.result.error_message;
+  EXPECT_NE(deleted.result.error_message.find("spring"), std::string::npos) << deleted.result.error_message;
+  EXPECT_EQ(call<sim::DeleteEntityResponse>("delete_entity", del).result.result, SimResult::kNotFound);
+  get.entity = "body_0";
+  EXPECT_EQ(call<sim::GetEntityStateResponse>("get_entity_state", get).result.result, SimResult::kNotFound);
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_1", "ball", "ball_1", "team/bot"}));
+  EXPECT_EQ(entities(named("^ball")), (std::vector<std::string>{"ball", "ball_1"}));
+  ASSERT_EQ(step(20).result, SimResult::kOk);
+  const auto live = states();
+  ASSERT_EQ(live.states.size(), 4u);
+
+  // The session's commands, as /NS/commands carries them, applied again offline: the same bits.
+  const test::Snapshot rerun = resimulated();
+  ASSERT_EQ(rerun.step, 30);
+  expect_states_equal(live, rerun);
+
+  // SCOPE_SPAWNED: what was spawned goes, the scene's bodies stay as they are (body_0 stays deleted).
+  sim::ResetSimulationRequest reset;
+  reset.scope = sim::ResetSimulationRequest::kScopeSpawned;
+  const auto body_1 = [&] {
+    sim::GetEntityStateRequest g;
+    g.entity = "body_1";
+    return call<sim::GetEntityStateResponse>("get_entity_state", g).state;
+  };
+  const sim::EntityState before = body_1();
+  ASSERT_EQ(call<sim::ResetSimulationResponse>("reset_simulation", reset).result.result, SimResult::kOk);
+  EXPECT_EQ(entities({}), std::vector<std::string>{"body_1"});
+  EXPECT_EQ(body_1(), before);
+  // A name once used is never given again.
+  EXPECT_EQ(spawn(spawn_request("ball", kTriangle, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
+}
+
 TEST_P(SimulationServicesTest, FiltersSelectByNameCategoryAndBounds) {
   const World w = stepped(scene_, 0);
   EXPECT_EQ(entities(named("1$")), std::vector<std::string>{"body_1"});
@@ -657,7 +768,8 @@ TEST_P(SimulationServicesTest, SimulationHandlersAreTheServedOnesWithTheirSource
   const std::vector<std::string> want = {
       "get_simulator_features", "get_simulation_state", "set_simulation_state", "reset_simulation",
       "step_simulation",        "get_entities",         "get_entities_states",  "get_entity_info",
-      "get_entity_state",       "get_entity_bounds",    "set_entity_state"};
+      "get_entity_state",       "get_entity_bounds",    "set_entity_state",     "spawn_entity",
+      "delete_entity"};
   std::vector<std::string> listed, handled, names;
   for (const NodeServices::Served& s : NodeServices::simulation_catalogue()) {
     listed.push_back(s.name + " " + s.type);

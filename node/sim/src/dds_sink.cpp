@@ -54,6 +54,14 @@ Status DdsSink::write(const World& world) {
   return Ok{};
 }
 
+Status DdsSink::restructure(const World& world, const Entities& entities) {
+  messages_->restructure(entities);
+  for (const msgs::TopicId id : ids_) {  // latched first
+    if (Status st = publish(id, world); !st) return st;
+  }
+  return Ok{};
+}
+
 void DdsSink::time_reset() {
   if (world_ == nullptr || !publishers_[static_cast<std::size_t>(msgs::TopicId::Clock)]) return;
   // A failed write is the next step's to report (an observer has no status).

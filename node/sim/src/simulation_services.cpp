@@ -25,17 +25,31 @@ using sim::Result;
 
 // What GetSimulatorFeatures lists: exactly what these services do. Not listed, and answered
 // RESULT_FEATURE_UNSUPPORTED: tags and convex-hull filters, resetting time or state alone (rbsim's
-// time is its step index, part of its state), spawned entities (issue 29), setting an
-// acceleration. (QUITTING has no feature of its own: rbsim node supports it, SIMULATION_STATE_SETTING.)
+// time is its step index, part of its state), spawnables and spawning from a uri, spawning several
+// entities at once, worlds, setting an acceleration. (QUITTING has no feature of its own: rbsim
+// node supports it, SIMULATION_STATE_SETTING.)
 constexpr sim::Feature kFeatures[] = {
-    sim::Feature::EntityBounds,           sim::Feature::EntityBoundsBox,
-    sim::Feature::EntityCategories,       sim::Feature::EntityStateGetting,
-    sim::Feature::EntityStateSetting,     sim::Feature::EntityInfoGetting,
-    sim::Feature::SimulationReset,        sim::Feature::SimulationStateGetting,
-    sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
-    sim::Feature::StepSimulationSingle,   sim::Feature::StepSimulationMultiple,
+    sim::Feature::Spawning,
+    sim::Feature::Deleting,
+    sim::Feature::SpawningResourceString,
+    sim::Feature::SimulationResetSpawned,
+    sim::Feature::EntityBounds,
+    sim::Feature::EntityBoundsBox,
+    sim::Feature::EntityCategories,
+    sim::Feature::EntityStateGetting,
+    sim::Feature::EntityStateSetting,
+    sim::Feature::EntityInfoGetting,
+    sim::Feature::SimulationReset,
+    sim::Feature::SimulationStateGetting,
+    sim::Feature::SimulationStateSetting,
+    sim::Feature::SimulationStatePause,
+    sim::Feature::StepSimulationSingle,
+    sim::Feature::StepSimulationMultiple,
     sim::Feature::StepSimulationAction,
 };
+// GetSimulatorFeatures.spawn_formats: a FOSSSim scene fragment of one body (rbsim/scene.hpp's
+// parse_fragment), as resource_string.
+constexpr std::string_view kSpawnFormat = "fosssim-fragment";
 constexpr std::size_t kMaxFilterBytes = 256;  // a longer name pattern is refused before it is compiled
 
 Result ok() {
@@ -43,13 +57,6 @@ Result ok() {
 }
 Result failure(std::uint8_t code, std::string message) {
   return Result{code, std::move(message)};
-}
-
-// The entity's body index, when `name` is body_<i> of a body of the world (scene_body_id's rule).
-std::optional<std::int32_t> body_of(const std::string& name, std::int32_t bodies) {
-  const std::optional<std::int32_t> i = scene_body_id(name);
-  if (!i || *i >= bodies) return std::nullopt;
-  return i;
 }
 
 sim::Vector3 planar(double x, double y) {
@@ -193,12 +200,14 @@ struct Filters {
     return read_bounds(in.bounds, bounds);
   }
 
-  // The names of the bodies that pass, in body order; `hull` is scratch.
-  std::vector<std::int32_t> select(const World& world, std::vector<Vec2>& hull) const {
+  // The bodies that pass (dense indices), in body order; `names` the bodies' names (Entities),
+  // `hull` scratch.
+  std::vector<std::int32_t> select(const World& world, const std::vector<std::string>& names,
+                                   std::vector<Vec2>& hull) const {
     std::vector<std::int32_t> out;
     if (!dynamic_objects) return out;
     for (std::int32_t i = 0; i < world.body_count(); ++i) {
-      if (name && !std::regex_search(msgs::body_frame("", i), *name)) continue;
+      if (name && !std::regex_search(names[static_cast<std::size_t>(i)], *name)) continue;
       // The hull in world axes only for a bounds filter: its vertices cost a sine and a cosine
       // each, most of a reply's own CPU without one (get_entities_states of every body).
       if (bounds.type != sim::BoundsType::Empty) {
@@ -242,6 +251,10 @@ auto at_boundary(control::Controller& controller, double timeout_s, F f, std::in
   return answer.get();
 }
 
+std::string no_entity(const std::string& name) {
+  return "no entity '" + name + "' (get_entities lists them)";
+}
+
 Result unanswered(double timeout_s) {
   return failure(Result::kOperationFailed, "the run loop did not reach a step boundary within " +
                                                std::to_string(timeout_s) + " s (or the run ended)");
@@ -257,14 +270,18 @@ void SimulationServices::add(std::vector<Entry>& out) {
             sim::GetSimulatorFeaturesResponse res;
             for (const sim::Feature f : kFeatures)
               res.features.features.push_back(static_cast<std::uint16_t>(f));
+            res.features.spawn_formats.emplace_back(kSpawnFormat);
             res.features.custom_info =
-                "rbsim: every body is an entity body_<i> (CATEGORY_DYNAMIC_OBJECT); state changes "
-                "are recorded on <node>/commands and re-simulate exactly";
+                "rbsim: every body is an entity (CATEGORY_DYNAMIC_OBJECT), a scene's named body_<id>, a "
+                "spawned one as spawned; spawn_formats: a FOSSSim scene fragment of one body as "
+                "resource_string; state changes, spawns and deletes are recorded on <node>/commands "
+                "and re-simulate exactly";
             return res;
           },
           [](const Error&) { return std::optional<sim::GetSimulatorFeaturesResponse>(); }));
   add_state(out);
   add_entities(out);
+  add_spawning(out);
 }
 
 // Simulation state, reset and stepping. The state is read at a boundary: STOPPED while stopped_ is
@@ -309,13 +326,20 @@ void SimulationServices::add_state(std::vector<Entry>& out) {
           [command](const RequestHeader&, const sim::ResetSimulationRequest& req) {
             using R = sim::ResetSimulationRequest;
             // Time and state are one in rbsim (the step index is part of the world's
-            // state): a reset of both is the full one; and nothing is ever spawned.
+            // state): a reset of both is the full one. SCOPE_SPAWNED alone removes what was
+            // spawned, the scene's bodies left as they are.
+            if (req.scope == R::kScopeSpawned) {
+              const CommandResult r = command(CommandKind::ResetSpawned);
+              return sim::ResetSimulationResponse{
+                  r.successful ? ok() : failure(Result::kOperationFailed, r.message)};
+            }
             if (req.scope != R::kScopeDefault && req.scope != R::kScopeAll &&
                 req.scope != (R::kScopeTime | R::kScopeState)) {
               return sim::ResetSimulationResponse{
                   failure(Result::kFeatureUnsupported, "scope " + std::to_string(req.scope) +
                                                            ": only SCOPE_DEFAULT, SCOPE_ALL or SCOPE_TIME | "
-                                                           "SCOPE_STATE (a full reset to step 0)")};
+                                                           "SCOPE_STATE (a full reset to step 0), or "
+                                                           "SCOPE_SPAWNED")};
             }
             const CommandResult r = command(CommandKind::Reset);
             return sim::ResetSimulationResponse{r.successful ? ok()
@@ -392,6 +416,24 @@ Result SimulationServices::step(std::uint64_t steps) {
   return ok();
 }
 
+// A pose in the plane: the position (x, y, 0) and a rotation about +z as theta (rad, CCW > 0), or
+// a Result with code `invalid` when it is not one.
+std::optional<Result> planar_pose(const sim::Vector3& p, const msgs::Quaternion& q, std::uint8_t invalid,
+                                  Vec2& position, double& theta) {
+  const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  for (double v : {p.x, p.y, p.z, q.x, q.y, q.z, q.w}) {
+    if (!std::isfinite(v)) return failure(invalid, "the pose must be finite");
+  }
+  if (p.z != 0.0) return failure(invalid, "position.z must be 0 (a planar world)");
+  // A unit quaternion of a rotation about +z: (0, 0, sin(theta/2), cos(theta/2)).
+  if (std::abs(norm - 1.0) > 1e-9) return failure(invalid, "the orientation is not a unit quaternion");
+  if (std::abs(q.x) > 1e-9 || std::abs(q.y) > 1e-9)
+    return failure(invalid, "the orientation must be a rotation about z (x and y 0)");
+  position = Vec2(p.x, p.y);
+  theta = 2.0 * std::atan2(q.z, q.w);
+  return std::nullopt;
+}
+
 // Checks SetEntityState's request against a planar world and makes its StateArgs (body unset): a
 // Result when it is refused.
 std::optional<Result> state_args(const sim::SetEntityStateRequest& req, control::StateArgs& a) {
@@ -406,20 +448,10 @@ std::optional<Result> state_args(const sim::SetEntityStateRequest& req, control:
     return failure(Result::kOperationFailed,
                    "state.header.frame_id '" + s.frame_id + "': only 'world' (or empty)");
   if (req.set_pose) {
-    const msgs::Quaternion& q = s.orientation;
-    const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-    for (double v : {s.position.x, s.position.y, s.position.z, q.x, q.y, q.z, q.w}) {
-      if (!std::isfinite(v)) return failure(R::kInvalidPose, "the pose must be finite");
-    }
-    if (s.position.z != 0.0) return failure(R::kInvalidPose, "position.z must be 0 (a planar world)");
-    // A unit quaternion of a rotation about +z: (0, 0, sin(theta/2), cos(theta/2)).
-    if (std::abs(norm - 1.0) > 1e-9)
-      return failure(R::kInvalidPose, "the orientation is not a unit quaternion");
-    if (std::abs(q.x) > 1e-9 || std::abs(q.y) > 1e-9)
-      return failure(R::kInvalidPose, "the orientation must be a rotation about z (x and y 0)");
+    if (std::optional<Result> bad =
+            planar_pose(s.position, s.orientation, R::kInvalidPose, a.position, a.theta))
+      return bad;
     a.set_pose = true;
-    a.position = Vec2(s.position.x, s.position.y);
-    a.theta = 2.0 * std::atan2(q.z, q.w);
   }
   if (req.set_twist) {
     const sim::Vector3 &v = s.linear_velocity, &w = s.angular_velocity;
@@ -444,14 +476,17 @@ Result SimulationServices::set_entity_state(const sim::SetEntityStateRequest& re
   if (std::optional<Result> refused = state_args(req, c.state)) return *refused;
   if (!c.state.set_pose && !c.state.set_twist)
     return failure(Result::kOk, "nothing to set (set_pose and set_twist false)");
-  const std::optional<std::int32_t> bodies =
-      at_boundary(controller_, timeout_s_, [](const World& w) { return w.body_count(); });
-  if (!bodies) return unanswered(timeout_s_);
-  const std::optional<std::int32_t> body = body_of(req.entity, *bodies);
-  if (!body)
-    return failure(Result::kNotFound, "no entity '" + req.entity + "' (entities are body_0 .. body_<n-1>)");
-  c.state.body = *body;
+  const std::optional<std::optional<std::int32_t>> id = at_boundary(
+      controller_, timeout_s_, [this, entity = req.entity](const World& w) -> std::optional<std::int32_t> {
+        const std::optional<std::int32_t> found = controller_.find_entity(entity);
+        return found && w.find_body_id(*found) ? found : std::nullopt;
+      });
+  if (!id) return unanswered(timeout_s_);
+  if (!*id) return failure(Result::kNotFound, no_entity(req.entity));
+  c.state.body = **id;
   const CommandResult r = apply_(std::move(c));
+  // Deleted between the look-up and the boundary the command applied at.
+  if (r.refusal == control::Refusal::NoSuchEntity) return failure(Result::kNotFound, r.message);
   return r.successful ? ok() : failure(Result::kOperationFailed, r.message);
 }
 
@@ -465,11 +500,12 @@ void SimulationServices::add_entities(std::vector<Entry>& out) {
                          auto filters = std::make_shared<Filters>();
                          if (std::optional<Result> bad = filters->read(req.filters))
                            return sim::GetEntitiesResponse{*bad, {}};
-                         std::optional<sim::GetEntitiesResponse> res = read([filters](const World& w) {
+                         std::optional<sim::GetEntitiesResponse> res = read([this, filters](const World& w) {
                            std::vector<Vec2> hull;
                            sim::GetEntitiesResponse r{ok(), {}};
-                           for (const std::int32_t i : filters->select(w, hull))
-                             r.entities.push_back(msgs::body_frame("", i));
+                           const std::vector<std::string>& names = controller_.entities()->body_names;
+                           for (const std::int32_t i : filters->select(w, names, hull))
+                             r.entities.push_back(names[static_cast<std::size_t>(i)]);
                            return r;
                          });
                          return res ? std::move(*res) : sim::GetEntitiesResponse{unanswered(timeout_s_), {}};
@@ -482,11 +518,12 @@ void SimulationServices::add_entities(std::vector<Entry>& out) {
             auto filters = std::make_shared<Filters>();
             if (std::optional<Result> bad = filters->read(req.filters))
               return sim::GetEntitiesStatesResponse{*bad, {}, {}};
-            std::optional<sim::GetEntitiesStatesResponse> res = read([filters](const World& w) {
+            std::optional<sim::GetEntitiesStatesResponse> res = read([this, filters](const World& w) {
               std::vector<Vec2> hull;
               sim::GetEntitiesStatesResponse r{ok(), {}, {}};
-              for (const std::int32_t i : filters->select(w, hull)) {
-                r.entities.push_back(msgs::body_frame("", i));
+              const std::vector<std::string>& names = controller_.entities()->body_names;
+              for (const std::int32_t i : filters->select(w, names, hull)) {
+                r.entities.push_back(names[static_cast<std::size_t>(i)]);
                 r.states.push_back(entity_state(w, BodyId{i}));
               }
               return r;
@@ -502,15 +539,14 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
   // f(world, body) makes the response's payload at a boundary; `Res` carries it with the result.
   const auto one = [this]<class Res, class Payload>(const std::string& entity, auto f) -> Res {
     std::optional<std::optional<Payload>> got =
-        at_boundary(controller_, timeout_s_, [entity, f](const World& w) -> std::optional<Payload> {
-          const std::optional<std::int32_t> i = body_of(entity, w.body_count());
-          if (!i) return std::nullopt;
-          return f(w, BodyId{*i});
+        at_boundary(controller_, timeout_s_, [this, entity, f](const World& w) -> std::optional<Payload> {
+          const std::optional<std::int32_t> id = controller_.find_entity(entity);
+          const std::optional<BodyId> b = id ? w.find_body_id(*id) : std::nullopt;
+          if (!b) return std::nullopt;
+          return f(w, *b);
         });
     if (!got) return Res{unanswered(timeout_s_), {}};
-    if (!*got)
-      return Res{failure(Result::kNotFound, "no entity '" + entity + "' (entities are body_0 .. body_<n-1>)"),
-                 {}};
+    if (!*got) return Res{failure(Result::kNotFound, no_entity(entity)), {}};
     return Res{ok(), std::move(**got)};
   };
   out.emplace_back("get_entity_info", std::string(sim::GetEntityInfoRequest::kService),
@@ -520,7 +556,7 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
                              req.entity, [](const World& w, BodyId b) {
                                sim::EntityInfo info;
                                info.category = static_cast<std::uint8_t>(sim::Category::DynamicObject);
-                               info.description = "rigid body " + std::to_string(b.index) + ": " +
+                               info.description = "rigid body " + std::to_string(w.body_id(b)) + ": " +
                                                   std::to_string(w.hull(b).size()) +
                                                   " point masses, M = " + std::to_string(w.mass(b)) +
                                                   " kg, I = " + std::to_string(w.inertia(b)) + " kg m^2";
@@ -558,6 +594,107 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
                          return sim::SetEntityStateResponse{set_entity_state(req)};
                        },
                        refuse_malformed<sim::SetEntityStateResponse>()));
+}
+
+namespace {
+
+// ROS 2's name rules for a spawned entity's name and namespace: tokens of letters, digits and
+// '_', not starting with a digit, joined by '/' (a namespace may start with one; a name may not).
+bool valid_name(std::string_view name, bool is_namespace) {
+  if (is_namespace && name.starts_with('/')) name.remove_prefix(1);
+  if (name.empty() || name.size() > 255) return false;
+  std::size_t token = 0;
+  for (std::size_t k = 0; k <= name.size(); ++k) {
+    if (k == name.size() || name[k] == '/') {
+      if (k == token || (name[token] >= '0' && name[token] <= '9')) return false;
+      token = k + 1;
+      continue;
+    }
+    const char c = name[k];
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_'))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// SpawnEntity: the request checked and its fragment parsed here (off the loop's thread, within
+// FragmentLimits), then a spawn_entity command carrying the fragment's text, applied at the next
+// boundary (while paused, at once). The full name is NAMESPACE/NAME.
+sim::SpawnEntityResponse SimulationServices::spawn_entity(const sim::SpawnEntityRequest& req) {
+  using R = sim::SpawnEntityResponse;
+  const auto fail = [](std::uint8_t code, std::string message) {
+    return R{failure(code, std::move(message)), {}};
+  };
+  if (!req.name.empty() && (!valid_name(req.name, false) || scene_body_id(req.name)))
+    return fail(R::kNameInvalid, "name '" + req.name +
+                                     "': letters, digits and '_' in '/'-separated tokens, none starting with "
+                                     "a digit, and not body_<id> (a scene body's)");
+  std::string ns = req.entity_namespace;
+  if (!ns.empty() && !valid_name(ns, true))
+    return fail(R::kNamespaceInvalid, "entity_namespace '" + ns + "': ROS 2 name rules, as for the name");
+  if (ns.starts_with('/')) ns.erase(0, 1);
+  const sim::Resource& res = req.entity_resource;
+  if (!res.uri.empty())
+    return fail(R::kNoResource, "entity_resource.uri '" + res.uri +
+                                    "': this node reads no files; give the fragment's text as "
+                                    "entity_resource.resource_string");
+  if (res.resource_string.empty())
+    return fail(R::kNoResource,
+                "entity_resource: resource_string is empty (a FOSSSim scene fragment of one body)");
+  if (!req.initial_pose.frame_id.empty() && req.initial_pose.frame_id != "world")
+    return fail(R::kInvalidPose,
+                "initial_pose.header.frame_id '" + req.initial_pose.frame_id + "': only 'world' (or empty)");
+  Command c;
+  c.kind = CommandKind::Spawn;
+  if (std::optional<Result> bad = planar_pose(req.initial_pose.position, req.initial_pose.orientation,
+                                              R::kInvalidPose, c.spawn.position, c.spawn.theta))
+    return R{*bad, {}};
+  rbsim::Result<Fragment> fragment = parse_fragment(res.resource_string, "resource_string");
+  if (!fragment) return fail(R::kResourceParseError, fragment.error().message);
+  c.spawn.resource = res.resource_string;
+  c.spawn.fragment = std::make_shared<const Fragment>(std::move(fragment.value()));
+  const std::string name = req.name.empty() && !ns.empty() ? "entity" : req.name;
+  c.spawn.name = ns.empty() || name.empty() ? name : ns + "/" + name;
+  c.spawn.allow_renaming = req.allow_renaming || req.name.empty();
+  const CommandResult r = apply_(std::move(c));
+  if (r.successful) return R{ok(), r.entity};
+  switch (r.refusal) {
+    case control::Refusal::NameTaken:
+      return fail(R::kNameNotUnique, r.message);
+    case control::Refusal::NoSuchEntity:
+      return fail(R::kMissingAssets, r.message);  // a spring names a body the world does not have
+    case control::Refusal::BadResource:
+      return fail(R::kResourceParseError, r.message);
+    case control::Refusal::Other:
+      break;
+  }
+  return fail(Result::kOperationFailed, r.message);
+}
+
+// SpawnEntity and DeleteEntity; ResetSimulation's SCOPE_SPAWNED is add_state's.
+void SimulationServices::add_spawning(std::vector<Entry>& out) {
+  out.emplace_back(
+      "spawn_entity", std::string(sim::SpawnEntityRequest::kService),
+      typed_handler<sim::SpawnEntityRequest, sim::SpawnEntityResponse>(
+          [this](const RequestHeader&, const sim::SpawnEntityRequest& req) { return spawn_entity(req); },
+          refuse_malformed<sim::SpawnEntityResponse>()));
+  // The reply's message names the springs removed with the body.
+  out.emplace_back(
+      "delete_entity", std::string(sim::DeleteEntityRequest::kService),
+      typed_handler<sim::DeleteEntityRequest, sim::DeleteEntityResponse>(
+          [this](const RequestHeader&, const sim::DeleteEntityRequest& req) {
+            Command c;
+            c.kind = CommandKind::Delete;
+            c.entity = req.entity;
+            const CommandResult r = apply_(std::move(c));
+            if (r.successful) return sim::DeleteEntityResponse{failure(Result::kOk, r.message)};
+            return sim::DeleteEntityResponse{failure(
+                r.refusal == control::Refusal::NoSuchEntity ? Result::kNotFound : Result::kOperationFailed,
+                r.message)};
+          },
+          refuse_malformed<sim::DeleteEntityResponse>()));
 }
 
 }  // namespace rbsim::node

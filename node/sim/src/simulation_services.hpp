@@ -55,6 +55,8 @@ class SimulationServices {
   msgs::simulation::Result set_entity_state(const msgs::simulation::SetEntityStateRequest& req);
   void add_entities(std::vector<Entry>& out);
   void add_entity(std::vector<Entry>& out);
+  void add_spawning(std::vector<Entry>& out);
+  msgs::simulation::SpawnEntityResponse spawn_entity(const msgs::simulation::SpawnEntityRequest& req);
 };
 
 }  // namespace rbsim::node

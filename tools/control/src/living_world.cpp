@@ -70,7 +70,7 @@ std::optional<std::int32_t> Controller::find_entity(std::string_view name) const
 
 std::string Controller::entity_name(std::int32_t id) const {
   if (const auto it = spawned_names_.find(id); it != spawned_names_.end()) return it->second;
-  return "body_" + std::to_string(id);
+  return scene_body_name(id);
 }
 
 void Controller::follow_structure(const World& world, CommandResult* r) {

@@ -48,12 +48,25 @@ Status FoxgloveSink::begin(const Scene& scene, const World& world) {
 
 Status FoxgloveSink::write(const World& world) {
   if (world.step_index() % options_.publish_every != 0) return Ok{};
+  publish_step(world);
+  return Ok{};
+}
+
+void FoxgloveSink::publish_step(const World& world) {
   // The step's messages go before its time message: each publish wakes the server's thread, and
   // a time message sent first would make the first wake-up (and the client's) carry 9 bytes.
   for (const msgs::TopicSpec& spec : msgs::topics()) {
     if (spec.per_step) publish(spec, world);
   }
   server_->time(msgs::sim_time_ns(world));
+}
+
+Status FoxgloveSink::restructure(const World& world, const Entities& entities) {
+  messages_->restructure(entities);
+  for (const msgs::TopicSpec& spec : msgs::topics()) {
+    if (spec.latched()) publish(spec, world);
+  }
+  publish_step(world);
   return Ok{};
 }
 

@@ -38,6 +38,11 @@ class DdsSink final : public Sink {
   // Waits (bounded) until subscribers acknowledged everything, so nothing in flight is lost
   // when the node exits.
   Status finish() override;
+  // Bodies came or went (a spawn or delete at this boundary): the latched scene description and
+  // markers of the world as it now is, then its current step's per-step topics at once, so a
+  // paused run shows the change without stepping (as a state set does).
+  bool follows_structure() const override { return true; }
+  Status restructure(const World& world, const Entities& entities) override;
   // A reset applied (the controller's observer, on the run loop's thread, the world at step 0 by
   // then): publishes /clock at once, so subscribers see time jump back to 0 while the run stays
   // paused (the other topics follow with the next step). Nothing before begin().

@@ -465,11 +465,17 @@ class FoxgloveSink final : public Sink {
   Status write(const World& world) override;
   // Flushes the server (bounded, 2 s): viewers that keep up get the last steps.
   Status finish() override;
+  // Bodies came or went: the scene description and markers again (latched; the markers start
+  // with a DELETEALL, so the 3D panel drops what went), then the current step's per-step topics
+  // at once, so a paused run shows the change without stepping.
+  bool follows_structure() const override { return true; }
+  Status restructure(const World& world, const Entities& entities) override;
   // A live change (a control command, between steps); values < 1 are taken as 1.
   void set_publish_every(std::int64_t every) { options_.publish_every = every < 1 ? 1 : every; }
 
  private:
   void publish(const msgs::TopicSpec& spec, const World& world);
+  void publish_step(const World& world);
   Server* server_;
   std::vector<ChannelId> ids_;  // by TopicId
   SinkOptions options_;
