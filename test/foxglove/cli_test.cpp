@@ -36,7 +36,8 @@ std::vector<std::string> node_services(const std::string& node) {
   for (const char* name :
        {"pause", "resume", "reset", "step", "apply_impulse", "get_simulator_features", "get_simulation_state",
         "set_simulation_state", "reset_simulation", "step_simulation", "get_entities", "get_entities_states",
-        "get_entity_info", "get_entity_state", "get_entity_bounds", "set_entity_state"})
+        "get_entity_info", "get_entity_state", "get_entity_bounds", "set_entity_state", "spawn_entity",
+        "delete_entity"})
     out.push_back(node + "/" + name);
   return out;
 }

@@ -532,7 +532,7 @@ def case_killed_client(ctx):
 # simulation_interfaces 2.1.0 and get_type_description (issue 37), through ros2-client
 
 
-SIM_FEATURES = {5, 6, 8, 10, 11, 12, 20, 24, 25, 26, 31, 32, 33}  # the README's list, by value
+SIM_FEATURES = {0, 1, 5, 6, 8, 9, 10, 11, 12, 20, 23, 24, 25, 26, 31, 32, 33}  # the README's list, by value
 OK, UNSUPPORTED, NOT_FOUND, FAILED = 1, 0, 2, 4  # simulation_interfaces/msg/Result
 ALREADY, INCORRECT = 101, 103  # SetSimulationState's own codes
 STOPPED, PLAYING, PAUSED = 0, 1, 2
@@ -594,7 +594,7 @@ def expect(ctx, got, op, **want):
 def case_simulation_state(ctx):
     """simulation_interfaces through ros2-client: GetSimulatorFeatures lists exactly the README's
     features, each listed interface answers and the unlisted ones (tags and convex-hull filters,
-    reset scopes TIME, STATE, SPAWNED alone, set_acceleration) answer RESULT_FEATURE_UNSUPPORTED;
+    reset scopes TIME, STATE alone, set_acceleration) answer RESULT_FEATURE_UNSUPPORTED;
     pause, StepSimulation of N and of 1 (each answered at the step reached: the next state read
     names it), play; STOPPED (step 0) then play starts the world again from step 0 (the states
     equal `rbsim run --csv`'s at the step they name); reset scopes; every SetSimulationState code."""
@@ -642,8 +642,9 @@ def case_simulation_state(ctx):
         # Played from step 0 after STOPPED: at the step it then paused at, the world is the one
         # `rbsim run` reaches from the scene (it did not go on from where it had been).
         same_as_csv(ctx, "STOPPED, played, paused", g[20], rows)
-        for k in (21, 22, 23):
-            expect(ctx, g, k, result=UNSUPPORTED)  # SCOPE_TIME, SCOPE_STATE alone, SCOPE_SPAWNED
+        for k in (21, 22):
+            expect(ctx, g, k, result=UNSUPPORTED)  # SCOPE_TIME, SCOPE_STATE alone
+        expect(ctx, g, 23, result=OK)  # SCOPE_SPAWNED: nothing was spawned, nothing changes
         expect(ctx, g, 24, result=OK)
         for k in (25, 29, 32):
             expect(ctx, g, k, result=OK)  # TIME | STATE, DEFAULT, ALL: a full reset

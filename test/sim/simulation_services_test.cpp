@@ -107,13 +107,16 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
   Status run() {
     Result<Driver> driver = Driver::create(scene_);
     if (!driver) return driver.error();
-    // /clock, on the in-memory network only: it is one global topic, which other test processes
-    // on the DDS domain publish too.
+    // /clock (and the scene description and body states), on the in-memory network only: /clock
+    // is one global topic, which other test processes on the DDS domain publish too.
     std::unique_ptr<DdsSink> clock;
     if (GetParam() == "memory") {
       NodeOptions o;
       o.ns = node_;
-      o.topics = msgs::TopicSet{}.set(static_cast<std::size_t>(msgs::TopicId::Clock));
+      o.topics = msgs::TopicSet{}
+                     .set(static_cast<std::size_t>(msgs::TopicId::Clock))
+                     .set(static_cast<std::size_t>(msgs::TopicId::SceneDescription))
+                     .set(static_cast<std::size_t>(msgs::TopicId::BodyStates));
       auto sink = DdsSink::create(*server_, o);
       if (!sink) return sink.error();
       clock = std::move(sink.value());
@@ -609,6 +612,67 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
   EXPECT_EQ(body_1(), before);
   // A name once used is never given again.
   EXPECT_EQ(spawn(spawn_request("ball", kTriangle, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
+}
+
+// While paused, a spawn and a delete show at once on the node's topics: the scene description
+// again (latched) with the world's bodies as they now are, and the current step's body states
+// with their ids, before any step.
+TEST_P(SimulationServicesTest, ASpawnOrDeleteWhilePausedPublishesTheChangedWorldAtOnce) {
+  if (GetParam() != "memory") GTEST_SKIP() << "the node's topics are published on the in-memory network";
+  const msgs::TopicSpec& scene_spec = msgs::topic(msgs::TopicId::SceneDescription);
+  const msgs::TopicSpec& states_spec = msgs::topic(msgs::TopicId::BodyStates);
+  auto scenes = Subscription::create(*client_, scene_spec, msgs::topic_name(scene_spec, node_),
+                                     qos_for(scene_spec, 100));
+  auto bodies = Subscription::create(*client_, states_spec, msgs::topic_name(states_spec, node_),
+                                     qos_for(states_spec, 1000));
+  ASSERT_TRUE(scenes.ok() && bodies.ok());
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  ASSERT_EQ(step(10).result, SimResult::kOk);
+  // The last scene description and body states received, waiting (bounded) for ones with
+  // `n` bodies.
+  const auto wait_for = [&](std::size_t n) {
+    std::optional<msgs::SceneMessage> scene;
+    msgs::BodyStatesMessage states;
+    Received r;
+    for (int i = 0; i < 4000; ++i) {
+      while (scenes.value().take(r)) {
+        Result<msgs::SceneMessage> m = msgs::decode_scene(r.cdr);
+        if (m) scene = std::move(m.value());
+      }
+      while (bodies.value().take(r)) EXPECT_TRUE(msgs::decode_body_states(r.cdr, states).ok());
+      if (scene && scene->bodies.size() == n && states.bodies.size() == n) break;
+      std::this_thread::sleep_for(5ms);
+    }
+    return std::pair{scene, states};
+  };
+  auto [before, at10] = wait_for(2);
+  ASSERT_TRUE(before.has_value());
+  EXPECT_EQ(at10.step, 10u);
+
+  const auto spawned =
+      call<sim::SpawnEntityResponse>("spawn_entity", spawn_request("ball", kTriangle, 1.5, 6.0, 0.4));
+  ASSERT_EQ(spawned.result.result, SimResult::kOk) << spawned.result.error_message;
+  auto [grown, now] = wait_for(3);
+  ASSERT_TRUE(grown.has_value());
+  ASSERT_EQ(grown->bodies.size(), 3u) << "no scene description with the spawned body within 20 s";
+  EXPECT_EQ(grown->bodies[2].mass, 3.0);
+  EXPECT_EQ(grown->bodies[2].hull.size(), 3u);
+  EXPECT_EQ(grown->springs.size(), before->springs.size() + 2);
+  ASSERT_EQ(now.bodies.size(), 3u);
+  EXPECT_EQ(now.step, 10u) << "the same step, not a step on";
+  EXPECT_EQ(now.bodies[2].id, 2);
+  EXPECT_EQ(now.bodies[2].state.position, Vec2(1.5, 6.0));
+
+  sim::DeleteEntityRequest del;
+  del.entity = "body_0";
+  ASSERT_EQ(call<sim::DeleteEntityResponse>("delete_entity", del).result.result, SimResult::kOk);
+  auto [shrunk, after] = wait_for(2);
+  ASSERT_TRUE(shrunk.has_value());
+  ASSERT_EQ(after.bodies.size(), 2u);
+  EXPECT_EQ(after.bodies[0].id, 1);
+  EXPECT_EQ(after.bodies[1].id, 2);
+  EXPECT_EQ(shrunk->bodies[1].mass, 3.0);
+  EXPECT_EQ(after.step, 10u);
 }
 
 TEST_P(SimulationServicesTest, FiltersSelectByNameCategoryAndBounds) {

@@ -355,9 +355,9 @@ fn op(s: &mut Session, words: &[String]) -> Result<String, String> {
     }
     "reset" => {
       let (r, d): (ResultResponse, _) =
-        // The probe: SCOPE_SPAWNED, unsupported.
+        // The probe: SCOPE_TIME alone, unsupported.
         s.call_probed("reset_simulation", &ty("ResetSimulation"), ResetRequest { scope: num(rest.first(), "scope")? }, ResetRequest {
-          scope: 4,
+          scope: 1,
         })?;
       format!("{}, {}", result_json(&r.result), took(d))
     }

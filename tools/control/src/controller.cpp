@@ -305,6 +305,11 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       return b;
     }
     if (!settings_.paused || step_budget_ > 0) break;
+    // Paused, bodies came or went: the sinks show the change now, not at the next step.
+    if (b.structure_changed) {
+      b.hold = true;
+      return b;
+    }
     // Offline, nothing can end this pause: no resume timer, nothing due now, and a command queued
     // for a later step is never reached while paused without a step budget.
     if (end_when_idle_ && !due(world.step_index()) && !resume_at_ &&

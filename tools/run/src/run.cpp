@@ -75,6 +75,7 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
         for (Sink* sink : sinks_) sink->rebase(world);
       }
       if (world.step_index() >= options.steps) break;
+      if (boundary.hold) continue;
     }
     world.step();
     ++steps_done_;

@@ -93,6 +93,9 @@ class Pacer final : public Sink {
   // After a pause, a reset or a change of pace: the next step is due now, the ones after it
   // counted from there (no burst to catch up the time spent paused).
   void rebase(const World& world) override;
+  // Pacing does not depend on the bodies: it follows any change.
+  bool follows_structure() const override { return true; }
+  Status restructure(const World&, const Entities&) override { return Ok{}; }
 
  private:
   double rate_;
