@@ -22,16 +22,7 @@ using test::Snapshot;
 
 constexpr std::int64_t kSteps = 120;
 
-// A triangle in its own frame (centre of mass at (1/3, 0) with these masses), spinning, with a
-// spring from its vertex side to the scene's body_1 and one to a fixed point.
-constexpr const char* kFragment = R"(<scene>
-  <description text="a triangle"/>
-  <rigidbodyvertex x="-1" y="-1" m="1"/><rigidbodyvertex x="-1" y="1" m="1"/>
-  <rigidbodyvertex x="3" y="0" m="1"/>
-  <rigidbody p="0" p="1" p="2" vx="0.25" vy="-0.5" omega="0.75" r="0.2"/>
-  <rigidbodyspringforce i="0" pix="0.5" piy="0.25" jbody="body_1" pjx="0.0" pjy="0.5" k="7.0" l0="1.5"/>
-  <rigidbodyspringforce i="-1" pix="2.0" piy="6.0" j="0" pjx="0.0" pjy="0.0" k="3.0" l0="0.5"/>
-</scene>)";
+using test::kFragment;
 
 // The control scene with the fragment's body as its body 2 and its springs as springs 2 and 3,
 // which is what a spawn at step k must step as, from the states the live world had at k.

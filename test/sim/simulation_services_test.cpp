@@ -505,16 +505,6 @@ TEST_P(SimulationServicesTest, SetEntityStateIsACommandAndReSimulatesExactly) {
       << "without the set, the run differs";
 }
 
-// A triangle in its own frame, spinning, with a spring to the scene's body_1 and one to a fixed
-// point (the control tests' fragment).
-constexpr const char* kTriangle = R"(<scene>
-  <rigidbodyvertex x="-1" y="-1" m="1"/><rigidbodyvertex x="-1" y="1" m="1"/>
-  <rigidbodyvertex x="3" y="0" m="1"/>
-  <rigidbody p="0" p="1" p="2" vx="0.25" vy="-0.5" omega="0.75" r="0.2"/>
-  <rigidbodyspringforce i="0" pix="0.5" piy="0.25" jbody="body_1" pjx="0.0" pjy="0.5" k="7.0" l0="1.5"/>
-  <rigidbodyspringforce i="-1" pix="2.0" piy="6.0" j="0" pjx="0.0" pjy="0.0" k="3.0" l0="0.5"/>
-</scene>)";
-
 sim::SpawnEntityRequest spawn_request(std::string name, std::string resource, double x, double y,
                                       double theta) {
   sim::SpawnEntityRequest req;
@@ -532,7 +522,7 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
     return call<sim::SpawnEntityResponse>("spawn_entity", req);
   };
   using Spawn = sim::SpawnEntityResponse;
-  const Spawn first = spawn(spawn_request("ball", kTriangle, 1.5, 6.0, 0.4));
+  const Spawn first = spawn(spawn_request("ball", test::kFragment, 1.5, 6.0, 0.4));
   ASSERT_EQ(first.result.result, SimResult::kOk) << first.result.error_message;
   EXPECT_EQ(first.entity_name, "ball");
   // While paused the spawn shows at once: its pose as asked, its velocities the fragment's.
@@ -548,15 +538,15 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
   EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1", "ball"}));
 
   // Names: unique, renamed when allowed, in a namespace; each refusal with its code.
-  EXPECT_EQ(spawn(spawn_request("ball", kTriangle, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
-  sim::SpawnEntityRequest again = spawn_request("ball", kTriangle, -3.0, 1.0, 0.0);
+  EXPECT_EQ(spawn(spawn_request("ball", test::kFragment, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
+  sim::SpawnEntityRequest again = spawn_request("ball", test::kFragment, -3.0, 1.0, 0.0);
   again.allow_renaming = true;
   EXPECT_EQ(spawn(again).entity_name, "ball_1");
-  sim::SpawnEntityRequest in_ns = spawn_request("bot", kTriangle, 3.0, 1.0, 0.0);
+  sim::SpawnEntityRequest in_ns = spawn_request("bot", test::kFragment, 3.0, 1.0, 0.0);
   in_ns.entity_namespace = "/team";
   EXPECT_EQ(spawn(in_ns).entity_name, "team/bot");
   for (const char* bad : {"body_7", "9lives", "a b", "a//b"}) {
-    EXPECT_EQ(spawn(spawn_request(bad, kTriangle, 0, 0, 0)).result.result, Spawn::kNameInvalid) << bad;
+    EXPECT_EQ(spawn(spawn_request(bad, test::kFragment, 0, 0, 0)).result.result, Spawn::kNameInvalid) << bad;
   }
   in_ns.entity_namespace = "team ns";
   EXPECT_EQ(spawn(in_ns).result.result, Spawn::kNamespaceInvalid);
@@ -568,10 +558,10 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
   EXPECT_EQ(unparsed.result.result, Spawn::kResourceParseError);
   EXPECT_NE(unparsed.result.error_message.find("resource_string:2"), std::string::npos)
       << unparsed.result.error_message;
-  std::string missing = kTriangle;
+  std::string missing = test::kFragment;
   missing.replace(missing.find("body_1"), 6, "nobody");
   EXPECT_EQ(spawn(spawn_request("m", missing, 0, 0, 0)).result.result, Spawn::kMissingAssets);
-  sim::SpawnEntityRequest off_plane = spawn_request("z", kTriangle, 0, 0, 0);
+  sim::SpawnEntityRequest off_plane = spawn_request("z", test::kFragment, 0, 0, 0);
   off_plane.initial_pose.position.z = 1.0;
   EXPECT_EQ(spawn(off_plane).result.result, Spawn::kInvalidPose);
   off_plane.initial_pose.position.z = 0.0;
@@ -611,7 +601,7 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
   EXPECT_EQ(entities({}), std::vector<std::string>{"body_1"});
   EXPECT_EQ(body_1(), before);
   // A name once used is never given again.
-  EXPECT_EQ(spawn(spawn_request("ball", kTriangle, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
+  EXPECT_EQ(spawn(spawn_request("ball", test::kFragment, 0, 0, 0)).result.result, Spawn::kNameNotUnique);
 }
 
 // While paused, a spawn and a delete show at once on the node's topics: the scene description
@@ -650,7 +640,7 @@ TEST_P(SimulationServicesTest, ASpawnOrDeleteWhilePausedPublishesTheChangedWorld
   EXPECT_EQ(at10.step, 10u);
 
   const auto spawned =
-      call<sim::SpawnEntityResponse>("spawn_entity", spawn_request("ball", kTriangle, 1.5, 6.0, 0.4));
+      call<sim::SpawnEntityResponse>("spawn_entity", spawn_request("ball", test::kFragment, 1.5, 6.0, 0.4));
   ASSERT_EQ(spawned.result.result, SimResult::kOk) << spawned.result.error_message;
   auto [grown, now] = wait_for(3);
   ASSERT_TRUE(grown.has_value());

@@ -165,16 +165,10 @@ Result<Fragment> parse_fragment(std::string_view text, const std::string& path,
     return Error{path + ": " + std::to_string(text.size()) + " bytes, over the limit of " +
                  std::to_string(limits.max_bytes) + " for a fragment"};
   }
-  std::string storage;
-  tinyxml2::XMLDocument doc;
-  if (Status st = scene_detail::parse_xml(text, path, "fragment", storage, doc); !st) return st.error();
   FragmentLoader loader(path, limits);
-  Fragment fragment;
-  try {
-    fragment = loader.load(doc);
-  } catch (const scene_detail::LoadError& e) {
-    return Error{e.message};
-  }
+  Result<Fragment> loaded = scene_detail::parse_with(loader, text, path, "fragment");
+  if (!loaded) return loaded.error();
+  Fragment fragment = std::move(loaded.value());
   fragment.path = path;
   // Backstop: anything the loader let through must also satisfy the core's own validation.
   if (Result<World> w = World::create(backstop_world(fragment)); !w)

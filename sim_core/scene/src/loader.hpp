@@ -28,6 +28,21 @@ struct LoadError {
 Status parse_xml(std::string_view text, const std::string& path, const char* what, std::string& storage,
                  tinyxml2::XMLDocument& doc);
 
+// The one entry of a loader: parses `text` into `doc`, then `loader.load(doc)`, its LoadError an
+// Error. `path` names the source in messages; `what` as parse_xml's.
+template <class Loader>
+auto parse_with(Loader& loader, std::string_view text, const std::string& path, const char* what)
+    -> Result<decltype(loader.load(std::declval<const tinyxml2::XMLDocument&>()))> {
+  std::string storage;
+  tinyxml2::XMLDocument doc;
+  if (Status st = parse_xml(text, path, what, storage, doc); !st) return st.error();
+  try {
+    return loader.load(doc);
+  } catch (const LoadError& e) {
+    return Error{e.message};
+  }
+}
+
 // The elements that describe the whole scene, not a body: a fragment refuses them.
 inline constexpr std::string_view kSceneWideElements[] = {
     "simtype",           "duration", "maxsimfreq",          "viewport",

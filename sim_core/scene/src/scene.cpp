@@ -188,16 +188,10 @@ std::string stem_of(const std::string& path) {
 }  // namespace
 
 Result<Scene> parse_scene(std::string_view text, const std::string& path) {
-  std::string storage;
-  tinyxml2::XMLDocument doc;
-  if (Status st = scene_detail::parse_xml(text, path, "file", storage, doc); !st) return st.error();
   SceneLoader loader(path);
-  Scene scene;
-  try {
-    scene = loader.load(doc);
-  } catch (const scene_detail::LoadError& e) {
-    return Error{e.message};
-  }
+  Result<Scene> loaded = scene_detail::parse_with(loader, text, path, "file");
+  if (!loaded) return loaded.error();
+  Scene scene = std::move(loaded.value());
   scene.path = path;
   scene.name = stem_of(path);
   // Backstop: anything the loader let through must also satisfy the core's own validation.

@@ -10,6 +10,7 @@
 #include "rbsim/assert.hpp"
 #include "rbsim/control.hpp"
 #include "rbsim/time.hpp"
+#include "wording.hpp"
 
 namespace rbsim::control {
 
@@ -17,16 +18,8 @@ namespace {
 // A paused loop wakes at least this often to poll its stop request (Ctrl-C).
 constexpr auto kIdleWait = std::chrono::milliseconds(20);
 
-CommandResult failed(std::string message) {
-  CommandResult r;
-  r.successful = false;
-  r.message = std::move(message);
-  return r;
-}
-
-std::string at(std::int64_t step) {
-  return "step " + std::to_string(step);
-}
+using detail::at;
+using detail::failed;
 
 // Whether a state value a command writes (an impulse's result, a set state) keeps every quantity
 // the run reports finite: finite, and within World::finite_bound() (0: none computed).

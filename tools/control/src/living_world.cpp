@@ -12,21 +12,13 @@
 #include <vector>
 
 #include "rbsim/control.hpp"
+#include "wording.hpp"
 
 namespace rbsim::control {
 
 namespace {
 
-CommandResult refuse(Refusal why, std::string message) {
-  CommandResult r;
-  r.refusal = why;
-  r.message = std::move(message);
-  return r;
-}
-
-std::string step_text(std::int64_t step) {
-  return "step " + std::to_string(step);
-}
+using detail::refuse;
 
 // The name a spawn takes: as asked if never used in the session; else (renaming allowed, or none
 // asked) the first unused of <name>_1, <name>_2, ... A scene body's name (body_<id>) is never
@@ -141,7 +133,7 @@ CommandResult Controller::spawn(const Command& command, World& world) {
       if (!dense) {
         return refuse(Refusal::NoSuchEntity, "spawn_entity: spring " + std::to_string(k) + " names '" +
                                                  end->body + "', which is no body of the world at " +
-                                                 step_text(now));
+                                                 detail::at(now));
       }
       *body = dense->index;
     }
@@ -190,7 +182,7 @@ CommandResult Controller::spawn(const Command& command, World& world) {
   r.body_id = body_id;
   r.message = "spawned '" + name + "' (body " + std::to_string(body_id) + ")" +
               (spring_ids.empty() ? std::string() : " with springs " + id_list(spring_ids)) + " at " +
-              step_text(now);
+              detail::at(now);
   follow_structure(world, &r);
   return r;
 }
@@ -201,7 +193,7 @@ CommandResult Controller::remove(const Command& command, World& world) {
   const std::optional<BodyId> dense = id ? world.find_body_id(*id) : std::nullopt;
   if (!dense) {
     return refuse(Refusal::NoSuchEntity,
-                  "delete_entity: no body named '" + command.entity + "' at " + step_text(now));
+                  "delete_entity: no body named '" + command.entity + "' at " + detail::at(now));
   }
   CommandResult r;
   const Status st = remove_dense(world, dense->index, r.removed_springs);
@@ -218,7 +210,7 @@ CommandResult Controller::remove(const Command& command, World& world) {
   r.message = "deleted '" + command.entity + "' (body " + std::to_string(*id) + ")" +
               (r.removed_springs.empty() ? std::string(" (no springs)")
                                          : " and the springs attached to it: " + id_list(r.removed_springs)) +
-              " at " + step_text(now);
+              " at " + detail::at(now);
   follow_structure(world, &r);
   return r;
 }
@@ -250,7 +242,7 @@ CommandResult Controller::reset_spawned(World& world) {
   }
   r.successful = true;
   r.message = "removed " + std::to_string(bodies) + " spawned bodies and " +
-              std::to_string(r.removed_springs.size()) + " springs at " + step_text(now);
+              std::to_string(r.removed_springs.size()) + " springs at " + detail::at(now);
   follow_structure(world, &r);
   return r;
 }
