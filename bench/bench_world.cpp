@@ -5,6 +5,11 @@
 //     wind_springs         gravity + wind (4 points per edge) + one spring per body
 //     *_shared             the same with every body sharing one hull Shape (the cheap case;
 //                          the unsuffixed cases perturb every hull so no two share a Shape)
+//   BM_Spawn/<case>/N    World::add_body of 1,000 bodies, one at a time, into the BM_Step world
+//                        of N bodies (each a distinct eight-vertex hull, a new Shape): the cost
+//                        of a spawn beside BM_Step's cost of a step of the same world
+//   BM_Delete/<case>/N   World::remove_body of the first body (its spring with it), 1,000 times
+//                        from N + 1,000: the stable erase's memmove of every later body
 //   BM_Box2D/<case>/N    Box2D: the same N hulls as 8-vertex polygon fixtures on dynamic bodies,
 //                        spaced so fat AABBs never overlap and filtered (maskBits 0) so no
 //                        contact can ever exist; gravity on, sleeping off
@@ -182,6 +187,46 @@ void bm_box2d(benchmark::State& state, bool wind_and_springs) {
 }
 #endif
 
+// 1,000 spawns (BM_Spawn) or deletes (BM_Delete) one at a time, as the node applies them at
+// step boundaries; counter ns_per_change, and ns_per_body_step of one step of the world as it
+// ends, for the ratio.
+constexpr std::int64_t kChanges = 1000;
+
+void bm_structure(benchmark::State& state, bool wind_and_springs, bool spawn) {
+  const auto n = static_cast<std::int32_t>(state.range(0));
+  const rbsim::WorldDef def =
+      rbsim::builders::grid(n + (spawn ? 0 : static_cast<std::int32_t>(kChanges)), wind_and_springs, true);
+  // The bodies to spawn: the grid's next ones (distinct hulls), placed where they would stand.
+  const rbsim::WorldDef more =
+      rbsim::builders::grid(n + static_cast<std::int32_t>(kChanges), wind_and_springs, true);
+  double ns = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto created = rbsim::World::create(def);
+    if (!created) {
+      state.SkipWithError(created.error().message.c_str());
+      return;
+    }
+    rbsim::World world = std::move(created.value());
+    world.reserve(n + static_cast<std::int32_t>(kChanges), static_cast<std::int32_t>(more.springs.size()));
+    state.ResumeTiming();
+    const double t0 = cpu_seconds();
+    for (std::int64_t k = 0; k < kChanges; ++k) {
+      if (spawn) {
+        const rbsim::BodyDef& b = more.bodies[static_cast<std::size_t>(n + k)];
+        const rbsim::Result<rbsim::BodyHandle> h =
+            world.add_body(b, rbsim::BodyState{b.hull[0], 0.0, b.velocity, 0.0});
+        if (!h) state.SkipWithError(h.error().message.c_str());
+      } else if (!world.remove_body(world.handle(rbsim::BodyId{0})).ok()) {
+        state.SkipWithError("remove_body refused");
+      }
+    }
+    ns += 1e9 * (cpu_seconds() - t0);
+    benchmark::DoNotOptimize(world.x().data());
+  }
+  state.counters["ns_per_change"] = ns / (static_cast<double>(state.iterations()) * kChanges);
+}
+
 void register_all() {
   struct Case {
     const char* name;
@@ -198,6 +243,15 @@ void register_all() {
     auto* b = benchmark::RegisterBenchmark(c.name, bm_rbsim, c.wind_and_springs, c.distinct_shapes);
     for (std::int64_t n : kSizes) b->Arg(n);
     b->Unit(benchmark::kMicrosecond);
+  }
+  for (bool wind : {false, true}) {
+    for (bool spawn : {true, false}) {
+      const std::string name =
+          std::string(spawn ? "BM_Spawn/" : "BM_Delete/") + (wind ? "wind_springs" : "gravity");
+      benchmark::RegisterBenchmark(name.c_str(), bm_structure, wind, spawn)
+          ->Arg(10'000)
+          ->Unit(benchmark::kMillisecond);
+    }
   }
 #ifdef RBSIM_BENCH_BOX2D
   for (bool wind : {false, true}) {
