@@ -485,6 +485,8 @@ const Bytes& StepMessages::get(TopicId id, const World& world) {
 }
 
 void StepMessages::restructure(const Entities& entities) {
+  if (entities.epoch == epoch_) return;  // a second sink told of the change this step
+  epoch_ = entities.epoch;
   encoder_.restructure(entities);
   step_.fill(-1);
 }

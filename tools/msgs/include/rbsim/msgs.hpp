@@ -254,11 +254,13 @@ class StepMessages {
  public:
   explicit StepMessages(const Scene& scene, std::string_view ns = "rbsim");
   const Bytes& get(TopicId id, const World& world);
-  // The world's bodies or springs changed at this step: what was encoded for it is stale.
+  // The world's bodies or springs changed at this step: what was encoded for it is stale. Every
+  // sink sharing these messages is told the same change; only the first telling re-encodes.
   void restructure(const Entities& entities);
 
  private:
   Encoder encoder_;
+  std::uint32_t epoch_ = 0;  // Entities::epoch the encoder holds (each change has its own)
   std::array<Bytes, kTopicCount> bytes_;
   std::array<const World*, kTopicCount> world_{};
   std::array<std::int64_t, kTopicCount> step_{};
