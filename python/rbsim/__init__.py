@@ -66,11 +66,15 @@ class Table:
     """Columns of one recorded topic, as NumPy arrays: by attribute (``t.x``) or by name (``t["x"]``).
 
     ``step`` and ``t`` (``step * dt``, the CSV's t) have one entry per recorded step; per-body and
-    per-spring columns are steps x bodies (or springs), scene-wide ones one per step.
+    per-spring columns are steps x bodies (or springs), scene-wide ones one per step. ``ids`` names
+    the bodies (springs) of the columns: every id the recording holds, increasing (a scene's own
+    0..n-1); where bodies came or went (spawned, deleted) a column is NaN at the steps its body was
+    not there. None for scene-wide topics.
     """
 
-    def __init__(self, topic, columns):
+    def __init__(self, topic, columns, ids=None):
         self.topic = topic
+        self.ids = ids
         self._columns = columns
 
     @property
@@ -115,7 +119,8 @@ class Recording:
     def _read(self, topic):
         if not self._per_step[topic]:
             raise Error(f"{self.path}: has no {topic} topic (its topics: {', '.join(self.topics)})")
-        return Table(self._per_step[topic], _rbsim._read_topic(self.path, self.namespace, topic))
+        columns = _rbsim._read_topic(self.path, self.namespace, topic)
+        return Table(self._per_step[topic], columns, columns.pop("id", None))
 
     @functools.cached_property
     def body_states(self):

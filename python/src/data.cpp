@@ -6,11 +6,14 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <optional>
 
 #include "bindings.hpp"
 #include "interrupt.hpp"
+#include "rbsim/assert.hpp"
 #include "rbsim/check.hpp"
 #include "rbsim/csv.hpp"
 #include "rbsim/export.hpp"
@@ -157,11 +160,89 @@ std::unique_ptr<recordings::Recording> open_recording(const std::string& path, c
   return std::move(opened.value());
 }
 
-// Per-step values of one topic: a row per recorded step, `width` values per row for each column
-// (bodies or springs; 0 for scene-wide columns).
+// The body (or spring) axis of a topic's columns: one column per id the recording holds, in
+// increasing order (ids are never reused, and a world's arrays are in id order). A recording whose
+// bodies never change has one set of ids in every row (0..n-1 for a scene's own): the rows are the
+// matrix as read. After a spawn or delete, each value moves to its id's column, NaN where the id
+// was not in the world at that step.
+struct EntityAxis {
+  std::vector<std::int32_t> ids;      // every row's ids, row after row, as read
+  std::vector<std::size_t> row_ends;  // where each row's ids end in `ids`
+  std::vector<std::int32_t> columns;  // the distinct ids, increasing
+
+  void end_row() { row_ends.push_back(ids.size()); }
+
+  std::size_t spread(std::size_t rows, std::vector<Column>& values) {
+    RBSIM_ASSERT(row_ends.size() == rows, "one row of ids per step");
+    columns = ids;
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+    const std::size_t width = columns.size();
+    if (ids.size() == rows * width) return width;  // every row holds every id, in order
+    for (Column& c : values) {
+      std::vector<double> spread(rows * width, std::numeric_limits<double>::quiet_NaN());
+      std::size_t k = 0;
+      for (std::size_t row = 0; row < rows; ++row) {
+        for (; k < row_ends[row]; ++k) {
+          const auto at = std::lower_bound(columns.begin(), columns.end(), ids[k]) - columns.begin();
+          spread[row * width + static_cast<std::size_t>(at)] = c.values[k];
+        }
+      }
+      c.values = std::move(spread);
+    }
+    return width;
+  }
+};
+
+// One recorded step's values of topic `id` appended to its columns (and its bodies' or springs'
+// ids to `ids`).
+void append_row(msgs::TopicId id, const recordings::RecordedStep& s, const msgs::SceneMessage& scene,
+                std::vector<Column>& columns, std::vector<std::int32_t>& ids) {
+  const auto put = [&columns](std::size_t column, double v) { columns[column].values.push_back(v); };
+  if (id == msgs::TopicId::BodyStates) {
+    for (const auto& b : s.body_states->bodies) {
+      ids.push_back(b.id);
+      put(0, b.state.position.x());
+      put(1, b.state.position.y());
+      put(2, b.state.theta);
+      put(3, b.state.velocity.x());
+      put(4, b.state.velocity.y());
+      put(5, b.state.omega);
+    }
+  } else if (id == msgs::TopicId::SpringStates) {
+    for (const auto& k : s.spring_states->springs) {
+      ids.push_back(k.id);
+      put(0, k.end_i.x());
+      put(1, k.end_i.y());
+      put(2, k.end_j.x());
+      put(3, k.end_j.y());
+      put(4, k.length);
+      put(5, k.rest_length);
+      put(6, k.potential);
+    }
+  } else {
+    // The energy CSV's numbers: World::energy() as recorded, U, T and E by Energy's formulas.
+    const Energy e =
+        recordings::recorded_energy(s.scene != nullptr ? *s.scene : scene, *s.energy, s.body_states);
+    put(0, e.potential());
+    put(1, e.t_point);
+    put(2, e.t_spin);
+    put(3, e.kinetic());
+    put(4, e.total());
+    put(5, e.u_gravity);
+    put(6, e.u_spring);
+    put(7, s.energy->momentum.x());
+    put(8, s.energy->momentum.y());
+    put(9, s.energy->angular_momentum);
+  }
+}
+
+// Per-step values of one topic: a row per recorded step, for each column one value per body or
+// spring by id (EntityAxis; "id" names them) or one for scene-wide columns.
 nb::dict read_topic(const std::string& path, const std::string& ns, const std::string& topic) {
   const msgs::TopicId id = topic_id(topic);
   std::unique_ptr<recordings::Recording> rec = open_recording(path, ns, {id});
+  std::vector<std::int32_t> out_ids;
   if (id == msgs::TopicId::Energy) {
     // A recording made before the potential split, with several gravity fields: its U_gravity
     // comes from the body states (recordings::recorded_energy).
@@ -174,16 +255,14 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
     }
   }
   const msgs::SceneMessage& scene = *rec->scene();
-  std::size_t width = 0;
   std::vector<Column> columns;
   const auto add = [&columns](std::initializer_list<const char*> names) {
     for (const char* n : names) columns.push_back({n, {}});
   };
+  const bool per_entity = id != msgs::TopicId::Energy;
   if (id == msgs::TopicId::BodyStates) {
-    width = scene.bodies.size();
     add({"x", "y", "theta", "vx", "vy", "omega"});
   } else if (id == msgs::TopicId::SpringStates) {
-    width = scene.springs.size();
     add({"end_i_x", "end_i_y", "end_j_x", "end_j_y", "length", "rest_length", "potential"});
   } else {
     add({"U", "T_point", "T_spin", "T", "E", "U_gravity", "U_spring", "px", "py", "L"});
@@ -193,10 +272,13 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
     if (c.spec != nullptr && c.spec->id == id && c.channel->topic == rec->topic(id))
       expected = c.message_count.value_or(0);
   }
+  const std::size_t first_width = id == msgs::TopicId::BodyStates     ? scene.bodies.size()
+                                  : id == msgs::TopicId::SpringStates ? scene.springs.size()
+                                                                      : 1;
   std::vector<std::uint64_t> steps;
   steps.reserve(expected);
-  for (Column& c : columns) c.values.reserve(expected * std::max<std::size_t>(width, 1));
-  const auto put = [&columns](std::size_t column, double v) { columns[column].values.push_back(v); };
+  for (Column& c : columns) c.values.reserve(expected * std::max<std::size_t>(first_width, 1));
+  EntityAxis axis;  // bodies or springs by id (a recording of a world whose bodies change)
   Status read;
   {
     nb::gil_scoped_release unlocked;
@@ -206,47 +288,22 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
                                                                 : static_cast<const void*>(s.energy);
       if (message == nullptr) return Ok{};  // a step only the other topic has (a lost message)
       steps.push_back(s.step);
-      if (id == msgs::TopicId::BodyStates) {
-        for (const auto& b : s.body_states->bodies) {
-          put(0, b.state.position.x());
-          put(1, b.state.position.y());
-          put(2, b.state.theta);
-          put(3, b.state.velocity.x());
-          put(4, b.state.velocity.y());
-          put(5, b.state.omega);
-        }
-      } else if (id == msgs::TopicId::SpringStates) {
-        for (const auto& k : s.spring_states->springs) {
-          put(0, k.end_i.x());
-          put(1, k.end_i.y());
-          put(2, k.end_j.x());
-          put(3, k.end_j.y());
-          put(4, k.length);
-          put(5, k.rest_length);
-          put(6, k.potential);
-        }
-      } else {
-        // The energy CSV's numbers: World::energy() as recorded, U, T and E by Energy's formulas.
-        const Energy e = recordings::recorded_energy(scene, *s.energy, s.body_states);
-        put(0, e.potential());
-        put(1, e.t_point);
-        put(2, e.t_spin);
-        put(3, e.kinetic());
-        put(4, e.total());
-        put(5, e.u_gravity);
-        put(6, e.u_spring);
-        put(7, s.energy->momentum.x());
-        put(8, s.energy->momentum.y());
-        put(9, s.energy->angular_momentum);
-      }
+      append_row(id, s, scene, columns, axis.ids);
+      if (per_entity) axis.end_row();
       return Ok{};
     });
   }
   if (!read) raise_error(read.error().message);
   const std::size_t rows = steps.size();
+  std::size_t width = 0;
+  if (per_entity) {
+    width = axis.spread(rows, columns);
+    out_ids = axis.columns;
+  }
   std::vector<double> t(rows);
   for (std::size_t i = 0; i < rows; ++i) t[i] = static_cast<double>(steps[i]) * scene.dt;  // World::time()
   nb::dict out;
+  if (per_entity) out["id"] = to_numpy(std::move(out_ids), width);
   out["step"] = to_numpy(std::move(steps), rows);
   out["t"] = to_numpy(std::move(t), rows);
   for (Column& c : columns) out[c.name.c_str()] = to_numpy(std::move(c.values), rows, width);

@@ -23,6 +23,12 @@ std::string describe(const test::Outcome& o) {
   return "exit " + std::to_string(o.exit_code) + "\nstdout: " + o.out + "\nstderr: " + o.err;
 }
 
+// A fragment (rbsim/scene.hpp) the scripts spawn: two vertices, centre of mass at its origin.
+constexpr const char* kBall =
+    "<scene>\n  <rigidbodyvertex x=\"-0.1\" y=\"0\" m=\"1\"/>\n"
+    "  <rigidbodyvertex x=\"0.1\" y=\"0\" m=\"1\"/>\n"
+    "  <rigidbody p=\"0\" p=\"1\" vx=\"0.5\" vy=\"0\" omega=\"0\" r=\"0.05\"/>\n</scene>\n";
+
 // The CSV rows of one step (5 bodies a step, after the header).
 std::vector<std::string> rows_at(const std::vector<std::string>& csv, std::size_t step) {
   return {csv.begin() + 1 + 5 * step, csv.begin() + 1 + 5 * (step + 1)};
@@ -89,14 +95,12 @@ TEST(RbsimRunCommands, ABadScriptIsAUsageErrorBeforeAnyOutput) {
 }
 
 // A script's spawn and delete: the CSV rows hold the bodies the world has at each step, each named
-// by its id (the spawned body the next id, 5; a deleted body's rows end), and the scene's bodies
-// step as the plain run's until the spawn's springs reach them.
-TEST(RbsimRunCommands, SpawnAndDeleteChangeTheCsvRowsFromTheNextStep) {
+// by its id (the spawned body the next id, 5; a deleted body's rows end), the step of the change
+// written with the world after it (as a recording read back holds it), and the scene's bodies step
+// as the plain run's until the spawn's springs reach them.
+TEST(RbsimRunCommands, SpawnAndDeleteChangeTheCsvRowsFromTheirStep) {
   const TempDir dir;
-  write_text(dir / "ball.xml",
-             "<scene>\n  <rigidbodyvertex x=\"-0.1\" y=\"0\" m=\"1\"/>\n"
-             "  <rigidbodyvertex x=\"0.1\" y=\"0\" m=\"1\"/>\n"
-             "  <rigidbody p=\"0\" p=\"1\" vx=\"0.5\" vy=\"0\" omega=\"0\" r=\"0.05\"/>\n</scene>\n");
+  write_text(dir / "ball.xml", kBall);
   write_text(dir / "c.yaml",
              "- {step: 10, spawn: {file: ball.xml, name: ball, x: [0.5, 2.0], theta: 0.25}}\n"
              "- {step: 20, delete: body_4}\n");
@@ -107,24 +111,30 @@ TEST(RbsimRunCommands, SpawnAndDeleteChangeTheCsvRowsFromTheNextStep) {
   ASSERT_EQ(o.exit_code, 0) << describe(o);
   const std::vector<std::string> a = lines_of(read_text(dir / "plain.csv"));
   const std::vector<std::string> b = lines_of(read_text(dir / "out.csv"));
-  ASSERT_EQ(b.size(), 1 + 11 * 5 + 10 * 6 + 10 * 5);
-  for (std::size_t step = 0; step <= 10; ++step) EXPECT_EQ(rows_at(a, step), rows_at(b, step)) << step;
+  ASSERT_EQ(b.size(), 1 + 10 * 5 + 10 * 6 + 11 * 5);
+  for (std::size_t step = 0; step < 10; ++step) EXPECT_EQ(rows_at(a, step), rows_at(b, step)) << step;
+  // Step 10: the scene's bodies as the plain run has them, and the ball at its spawn pose (its
+  // centre of mass at x, theta as given, the fragment's velocity).
+  const std::vector<std::string> at10(b.begin() + 1 + 10 * 5, b.begin() + 1 + 10 * 5 + 6);
+  ASSERT_EQ(at10.size(), 6u);
+  EXPECT_EQ(std::vector<std::string>(at10.begin(), at10.begin() + 5), rows_at(a, 10));
+  EXPECT_TRUE(at10[5].starts_with("10,0.01,5,0.5,2,0.25,0.5,0,0,")) << at10[5];
   const auto body_of = [](const std::string& row) {
     const std::size_t c1 = row.find(',');
     const std::size_t c2 = row.find(',', c1 + 1);
     return row.substr(c2 + 1, row.find(',', c2 + 1) - c2 - 1);
   };
-  for (std::size_t step = 11; step <= 20; ++step) {
+  for (std::size_t step = 10; step < 20; ++step) {
     for (std::size_t k = 0; k < 6; ++k) {
-      const std::string& row = b[1 + 11 * 5 + (step - 11) * 6 + k];
+      const std::string& row = b[1 + 10 * 5 + (step - 10) * 6 + k];
       EXPECT_EQ(body_of(row), std::to_string(k)) << row;
       EXPECT_TRUE(row.starts_with(std::to_string(step) + ",")) << row;
     }
   }
-  for (std::size_t step = 21; step <= 30; ++step) {
+  for (std::size_t step = 20; step <= 30; ++step) {
     const std::vector<std::string> ids = {"0", "1", "2", "3", "5"};
     for (std::size_t k = 0; k < 5; ++k) {
-      EXPECT_EQ(body_of(b[1 + 11 * 5 + 10 * 6 + (step - 21) * 5 + k]), ids[k]) << step;
+      EXPECT_EQ(body_of(b[1 + 10 * 5 + 10 * 6 + (step - 20) * 5 + k]), ids[k]) << step;
     }
   }
   // An output that cannot follow a changed world (the FOSSSim binary): the run is refused,
@@ -134,6 +144,44 @@ TEST(RbsimRunCommands, SpawnAndDeleteChangeTheCsvRowsFromTheNextStep) {
   EXPECT_NE(refused.exit_code, 0) << describe(refused);
   EXPECT_NE(refused.err.find("spawn_entity"), std::string::npos) << describe(refused);
   EXPECT_FALSE(fs::exists(dir / "out.bin"));
+}
+
+// A recording of a run whose bodies change holds an epoch per scene description: read back
+// (`log export`), it gives the run's own CSVs byte for byte (the spawn's and the delete's steps
+// with the world after them, each body by id); `render` draws it; and the session re-simulated
+// from the recording's commands records the same bytes (`rbsim check`, tolerance 0).
+TEST(RbsimRunCommands, ARecordingFollowsSpawnsAndDeletesAndReadsBackAsTheCsv) {
+  const TempDir dir;
+  write_text(dir / "ball.xml", kBall);
+  write_text(dir / "c.yaml",
+             "- {step: 10, spawn: {file: ball.xml, name: ball, x: [0.5, 2.0], theta: 0.25}}\n"
+             "- {step: 20, delete: body_4}\n- {step: 20, spawn: {file: ball.xml, x: [-0.5, 2.0], theta: 0}}\n"
+             "- {step: 25, reset_spawned: true}\n");
+  const test::Outcome o = rbsim({"run", kScene, "--steps", "40", "--csv", (dir / "run.csv").string(),
+                                 "--energy-csv", (dir / "run_energy.csv").string(), "--record",
+                                 (dir / "r.mcap").string(), "--commands", (dir / "c.yaml").string()});
+  ASSERT_EQ(o.exit_code, 0) << describe(o);
+  const test::Outcome exported =
+      rbsim({"log", "export", (dir / "r.mcap").string(), "--csv", (dir / "x.csv").string(), "--energy-csv",
+             (dir / "x_energy.csv").string()});
+  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  const std::string csv = read_text(dir / "run.csv");
+  EXPECT_EQ(read_text(dir / "x.csv"), csv);
+  EXPECT_EQ(read_text(dir / "x_energy.csv"), read_text(dir / "run_energy.csv"));
+  // The epochs are really there: ids 5 and 6 appear, body 4 goes at 20, both spawned at 25.
+  const std::vector<std::string> rows = lines_of(csv);
+  EXPECT_EQ(rows.size(), 1 + 10 * 5 + 10 * 6 + 5 * 6 + 16 * 4);
+
+  const test::Outcome frames =
+      rbsim({"render", (dir / "r.mcap").string(), "--out", (dir / "frames").string(), "--fps", "200"});
+  ASSERT_EQ(frames.exit_code, 0) << describe(frames);
+  EXPECT_TRUE(fs::exists(dir / "frames" / "frame00007.png")) << describe(frames);
+
+  const test::Outcome rerun = rbsim({"run", kScene, "--steps", "40", "--commands", (dir / "r.mcap").string(),
+                                     "--record", (dir / "rerun.mcap").string()});
+  ASSERT_EQ(rerun.exit_code, 0) << describe(rerun);
+  const test::Outcome same = rbsim({"check", (dir / "rerun.mcap").string(), (dir / "r.mcap").string()});
+  EXPECT_EQ(same.exit_code, 0) << describe(same);
 }
 
 }  // namespace

@@ -253,6 +253,30 @@ def test_recording_reads_what_the_csv_holds(tmp_path):
     assert np.array_equal(rec.scene["mass"], world.mass)
 
 
+def test_recording_of_a_changing_world_has_a_column_per_body_id(tmp_path):
+    (tmp_path / "ball.xml").write_text(
+        '<scene><rigidbodyvertex x="-0.1" y="0" m="1"/><rigidbodyvertex x="0.1" y="0" m="1"/>'
+        '<rigidbody p="0" p="1" vx="0.5" vy="0" omega="0" r="0.05"/></scene>\n')
+    (tmp_path / "c.yaml").write_text(
+        "- {step: 10, spawn: {file: ball.xml, name: ball, x: [0.5, 2.0], theta: 0.25}}\n"
+        "- {step: 20, delete: body_4}\n")
+    rbsim.run(SOURCE / "scenes/chain.xml", steps=30, record=tmp_path / "r.mcap", csv=tmp_path / "b.csv",
+              commands=tmp_path / "c.yaml")
+    states = rbsim.Recording(tmp_path / "r.mcap").body_states
+    assert list(states.ids) == [0, 1, 2, 3, 4, 5]
+    assert states.x.shape == (31, 6)
+    rows = read_csv(tmp_path / "b.csv")
+    column = {int(i): k for k, i in enumerate(states.ids)}
+    for c in COLUMNS:
+        expected = np.full((31, 6), np.nan)
+        for r in rows:
+            expected[int(r["step"]), column[int(r["body"])]] = r[c]
+        assert np.array_equal(states[c], expected, equal_nan=True), c
+    assert np.isnan(states.x[:10, 5]).all() and not np.isnan(states.x[10:, 5]).any()
+    assert np.isnan(states.x[20:, 4]).all() and not np.isnan(states.x[:20, 4]).any()
+    assert rbsim.Recording(tmp_path / "r.mcap").energy.ids is None
+
+
 def test_recording_errors_name_the_file(tmp_path):
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"not an mcap file at all")

@@ -262,6 +262,23 @@ TEST(Recording, ReadStepsRefusesARepeatedOrDecreasingStep) {
       << st.error().message;
 }
 
+// Each scene description after the first starts an epoch at its step, so they cannot go back.
+TEST(Recording, ReadStepsRefusesASceneDescriptionOfAnEarlierStep) {
+  TempDir dir;
+  const fs::path file = dir / "back.mcap";
+  write_recording(file, {{TopicId::SceneDescription, 5, 0},
+                         {TopicId::BodyStates, 5, 1},
+                         {TopicId::SceneDescription, 3, 2},
+                         {TopicId::BodyStates, 6, 3}});
+  auto opened = recordings::Recording::open(file.string(), {});
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  const Status st =
+      opened.value()->read_steps([](const recordings::RecordedStep&) -> Status { return Ok{}; });
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("a scene description of step 3 after one of step 5"), std::string::npos)
+      << st.error().message;
+}
+
 TEST(Recording, OpenChoosesTheNamespaceAmongSeveralRecordings) {
   TempDir dir;
   const fs::path a = dir / "a.mcap";

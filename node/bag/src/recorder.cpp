@@ -18,6 +18,8 @@ namespace rbsim::bag {
 using namespace node;
 
 namespace {
+// How many samples of a latched topic a subscription holds between two polls.
+constexpr std::int32_t kLatchedQueue = 256;
 // Log times: the wall clock, unsigned as MCAP's.
 std::uint64_t log_time_now() {
   return static_cast<std::uint64_t>(wall_ns());
@@ -93,7 +95,13 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const Participant& participan
   }
   for (const msgs::TopicSpec* spec : wanted) {
     const std::string ros = msgs::topic_name(*spec, options.ns);
-    auto sub = Subscription::create(participant, *spec, ros, qos_for(*spec));
+    // A latched topic's writer keeps its last sample for late joiners, but every change of the
+    // world publishes a new scene description and markers (an epoch, rbsim/recording.hpp): the
+    // reader's own queue holds many, so changes that come faster than the recorder polls all reach
+    // the file.
+    QosSpec qos = qos_for(*spec);
+    if (qos.transient_local) qos.depth = kLatchedQueue;
+    auto sub = Subscription::create(participant, *spec, ros, qos);
     if (!sub) return sub.error();
     r->waitset_.attach(sub.value());
     Topic topic{std::move(sub.value()), nullptr, 0, 0, {}, {}, 0, Gaps{}};

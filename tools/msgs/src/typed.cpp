@@ -273,7 +273,12 @@ std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte>
     if (!r.ok()) return std::nullopt;
     return step;
   }
-  const std::optional<Time> stamp = decode_stamp(id, cdr);
+  std::optional<Time> stamp = decode_stamp(id, cdr);
+  if (id == TopicId::SceneDescription) {  // the step it describes the world at (an epoch's first)
+    Reader r(cdr);
+    stamp = r.time();
+    if (!r.ok()) return std::nullopt;
+  }
   if (!stamp || !std::isfinite(dt) || !(dt > 0.0)) return std::nullopt;
   // Stamps are written as sec + nanosec of step * dt; rounding undoes the nanosecond truncation.
   const double ns = static_cast<double>(stamp->sec) * 1e9 + static_cast<double>(stamp->nanosec);

@@ -99,9 +99,10 @@ class Exporter {
   }
 
  private:
-  // One step's rows; the reader has checked the messages against the scene description.
+  // One step's rows; the reader has checked the messages against the step's scene description. A
+  // row's body is the body's id (its index until bodies come or go), as the CSV sink writes it.
   Status write(const RecordedStep& d) {
-    const msgs::SceneMessage& s = *scene_;
+    const msgs::SceneMessage& s = d.scene != nullptr ? *d.scene : *scene_;
     const bool need_states = csv_.is_open() || (energy_.is_open() && d.energy != nullptr &&
                                                 recorded_energy_needs_states(s, *d.energy));
     if ((need_states && d.body_states == nullptr) || d.energy == nullptr) {
@@ -118,8 +119,8 @@ class Exporter {
       for (std::size_t b = 0; b < n; ++b) {
         const msgs::EnergyTermsMessage::Body& q = en.bodies[b];
         const BodyQuantities quantities{q.momentum, q.l_point, q.l_spin, q.t_point, q.t_spin};
-        append_body_row(csv_.rows(), step, t, static_cast<std::int32_t>(b), d.body_states->bodies[b].state,
-                        quantities);
+        const msgs::BodyStatesMessage::Body& body = d.body_states->bodies[b];
+        append_body_row(csv_.rows(), step, t, body.id, body.state, quantities);
       }
       if (Status st = csv_.flush_if_full(); !st) return st;
     }

@@ -72,6 +72,15 @@ class McapFileSink final : public McapSink {
     return Ok{};
   }
 
+  bool follows_structure() const override { return true; }
+  // Bodies came or went at this step's boundary: the scene description and markers again (the
+  // markers led by a DELETEALL), then this step's per-step topics with the new arrays, at this
+  // step's time, as the node's DDS sink publishes them, so a re-run records the live bytes.
+  Status restructure(const World& world, const Entities& entities) override {
+    encoder_->restructure(entities);
+    return record(world, true);
+  }
+
   Status finish() override {
     if (auto st = writer_.close(); !st.ok()) return fail(path_, st.error());
     if (Status st = file_.commit(); !st) return st;

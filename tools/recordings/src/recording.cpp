@@ -98,6 +98,7 @@ struct Recording::Impl {
   std::deque<RecordedChannel> channels;
   std::map<std::uint16_t, std::size_t> channel_at;  // channel id -> index in channels
   std::optional<msgs::SceneMessage> scene;
+  std::uint64_t scene_step = 0;  // the step its stamp names
   std::array<std::string, msgs::kTopicCount> topics;
   std::map<std::uint16_t, msgs::TopicId> route;  // channel id -> the topic it carries
   msgs::EnergyTermsVersion energy_version = msgs::EnergyTermsVersion::Current;
@@ -107,6 +108,20 @@ struct Recording::Impl {
   // Steps not passed on yet, by increasing step; spare slots keep their storage for reuse.
   std::vector<std::unique_ptr<Slot>> pending, spare;
   std::array<std::optional<std::uint64_t>, kPerStep.size()> last;  // last step seen per topic
+  // The epochs of a pass (RecordedStep). Where they start is known before the pass (the steps of
+  // every scene description, in log-time order, nondecreasing), so neither the epoch of a step nor
+  // how often a step may be recorded again depends on how the topics' log times interleave (a
+  // recorder that fell behind takes a topic's samples in a batch). Their descriptions are decoded
+  // as the pass meets them, and one that no step still to come can be in is dropped.
+  struct Epoch {
+    std::uint32_t index = 0;
+    msgs::SceneMessage scene;
+  };
+  std::vector<std::uint64_t> epoch_starts;  // the step of each scene description
+  std::deque<Epoch> epochs;                 // decoded, the oldest still needed first
+  std::uint32_t scenes_seen = 0;            // scene descriptions met in this pass
+  // How many times each topic's last step came again (up to the epochs that start at it).
+  std::array<std::uint32_t, kPerStep.size()> again_count{};
   msgs::BodyStatesMessage scratch_states;
   msgs::SpringStatesMessage scratch_springs;
   msgs::EnergyTermsMessage scratch_energy;
@@ -196,30 +211,99 @@ struct Recording::Impl {
            (e.channel != nullptr ? e.channel->topic : std::string("?"));
   }
 
-  Status read_scene() {
-    const std::string& topic = topics[static_cast<std::size_t>(msgs::TopicId::SceneDescription)];
-    if (topic.empty()) return Ok{};
+  // Each message of the scene description's topic in log-time order, until `on` returns false or
+  // sets `failure`.
+  Status each_scene(const std::function<bool(const mcap::MessageEntry&, Status& failure)>& on) {
     mcap::ReadMessagesOptions ro;
-    ro.topics.push_back(topic);
+    ro.topics.push_back(topics[static_cast<std::size_t>(msgs::TopicId::SceneDescription)]);
     Status failure = Ok{};
     const Status st = each_message(ro, [&](const mcap::MessageEntry& e) {
       const auto r = route.find(e.message.channel_id);
       if (r == route.end() || r->second != msgs::TopicId::SceneDescription) return true;
+      return on(e, failure) && static_cast<bool>(failure);
+    });
+    if (!st.ok()) return fail(mcap_tools::read_error(st.error()));
+    return failure;
+  }
+
+  Status read_scene() {
+    const std::string& topic = topics[static_cast<std::size_t>(msgs::TopicId::SceneDescription)];
+    if (topic.empty()) return Ok{};
+    const Status st = each_scene([&](const mcap::MessageEntry& e, Status& failure) {
       Result<msgs::SceneMessage> decoded = msgs::decode_scene(e.message.data);
       if (!decoded) {
         failure = fail(where(e) + ": " + decoded.error().message);
         return false;
       }
       scene = std::move(decoded.value());
-      return false;  // published once (latched): a repeat carries the same constants
+      scene_step = msgs::message_step(msgs::TopicId::SceneDescription, e.message.data, scene->dt).value_or(0);
+      return false;  // the first: a later one starts an epoch (read_steps)
     });
-    if (!st.ok()) return fail(mcap_tools::read_error(st.error()));
-    if (!failure) return failure;
+    if (!st) return st;
     if (!scene && options.require_scene) {
       return fail("no scene description recorded (topic " + topic + " of type " +
                   std::string(msgs::topic(msgs::TopicId::SceneDescription).type) + " has no messages)");
     }
     return Ok{};
+  }
+
+  // Where the epochs start: the step of every scene description, in log-time order (one read of
+  // that topic's messages; none when the summary counts a single one).
+  Status find_epochs() {
+    epoch_starts.assign(1, scene_step);
+    const std::string& topic = topics[static_cast<std::size_t>(msgs::TopicId::SceneDescription)];
+    for (const RecordedChannel& c : channels) {
+      if (c.channel->topic == topic && c.message_count == 1u) return Ok{};
+    }
+    epoch_starts.clear();
+    const Status st = each_scene([&](const mcap::MessageEntry& e, Status& failure) {
+      const std::optional<std::uint64_t> at =
+          msgs::message_step(msgs::TopicId::SceneDescription, e.message.data, scene->dt);
+      if (!at) {
+        failure = fail(where(e) + ": a scene description without a stamp of dt " + std::to_string(scene->dt));
+      } else if (!epoch_starts.empty() && *at < epoch_starts.back()) {
+        failure = fail(where(e) + ": a scene description of step " + std::to_string(*at) +
+                       " after one of step " + std::to_string(epoch_starts.back()) +
+                       " (steps must increase: a recording of several runs?)");
+      }
+      if (!failure) return false;
+      epoch_starts.push_back(*at);
+      return true;
+    });
+    if (!st) return st;
+    if (epoch_starts.empty()) epoch_starts.push_back(scene_step);
+    return Ok{};
+  }
+
+  // The epoch a step is in: the last whose scene description starts at or before it (the first for
+  // a step before every start: a recorder that joined late holds the latest description only).
+  std::uint32_t epoch_index(std::uint64_t step) const {
+    const auto after = std::upper_bound(epoch_starts.begin(), epoch_starts.end(), step);
+    return after == epoch_starts.begin() ? 0u : static_cast<std::uint32_t>(after - epoch_starts.begin() - 1);
+  }
+  // How many epochs start at `step` after the first: how often the step may be recorded again.
+  std::uint32_t changes_at(std::uint64_t step) const {
+    const auto [from, to] = std::equal_range(epoch_starts.begin() + 1, epoch_starts.end(), step);
+    return static_cast<std::uint32_t>(to - from);
+  }
+
+  // A scene description met in a pass: the first epoch's was read by open; each later one decoded.
+  Status scene_message(const mcap::MessageEntry& e) {
+    const std::uint32_t index = scenes_seen++;
+    if (index == 0 || epochs.empty()) return Ok{};
+    Result<msgs::SceneMessage> decoded = msgs::decode_scene(e.message.data);
+    if (!decoded) return fail(where(e) + ": " + decoded.error().message);
+    epochs.push_back({index, std::move(decoded.value())});
+    return Ok{};
+  }
+
+  // The epoch of a step ready to be passed on (its description met); older ones are dropped, as
+  // steps are passed on in increasing order.
+  const Epoch& epoch_of(std::uint64_t step) {
+    const std::uint32_t index = epoch_index(step);
+    while (epochs.size() > 1 && epochs.front().index < index) epochs.pop_front();
+    RBSIM_ASSERT(epochs.front().index == index, "a step is passed on once its scene description was read");
+    return epochs.front();
   }
 
   Slot& slot_for(std::uint64_t step) {
@@ -262,7 +346,10 @@ struct Recording::Impl {
     const std::optional<std::uint64_t> at = msgs::message_step(kPerStep[i], cdr, scene ? scene->dt : 0.0);
     RBSIM_ASSERT(at.has_value(), "a decoded per-step message carries its step");
     const std::uint64_t step = *at;
-    if (last[i] && step <= *last[i]) {
+    // The step of a change recorded again (once per epoch that starts at it): the last one wins.
+    const bool again = last[i] && step == *last[i] && !epochs.empty() && again_count[i] < changes_at(step);
+    again_count[i] = again ? again_count[i] + 1 : 0;
+    if (last[i] && step <= *last[i] && !again) {
       const std::string type(msgs::topic(kPerStep[i]).type);
       if (step == *last[i])
         return fail(where(e) + ": step " + std::to_string(step) + " has two " + type + " messages");
@@ -289,18 +376,19 @@ struct Recording::Impl {
     return Ok{};
   }
 
-  // Whether every read topic has delivered the oldest pending step or moved past it.
+  // Whether every read topic has moved past the oldest pending step (until then, a change may still
+  // record it again).
   bool ready(const Slot& s) const {
     for (std::size_t i = 0; i < kPerStep.size(); ++i) {
-      if (present[i] && !s.has[i] && !(last[i] && *last[i] > s.step)) return false;
+      if (present[i] && !(last[i] && *last[i] > s.step)) return false;
     }
-    return true;
+    return epochs.empty() || epoch_index(s.step) < scenes_seen;  // and its description was met
   }
 
-  Status check(const Slot& s) const {
-    if (!scene) return Ok{};
+  Status check(const Slot& s, const msgs::SceneMessage* described) const {
+    if (described == nullptr) return Ok{};
     const std::string at = "step " + std::to_string(s.step) + ": ";
-    const std::size_t bodies = scene->bodies.size(), springs = scene->springs.size();
+    const std::size_t bodies = described->bodies.size(), springs = described->springs.size();
     const auto count = [&](msgs::TopicId id, const char* what, std::size_t got, std::size_t want) -> Status {
       if (got == want) return Ok{};
       return fail(at + topics[static_cast<std::size_t>(id)] + " has " + std::to_string(got) + " " + what +
@@ -320,7 +408,8 @@ struct Recording::Impl {
       for (const auto& f : s.energy.forces) {
         if (f.kind == static_cast<std::uint8_t>(msgs::EnergyTermsMessage::ForceKind::Gravity)) ++gravity;
       }
-      if (Status st = count(msgs::TopicId::Energy, "gravity potentials", gravity, scene->gravity.size()); !st)
+      if (Status st = count(msgs::TopicId::Energy, "gravity potentials", gravity, described->gravity.size());
+          !st)
         return st;
       if (Status st =
               count(msgs::TopicId::Energy, "spring potentials", s.energy.forces.size() - gravity, springs);
@@ -337,9 +426,14 @@ struct Recording::Impl {
     while (done < pending.size() && (all || ready(*pending[done]))) {
       const Slot& s = *pending[done];
       ++done;
-      if (result = check(s); !result) break;
+      const Epoch* epoch = epochs.empty() ? nullptr : &epoch_of(s.step);
+      if (result = check(s, epoch != nullptr ? &epoch->scene : nullptr); !result) break;
       RecordedStep step;
       step.step = s.step;
+      if (epoch != nullptr) {
+        step.scene = &epoch->scene;
+        step.epoch = epoch->index;
+      }
       if (s.has[kStates]) step.body_states = &s.states;
       if (s.has[kSprings]) step.spring_states = &s.springs;
       if (s.has[kEnergy]) step.energy = &s.energy;
@@ -484,10 +578,21 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   Impl& im = *impl_;
   im.pending.clear();
   im.last = {};
+  im.again_count = {};
+  im.epochs.clear();
+  im.scenes_seen = 0;
+  const bool any_steps = std::find(im.present.begin(), im.present.end(), true) != im.present.end();
+  if (im.scene && any_steps) {
+    if (Status st = im.find_epochs(); !st) return st;
+    im.epochs.push_back({0, *im.scene});
+  }
   mcap::ReadMessagesOptions ro;
   for (std::size_t i = 0; i < kPerStep.size(); ++i) {
     if (im.present[i]) ro.topics.push_back(im.topics[static_cast<std::size_t>(kPerStep[i])]);
   }
+  // The scene descriptions, for the epochs (only when there are steps to put in them).
+  const std::string& scene_topic = im.topics[static_cast<std::size_t>(msgs::TopicId::SceneDescription)];
+  if (im.scene && !ro.topics.empty()) ro.topics.push_back(scene_topic);
   const std::size_t step_topics = ro.topics.size();
   if (on_message) ro.topics.insert(ro.topics.end(), also.topics.begin(), also.topics.end());
   if (ro.topics.empty()) return Ok{};
@@ -503,6 +608,10 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   const Status st = im.each_message(ro, [&](const mcap::MessageEntry& e) {
     const auto r = im.route.find(e.message.channel_id);
     const int i = r == im.route.end() ? -1 : per_step_index(r->second);
+    if (r != im.route.end() && r->second == msgs::TopicId::SceneDescription) {
+      failure = im.scene_message(e);
+      if (!failure) return false;
+    }
     if (i < 0) {
       // Not a joined topic: a raw message of `also`, or another channel of a joined topic's name.
       if (!is_also(e)) return true;

@@ -192,8 +192,14 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
     stage.duration = o.duration.value_or(INFINITY);
     if (Status st = frames.open(); !st) return st.error();
     std::optional<std::uint64_t> last;
+    std::uint32_t epoch = 0;
     Status st = recording.value()->read_steps([&](const recordings::RecordedStep& step) -> Status {
       if (step.body_states == nullptr) return Ok{};
+      if (step.epoch != epoch) {  // bodies came or went: the shapes of the step's scene description
+        epoch = step.epoch;
+        stage = stage_of(*step.scene);
+        stage.duration = o.duration.value_or(INFINITY);
+      }
       last = step.step;
       poses.clear();
       for (const auto& b : step.body_states->bodies)

@@ -11,7 +11,10 @@ namespace rbsim {
 
 namespace {
 
-// The CSV sinks: one CsvWriter, rows appended after every step.
+// The CSV sinks: one CsvWriter, rows appended after every step. A step's rows stay in the buffer
+// until the next step's come (the earlier ones are written as the buffer fills), so a change of
+// bodies at its boundary can write them again: a step's rows hold the world after its changes, as
+// a recording read back does (rbsim/recording.hpp: of a step recorded again, the last).
 class CsvSink : public Sink {
  public:
   CsvSink(std::string path, const char* columns) : path_(std::move(path)), columns_(columns) {}
@@ -20,20 +23,27 @@ class CsvSink : public Sink {
     return write(world);
   }
   Status write(const World& world) override {
+    if (Status st = csv_.flush_if_full(); !st) return st;
+    step_rows_ = csv_.rows().size();
     rows(world, csv_.rows());
-    return csv_.flush_if_full();
+    return Ok{};
   }
   Status finish() override { return csv_.commit(); }
-  // Rows name bodies by id (World::body_id), so a changed world needs no new header: the rows of
-  // later steps hold the bodies it then has.
+  // Rows name bodies by id (World::body_id), so a changed world needs no new header: this step's
+  // rows are written again with the bodies it now has, and later steps' hold them too.
   bool follows_structure() const override { return true; }
-  Status restructure(const World&, const Entities&) override { return Ok{}; }
+  Status restructure(const World& world, const Entities&) override {
+    csv_.rows().resize(step_rows_);
+    rows(world, csv_.rows());
+    return Ok{};
+  }
 
  private:
   virtual void rows(const World& world, std::string& out) const = 0;
   std::string path_;
   const char* columns_;
   CsvWriter csv_;
+  std::size_t step_rows_ = 0;  // where the current step's rows start in the buffer
 };
 
 class BodyCsvSink final : public CsvSink {

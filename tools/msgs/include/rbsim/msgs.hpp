@@ -386,8 +386,10 @@ std::optional<Time> decode_stamp(TopicId id, std::span<const std::byte> cdr);
 // recording reader, rbsim check, the golden verifier). Body states, spring states and energy terms
 // carry their step (`uint64 step` after the header); the other per-step topics carry only the
 // stamp of their step, t = step * dt, so their step is round(stamp / dt) with the recording's dt
-// (from its scene description). nullopt for a message without either (the scene description, an
-// empty MarkerArray or TFMessage, bytes too short) or, for a stamp, a dt that is not finite and > 0.
+// (from its scene description). The scene description's is the step its header stamp names: the
+// world it describes is the one from that step on (rbsim/recording.hpp's epochs). nullopt for a
+// message without either (an empty MarkerArray or TFMessage, bytes too short) or, for a stamp, a dt
+// that is not finite and > 0.
 std::optional<std::uint64_t> message_step(TopicId id, std::span<const std::byte> cdr, double dt);
 // The name of that field: schema-driven readers (rbsim check) find a message's step by it.
 inline constexpr std::string_view kStepField = "step";

@@ -26,7 +26,9 @@ struct McapSinkOptions {
 };
 
 // A Sink that records a run: every selected latched topic (scene description, markers) once at
-// step 0, then every selected per-step topic at step 0 and every k-th step after it.
+// step 0, then every selected per-step topic at step 0 and every k-th step after it. It follows a
+// world whose bodies change: at a change, every selected topic again at that step (the latched
+// ones first), so a recording holds one epoch per scene description (rbsim/recording.hpp).
 // log_time = publish_time = simulated time in ns, so a recording is deterministic.
 class McapSink : public Sink {
  public:

@@ -99,10 +99,20 @@ inline RecordingOptions raw_options() {
 
 // One recorded step. A message pointer is null when the topic is not read, not recorded, or has
 // no message for this step (lost by a live recorder, or a recording cut short). The messages are
-// checked against the scene description when there is one: as many bodies, springs, and gravity
-// and spring potentials. Valid during the callback only: the reader reuses their storage.
+// checked against the step's scene description when there is one: as many bodies, springs, and
+// gravity and spring potentials. Valid during the callback only: the reader reuses their storage.
+//
+// Epochs: a world whose bodies change (a spawn, a delete, rbsim/control.hpp) is recorded as a new
+// scene description at the step of the change, followed by that step's per-step messages again
+// with the new arrays. Each scene description after the first (in log-time order) starts an epoch
+// at its step; a step's messages are those of the last epoch that starts at or before it, and of a
+// step recorded again after a change, the last in log-time order. The arrays of each message are
+// in its epoch's order (BodyStates' ids and the scene description's bodies index for index).
 struct RecordedStep {
   std::uint64_t step = 0;
+  // The scene description of the step's epoch (scene() for the first); null without one.
+  const msgs::SceneMessage* scene = nullptr;
+  std::uint32_t epoch = 0;  // 0, then one more at each later scene description
   const msgs::BodyStatesMessage* body_states = nullptr;
   const msgs::SpringStatesMessage* spring_states = nullptr;
   const msgs::EnergyTermsMessage* energy = nullptr;
@@ -125,17 +135,19 @@ class Recording {
   Recording& operator=(const Recording&) = delete;
 
   const std::string& path() const;
-  // The scene description; null only when require_scene was false and the file has none.
+  // The first scene description (the first epoch's); null only when require_scene was false and
+  // the file has none. A later one, after bodies came or went, is a step's (RecordedStep::scene).
   const msgs::SceneMessage* scene() const;
   // The topic name read for `id` ("/rbsim/body_states"); empty when the file has none.
   const std::string& topic(msgs::TopicId id) const;
 
   // Calls `on_step` for every recorded step in increasing step order, with the messages of the
   // read topics that carry it, until the callback fails (its error is returned). A step is passed
-  // on once every read topic has either delivered it or moved past it, so messages are held back
-  // only as long as the topics' log times interleave. Fails (naming the file, the topic and the
-  // message's log time) on a malformed message, a step that does not increase on its topic (a
-  // repeat included), or a message that does not match the scene description. Decoding and
+  // on once every read topic has moved past it (or the file ends), so messages are held back only
+  // as long as the topics' log times interleave, and one step more (it may be recorded again). Fails (naming
+  // the file, the topic and the message's log time) on a malformed message, a step that does not increase on
+  // its topic (a repeat included, unless a scene description came between: an epoch), a scene description
+  // whose step goes back, or a message that does not match its step's scene description. Decoding and
   // joining reuse their storage: once warm, they do not allocate for a recording whose topics
   // interleave no more than they did so far. `also` names other topics whose raw messages go to
   // `on_message` in the same pass (log-time order), so a reader of both reads the file once.
