@@ -168,6 +168,25 @@ TEST(ControllerDelete, RemovesTheBodyAndNamesTheSpringsAttachedToIt) {
   EXPECT_EQ(entities[1].epoch, 2U);
 }
 
+// Changes due at one boundary reach the outputs one at a time, as a paused node's arrive, so a
+// session and its re-run (which applies a step's commands together) write the same messages.
+TEST(ControllerSpawn, ChangesAtOneBoundaryAreWrittenOneAtATime) {
+  const Scene scene = test::control_scene();
+  Controller controller(scene, kSteps, RunSettings{0.0, 1, false});
+  std::vector<std::future<CommandResult>> results;
+  results.push_back(controller.submit(spawn_command(5, "a", {1.5, 6.0}, 0.0)));
+  results.push_back(controller.submit(spawn_command(5, "b", {-4.0, 6.0}, 1.0)));
+  results.push_back(controller.submit(delete_command(5, "a")));
+  std::vector<Entities> told;
+  const std::vector<Snapshot> live = test::run(scene, kSteps, &controller, &told);
+  for (auto& r : results) ASSERT_TRUE(wait(r).successful);
+  ASSERT_EQ(told.size(), 3u);
+  EXPECT_EQ(told[0].body_names, (std::vector<std::string>{"body_0", "body_1", "a"}));
+  EXPECT_EQ(told[1].body_names, (std::vector<std::string>{"body_0", "body_1", "a", "b"}));
+  EXPECT_EQ(told[2].body_names, (std::vector<std::string>{"body_0", "body_1", "b"}));
+  EXPECT_EQ(from_step(live, 6).front().state.size(), 3u * 6u);
+}
+
 TEST(ControllerSpawn, NamesAreNeverGivenTwiceInASession) {
   const Scene scene = test::control_scene();
   Controller controller(scene, kSteps, RunSettings{0.0, 1, false});

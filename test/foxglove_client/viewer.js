@@ -11,7 +11,11 @@
 //               client; the wind (forces.0.fx) set by typing in that panel and clicking its submit
 //               button makes the square of viewer/drift.xml drift right, not before, in the 3D
 //               panel's pixels, and the node publishes the set on /rbsim/commands, from "foxglove"
-//               (foxglove_client.viewer_parameters).
+//               (foxglove_client.viewer_parameters);
+//   changes     a body spawned through the node's spawn_entity service (called by an independent
+//               client) appears in the 3D panel in its fragment's colour, and the scene's square,
+//               deleted through delete_entity, disappears, without a reload
+//               (foxglove_client.viewer_changes).
 //
 //   viewer.js --case colours|parameters --rbsim BUILD/rbsim --source-dir SRC --workdir DIR
 //             --npm BUILD/npm --index N [--scene FILE] [--screenshot PNG]
@@ -25,7 +29,11 @@ const { Failure, until, startServer, Client, runMain } = lib;
 const { A, workdir } = lib.caseArgs(["case", "rbsim", "source-dir", "workdir", "npm", "index"]);
 const need = lib.npmModules(A.npm);
 const src = path.resolve(A["source-dir"]);
-const CASES = { colours: ["foxglove_client.viewer", caseColours], parameters: ["foxglove_client.viewer_parameters", caseParameters] };
+const CASES = {
+  colours: ["foxglove_client.viewer", caseColours],
+  parameters: ["foxglove_client.viewer_parameters", caseParameters],
+  changes: ["foxglove_client.viewer_changes", caseChanges],
+};
 if (!CASES[A.case]) throw new Error(`unknown --case ${A.case}`);
 const log = lib.log;
 
@@ -258,6 +266,68 @@ async function caseParameters(check) {
     check(after.n >= 200 && dx >= 60 && Math.abs(dy) < dx / 4,
       `the square did not drift right after forces.0.fx = 2.5: moved (${dx.toFixed(1)}, ${dy.toFixed(1)}) px`);
     check(c.messages.filter((m) => m.topic === "/rbsim/commands").length === 1, "more than one command published");
+    await page.screenshot({ path: path.join(workdir, "viewer.png") });
+    c.close();
+  });
+}
+
+// A blue square, spawned 3 m right of drift.xml's orange one (which then goes).
+const BLUE_SQUARE = `<scene>
+  <rigidbodyvertex x="-1" y="-1" m="1"/><rigidbodyvertex x="1" y="-1" m="1"/>
+  <rigidbodyvertex x="1" y="1" m="1"/><rigidbodyvertex x="-1" y="1" m="1"/>
+  <rigidbody p="0" p="1" p="2" p="3" vx="0" vy="0" omega="0" r="0.05"/>
+  <rigidbodycolor body="0" r="0.1" g="0.35" b="0.95"/>
+</scene>`;
+
+async function caseChanges(check) {
+  const sceneFile = path.join(__dirname, "viewer", "drift.xml");
+  const [orange] = expectedColours(sceneFile);
+  const blue = [0.1, 0.35, 0.95].map((v) => Math.round(v * 255));
+  await withStudio(check, sceneFile, ["--rate", 1, "--publish-every", 10], async ({ page, url, PNG, canvas }) => {
+    // The node's services, called in json by an independent client.
+    const c = new Client(need, url, { name: "changes", subscribeAll: false });
+    let services;
+    const responses = new Map();
+    c.client.on("advertiseServices", (s) => (services = s));
+    c.client.on("serviceCallResponse", (r) => responses.set(r.callId, r));
+    await c.ready();
+    await until("advertiseServices", 5000, () => services);
+    let callId = 0;
+    const call = async (name, request) => {
+      const s = services.find((x) => x.name === `/rbsim/${name}`);
+      if (!s) throw new Failure(`no service /rbsim/${name}: ${services.map((x) => x.name)}`);
+      const id = ++callId;
+      const data = new TextEncoder().encode(JSON.stringify(request));
+      c.client.sendServiceCallRequest({ serviceId: s.id, callId: id, encoding: "json",
+        data: new DataView(data.buffer, data.byteOffset, data.byteLength) });
+      const r = await until(`the answer to ${name}`, 10000, () => responses.get(id));
+      return JSON.parse(new TextDecoder().decode(r.data));
+    };
+    // Pixels of a colour in the 3D panel, looked at until `want` holds (bounded: software WebGL on
+    // a busy machine paints late).
+    const seen = async (what, want) => {
+      let counts;
+      for (const deadline = Date.now() + 30000; ; ) {
+        const png = PNG.sync.read(await page.screenshot({ clip: canvas }));
+        counts = { orange: centroid(png, orange, 10).n, blue: centroid(png, blue, 10).n };
+        if (want(counts) || Date.now() >= deadline) break;
+        await page.waitForTimeout(250);
+      }
+      log(`${what}: ${JSON.stringify(counts)} pixels`);
+      return check(want(counts), `${what}: ${JSON.stringify(counts)} pixels`);
+    };
+    if (!(await seen("the scene's orange square alone", (n) => n.orange >= 200 && n.blue < 20))) return;
+    const spawned = await call("spawn_entity", {
+      name: "blue", allow_renaming: false, entity_namespace: "",
+      entity_resource: { uri: "", resource_string: BLUE_SQUARE },
+      initial_pose: { header: { stamp: { sec: 0, nanosec: 0 }, frame_id: "" },
+        pose: { position: { x: -3, y: 0, z: 0 }, orientation: { x: 0, y: 0, z: 0, w: 1 } } },
+    });
+    check(spawned.result?.result === 1 && spawned.entity_name === "blue", `spawn_entity: ${JSON.stringify(spawned)}`);
+    if (!(await seen("spawned: both squares", (n) => n.orange >= 200 && n.blue >= 200))) return;
+    const deleted = await call("delete_entity", { entity: "body_0" });
+    check(deleted.result?.result === 1, `delete_entity: ${JSON.stringify(deleted)}`);
+    await seen("deleted: the blue square alone", (n) => n.orange < 20 && n.blue >= 200);
     await page.screenshot({ path: path.join(workdir, "viewer.png") });
     c.close();
   });

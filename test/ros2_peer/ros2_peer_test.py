@@ -249,6 +249,13 @@ def case_services(ctx):
     return with_node(ctx, body)
 
 
+def recorded_node(ctx, net, scene, duration, live, expected):
+    """`rbsim record` of `expected` messages into `live`, and `rbsim node` on `scene` waiting for it."""
+    rec = net.rb("record", "a", *e2e.record_args(ctx, live, "--max-messages", expected, "--wall-duration", 120))
+    node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1))
+    return rec, node
+
+
 def case_steered(ctx):
     """A session steered by ros2-client (pause, a parameter, step N, an impulse, resume), each command
     on /NS/commands with its step, read back by ros2-client; the session recorded by
@@ -265,8 +272,7 @@ def case_steered(ctx):
         if net.skip:
             print(f"SKIP: {net.skip}")
             return e2e.SKIP
-        rec = net.rb("record", "a", *e2e.record_args(ctx, live, "--max-messages", expected, "--wall-duration", 120))
-        node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1))
+        rec, node = recorded_node(ctx, net, scene, duration, live, expected)
         svc = f"/{ctx.ns}"
         try:
             pause = peer_json(ctx, net, "pause", "call", f"{svc}/pause", "trigger")
@@ -727,8 +733,7 @@ def case_entities(ctx):
         if net.skip:
             print(f"SKIP: {net.skip}")
             return e2e.SKIP
-        rec = net.rb("record", "a", *e2e.record_args(ctx, live, "--max-messages", expected, "--wall-duration", 120))
-        node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1))
+        rec, node = recorded_node(ctx, net, scene, duration, live, expected)
         try:
             g = sim(ctx, net, "sim", ("set-state", PAUSED), ("states", "all"), ("entity", "body_3"),
                     ("set-entity", "body_3", "pose", 3.5, -0.1, *q, "twist", 0.75, -0.5, 1.5), ("entity", "body_3"),
@@ -768,6 +773,67 @@ def case_entities(ctx):
                              ok=False)
     ctx.check(rc == 1 and f"body_states, step {s0 + 1}," in out,
               f"the states without the set do not first differ at step {s0 + 1}\n{out}{err}")
+    return 0
+
+
+BALL = ('<scene>\n  <rigidbodyvertex x="-0.1" y="0" m="1"/>\n  <rigidbodyvertex x="0.1" y="0" m="1"/>\n'
+        '  <rigidbody p="0" p="1" vx="0.5" vy="0" omega="0" r="0.05"/>\n</scene>\n')
+
+
+def case_spawn(ctx):
+    """SpawnEntity (three fragments as resource_string, one renamed into a namespace), DeleteEntity and
+    SetEntityState on a spawned body through ros2-client while paused, then step and play; `rbsim
+    record` records every change (a scene description, markers and the step again); the session
+    re-simulated from its recorded commands equals it, every message; `log export` of the live
+    recording equals the re-run's CSV, byte for byte."""
+    if not PEER or not os.access(PEER, os.X_OK):
+        raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
+    scene, duration = ctx.scene("chain.xml"), 8.0
+    steps = round(duration * 1e9 / DT_NS)
+    ball = ctx.path("ball.xml")
+    with open(ball, "w") as f:
+        f.write(BALL)
+    commands, changes = 8, 4  # pause, 3 spawns, delete, set_entity_state, step, play; 3 spawns and a delete
+    expected = (len(e2e.LATCHED) + len(e2e.PER_STEP) * (steps + 1) + commands
+                + changes * (len(e2e.LATCHED) + len(e2e.PER_STEP)))
+    live = ctx.path("live.mcap")
+    with PeerNet(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return e2e.SKIP
+        rec, node = recorded_node(ctx, net, scene, duration, live, expected)
+        try:
+            g = sim(ctx, net, "sim", ("set-state", PAUSED), ("spawn", "ball", "string", ball, 0.5, 2.0, 0.25),
+                    ("spawn", "ball", "string", ball, -0.5, 2.0, 0.0, "rename"),
+                    ("spawn", "crate", "string", ball, 1.0, 3.0, 0.5, "ns", "/team"),
+                    ("delete", "ball_1"), ("set-entity", "ball", "twist", 0.0, 1.0, 2.0), ("entity", "ball"),
+                    ("step", 5), ("entities", "all"), ("entity", "ball"), ("set-state", PLAYING))
+        finally:
+            e2e.exited_ok(ctx, node, 60, "rbsim node")
+            e2e.exited_ok(ctx, rec, 60, "rbsim record")
+    expect(ctx, g, 0, result=OK)
+    expect(ctx, g, 1, result=OK, entity_name="ball")
+    expect(ctx, g, 2, result=OK, entity_name="ball_1")
+    expect(ctx, g, 3, result=OK, entity_name="team/crate")
+    expect(ctx, g, 4, result=OK)
+    expect(ctx, g, 5, result=OK)
+    placed = g[6]["state"]
+    ctx.check(placed["position"] == [0.5, 2.0, 0.0] and placed["linear"] == [0.0, 1.0, 0.0]
+              and placed["angular"] == [0.0, 0.0, 2.0], f"ball read back after its spawn and twist: {placed}")
+    expect(ctx, g, 7, result=OK)
+    ctx.check(g[8]["entities"] == [f"body_{i}" for i in range(5)] + ["ball", "team/crate"], f"entities: {g[8]}")
+    ctx.check(g[9]["state"]["stamp_ns"] == placed["stamp_ns"] + 5 * DT_NS, f"5 steps on: {g[9]}")
+    expect(ctx, g, 10, result=OK)
+    # The recording re-simulated from its own commands: every message equal, commands included.
+    again = ctx.path("again.mcap")
+    ctx.rbrun("again", "run", scene, "--duration", duration, "--commands", live, "--record", again,
+              "--namespace", ctx.ns, "--csv", ctx.path("again.csv"))
+    e2e.rbsim_check(ctx, live, again, "check-again", live=True)
+    ctx.rbrun("export", "log", "export", live, "--csv", ctx.path("live.csv"))
+    with open(ctx.path("live.csv")) as a, open(ctx.path("again.csv")) as b:
+        ctx.check(a.read() == b.read(), "log export of the live recording differs from the re-run's CSV")
+    ctx.log(f"spawned 3 bodies, deleted one, set a twist while paused at step {placed['stamp_ns'] // DT_NS}; "
+            "re-simulated from the recording: every message equal")
     return 0
 
 
@@ -821,7 +887,7 @@ e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "ki
                   "parameters": case_parameters, "services": case_services, "flood": case_flood,
                   "bad_requests": case_bad_requests, "killed_client": case_killed_client, "steered": case_steered,
                   "simulation_state": case_simulation_state, "simulate_steps": case_simulate_steps,
-                  "entities": case_entities, "type_description": case_type_description})
+                  "entities": case_entities, "spawn": case_spawn, "type_description": case_type_description})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

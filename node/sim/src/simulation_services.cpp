@@ -596,11 +596,9 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
                        refuse_malformed<sim::SetEntityStateResponse>()));
 }
 
-namespace {
-
 // ROS 2's name rules for a spawned entity's name and namespace: tokens of letters, digits and
 // '_', not starting with a digit, joined by '/' (a namespace may start with one; a name may not).
-bool valid_name(std::string_view name, bool is_namespace) {
+static bool valid_name(std::string_view name, bool is_namespace) {
   if (is_namespace && name.starts_with('/')) name.remove_prefix(1);
   if (name.empty() || name.size() > 255) return false;
   std::size_t token = 0;
@@ -616,8 +614,6 @@ bool valid_name(std::string_view name, bool is_namespace) {
   }
   return true;
 }
-
-}  // namespace
 
 // SpawnEntity: the request checked and its fragment parsed here (off the loop's thread, within
 // FragmentLimits), then a spawn_entity command carrying the fragment's text, applied at the next
@@ -685,6 +681,8 @@ void SimulationServices::add_spawning(std::vector<Entry>& out) {
       "delete_entity", std::string(sim::DeleteEntityRequest::kService),
       typed_handler<sim::DeleteEntityRequest, sim::DeleteEntityResponse>(
           [this](const RequestHeader&, const sim::DeleteEntityRequest& req) {
+            if (req.entity.empty())
+              return sim::DeleteEntityResponse{failure(Result::kNotFound, "entity: empty, names no entity")};
             Command c;
             c.kind = CommandKind::Delete;
             c.entity = req.entity;

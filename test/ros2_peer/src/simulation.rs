@@ -9,6 +9,10 @@
 //! OPs: features | state | set-state S | reset SCOPE | step N | entities FILTER | states FILTER
 //!    | info NAME | entity NAME | bounds NAME
 //!    | set-entity NAME [pose X Y QX QY QZ QW] [twist VX VY OMEGA] [accel]
+//!    | spawn NAME string|uri FILE X Y THETA [rename] [ns NAMESPACE]
+//!                                       SpawnEntity: the fragment FILE's text as resource_string,
+//!                                       or FILE as the uri; the pose (X, Y, 0) and yaw THETA
+//!    | delete NAME
 //!    | goal N [cancel-after K]          the action: accepted, feedback, (cancel,) result, status
 //!    | typedesc DDS_TOPIC TYPE          the hash in USER_DATA of the node's endpoint on DDS_TOPIC
 //!                                       (rt/..., rq/...Request, rr/...Reply) as RustDDS's discovery
@@ -110,6 +114,16 @@ pub struct EntityInfo {
   pub description: String,
   pub tags: Vec<String>,
 }
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Resource {
+  pub uri: String,
+  pub resource_string: String,
+}
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PoseStamped {
+  pub header: Header,
+  pub pose: Pose,
+}
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SimulatorFeatures {
   pub features: Vec<u16>,
@@ -144,6 +158,10 @@ messages! {
   EntityStateResponse { result: SimResult, state: EntityState }
   BoundsResponse { result: SimResult, bounds: Bounds }
   SetEntityRequest { entity: String, state: EntityState, set_pose: bool, set_twist: bool, set_acceleration: bool }
+  SpawnRequest {
+    name: String, allow_renaming: bool, entity_resource: Resource, entity_namespace: String, initial_pose: PoseStamped
+  }
+  SpawnResponse { result: SimResult, entity_name: String }
   Goal { steps: u64 }
   Feedback { completed_steps: u64, remaining_steps: u64 }
   FieldType { type_id: u8, capacity: u64, string_capacity: u64, nested_type_name: String }
@@ -326,6 +344,47 @@ fn set_entity_request(words: &[String]) -> Result<SetEntityRequest, String> {
   Ok(r)
 }
 
+/// spawn NAME string|uri FILE X Y THETA [rename] [ns NAMESPACE]: the SpawnEntity request.
+fn spawn_request(words: &[String]) -> Result<SpawnRequest, String> {
+  let usage = "spawn NAME string|uri FILE X Y THETA [rename] [ns NAMESPACE]";
+  let [name, how, file, x, y, theta, more @ ..] = words else { return Err(usage.to_string()) };
+  let entity_resource = match how.as_str() {
+    "string" => Resource {
+      uri: String::new(),
+      resource_string: std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"))?,
+    },
+    "uri" => Resource { uri: file.clone(), resource_string: String::new() },
+    _ => return Err(usage.to_string()),
+  };
+  let theta: f64 = num(Some(theta), "theta")?;
+  let mut r = SpawnRequest {
+    name: name.clone(),
+    allow_renaming: false,
+    entity_resource,
+    entity_namespace: String::new(),
+    initial_pose: PoseStamped {
+      header: Header { stamp: Time::ZERO, frame_id: String::new() },
+      pose: Pose {
+        position: Vector3 { x: num(Some(x), "x")?, y: num(Some(y), "y")?, z: 0.0 },
+        orientation: Quaternion { x: 0.0, y: 0.0, z: (0.5 * theta).sin(), w: (0.5 * theta).cos() },
+      },
+    },
+  };
+  let mut i = 0;
+  while i < more.len() {
+    match more[i].as_str() {
+      "rename" => r.allow_renaming = true,
+      "ns" => {
+        i += 1;
+        r.entity_namespace = more.get(i).cloned().ok_or(usage)?;
+      }
+      _ => return Err(usage.to_string()),
+    }
+    i += 1;
+  }
+  Ok(r)
+}
+
 /// One op: its JSON fields (without the braces), or an error that ends the sequence.
 fn op(s: &mut Session, words: &[String]) -> Result<String, String> {
   const SIM: &str = "simulation_interfaces";
@@ -406,6 +465,19 @@ fn op(s: &mut Session, words: &[String]) -> Result<String, String> {
       let probe = SetEntityRequest { set_pose: false, set_twist: false, set_acceleration: false, ..set_entity_request(rest)? };
       let (r, d): (ResultResponse, _) =
         s.call_probed("set_entity_state", &ty("SetEntityState"), set_entity_request(rest)?, probe)?;
+      format!("{}, {}", result_json(&r.result), took(d))
+    }
+    "spawn" => {
+      // The probe: a name no entity may have (a digit first), refused before it is a command.
+      let probe = SpawnRequest { name: "0probe".into(), allow_renaming: false, ..spawn_request(rest)? };
+      let (r, d): (SpawnResponse, _) = s.call_probed("spawn_entity", &ty("SpawnEntity"), spawn_request(rest)?, probe)?;
+      format!("{}, \"entity_name\": {}, {}", result_json(&r.result), json_string(&r.entity_name), took(d))
+    }
+    "delete" => {
+      let req = EntityRequest { entity: rest.first().cloned().unwrap_or_default() };
+      // The probe: no name at all, refused before it is a command.
+      let probe = EntityRequest { entity: String::new() };
+      let (r, d): (ResultResponse, _) = s.call_probed("delete_entity", &ty("DeleteEntity"), req, probe)?;
       format!("{}, {}", result_json(&r.result), took(d))
     }
     "goal" => goal(s, rest)?,

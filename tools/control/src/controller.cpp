@@ -265,10 +265,13 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     bool applied = false;
     // What a command's `done` submits as it applies (a re-run's next epoch after its reset) is
     // taken at this same boundary: due now, it applies here, before the world steps on.
-    for (bool more = true; more;) {
+    // Bodies came or went: the sinks write the changed world before the next command applies, one
+    // change at a time, whether the commands came one by one (a paused node) or together (a re-run,
+    // a running node), so both write the same messages.
+    for (bool more = true; more && !b.structure_changed;) {
       if (has_incoming_.load(std::memory_order_acquire)) take_incoming();
       more = false;
-      while (due(world.step_index())) {
+      while (due(world.step_index()) && !b.structure_changed) {
         Pending p = std::move(schedule_.front());
         schedule_.erase(schedule_.begin());
         apply_now(p, world, b);
@@ -297,12 +300,13 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
       b.stop = true;
       return b;
     }
-    if (!settings_.paused || step_budget_ > 0) break;
-    // Paused, bodies came or went: the sinks show the change now, not at the next step.
+    // Bodies came or went: the sinks show the change now (while paused, not at the next step), then
+    // the driver comes back to this boundary for what else is due.
     if (b.structure_changed) {
       b.hold = true;
       return b;
     }
+    if (!settings_.paused || step_budget_ > 0) break;
     // Offline, nothing can end this pause: no resume timer, nothing due now, and a command queued
     // for a later step is never reached while paused without a step budget.
     if (end_when_idle_ && !due(world.step_index()) && !resume_at_ &&

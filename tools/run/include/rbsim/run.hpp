@@ -39,8 +39,9 @@ class StepHook {
     bool timeline_changed = false;   // resumed, reset or re-paced: every sink's rebase() is called
     bool structure_changed = false;  // bodies or springs came or went (World::add_body, remove_body)
     bool stop = false;               // a stop request arrived while paused: the pass ends (Stopped)
-    bool hold = false;  // paused, the structure changed: the sinks follow it (a paused viewer sees
-                        // the change at once), then boundary() is asked again before any step
+    bool hold = false;               // the structure changed: the sinks follow it (a paused viewer sees the
+                                     // change at once), then boundary() is asked again before any step, so
+                                     // each change is written on its own
   };
   // A pass starts (Driver::run), on the world it will step.
   virtual void start(World& world) = 0;
