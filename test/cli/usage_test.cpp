@@ -82,6 +82,10 @@ INSTANTIATE_TEST_SUITE_P(
                   "rbsim node: error: --topics",
                   "unknown topic \"bogus\""},
         UsageCase{{"node", "scene.xml", "--topics", ","}, "rbsim node: error: --topics", "no topic given"},
+        // --spawnables names a folder that exists.
+        UsageCase{{"node", "scene.xml", "--spawnables", "/no/such/folder"},
+                  "rbsim node: error: --spawnables",
+                  "no folder \"/no/such/folder\""},
         UsageCase{{"log", "cat"}, "rbsim log cat: error:", "file"},
         UsageCase{{"log", "cat", "x.mcap", "--start", "-1"}, "rbsim log cat: error:", "--start"}));
 
@@ -160,6 +164,23 @@ TEST(Help, EveryCommandStatesItsExitStatus) {
     EXPECT_NE(o.out.find("Exit status"), std::string::npos)
         << "rbsim " << testing::PrintToString(command) << o;
   }
+}
+
+// rbsim node --spawnables: its --help says what the folder is for and its rules; a file where a
+// folder belongs is a usage error too.
+TEST(Help, NodeDescribesSpawnables) {
+  const test::Outcome o = rbsim({"node", "--help"});
+  EXPECT_EQ(o.exit_code, 0) << o;
+  for (const char* text :
+       {"--spawnables", "spawn_entity", "spawn_entities", "get_spawnables", "no '..'", "no symbolic links"}) {
+    EXPECT_NE(o.out.find(text), std::string::npos) << text << o;
+  }
+  const std::string scene = std::string(RBSIM_TEST_DATA_DIR) + "/fosssim/scenes/gravitytests/test00sym.xml";
+  const test::Outcome file = rbsim({"node", scene, "--domain", "0", "--spawnables", scene});
+  EXPECT_EQ(file.exit_code, 2) << file;
+  ASSERT_FALSE(file.err_lines().empty()) << file;
+  EXPECT_EQ(file.err_lines()[0], "rbsim node: error: --spawnables: \"" + scene + "\" is not a folder")
+      << file;
 }
 
 // rbsim replay's player: every flag and the services in its --help; a bad value is a usage error.

@@ -33,11 +33,26 @@ namespace {
 // simulation_interfaces' (node/sim's list).
 std::vector<std::string> node_services(const std::string& node) {
   std::vector<std::string> out;
-  for (const char* name :
-       {"pause", "resume", "reset", "step", "apply_impulse", "get_simulator_features", "get_simulation_state",
-        "set_simulation_state", "reset_simulation", "step_simulation", "get_entities", "get_entities_states",
-        "get_entity_info", "get_entity_state", "get_entity_bounds", "set_entity_state", "spawn_entity",
-        "delete_entity"})
+  for (const char* name : {"pause",
+                           "resume",
+                           "reset",
+                           "step",
+                           "apply_impulse",
+                           "get_simulator_features",
+                           "get_simulation_state",
+                           "set_simulation_state",
+                           "reset_simulation",
+                           "step_simulation",
+                           "get_entities",
+                           "get_entities_states",
+                           "get_entity_info",
+                           "get_entity_state",
+                           "get_entity_bounds",
+                           "set_entity_state",
+                           "spawn_entity",
+                           "spawn_entities",
+                           "delete_entity",
+                           "get_spawnables"})
     out.push_back(node + "/" + name);
   return out;
 }

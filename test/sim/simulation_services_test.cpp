@@ -5,10 +5,17 @@
 // definitions' constants.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <mutex>
 #include <optional>
@@ -55,6 +62,7 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
       ++quits_;
       controller_.close("quitting");
     };
+    configure(options);
     auto services = NodeServices::create(*server_, controller_, options);
     ASSERT_TRUE(services.ok()) << services.error().message;
     services_ = std::move(services.value());
@@ -77,6 +85,9 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
       EXPECT_EQ(run_.wait_for(60s), std::future_status::ready);
     }
   }
+
+  // A derived fixture's own options (SpawnablesTest's folder).
+  virtual void configure(NodeServicesOptions&) {}
 
   Participant participant(const std::string& name) {
     return test::participant(GetParam(), network_, kDomain, name);
@@ -246,15 +257,15 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
   };
   for (const sim::Feature f :
        {sim::Feature::Spawning, sim::Feature::Deleting, sim::Feature::SpawningResourceString,
-        sim::Feature::SimulationResetSpawned, sim::Feature::EntityBounds, sim::Feature::EntityBoundsBox,
-        sim::Feature::EntityCategories, sim::Feature::EntityStateGetting, sim::Feature::EntityStateSetting,
-        sim::Feature::EntityInfoGetting, sim::Feature::SimulationReset, sim::Feature::SimulationStateGetting,
-        sim::Feature::SimulationStateSetting, sim::Feature::SimulationStatePause,
-        sim::Feature::StepSimulationSingle, sim::Feature::StepSimulationMultiple,
-        sim::Feature::StepSimulationAction}) {
+        sim::Feature::SpawningEntities, sim::Feature::SimulationResetSpawned, sim::Feature::EntityBounds,
+        sim::Feature::EntityBoundsBox, sim::Feature::EntityCategories, sim::Feature::EntityStateGetting,
+        sim::Feature::EntityStateSetting, sim::Feature::EntityInfoGetting, sim::Feature::SimulationReset,
+        sim::Feature::SimulationStateGetting, sim::Feature::SimulationStateSetting,
+        sim::Feature::SimulationStatePause, sim::Feature::StepSimulationSingle,
+        sim::Feature::StepSimulationMultiple, sim::Feature::StepSimulationAction}) {
     EXPECT_TRUE(has(f)) << static_cast<int>(f);
   }
-  EXPECT_EQ(listed.size(), 17u);
+  EXPECT_EQ(listed.size(), 18u);
   EXPECT_EQ(features.features.spawn_formats, std::vector<std::string>{"fosssim-fragment"});
 
   // What is not listed answers RESULT_FEATURE_UNSUPPORTED.
@@ -272,8 +283,21 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
             SimResult::kFeatureUnsupported);
   EXPECT_FALSE(has(sim::Feature::SimulationResetTime));
   EXPECT_FALSE(has(sim::Feature::SimulationResetState));
+  // No spawnables folder (rbsim node --spawnables): get_spawnables is unsupported, a uri refused.
   EXPECT_FALSE(has(sim::Feature::Spawnables));
-  EXPECT_FALSE(has(sim::Feature::SpawningEntities));
+  const auto spawnables =
+      call<sim::GetSpawnablesResponse>("get_spawnables", sim::GetSpawnablesRequest{{"/tmp"}});
+  EXPECT_EQ(spawnables.result.result, SimResult::kFeatureUnsupported);
+  EXPECT_NE(spawnables.result.error_message.find("--spawnables"), std::string::npos)
+      << spawnables.result.error_message;
+  EXPECT_TRUE(spawnables.spawnables.empty());
+  sim::SpawnEntityRequest by_uri;
+  by_uri.name = "ball";
+  by_uri.entity_resource.uri = "ball.xml";
+  const auto refused = call<sim::SpawnEntityResponse>("spawn_entity", by_uri);
+  EXPECT_EQ(refused.result.result, sim::SpawnEntityResponse::kNoResource);
+  EXPECT_NE(refused.result.error_message.find("--spawnables DIR"), std::string::npos)
+      << refused.result.error_message;
   for (const std::uint8_t scope :
        {sim::ResetSimulationRequest::kScopeTime, sim::ResetSimulationRequest::kScopeState}) {
     sim::ResetSimulationRequest reset;
@@ -545,7 +569,7 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
   sim::SpawnEntityRequest in_ns = spawn_request("bot", test::kFragment, 3.0, 1.0, 0.0);
   in_ns.entity_namespace = "/team";
   EXPECT_EQ(spawn(in_ns).entity_name, "team/bot");
-  for (const char* bad : {"body_7", "9lives", "a b", "a//b"}) {
+  for (const char* bad : {"body_7", "9lives", "a b", "a//b", ""}) {  // "": and allow_renaming false
     EXPECT_EQ(spawn(spawn_request(bad, test::kFragment, 0, 0, 0)).result.result, Spawn::kNameInvalid) << bad;
   }
   in_ns.entity_namespace = "team ns";
@@ -823,7 +847,7 @@ TEST_P(SimulationServicesTest, SimulationHandlersAreTheServedOnesWithTheirSource
       "get_simulator_features", "get_simulation_state", "set_simulation_state", "reset_simulation",
       "step_simulation",        "get_entities",         "get_entities_states",  "get_entity_info",
       "get_entity_state",       "get_entity_bounds",    "set_entity_state",     "spawn_entity",
-      "delete_entity"};
+      "spawn_entities",         "delete_entity",        "get_spawnables"};
   std::vector<std::string> listed, handled, names;
   for (const NodeServices::Served& s : NodeServices::simulation_catalogue()) {
     listed.push_back(s.name + " " + s.type);
@@ -902,6 +926,308 @@ TEST_P(SimulationServicesTest, ForwardedServiceCallsTheNodesServiceWithRawCdr) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, SimulationServicesTest, ::testing::Values("dds", "memory"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// ---------------------------------------------------------------------------------------------
+// Spawning from the node's spawnables folder (rbsim node --spawnables DIR), spawn_entities and
+// get_spawnables: a folder of fragments beside every kind of file its policy refuses.
+
+// A fragment of one body, no spring, a 2 m square about (1, 1).
+constexpr const char* kSquare = R"(<scene>
+  <description text="a square"/>
+  <rigidbodyvertex x="0" y="0" m="1"/><rigidbodyvertex x="0" y="2" m="1"/>
+  <rigidbodyvertex x="2" y="2" m="1"/><rigidbodyvertex x="2" y="0" m="1"/>
+  <rigidbody p="0" p="1" p="2" p="3" vx="0.5" vy="0" omega="0.25" r="0.1"/>
+</scene>)";
+
+class SpawnablesTest : public SimulationServicesTest {
+ protected:
+  void SetUp() override {
+    namespace fs = std::filesystem;
+    root_ = fs::path(::testing::TempDir()) / test::node_name("rbsim_spawnables");
+    folder_ = root_ / "spawnables";
+    fs::remove_all(root_);
+    fs::create_directories(folder_ / "sub");
+    fs::create_directories(folder_ / "dir.xml");
+    write(folder_ / "ball.xml", test::kFragment);
+    write(folder_ / "square.xml", kSquare);
+    write(folder_ / "sub" / "inner.xml", kSquare);
+    write(folder_ / "notes.txt", "not a fragment");
+    write(folder_ / "bad.xml", "<scene>\n<rigidbodyvertex x=\"0\"/>\n</scene>\n");
+    write(folder_ / "huge.xml", std::string(FragmentLimits{}.max_bytes + 1, ' '));
+    write(root_ / "outside.xml", kSquare);
+    fs::create_symlink(folder_ / "ball.xml", folder_ / "link_in.xml");
+    fs::create_symlink(root_ / "outside.xml", folder_ / "link_out.xml");
+    fs::create_directory_symlink(folder_ / "sub", folder_ / "linkdir");
+    ASSERT_EQ(::mkfifo((folder_ / "fifo.xml").c_str(), 0600), 0) << std::strerror(errno);
+    // A device inside the folder where this process may make one (as root): /dev/null's.
+    has_device_ = ::mknod((folder_ / "null.xml").c_str(), S_IFCHR | 0600, makedev(1, 3)) == 0;
+    SimulationServicesTest::SetUp();
+  }
+  void TearDown() override {
+    SimulationServicesTest::TearDown();
+    std::error_code ec;
+    std::filesystem::remove_all(root_, ec);
+  }
+  void configure(NodeServicesOptions& options) override { options.spawnables = {folder_.string()}; }
+
+  static void write(const std::filesystem::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+  }
+  sim::SpawnEntityResponse spawn(const sim::SpawnEntityRequest& req) {
+    return call<sim::SpawnEntityResponse>("spawn_entity", req);
+  }
+  static sim::SpawnEntityRequest by_uri(std::string name, std::string uri, double x = 0, double y = 0) {
+    sim::SpawnEntityRequest req = spawn_request(std::move(name), "", x, y, 0.0);
+    req.allow_renaming = req.name.empty();  // a name generated
+    req.entity_resource.uri = std::move(uri);
+    return req;
+  }
+  static sim::SpawnEntity entity(std::string name, std::string uri, std::string resource, double x) {
+    sim::SpawnEntity e;
+    e.allow_renaming = name.empty();  // a name generated
+    e.name = std::move(name);
+    e.entity_resource.uri = std::move(uri);
+    e.entity_resource.resource_string = std::move(resource);
+    e.initial_pose.position = {x, 1.0, 0.0};
+    e.initial_pose.orientation = msgs::quaternion_z(0.0);
+    return e;
+  }
+  // The spawn_entity commands of the session as <node>/commands carried them.
+  std::vector<msgs::CommandMessage> spawns() {
+    const std::lock_guard lock(mu_);
+    std::vector<msgs::CommandMessage> out;
+    for (const msgs::CommandMessage& m : recorded_) {
+      if (m.kind == msgs::CommandMessage::SpawnEntity) out.push_back(m);
+    }
+    return out;
+  }
+
+  std::filesystem::path root_, folder_;
+  bool has_device_ = false;
+};
+
+TEST_P(SpawnablesTest, AUriInsideTheFolderSpawnsItsTextAndReSimulatesExactly) {
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  ASSERT_EQ(step(10).result, SimResult::kOk);
+  // Relative to the folder (a resource_string beside a uri is ignored, as Resource.msg says).
+  sim::SpawnEntityRequest rel = by_uri("ball", "ball.xml", 1.5, 6.0);
+  rel.initial_pose.orientation = msgs::quaternion_z(0.4);
+  rel.entity_resource.resource_string = "ignored: the uri is given";
+  const auto ball = spawn(rel);
+  ASSERT_EQ(ball.result.result, SimResult::kOk) << ball.result.error_message;
+  EXPECT_EQ(ball.entity_name, "ball");
+  sim::GetEntityStateRequest get;
+  get.entity = "ball";
+  const auto placed = call<sim::GetEntityStateResponse>("get_entity_state", get);
+  ASSERT_EQ(placed.result.result, SimResult::kOk) << placed.result.error_message;
+  EXPECT_EQ(placed.state.position, (sim::Vector3{1.5, 6.0, 0.0}));
+  EXPECT_EQ(placed.state.linear_velocity, (sim::Vector3{0.25, -0.5, 0.0})) << "the file's fragment";
+  // An absolute path inside the folder, a file:// URI of one in a subfolder.
+  const auto square = spawn(by_uri("square", (folder_ / "square.xml").string(), -3.0, 1.0));
+  ASSERT_EQ(square.result.result, SimResult::kOk) << square.result.error_message;
+  const std::string inner_uri = "file://" + (folder_ / "sub" / "inner.xml").string();
+  const auto inner = spawn(by_uri("inner", inner_uri, 3.0, 1.0));
+  ASSERT_EQ(inner.result.result, SimResult::kOk) << inner.result.error_message;
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1", "ball", "square", "inner"}));
+
+  // The commands carry the files' texts (and the uris, for the record): a re-run needs no file.
+  const std::vector<msgs::CommandMessage> recorded = spawns();
+  ASSERT_EQ(recorded.size(), 3u);
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {"ball.xml", test::kFragment}, {(folder_ / "square.xml").string(), kSquare}, {inner_uri, kSquare}};
+  for (std::size_t k = 0; k < recorded.size(); ++k) {
+    Result<control::Command> back = control::from_message(recorded[k]);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back.value().spawn.uri, want[k].first);
+    EXPECT_EQ(back.value().spawn.resource, want[k].second);
+  }
+  ASSERT_EQ(step(20).result, SimResult::kOk);
+  const auto live = states();
+  ASSERT_EQ(live.states.size(), 5u);
+  std::filesystem::remove_all(folder_);
+  const test::Snapshot rerun = resimulated();
+  ASSERT_EQ(rerun.step, 30);
+  expect_states_equal(live, rerun);
+}
+
+TEST_P(SpawnablesTest, EveryUriOutsideThePolicyIsRefusedNamingTheUriAndTheRule) {
+  using Spawn = sim::SpawnEntityResponse;
+  struct Case {
+    std::string uri;
+    std::uint8_t code;
+    std::string says;
+  };
+  const std::string outside = (root_ / "outside.xml").string();
+  std::vector<Case> cases = {
+      {"../outside.xml", Spawn::kNoResource, "'..' is not allowed"},
+      {"sub/../../outside.xml", Spawn::kNoResource, "'..' is not allowed"},
+      {outside, Spawn::kNoResource, "outside the spawnables folder"},
+      {"file://" + outside, Spawn::kNoResource, "outside the spawnables folder"},
+      {"link_out.xml", Spawn::kNoResource, "link_out.xml is a symbolic link"},
+      {"link_in.xml", Spawn::kNoResource, "link_in.xml is a symbolic link"},
+      {"linkdir/inner.xml", Spawn::kNoResource, "linkdir is a symbolic link"},
+      {"fifo.xml", Spawn::kNoResource, "fifo.xml is a FIFO, not a regular file"},
+      {"/dev/null", Spawn::kNoResource, "outside the spawnables folder"},
+      {"file:///dev/zero", Spawn::kNoResource, "outside the spawnables folder"},
+      {"dir.xml", Spawn::kNoResource, "dir.xml is a directory, not a regular file"},
+      {folder_.string(), Spawn::kNoResource, "the spawnables folder itself"},
+      {"missing.xml", Spawn::kNoResource, "no such file"},
+      {"http://example.com/ball.xml", Spawn::kNoResource, "only a path or a file:// URI"},
+      {"file://elsewhere/ball.xml", Spawn::kNoResource, "an absolute path on this host"},
+      {"huge.xml", Spawn::kResourceParseError, "more than 1,048,576"},
+      {"bad.xml", Spawn::kResourceParseError, "bad.xml:2: "},
+  };
+  if (has_device_) cases.push_back({"null.xml", Spawn::kNoResource, "null.xml is a character device"});
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const Case& c : cases) {
+    const Spawn res = spawn(by_uri("x", c.uri));
+    EXPECT_EQ(res.result.result, c.code) << c.uri << ": " << res.result.error_message;
+    EXPECT_NE(res.result.error_message.find(c.says), std::string::npos)
+        << c.uri << ": " << res.result.error_message;
+    if (c.code == Spawn::kNoResource) {
+      EXPECT_NE(res.result.error_message.find("uri '" + c.uri + "'"), std::string::npos)
+          << res.result.error_message;
+    }
+    EXPECT_TRUE(res.entity_name.empty());
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 20s) << "nothing blocks (the FIFO, the devices)";
+  EXPECT_TRUE(spawns().empty()) << "no refusal became a command";
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1"}));
+}
+
+TEST_P(SpawnablesTest, GetSpawnablesListsExactlyTheFoldersFragments) {
+  const auto features =
+      call<sim::GetSimulatorFeaturesResponse>("get_simulator_features", sim::GetSimulatorFeaturesRequest{});
+  const std::vector<std::uint16_t>& listed = features.features.features;
+  EXPECT_EQ(listed.size(), 19u);
+  EXPECT_NE(std::find(listed.begin(), listed.end(), static_cast<std::uint16_t>(sim::Feature::Spawnables)),
+            listed.end());
+
+  sim::GetSpawnablesRequest req;
+  req.sources = {"model://elsewhere"};
+  const auto res = call<sim::GetSpawnablesResponse>("get_spawnables", req);
+  ASSERT_EQ(res.result.result, SimResult::kOk) << res.result.error_message;
+  // The regular *.xml files directly in the folder that parse; not the subfolder's, the links, the
+  // FIFO, the device, the directory, the text file, the file too large or the one that does not parse.
+  ASSERT_EQ(res.spawnables.size(), 2u);
+  EXPECT_EQ(res.spawnables[0].entity_resource.uri, "ball.xml");
+  EXPECT_EQ(res.spawnables[0].description, "a triangle");
+  EXPECT_EQ(res.spawnables[1].entity_resource.uri, "square.xml");
+  EXPECT_EQ(res.spawnables[1].description, "a square");
+  EXPECT_TRUE(res.spawnables[0].entity_resource.resource_string.empty());
+  // Each one's hull box about its centre of mass, as get_entity_bounds gives a body's.
+  const sim::Bounds& triangle = res.spawnables[0].spawn_bounds;
+  EXPECT_EQ(triangle.type, static_cast<std::uint8_t>(sim::BoundsType::Box));
+  ASSERT_EQ(triangle.points.size(), 2u);
+  EXPECT_NEAR(triangle.points[0].x, 8.0 / 3.0, 1e-12);
+  EXPECT_NEAR(triangle.points[0].y, 1.0, 1e-12);
+  EXPECT_NEAR(triangle.points[1].x, -4.0 / 3.0, 1e-12);
+  EXPECT_NEAR(triangle.points[1].y, -1.0, 1e-12);
+  EXPECT_EQ(res.spawnables[1].spawn_bounds.points,
+            (std::vector<sim::Vector3>{{1.0, 1.0, 0.0}, {-1.0, -1.0, 0.0}}));
+  // What was left out and the sources not searched, in the message.
+  for (const char* says : {"bad.xml:2: ", "huge.xml", "'model://elsewhere' not searched"})
+    EXPECT_NE(res.result.error_message.find(says), std::string::npos)
+        << says << ": " << res.result.error_message;
+
+  // Each uri, given back as listed, spawns; its bounds are the spawned body's.
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  for (const sim::Spawnable& s : res.spawnables) {
+    const auto spawned = spawn(by_uri("", s.entity_resource.uri));
+    ASSERT_EQ(spawned.result.result, SimResult::kOk) << spawned.result.error_message;
+    sim::GetEntityBoundsRequest bounds;
+    bounds.entity = spawned.entity_name;
+    const auto got = call<sim::GetEntityBoundsResponse>("get_entity_bounds", bounds);
+    ASSERT_EQ(got.result.result, SimResult::kOk) << got.result.error_message;
+    ASSERT_EQ(got.bounds.points.size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+      EXPECT_NEAR(got.bounds.points[k].x, s.spawn_bounds.points[k].x, 1e-12);
+      EXPECT_NEAR(got.bounds.points[k].y, s.spawn_bounds.points[k].y, 1e-12);
+    }
+  }
+}
+
+TEST_P(SpawnablesTest, SpawnEntitiesAppliesEveryEntityAtOneStepBoundary) {
+  ASSERT_EQ(set_state(State::Playing).result, SimResult::kOk);
+  using Codes = sim::SpawnResult;
+  sim::SpawnEntitiesRequest req;
+  req.spawn_requests = {entity("one", "ball.xml", "", -4.0), entity("two", "square.xml", "", 4.0),
+                        entity("three", "", kSquare, 8.0), entity("9bad", "", kSquare, 0.0),
+                        entity("one", "square.xml", "", 0.0)};
+  const auto res = call<sim::SpawnEntitiesResponse>("spawn_entities", req);
+  EXPECT_EQ(res.result.result, sim::SpawnEntitiesResponse::kEntitiesSpawnFailed) << res.result.error_message;
+  EXPECT_NE(res.result.error_message.find("2 of 5 spawns failed"), std::string::npos)
+      << res.result.error_message;
+  ASSERT_EQ(res.results.size(), 5u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(res.results[k].result.result, SimResult::kOk)
+        << k << ": " << res.results[k].result.error_message;
+    EXPECT_EQ(res.results[k].entity_name, req.spawn_requests[k].name);
+  }
+  EXPECT_EQ(res.results[3].result.result, Codes::kNameInvalid);
+  EXPECT_EQ(res.results[4].result.result, Codes::kNameNotUnique) << res.results[4].result.error_message;
+  EXPECT_TRUE(res.results[4].entity_name.empty());
+  // The four that became commands (the name taken refused as it applied) applied at one step
+  // boundary while the world played on.
+  std::vector<msgs::CommandMessage> recorded = spawns();
+  ASSERT_EQ(recorded.size(), 4u);
+  for (const msgs::CommandMessage& m : recorded) EXPECT_EQ(m.step, recorded[0].step);
+  EXPECT_EQ(std::count_if(recorded.begin(), recorded.end(), [](const auto& m) { return m.success; }), 3);
+
+  // All of them well: RESULT_OK, one boundary again.
+  req.spawn_requests = {entity("a", "ball.xml", "", -4.0), entity("b", "ball.xml", "", 4.0),
+                        entity("c", "sub/inner.xml", "", 8.0)};
+  const auto all = call<sim::SpawnEntitiesResponse>("spawn_entities", req);
+  EXPECT_EQ(all.result.result, SimResult::kOk) << all.result.error_message;
+  ASSERT_EQ(all.results.size(), 3u);
+  recorded = spawns();
+  ASSERT_EQ(recorded.size(), 7u);
+  EXPECT_EQ(recorded[4].step, recorded[6].step);
+  EXPECT_EQ(recorded[5].step, recorded[6].step);
+  EXPECT_GT(recorded[4].step, recorded[0].step) << "the world played on between the calls";
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  EXPECT_EQ(entities({}),
+            (std::vector<std::string>{"body_0", "body_1", "one", "two", "three", "a", "b", "c"}));
+  // Nothing to spawn is nothing done.
+  EXPECT_EQ(call<sim::SpawnEntitiesResponse>("spawn_entities", sim::SpawnEntitiesRequest{}).result.result,
+            SimResult::kOk);
+}
+
+TEST_P(SpawnablesTest, AnOversizedSpawnEntitiesCallIsRefusedWholeAndTheNodeGoesOn) {
+  sim::SpawnEntitiesRequest many;
+  many.spawn_requests.assign(10000, entity("", "", kSquare, 0.0));
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto res = call<sim::SpawnEntitiesResponse>("spawn_entities", many);
+  EXPECT_EQ(res.result.result, SimResult::kOperationFailed);
+  EXPECT_NE(res.result.error_message.find("10,000 entities in one call, at most 1,000: nothing was spawned"),
+            std::string::npos)
+      << res.result.error_message;
+  EXPECT_TRUE(res.results.empty());
+  many.spawn_requests.resize(1001);
+  EXPECT_EQ(call<sim::SpawnEntitiesResponse>("spawn_entities", many).result.result,
+            SimResult::kOperationFailed);
+  // Fragments adding up to more than 16 MiB in one call (a file of nearly 1 MiB, 20 times).
+  write(folder_ / "near.xml", std::string(kSquare) + "<!--" + std::string(1000000, '-') + "-->\n");
+  sim::SpawnEntitiesRequest heavy;
+  heavy.spawn_requests.assign(20, entity("", "near.xml", "", 0.0));
+  const auto refused = call<sim::SpawnEntitiesResponse>("spawn_entities", heavy);
+  EXPECT_EQ(refused.result.result, SimResult::kOperationFailed);
+  EXPECT_NE(refused.result.error_message.find("add up to more than 16,777,216 bytes"), std::string::npos)
+      << refused.result.error_message;
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 30s);
+  // Nothing spawned; the node answers as before.
+  EXPECT_TRUE(spawns().empty());
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1"}));
+  heavy.spawn_requests.resize(2);
+  const auto two = call<sim::SpawnEntitiesResponse>("spawn_entities", heavy);
+  EXPECT_EQ(two.result.result, SimResult::kOk) << two.result.error_message;
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1", "entity_1", "entity_2"}));
+}
+
+INSTANTIATE_TEST_SUITE_P(Middleware, SpawnablesTest, ::testing::Values("dds", "memory"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 // ---------------------------------------------------------------------------------------------

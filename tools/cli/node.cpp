@@ -26,7 +26,8 @@ struct NodeArgs {
   std::int32_t wait_for = 0;
   bool quiet = false;
   std::string topics;
-  FoxgloveArgs foxglove;  // --foxglove [ADDR:]PORT and its access options
+  FoxgloveArgs foxglove;   // --foxglove [ADDR:]PORT and its access options
+  std::string spawnables;  // --spawnables DIR
 };
 
 std::vector<std::string>& ros_args() {
@@ -227,6 +228,7 @@ int node_command(const NodeArgs& a) {
   };
   service_options.start_type_description_service = settings.start_type_description_service;
   service_options.introspection = settings.service_introspection;  // -p service_configure_introspection:=...
+  if (!a.spawnables.empty()) service_options.spawnables = {a.spawnables};
   auto services = node::NodeServices::create(participant.value(), controller, service_options);
   if (!services) return fail("node", services.error().message);
   // The Foxglove server serves beside DDS, steered through the controller. The pacer releases
@@ -314,6 +316,13 @@ Subcommand add_node_command(CLI::App& parent) {
       ->check(positive());
   add_topics_option(app, a->topics, a->node.ns, a->node.topics, "Topics to publish (DDS and --foxglove)");
   add_foxglove_option(app, a->foxglove);
+  app->add_option(
+         "--spawnables", a->spawnables,
+         "A folder of spawnable fragments (FOSSSim XML of one body each, *.xml): simulation_interfaces' "
+         "spawn_entity and spawn_entities take a uri naming a file in it (relative to it, or an "
+         "absolute path or file:// URI inside it; no '..', no symbolic links, regular files of at "
+         "most 1 MiB), and get_spawnables lists them. Without it the node reads no files")
+      ->check(existing_folder());
   app->add_flag("-q,--quiet", a->quiet,
                 "No start and end lines (--foxglove's listening line is always printed)");
   app->footer(

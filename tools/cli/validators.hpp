@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "rbsim/msgs.hpp"
@@ -38,6 +39,18 @@ inline CLI::Validator ros_namespace() {
         return {};
       },
       "NAMESPACE");
+}
+
+// A folder that exists (a directory, or a link to one).
+inline CLI::Validator existing_folder() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        std::error_code ec;
+        if (std::filesystem::is_directory(value, ec)) return {};
+        if (std::filesystem::exists(value, ec)) return "\"" + value + "\" is not a folder";
+        return "no folder \"" + value + "\"";
+      },
+      "DIR");
 }
 
 // --node-name NAME: the node a DDS command is on the ROS 2 graph ("rbsim_recorder", or with a

@@ -26,9 +26,11 @@ ServiceSet::~ServiceSet() {
 }
 
 Status ServiceSet::add(const Participant& participant, const std::string& node, std::string_view name,
-                       std::string_view srv_type, ServiceServer::Handler handler) {
+                       std::string_view srv_type, ServiceServer::Handler handler,
+                       std::size_t max_request_bytes) {
   ServiceOptions so;
   so.in_graph = true;
+  so.max_request_bytes = max_request_bytes;
   so.on_arrival = [this] {
     {
       const std::lock_guard lock(mutex_);

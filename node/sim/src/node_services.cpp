@@ -81,6 +81,7 @@ struct NodeServices::Impl {
   Bytes event_cdr;
   std::atomic<std::uint64_t> event_count{0};
   std::atomic<std::uint64_t> command_count{0};
+  ResourceFolders spawnables;                      // options.spawnables, opened by create()
   std::unique_ptr<SimulationServices> simulation;  // simulation_interfaces' services
   std::unique_ptr<SimulateSteps> simulate_steps;   // and its action
   // simulation_interfaces' services in collect()'s list: [first, end); their entries (handlers
@@ -99,8 +100,9 @@ struct NodeServices::Impl {
     add_controls(all);
     add_parameters(all);
     simulation = std::make_unique<SimulationServices>(
-        controller, [this](Command c) { return apply(std::move(c)); }, options.apply_timeout_s, options.dt,
-        options.quit);
+        controller, [this](Command c) { return apply(std::move(c)); },
+        [this](std::vector<Command> c) { return apply_all(std::move(c)); }, options.apply_timeout_s,
+        options.dt, spawnables, options.quit);
     simulation_first = all.size();
     simulation->add(all);
     simulation_end = all.size();
@@ -118,6 +120,27 @@ struct NodeServices::Impl {
       return r;
     }
     return done.get();
+  }
+
+  // Submits `batch` together (Controller::submit_all: they apply at one boundary) and waits
+  // (bounded, once for all) for their results.
+  std::vector<CommandResult> apply_all(std::vector<Command> batch) {
+    for (Command& c : batch) c.source = t_source != nullptr ? *t_source : "ros2 service";
+    std::vector<std::future<CommandResult>> done = controller.submit_all(std::move(batch));
+    std::vector<CommandResult> out;
+    bool late = false;  // one wait for all: after a timeout, what is not ready at once is late too
+    for (std::future<CommandResult>& f : done) {
+      const double wait = late ? 0.0 : options.apply_timeout_s;
+      if (f.wait_for(std::chrono::duration<double>(wait)) != std::future_status::ready) {
+        late = true;
+        CommandResult r;
+        r.message = "not applied within " + std::to_string(options.apply_timeout_s) + " s";
+        out.push_back(std::move(r));
+        continue;
+      }
+      out.push_back(f.get());
+    }
+    return out;
   }
 
   // The control services through the control module's one mapping (control::control_services()).
@@ -279,11 +302,16 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
                                                            control::Controller& controller,
                                                            const NodeServicesOptions& options) {
   auto impl = std::make_unique<Impl>(&participant, controller, options);
+  Result<ResourceFolders> spawnables = ResourceFolders::open(options.spawnables, "spawnables folder");
+  if (!spawnables) return spawnables.error();
+  impl->spawnables = std::move(spawnables.value());
   std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services = impl->collect();
   impl->simulation_entries.assign(services.begin() + static_cast<std::ptrdiff_t>(impl->simulation_first),
                                   services.begin() + static_cast<std::ptrdiff_t>(impl->simulation_end));
   for (auto& [name, type, handler] : services) {
-    if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler)); !st)
+    if (Status st = impl->services.add(participant, options.node, name, type, std::move(handler),
+                                       SimulationServices::max_request_bytes(name));
+        !st)
       return st.error();
   }
   auto action = SimulateSteps::create(participant, options.node, controller);

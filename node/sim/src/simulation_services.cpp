@@ -23,15 +23,17 @@ using control::CommandKind;
 using control::CommandResult;
 using sim::Result;
 
-// What GetSimulatorFeatures lists: exactly what these services do. Not listed, and answered
-// RESULT_FEATURE_UNSUPPORTED: tags and convex-hull filters, resetting time or state alone (rbsim's
-// time is its step index, part of its state), spawnables and spawning from a uri, spawning several
-// entities at once, worlds, setting an acceleration. (QUITTING has no feature of its own: rbsim
-// node supports it, SIMULATION_STATE_SETTING.)
+// What GetSimulatorFeatures lists: exactly what these services do, and SPAWNABLES when the node
+// has a spawnables folder (--spawnables). Not listed, and answered RESULT_FEATURE_UNSUPPORTED: tags
+// and convex-hull filters, resetting time or state alone (rbsim's time is its step index, part of
+// its state), worlds, setting an acceleration. (QUITTING has no feature of its own: rbsim node
+// supports it, SIMULATION_STATE_SETTING. Spawning from a uri has none either: SPAWNING's, with a
+// folder.)
 constexpr sim::Feature kFeatures[] = {
     sim::Feature::Spawning,
     sim::Feature::Deleting,
     sim::Feature::SpawningResourceString,
+    sim::Feature::SpawningEntities,
     sim::Feature::SimulationResetSpawned,
     sim::Feature::EntityBounds,
     sim::Feature::EntityBoundsBox,
@@ -48,16 +50,13 @@ constexpr sim::Feature kFeatures[] = {
     sim::Feature::StepSimulationAction,
 };
 // GetSimulatorFeatures.spawn_formats: a FOSSSim scene fragment of one body (rbsim/scene.hpp's
-// parse_fragment), as resource_string.
+// parse_fragment), as resource_string or a uri (spawning.cpp).
 constexpr std::string_view kSpawnFormat = "fosssim-fragment";
 constexpr std::size_t kMaxFilterBytes = 256;  // a longer name pattern is refused before it is compiled
 
-Result ok() {
-  return Result{Result::kOk, {}};
-}
-Result failure(std::uint8_t code, std::string message) {
-  return Result{code, std::move(message)};
-}
+using simulation_detail::failure;
+using simulation_detail::ok;
+using simulation_detail::refuse_malformed;
 
 sim::Vector3 planar(double x, double y) {
   return {x, y, 0.0};
@@ -223,15 +222,6 @@ struct Filters {
   }
 };
 
-template <class Res>
-auto refuse_malformed() {
-  return [](const Error& e) {
-    Res r;
-    r.result = failure(Result::kOperationFailed, e.message);
-    return std::optional<Res>(std::move(r));
-  };
-}
-
 // Runs `f(world)` on the run loop's thread at the next step boundary at or after `at_step`
 // (Controller::read) and waits up to `timeout_s` for it; nullopt when it timed out or the run
 // ended first.
@@ -266,16 +256,19 @@ void SimulationServices::add(std::vector<Entry>& out) {
   out.emplace_back(
       "get_simulator_features", std::string(sim::GetSimulatorFeaturesRequest::kService),
       typed_handler<sim::GetSimulatorFeaturesRequest, sim::GetSimulatorFeaturesResponse>(
-          [](const RequestHeader&, const sim::GetSimulatorFeaturesRequest&) {
+          [this](const RequestHeader&, const sim::GetSimulatorFeaturesRequest&) {
             sim::GetSimulatorFeaturesResponse res;
             for (const sim::Feature f : kFeatures)
               res.features.features.push_back(static_cast<std::uint16_t>(f));
+            if (!spawnables_.empty())
+              res.features.features.push_back(static_cast<std::uint16_t>(sim::Feature::Spawnables));
             res.features.spawn_formats.emplace_back(kSpawnFormat);
             res.features.custom_info =
                 "rbsim: every body is an entity (CATEGORY_DYNAMIC_OBJECT), a scene's named body_<id>, a "
                 "spawned one as spawned; spawn_formats: a FOSSSim scene fragment of one body as "
-                "resource_string; state changes, spawns and deletes are recorded on <node>/commands "
-                "and re-simulate exactly";
+                "resource_string, or as a uri naming a file of the node's spawnables folder (rbsim node "
+                "--spawnables DIR; get_spawnables lists them); state changes, spawns and deletes are "
+                "recorded on <node>/commands (a fragment's text, not its path) and re-simulate exactly";
             return res;
           },
           [](const Error&) { return std::optional<sim::GetSimulatorFeaturesResponse>(); }));
@@ -416,8 +409,6 @@ Result SimulationServices::step(std::uint64_t steps) {
   return ok();
 }
 
-// A pose in the plane: the position (x, y, 0) and a rotation about +z as theta (rad, CCW > 0), or
-// a Result with code `invalid` when it is not one.
 std::optional<Result> planar_pose(const sim::Vector3& p, const msgs::Quaternion& q, std::uint8_t invalid,
                                   Vec2& position, double& theta) {
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
@@ -594,105 +585,6 @@ void SimulationServices::add_entity(std::vector<Entry>& out) {
                          return sim::SetEntityStateResponse{set_entity_state(req)};
                        },
                        refuse_malformed<sim::SetEntityStateResponse>()));
-}
-
-// ROS 2's name rules for a spawned entity's name and namespace: tokens of letters, digits and
-// '_', not starting with a digit, joined by '/' (a namespace may start with one; a name may not).
-static bool valid_name(std::string_view name, bool is_namespace) {
-  if (is_namespace && name.starts_with('/')) name.remove_prefix(1);
-  if (name.empty() || name.size() > 255) return false;
-  std::size_t token = 0;
-  for (std::size_t k = 0; k <= name.size(); ++k) {
-    if (k == name.size() || name[k] == '/') {
-      if (k == token || (name[token] >= '0' && name[token] <= '9')) return false;
-      token = k + 1;
-      continue;
-    }
-    const char c = name[k];
-    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_'))
-      return false;
-  }
-  return true;
-}
-
-// SpawnEntity: the request checked and its fragment parsed here (off the loop's thread, within
-// FragmentLimits), then a spawn_entity command carrying the fragment's text, applied at the next
-// boundary (while paused, at once). The full name is NAMESPACE/NAME.
-sim::SpawnEntityResponse SimulationServices::spawn_entity(const sim::SpawnEntityRequest& req) {
-  using R = sim::SpawnEntityResponse;
-  const auto fail = [](std::uint8_t code, std::string message) {
-    return R{failure(code, std::move(message)), {}};
-  };
-  if (!req.name.empty() && (!valid_name(req.name, false) || scene_body_id(req.name)))
-    return fail(R::kNameInvalid, "name '" + req.name +
-                                     "': letters, digits and '_' in '/'-separated tokens, none starting with "
-                                     "a digit, and not body_<id> (a scene body's)");
-  std::string ns = req.entity_namespace;
-  if (!ns.empty() && !valid_name(ns, true))
-    return fail(R::kNamespaceInvalid, "entity_namespace '" + ns + "': ROS 2 name rules, as for the name");
-  if (ns.starts_with('/')) ns.erase(0, 1);
-  const sim::Resource& res = req.entity_resource;
-  if (!res.uri.empty())
-    return fail(R::kNoResource, "entity_resource.uri '" + res.uri +
-                                    "': this node reads no files; give the fragment's text as "
-                                    "entity_resource.resource_string");
-  if (res.resource_string.empty())
-    return fail(R::kNoResource,
-                "entity_resource: resource_string is empty (a FOSSSim scene fragment of one body)");
-  if (!req.initial_pose.frame_id.empty() && req.initial_pose.frame_id != "world")
-    return fail(R::kInvalidPose,
-                "initial_pose.header.frame_id '" + req.initial_pose.frame_id + "': only 'world' (or empty)");
-  Command c;
-  c.kind = CommandKind::Spawn;
-  if (std::optional<Result> bad = planar_pose(req.initial_pose.position, req.initial_pose.orientation,
-                                              R::kInvalidPose, c.spawn.position, c.spawn.theta))
-    return R{*bad, {}};
-  rbsim::Result<Fragment> fragment = parse_fragment(res.resource_string, "resource_string");
-  if (!fragment) return fail(R::kResourceParseError, fragment.error().message);
-  c.spawn.resource = res.resource_string;
-  c.spawn.fragment = std::make_shared<const Fragment>(std::move(fragment.value()));
-  const std::string name = req.name.empty() && !ns.empty() ? "entity" : req.name;
-  c.spawn.name = ns.empty() || name.empty() ? name : ns + "/" + name;
-  c.spawn.allow_renaming = req.allow_renaming || req.name.empty();
-  const CommandResult r = apply_(std::move(c));
-  if (r.successful) return R{ok(), r.entity};
-  switch (r.refusal) {
-    case control::Refusal::NameTaken:
-      return fail(R::kNameNotUnique, r.message);
-    case control::Refusal::NoSuchEntity:
-      return fail(R::kMissingAssets, r.message);  // a spring names a body the world does not have
-    case control::Refusal::BadResource:
-      return fail(R::kResourceParseError, r.message);
-    case control::Refusal::Other:
-      break;
-  }
-  return fail(Result::kOperationFailed, r.message);
-}
-
-// SpawnEntity and DeleteEntity; ResetSimulation's SCOPE_SPAWNED is add_state's.
-void SimulationServices::add_spawning(std::vector<Entry>& out) {
-  out.emplace_back(
-      "spawn_entity", std::string(sim::SpawnEntityRequest::kService),
-      typed_handler<sim::SpawnEntityRequest, sim::SpawnEntityResponse>(
-          [this](const RequestHeader&, const sim::SpawnEntityRequest& req) { return spawn_entity(req); },
-          refuse_malformed<sim::SpawnEntityResponse>()));
-  // The reply's message names the springs removed with the body.
-  out.emplace_back(
-      "delete_entity", std::string(sim::DeleteEntityRequest::kService),
-      typed_handler<sim::DeleteEntityRequest, sim::DeleteEntityResponse>(
-          [this](const RequestHeader&, const sim::DeleteEntityRequest& req) {
-            if (req.entity.empty())
-              return sim::DeleteEntityResponse{failure(Result::kNotFound, "entity: empty, names no entity")};
-            Command c;
-            c.kind = CommandKind::Delete;
-            c.entity = req.entity;
-            const CommandResult r = apply_(std::move(c));
-            if (r.successful) return sim::DeleteEntityResponse{failure(Result::kOk, r.message)};
-            return sim::DeleteEntityResponse{failure(
-                r.refusal == control::Refusal::NoSuchEntity ? Result::kNotFound : Result::kOperationFailed,
-                r.message)};
-          },
-          refuse_malformed<sim::DeleteEntityResponse>()));
 }
 
 }  // namespace rbsim::node

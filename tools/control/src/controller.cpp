@@ -94,20 +94,38 @@ std::future<CommandResult> Controller::submit(Command command) {
 }
 
 void Controller::submit(Command command, std::function<void(const CommandResult&)> done) {
-  enqueue(Pending{std::move(command), 0, std::move(done)});
+  std::vector<Pending> one;
+  one.push_back(Pending{std::move(command), 0, std::move(done)});
+  enqueue(std::move(one));
 }
 
-void Controller::enqueue(Pending pending) {
+std::vector<std::future<CommandResult>> Controller::submit_all(std::vector<Command> commands) {
+  std::vector<std::future<CommandResult>> futures;
+  std::vector<Pending> pending;
+  for (Command& c : commands) {
+    auto promise = std::make_shared<std::promise<CommandResult>>();
+    futures.push_back(promise->get_future());
+    pending.push_back(Pending{std::move(c), 0, [promise](const CommandResult& r) { promise->set_value(r); }});
+  }
+  enqueue(std::move(pending));
+  return futures;
+}
+
+void Controller::enqueue(std::vector<Pending> pending) {
   std::unique_lock lock(mutex_);
   if (closed_) {
-    ++counters_.commands;
+    counters_.commands += pending.size();
     const std::string reason = close_reason_;
     lock.unlock();
-    if (pending.done) pending.done(failed(std::string(to_string(pending.command.kind)) + ": " + reason));
+    for (Pending& p : pending) {
+      if (p.done) p.done(failed(std::string(to_string(p.command.kind)) + ": " + reason));
+    }
     return;
   }
-  pending.sequence = next_sequence_++;
-  incoming_.push_back(std::move(pending));
+  for (Pending& p : pending) {
+    p.sequence = next_sequence_++;
+    incoming_.push_back(std::move(p));
+  }
   has_incoming_.store(true, std::memory_order_release);
   wake_.notify_all();
 }

@@ -50,9 +50,11 @@ class ServiceSet {
   ServiceSet& operator=(const ServiceSet&) = delete;
 
   // Adds the server <node>/<name> of `srv_type` ("pkg/srv/Name"), served by `handler` once
-  // start() was called. Not after start().
+  // start() was called; larger requests than `max_request_bytes` are dropped unread
+  // (ServiceOptions'). Not after start().
   [[nodiscard]] Status add(const Participant& participant, const std::string& node, std::string_view name,
-                           std::string_view srv_type, ServiceServer::Handler handler);
+                           std::string_view srv_type, ServiceServer::Handler handler,
+                           std::size_t max_request_bytes = ServiceOptions{}.max_request_bytes);
   // Starts the serving thread (handlers run there, `budget` requests per server in turn).
   void start(std::size_t budget = 8);
   // Stops serving (a request being handled is answered first); idempotent.

@@ -37,6 +37,10 @@ struct NodeServicesOptions {
   // description of every type the node's endpoints use (rbsim/node_types.hpp), as rclcpp serves it
   // unless its read-only parameter start_type_description_service is false.
   bool start_type_description_service = true;
+  // The folders simulation_interfaces' spawn_entity and spawn_entities read a uri's fragment from,
+  // and get_spawnables lists (rbsim node --spawnables DIR): each must be a directory. Empty: a uri
+  // is refused and get_spawnables answers RESULT_FEATURE_UNSUPPORTED.
+  std::vector<std::string> spawnables = {};
   // REP 2012 introspection of the services from the start (the parameter
   // service_configure_introspection as the run starts; later changes of it turn it on and off).
   IntrospectionState introspection = IntrospectionState::Off;

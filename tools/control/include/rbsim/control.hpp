@@ -202,6 +202,10 @@ class Controller final : public StepHook, public Steering {
   std::future<CommandResult> submit(Command command);
   // Same; `done` runs on the run loop's thread (or the closing one) and must not block.
   void submit(Command command, std::function<void(const CommandResult&)> done) override;
+  // Queues `commands` as one: they reach the run loop together, so those for the next boundary
+  // (kNextStep) all apply at that one boundary, in order, with no other command between them
+  // (simulation_interfaces' SpawnEntities). One result each, in order.
+  std::vector<std::future<CommandResult>> submit_all(std::vector<Command> commands);
   // The body names (spawned bodies' own, "body_<id>" for the scene's), on the loop's thread only:
   // inside a read(). A body's id, or nullopt.
   std::optional<std::int32_t> find_entity(std::string_view name) const;
@@ -259,7 +263,8 @@ class Controller final : public StepHook, public Steering {
     std::uint64_t sequence = 0;
     std::function<void(const CommandResult&)> done;
   };
-  void enqueue(Pending pending);
+  // Queues `pending` in order, under one lock (consecutive sequence numbers).
+  void enqueue(std::vector<Pending> pending);
   // Moves the incoming queue into the schedule (step order, then arrival order).
   void take_incoming();
   bool due(std::int64_t step) const;
