@@ -58,7 +58,7 @@ int hex_digit(char c) {
 
 // The path a uri names: a path as it is, or a file:// URI's (file:///p, file://localhost/p; %XX
 // decoded). Another scheme ("scheme://...") is an error naming the rule.
-Result<std::string> path_of(std::string_view uri) {
+rbsim::Result<std::string> path_of(std::string_view uri) {
   const std::size_t colon = uri.find("://");
   const auto scheme_char = [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '+' || c == '-' || c == '.';
@@ -91,7 +91,7 @@ Result<std::string> path_of(std::string_view uri) {
 }
 
 // A path's components, "." and empty ones dropped; '..' and NUL bytes are errors.
-Result<std::vector<std::string>> components(std::string_view path, const std::string& what) {
+rbsim::Result<std::vector<std::string>> components(std::string_view path, const std::string& what) {
   if (path.find('\0') != std::string_view::npos) return Error{"a NUL byte in the path"};
   std::vector<std::string> parts;
   std::size_t start = 0;
@@ -138,7 +138,8 @@ Text read_bounded(int fd, std::string_view uri, const std::string& path, std::si
 
 }  // namespace
 
-Result<ResourceFolders> ResourceFolders::open(const std::vector<std::string>& folders, std::string what) {
+rbsim::Result<ResourceFolders> ResourceFolders::open(const std::vector<std::string>& folders,
+                                                     std::string what) {
   ResourceFolders out;
   out.what_ = std::move(what);
   for (const std::string& f : folders) {
@@ -207,9 +208,9 @@ ResourceFolders::Text ResourceFolders::read_in(const Folder& folder, const std::
 
 ResourceFolders::Text ResourceFolders::read(std::string_view uri, std::size_t max_bytes) const {
   if (folders_.empty()) return refuse(Refusal::NotAllowed, uri, "no " + what_ + " was given");
-  const Result<std::string> path = path_of(uri);
+  const rbsim::Result<std::string> path = path_of(uri);
   if (!path) return refuse(Refusal::NotAllowed, uri, path.error().message);
-  const Result<std::vector<std::string>> parts = components(path.value(), what_);
+  const rbsim::Result<std::vector<std::string>> parts = components(path.value(), what_);
   if (!parts) return refuse(Refusal::NotAllowed, uri, parts.error().message);
   if (parts.value().empty()) return refuse(Refusal::NotFound, uri, "names no file");
   std::string list;
@@ -225,7 +226,7 @@ ResourceFolders::Text ResourceFolders::read(std::string_view uri, std::size_t ma
   // Absolute: inside a folder, as given or as its canonical path.
   for (const Folder& f : folders_) {
     for (const std::string* root : {&f.given, &f.canonical}) {
-      const Result<std::vector<std::string>> under = components(*root, what_);
+      const rbsim::Result<std::vector<std::string>> under = components(*root, what_);
       if (!under || under.value().size() > parts.value().size() ||
           !std::equal(under.value().begin(), under.value().end(), parts.value().begin()))
         continue;
