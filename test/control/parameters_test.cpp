@@ -113,6 +113,52 @@ std::vector<Case> cases() {
   };
 }
 
+// After every change the table holds one springs.<id>.k|l0 pair per spring of the world, in its
+// order, each pair's target the spring's index in the world and its name found at its place; the
+// names that came and went are reported, and a spring kept keeps the value stored for it.
+TEST(ParameterTable, FollowStructureKeepsOnePairPerSpringInTheWorldsOrder) {
+  const Scene scene = test::control_scene();
+  ParameterTable t(scene, 200, RunSettings{});
+  World w = World::create(scene.world).value();
+  const std::size_t springs_from = t.size() - 2 * static_cast<std::size_t>(w.spring_count());
+  SpringDef extra = w.spring(SpringId{0});
+  const auto expect_follows = [&](const char* what) {
+    ASSERT_EQ(t.size(), springs_from + 2 * static_cast<std::size_t>(w.spring_count())) << what;
+    for (std::int32_t s = 0; s < w.spring_count(); ++s) {
+      const std::string p = "springs." + std::to_string(w.spring_id(SpringId{s})) + ".";
+      for (std::size_t k = 0; k < 2; ++k) {
+        const std::size_t i = springs_from + 2 * static_cast<std::size_t>(s) + k;
+        EXPECT_EQ(t.descriptor(i).name, p + (k == 0 ? "k" : "l0")) << what;
+        EXPECT_EQ(t.target(i).index, s) << what;
+        EXPECT_EQ(t.find(t.descriptor(i).name), i) << what;
+      }
+    }
+  };
+  std::vector<Parameter> added;
+  std::vector<std::string> removed;
+  // Three springs join (ids 2, 3, 4 after the scene's two), one stored value set on id 2.
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(w.add_spring(extra).ok());
+  t.follow_structure(w, &added, &removed);
+  expect_follows("after three added");
+  EXPECT_EQ(added.size(), 6u);
+  EXPECT_TRUE(removed.empty());
+  t.store(*t.find("springs.2.k"), ParameterValue::of_double(42.0));
+  // The scene's first and the second that joined go: the rest move up, keeping their values; one
+  // more joins (id 5).
+  added.clear();
+  ASSERT_TRUE(w.remove_spring(w.spring_id(SpringId{0})).ok());
+  ASSERT_TRUE(w.remove_spring(3).ok());
+  ASSERT_TRUE(w.add_spring(extra).ok());
+  t.follow_structure(w, &added, &removed);
+  expect_follows("after removals");
+  EXPECT_EQ(removed,
+            (std::vector<std::string>{"springs.0.k", "springs.0.l0", "springs.3.k", "springs.3.l0"}));
+  ASSERT_EQ(added.size(), 2u);
+  EXPECT_EQ(added[0].name, "springs.5.k");
+  EXPECT_FALSE(t.find("springs.0.k").has_value());
+  EXPECT_EQ(t.value(*t.find("springs.2.k")), ParameterValue::of_double(42.0));
+}
+
 TEST(ParameterTableCheck, EveryReadWriteParameterTakesItsTypeInRangeAndRefusesTheRest) {
   const ParameterTable t(test::control_scene(), 200, RunSettings{});
   for (const Case& c : cases()) {

@@ -150,6 +150,7 @@ class ParameterTable {
   void add(ParameterDescriptor descriptor, ParameterValue value, ParameterTarget target);
   void add_spring(std::int32_t id, std::size_t index, const SpringDef& spring);
   std::vector<Entry> entries_;
+  std::vector<std::int32_t> spring_ids_;  // the id of each spring's entries, in table order
   // Name -> index: a lookup stays O(log n) however many names a request (or a client) sends.
   std::map<std::string, std::size_t, std::less<>> index_;
 };
