@@ -569,6 +569,16 @@ TEST_P(SimulationServicesTest, SpawnAndDeleteAreCommandsAndReSimulateExactly) {
   sim::SpawnEntityRequest in_ns = spawn_request("bot", test::kFragment, 3.0, 1.0, 0.0);
   in_ns.entity_namespace = "/team";
   EXPECT_EQ(spawn(in_ns).entity_name, "team/bot");
+  // A fragment of more than the 64 KiB other services read is read (spawned); one over the
+  // fragment limit is answered in words, not dropped unread.
+  const std::string padded = std::string(test::kFragment) + "<!--" + std::string(200000, '-') + "-->";
+  EXPECT_EQ(spawn(spawn_request("padded", padded, 4.0, 9.0, 0.0)).result.result, SimResult::kOk);
+  sim::DeleteEntityRequest unpad;
+  unpad.entity = "padded";
+  EXPECT_EQ(call<sim::DeleteEntityResponse>("delete_entity", unpad).result.result, SimResult::kOk);
+  const std::string huge = std::string(test::kFragment) + "<!--" + std::string(1200000, '-') + "-->";
+  const Spawn over = spawn(spawn_request("huge", huge, 4.0, 9.0, 0.0));
+  EXPECT_EQ(over.result.result, Spawn::kResourceParseError) << over.result.error_message;
   for (const char* bad : {"body_7", "9lives", "a b", "a//b", ""}) {  // "": and allow_renaming false
     EXPECT_EQ(spawn(spawn_request(bad, test::kFragment, 0, 0, 0)).result.result, Spawn::kNameInvalid) << bad;
   }

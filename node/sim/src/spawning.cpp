@@ -209,8 +209,13 @@ sim::Bounds hull_box(const BodyDef& body) {
 
 }  // namespace
 
+// The requests a spawn service reads: a call's fragments (spawn_entities), or one fragment at its
+// limit and the request's other fields (spawn_entity), so a fragment over the limit is answered in
+// words rather than dropped unread as a larger request to another service is.
 std::size_t SimulationServices::max_request_bytes(std::string_view service) {
-  return service == "spawn_entities" ? kMaxCallFragmentBytes : ServiceOptions{}.max_request_bytes;
+  if (service == "spawn_entities") return kMaxCallFragmentBytes;
+  if (service == "spawn_entity") return 2 * FragmentLimits{}.max_bytes;
+  return ServiceOptions{}.max_request_bytes;
 }
 
 // SpawnEntity: one spawn, applied at the next boundary.
