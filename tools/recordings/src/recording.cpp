@@ -111,14 +111,16 @@ struct Recording::Impl {
   // The epochs of a pass (RecordedStep). Where they start is known before the pass (the steps of
   // every scene description, in log-time order, nondecreasing), so neither the epoch of a step nor
   // how often a step may be recorded again depends on how the topics' log times interleave (a
-  // recorder that fell behind takes a topic's samples in a batch). Their descriptions are decoded
-  // as the pass meets them, and one that no step still to come can be in is dropped.
+  // recorder that fell behind takes a topic's samples in a batch). The first epoch's description
+  // is `scene`; later ones are decoded as the pass meets them, and one that no step still to come
+  // can be in is dropped. No epochs are followed (epoch_starts empty) without a scene description
+  // or a per-step topic.
   struct Epoch {
     std::uint32_t index = 0;
     msgs::SceneMessage scene;
   };
   std::vector<std::uint64_t> epoch_starts;  // the step of each scene description
-  std::deque<Epoch> epochs;                 // decoded, the oldest still needed first
+  std::deque<Epoch> epochs;                 // those after the first, decoded, the oldest still needed first
   std::uint32_t scenes_seen = 0;            // scene descriptions met in this pass
   // How many times each topic's last step came again (up to the epochs that start at it).
   std::array<std::uint32_t, kPerStep.size()> again_count{};
@@ -290,20 +292,21 @@ struct Recording::Impl {
   // A scene description met in a pass: the first epoch's was read by open; each later one decoded.
   Status scene_message(const mcap::MessageEntry& e) {
     const std::uint32_t index = scenes_seen++;
-    if (index == 0 || epochs.empty()) return Ok{};
+    if (index == 0 || epoch_starts.empty()) return Ok{};
     Result<msgs::SceneMessage> decoded = msgs::decode_scene(e.message.data);
     if (!decoded) return fail(where(e) + ": " + decoded.error().message);
     epochs.push_back({index, std::move(decoded.value())});
     return Ok{};
   }
 
-  // The epoch of a step ready to be passed on (its description met); older ones are dropped, as
-  // steps are passed on in increasing order.
-  const Epoch& epoch_of(std::uint64_t step) {
-    const std::uint32_t index = epoch_index(step);
-    while (epochs.size() > 1 && epochs.front().index < index) epochs.pop_front();
-    RBSIM_ASSERT(epochs.front().index == index, "a step is passed on once its scene description was read");
-    return epochs.front();
+  // The description of epoch `index`, for a step ready to be passed on (its description met); older
+  // ones are dropped, as steps are passed on in increasing order.
+  const msgs::SceneMessage& epoch_scene(std::uint32_t index) {
+    if (index == 0) return *scene;
+    while (!epochs.empty() && epochs.front().index < index) epochs.pop_front();
+    RBSIM_ASSERT(!epochs.empty() && epochs.front().index == index,
+                 "a step is passed on once its scene description was read");
+    return epochs.front().scene;
   }
 
   Slot& slot_for(std::uint64_t step) {
@@ -347,7 +350,8 @@ struct Recording::Impl {
     RBSIM_ASSERT(at.has_value(), "a decoded per-step message carries its step");
     const std::uint64_t step = *at;
     // The step of a change recorded again (once per epoch that starts at it): the last one wins.
-    const bool again = last[i] && step == *last[i] && !epochs.empty() && again_count[i] < changes_at(step);
+    const bool again =
+        last[i] && step == *last[i] && !epoch_starts.empty() && again_count[i] < changes_at(step);
     again_count[i] = again ? again_count[i] + 1 : 0;
     if (last[i] && step <= *last[i] && !again) {
       const std::string type(msgs::topic(kPerStep[i]).type);
@@ -382,7 +386,7 @@ struct Recording::Impl {
     for (std::size_t i = 0; i < kPerStep.size(); ++i) {
       if (present[i] && !(last[i] && *last[i] > s.step)) return false;
     }
-    return epochs.empty() || epoch_index(s.step) < scenes_seen;  // and its description was met
+    return epoch_starts.empty() || epoch_index(s.step) < scenes_seen;  // and its description was met
   }
 
   Status check(const Slot& s, const msgs::SceneMessage* described) const {
@@ -426,14 +430,13 @@ struct Recording::Impl {
     while (done < pending.size() && (all || ready(*pending[done]))) {
       const Slot& s = *pending[done];
       ++done;
-      const Epoch* epoch = epochs.empty() ? nullptr : &epoch_of(s.step);
-      if (result = check(s, epoch != nullptr ? &epoch->scene : nullptr); !result) break;
       RecordedStep step;
       step.step = s.step;
-      if (epoch != nullptr) {
-        step.scene = &epoch->scene;
-        step.epoch = epoch->index;
+      if (!epoch_starts.empty()) {
+        step.epoch = epoch_index(s.step);
+        step.scene = &epoch_scene(step.epoch);
       }
+      if (result = check(s, step.scene); !result) break;
       if (s.has[kStates]) step.body_states = &s.states;
       if (s.has[kSprings]) step.spring_states = &s.springs;
       if (s.has[kEnergy]) step.energy = &s.energy;
@@ -579,12 +582,12 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   im.pending.clear();
   im.last = {};
   im.again_count = {};
+  im.epoch_starts.clear();
   im.epochs.clear();
   im.scenes_seen = 0;
   const bool any_steps = std::find(im.present.begin(), im.present.end(), true) != im.present.end();
   if (im.scene && any_steps) {
     if (Status st = im.find_epochs(); !st) return st;
-    im.epochs.push_back({0, *im.scene});
   }
   mcap::ReadMessagesOptions ro;
   for (std::size_t i = 0; i < kPerStep.size(); ++i) {
