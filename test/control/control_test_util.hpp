@@ -32,6 +32,28 @@ inline constexpr const char* kFragment = R"(<scene>
   <rigidbodyspringforce i="-1" pix="2.0" piy="6.0" j="0" pjx="0.0" pjy="0.0" k="3.0" l0="0.5"/>
 </scene>)";
 
+// A spawn of kFragment (named `name`, placed at `position`, rotated by `theta`) and a delete, each at
+// `step`, from source "test".
+inline control::Command spawn_command(std::int64_t step, std::string name, Vec2 position, double theta) {
+  control::Command c;
+  c.step = step;
+  c.kind = control::CommandKind::Spawn;
+  c.spawn.resource = kFragment;
+  c.spawn.name = std::move(name);
+  c.spawn.position = position;
+  c.spawn.theta = theta;
+  c.source = "test";
+  return c;
+}
+inline control::Command delete_command(std::int64_t step, std::string name) {
+  control::Command c;
+  c.step = step;
+  c.kind = control::CommandKind::Delete;
+  c.entity = std::move(name);
+  c.source = "test";
+  return c;
+}
+
 // Every step a sink is given: the step index and the state arrays, in order.
 struct Snapshot {
   std::int64_t step = 0;

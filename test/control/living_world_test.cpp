@@ -22,7 +22,9 @@ using test::Snapshot;
 
 constexpr std::int64_t kSteps = 120;
 
+using test::delete_command;
 using test::kFragment;
+using test::spawn_command;
 
 // The control scene with the fragment's body as its body 2 and its springs as springs 2 and 3,
 // which is what a spawn at step k must step as, from the states the live world had at k.
@@ -36,27 +38,6 @@ std::string edited_scene_text() {
   <rigidbodyspringforce i="-1" pix="2.0" piy="6.0" j="2" pjx="0.0" pjy="0.0" k="3.0" l0="0.5"/>
 </scene>)";
   return text.replace(text.rfind("</scene>"), 8, added);
-}
-
-Command spawn_command(std::int64_t step, std::string name, Vec2 position, double theta) {
-  Command c;
-  c.step = step;
-  c.kind = CommandKind::Spawn;
-  c.spawn.resource = kFragment;
-  c.spawn.name = std::move(name);
-  c.spawn.position = position;
-  c.spawn.theta = theta;
-  c.source = "test";
-  return c;
-}
-
-Command delete_command(std::int64_t step, std::string name) {
-  Command c;
-  c.step = step;
-  c.kind = CommandKind::Delete;
-  c.entity = std::move(name);
-  c.source = "test";
-  return c;
 }
 
 CommandResult wait(std::future<CommandResult>& f) {

@@ -41,6 +41,14 @@ std::string bodies_text(const World& world) {
               : std::string()) +
          ")";
 }
+
+// A command's `done` that fulfils `future`.
+std::function<void(const CommandResult&)> fulfilling(std::future<CommandResult>& future) {
+  auto promise = std::make_shared<std::promise<CommandResult>>();
+  future = promise->get_future();
+  return [promise](const CommandResult& r) { promise->set_value(r); };
+}
+
 }  // namespace
 
 const char* to_string(CommandKind kind) {
@@ -87,9 +95,8 @@ Controller::~Controller() {
 }
 
 std::future<CommandResult> Controller::submit(Command command) {
-  auto promise = std::make_shared<std::promise<CommandResult>>();
-  std::future<CommandResult> future = promise->get_future();
-  submit(std::move(command), [promise](const CommandResult& r) { promise->set_value(r); });
+  std::future<CommandResult> future;
+  submit(std::move(command), fulfilling(future));
   return future;
 }
 
@@ -102,11 +109,7 @@ void Controller::submit(Command command, std::function<void(const CommandResult&
 std::vector<std::future<CommandResult>> Controller::submit_all(std::vector<Command> commands) {
   std::vector<std::future<CommandResult>> futures;
   std::vector<Pending> pending;
-  for (Command& c : commands) {
-    auto promise = std::make_shared<std::promise<CommandResult>>();
-    futures.push_back(promise->get_future());
-    pending.push_back(Pending{std::move(c), 0, [promise](const CommandResult& r) { promise->set_value(r); }});
-  }
+  for (Command& c : commands) pending.push_back(Pending{std::move(c), 0, fulfilling(futures.emplace_back())});
   enqueue(std::move(pending));
   return futures;
 }

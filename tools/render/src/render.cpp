@@ -186,10 +186,14 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
     auto recording = recordings::Recording::open(input, ro);
     if (!recording) return recording.error();
     const msgs::SceneMessage& scene = *recording.value()->scene();
-    Stage stage = stage_of(scene);
     // The recording's T is known once its last step is read: draw up to it, then drop the frames
     // at or after T (those showing exactly the last step's time, or past the scene's duration).
-    stage.duration = o.duration.value_or(INFINITY);
+    const auto drawn = [&](const msgs::SceneMessage& described) {
+      Stage s = stage_of(described);
+      s.duration = o.duration.value_or(INFINITY);
+      return s;
+    };
+    Stage stage = drawn(scene);
     if (Status st = frames.open(); !st) return st.error();
     std::optional<std::uint64_t> last;
     std::uint32_t epoch = 0;
@@ -197,8 +201,7 @@ Result<std::int64_t> render(const std::string& input, const RenderOptions& o) {
       if (step.body_states == nullptr) return Ok{};
       if (step.epoch != epoch) {  // bodies came or went: the shapes of the step's scene description
         epoch = step.epoch;
-        stage = stage_of(*step.scene);
-        stage.duration = o.duration.value_or(INFINITY);
+        stage = drawn(*step.scene);
       }
       last = step.step;
       poses.clear();
