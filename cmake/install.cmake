@@ -44,6 +44,9 @@ install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
 # The Foxglove layout `rbsim node --foxglove` points to (tools/cli/foxglove.cpp looks here first).
 install(FILES ${PROJECT_SOURCE_DIR}/docs/foxglove-layout.json DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim)
+# The bundled scenes: rbsim node's worlds folder by default (get_available_worlds, load_world's uri).
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rbsim/scenes
+        FILES_MATCHING PATTERN "*.xml")
 
 # A package of a ROS 2 workspace (package.xml, colcon.pkg; colcon builds it as plain CMake, no ament):
 # what ROS 2's tools look up through the ament index under an AMENT_PREFIX_PATH entry.

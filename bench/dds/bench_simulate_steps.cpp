@@ -73,7 +73,6 @@ int main(int argc, char** argv) {
   if (!server) return fail(server.error().message);
   node::NodeServicesOptions options;
   options.node = "/bench_sim";
-  options.dt = scene.value().world.dt;
   auto services = node::NodeServices::create(server.value(), controller, options);
   if (!services) return fail(services.error().message);
   Result<Driver> node_driver = Driver::create(scene.value());

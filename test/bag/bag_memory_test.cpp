@@ -151,7 +151,7 @@ TEST(Recorder, RecordsASessionWhoseBodiesChangeAsItsRerunWritesIt) {
     MemoryNode node(network, scene);
     control::Controller controller(scene, kSteps, control::RunSettings{0.0, 1, false});
     Result<std::unique_ptr<NodeServices>> services =
-        NodeServices::create(node.participant, controller, NodeServicesOptions{"/rbsim", scene.world.dt});
+        NodeServices::create(node.participant, controller, NodeServicesOptions{"/rbsim"});
     ASSERT_TRUE(services.ok()) << services.error().message;
     controller.on_command(
         [&applied = *services.value()](const control::Command& c, const control::CommandResult& r) {
@@ -312,7 +312,7 @@ TEST(Recorder, RecordsTheNodesServiceEvents) {
   ASSERT_TRUE(recorder.ok()) << recorder.error().message;
 
   control::Controller controller(scene, kSteps, control::RunSettings{});
-  NodeServicesOptions so{"/rbsim", scene.world.dt};
+  NodeServicesOptions so{"/rbsim"};
   so.introspection = IntrospectionState::Contents;
   Result<std::unique_ptr<NodeServices>> services = NodeServices::create(node_side, controller, so);
   ASSERT_TRUE(services.ok()) << services.error().message;

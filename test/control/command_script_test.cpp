@@ -322,10 +322,10 @@ TEST(CommandMessage, ToMessageAndBackKeepsEveryCommand) {
   EXPECT_EQ(stop_back->step, 40);
   msgs::CommandMessage bad;
   bad.seq = 4;
-  bad.kind = 11;
+  bad.kind = 13;
   Result<Command> refused = from_message(bad);
   ASSERT_FALSE(refused);
-  EXPECT_NE(refused.error().message.find("command 4: unknown kind 11"), std::string::npos)
+  EXPECT_NE(refused.error().message.find("command 4: unknown kind 13"), std::string::npos)
       << refused.error().message;
 }
 

@@ -355,8 +355,8 @@ TEST(CommandMessage, RefusesMissingOrMistypedSpawnArguments) {
   m.parameters.push_back(m.parameters[0]);
   EXPECT_NE(from_message(m).error().message.find("given twice"), std::string::npos);
   m = full;
-  m.kind = 11;
-  EXPECT_NE(from_message(m).error().message.find("unknown kind 11"), std::string::npos);
+  m.kind = 13;
+  EXPECT_NE(from_message(m).error().message.find("unknown kind 13"), std::string::npos);
 }
 
 TEST(CommandScript, SpawnReadsItsFileNowAndNamesTheLineOfABadOne) {

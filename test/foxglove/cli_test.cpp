@@ -52,7 +52,11 @@ std::vector<std::string> node_services(const std::string& node) {
                            "spawn_entity",
                            "spawn_entities",
                            "delete_entity",
-                           "get_spawnables"})
+                           "get_spawnables",
+                           "load_world",
+                           "unload_world",
+                           "get_current_world",
+                           "get_available_worlds"})
     out.push_back(node + "/" + name);
   return out;
 }

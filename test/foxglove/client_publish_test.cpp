@@ -186,7 +186,7 @@ TEST(FoxgloveCommandIn, MalformedPayloadsAreRefusedWithTheirReason) {
       {"", "not a JSON object"},
       {"[1]", "not a JSON object"},
       {"{\"kind\":", "not a JSON object"},
-      {R"({"kind":11})", "unknown kind 11"},
+      {R"({"kind":13})", "unknown kind 13"},
       {R"({"kind":9})", "delete_entity: parameter 'name' missing"},
       {R"({"kind":-1})", "'kind' must be an integer"},
       {R"({"kind":256})", "'kind' must be an integer"},

@@ -130,5 +130,77 @@ TEST(RunCommands, ARecordingThatEndsPausedEndsTheRerunThere) {
   EXPECT_NE(later.err.find("1 of its commands never applied"), std::string::npos) << later.err;
 }
 
+// A session that loaded another world (simulation_interfaces' LoadWorld: a load_world command
+// carrying the scene's text) re-runs from its recording to the same bytes, with no scene file:
+// the recording holds both worlds, the second from its own step 0, and rbsim check finds them
+// equal. Outputs that cannot hold a second world are refused before step 0.
+TEST(RunCommands, AWorldLoadedInTheSessionRerunsToTheSameBytes) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/chain.xml");
+  const fs::path other = dir / "other.xml";
+  // The cantilever, 0.05 s long.
+  std::string text = read_text(source_path("scenes/cantilever.xml"));
+  const std::size_t at = text.find("<duration");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, text.find("/>", at) + 2 - at, "<duration time=\"0.05\"/>");
+  write_text(other, text);
+  // The session's commands as the node numbers them: the other world at step 6, played there.
+  {
+    Result<Scene> s = load_scene(scene);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    Result<World> world = World::create(s.value().world);
+    ASSERT_TRUE(world.ok());
+    std::unique_ptr<recordings::McapSink> sink = recordings::make_mcap_sink((dir / "cmds.mcap").string());
+    ASSERT_TRUE(sink->begin(s.value(), world.value()).ok());
+    msgs::CommandMessage load;
+    load.seq = 0;
+    load.step = 6;
+    load.kind = msgs::CommandMessage::LoadWorld;
+    load.parameters = {{"resource", msgs::ParameterValue::of_string(read_text(other))},
+                       {"uri", msgs::ParameterValue::of_string("other.xml")}};
+    load.success = true;
+    msgs::CommandMessage play;
+    play.seq = 1;
+    play.kind = msgs::CommandMessage::Resume;
+    play.success = true;
+    for (const msgs::CommandMessage& c : {load, play}) {
+      msgs::Bytes cdr;
+      msgs::encode(c, cdr);
+      ASSERT_TRUE(sink->record_command(cdr, static_cast<std::int64_t>(c.step)).ok());
+    }
+    ASSERT_TRUE(sink->finish().ok());
+  }
+  const Outcome a = rbsim({"run", scene, "--steps", "40", "--commands", (dir / "cmds.mcap").string(),
+                           "--record", (dir / "a.mcap").string()});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  fs::remove(other);
+  const Outcome b = rbsim({"run", scene, "--steps", "40", "--commands", (dir / "a.mcap").string(), "--record",
+                           (dir / "b.mcap").string()});
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(read_bytes(dir / "a.mcap"), read_bytes(dir / "b.mcap"));
+  const Outcome check = rbsim({"check", (dir / "a.mcap").string(), (dir / "b.mcap").string()});
+  EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+  // The recording holds two scene descriptions: the chain's, then the other world's at its step 0.
+  Result<std::unique_ptr<recordings::Recording>> rec = recordings::Recording::open((dir / "a.mcap").string());
+  ASSERT_TRUE(rec.ok()) << rec.error().message;
+  std::vector<std::string> names;
+  recordings::MessageFilter scenes;
+  scenes.topics = {rec.value()->topic(msgs::TopicId::SceneDescription)};
+  ASSERT_TRUE(rec.value()
+                  ->read_messages(scenes,
+                                  [&](const recordings::RecordedMessage& m) {
+                                    Result<msgs::SceneMessage> d = msgs::decode_scene(m.cdr());
+                                    if (d) names.push_back(d.value().name);
+                                    return true;
+                                  })
+                  .ok());
+  EXPECT_EQ(names, (std::vector<std::string>{"chain", "other"}));
+  const Outcome csv = rbsim({"run", scene, "--steps", "40", "--commands", (dir / "a.mcap").string(), "--csv",
+                             (dir / "out.csv").string()});
+  EXPECT_EQ(csv.exit_code, 2) << csv.err;
+  EXPECT_NE(csv.err.find("cannot follow a world loaded during the run"), std::string::npos) << csv.err;
+  EXPECT_FALSE(fs::exists(dir / "out.csv"));
+}
+
 }  // namespace
 }  // namespace rbsim::test

@@ -538,7 +538,7 @@ def case_killed_client(ctx):
 # simulation_interfaces 2.1.0 and get_type_description (issue 37), through ros2-client
 
 
-SIM_FEATURES = {0, 1, 5, 6, 8, 9, 10, 11, 12, 20, 23, 24, 25, 26, 31, 32, 33, 50}  # the README's list, by value
+SIM_FEATURES = {0, 1, 5, 6, 8, 9, 10, 11, 12, 20, 23, 24, 25, 26, 31, 32, 33, 40, 41, 43, 44, 45, 50}  # the README's list, by value
 OK, UNSUPPORTED, NOT_FOUND, FAILED = 1, 0, 2, 4  # simulation_interfaces/msg/Result
 ALREADY, INCORRECT = 101, 103  # SetSimulationState's own codes
 STOPPED, PLAYING, PAUSED = 0, 1, 2

@@ -56,7 +56,6 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
     server_.emplace(participant(node_));
     NodeServicesOptions options;
     options.node = "/" + node_;
-    options.dt = scene_.world.dt;
     // As rbsim node's STATE_QUITTING asks its loop to stop: here the controller ends the run.
     options.quit = [this] {
       ++quits_;
@@ -74,7 +73,7 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
         clock_sink_->time_reset();
       const std::lock_guard lock(mu_);
       applied_.push_back(c.kind);
-      recorded_.push_back(control::to_message(c, r, recorded_.size(), scene_.world.dt));
+      recorded_.push_back(control::to_message(c, r, recorded_.size(), controller_.world_info().dt));
     });
     run_ = std::async(std::launch::async, [this] { return run(); });
     client_.emplace(participant(node_ + "_client"));
@@ -182,11 +181,14 @@ class SimulationServicesTest : public ::testing::TestWithParam<std::string> {
     std::vector<control::ScriptedCommand> commands;
     {
       const std::lock_guard lock(mu_);
+      std::uint32_t epoch = 0;  // restarts (resets, world loads) before it, as load_commands counts them
       for (std::size_t k = 0; k < recorded_.size(); ++k) {
         Result<control::Command> back = control::from_message(recorded_[k]);
         if (!back) throw std::runtime_error(back.error().message);
-        if (back.value().kind == without) continue;
-        commands.push_back({back.value(), recorded_[k].success, "command " + std::to_string(k)});
+        const bool restarts = control::restarts_steps(back.value().kind) && recorded_[k].success;
+        if (back.value().kind != without)
+          commands.push_back({back.value(), recorded_[k].success, "command " + std::to_string(k), epoch});
+        if (restarts) ++epoch;
       }
     }
     control::ScriptedRun run(scene_, kSteps, std::move(commands));
@@ -255,17 +257,36 @@ TEST_P(SimulationServicesTest, FeaturesListWhatWorksAndTheRestIsUnsupported) {
   const auto has = [&](sim::Feature f) {
     return std::find(listed.begin(), listed.end(), static_cast<std::uint16_t>(f)) != listed.end();
   };
-  for (const sim::Feature f :
-       {sim::Feature::Spawning, sim::Feature::Deleting, sim::Feature::SpawningResourceString,
-        sim::Feature::SpawningEntities, sim::Feature::SimulationResetSpawned, sim::Feature::EntityBounds,
-        sim::Feature::EntityBoundsBox, sim::Feature::EntityCategories, sim::Feature::EntityStateGetting,
-        sim::Feature::EntityStateSetting, sim::Feature::EntityInfoGetting, sim::Feature::SimulationReset,
-        sim::Feature::SimulationStateGetting, sim::Feature::SimulationStateSetting,
-        sim::Feature::SimulationStatePause, sim::Feature::StepSimulationSingle,
-        sim::Feature::StepSimulationMultiple, sim::Feature::StepSimulationAction}) {
+  for (const sim::Feature f : {sim::Feature::Spawning,
+                               sim::Feature::Deleting,
+                               sim::Feature::SpawningResourceString,
+                               sim::Feature::SpawningEntities,
+                               sim::Feature::SimulationResetSpawned,
+                               sim::Feature::EntityBounds,
+                               sim::Feature::EntityBoundsBox,
+                               sim::Feature::EntityCategories,
+                               sim::Feature::EntityStateGetting,
+                               sim::Feature::EntityStateSetting,
+                               sim::Feature::EntityInfoGetting,
+                               sim::Feature::SimulationReset,
+                               sim::Feature::SimulationStateGetting,
+                               sim::Feature::SimulationStateSetting,
+                               sim::Feature::SimulationStatePause,
+                               sim::Feature::StepSimulationSingle,
+                               sim::Feature::StepSimulationMultiple,
+                               sim::Feature::StepSimulationAction,
+                               sim::Feature::WorldLoading,
+                               sim::Feature::WorldResourceString,
+                               sim::Feature::WorldUnloading,
+                               sim::Feature::WorldInfoGetting}) {
     EXPECT_TRUE(has(f)) << static_cast<int>(f);
   }
-  EXPECT_EQ(listed.size(), 18u);
+  EXPECT_EQ(listed.size(), 22u);
+  // No worlds folder: get_available_worlds is unsupported (AVAILABLE_WORLDS not listed).
+  EXPECT_FALSE(has(sim::Feature::AvailableWorlds));
+  EXPECT_EQ(call<sim::GetAvailableWorldsResponse>("get_available_worlds", sim::GetAvailableWorldsRequest{})
+                .result.result,
+            SimResult::kFeatureUnsupported);
   EXPECT_EQ(features.features.spawn_formats, std::vector<std::string>{"fosssim-fragment"});
 
   // What is not listed answers RESULT_FEATURE_UNSUPPORTED.
@@ -857,7 +878,8 @@ TEST_P(SimulationServicesTest, SimulationHandlersAreTheServedOnesWithTheirSource
       "get_simulator_features", "get_simulation_state", "set_simulation_state", "reset_simulation",
       "step_simulation",        "get_entities",         "get_entities_states",  "get_entity_info",
       "get_entity_state",       "get_entity_bounds",    "set_entity_state",     "spawn_entity",
-      "spawn_entities",         "delete_entity",        "get_spawnables"};
+      "spawn_entities",         "delete_entity",        "get_spawnables",       "load_world",
+      "unload_world",           "get_current_world",    "get_available_worlds"};
   std::vector<std::string> listed, handled, names;
   for (const NodeServices::Served& s : NodeServices::simulation_catalogue()) {
     listed.push_back(s.name + " " + s.type);
@@ -1112,7 +1134,7 @@ TEST_P(SpawnablesTest, GetSpawnablesListsExactlyTheFoldersFragments) {
   const auto features =
       call<sim::GetSimulatorFeaturesResponse>("get_simulator_features", sim::GetSimulatorFeaturesRequest{});
   const std::vector<std::uint16_t>& listed = features.features.features;
-  EXPECT_EQ(listed.size(), 19u);
+  EXPECT_EQ(listed.size(), 23u);
   EXPECT_NE(std::find(listed.begin(), listed.end(), static_cast<std::uint16_t>(sim::Feature::Spawnables)),
             listed.end());
 
@@ -1486,6 +1508,174 @@ TEST_P(SimulateStepsTest, RefusedGoalsAndHostileClientsAreAnsweredNeverStalled) 
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, SimulateStepsTest, ::testing::Values("dds", "memory"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// ---------------------------------------------------------------------------------------------
+// Worlds: load_world (a uri of the node's worlds folder, or a scene's text), unload_world,
+// get_current_world and get_available_worlds; every code of LoadWorld.srv and UnloadWorld.srv; the
+// session re-simulated from its commands, which carry the scenes' texts.
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+// A world of one body, its own dt and integrator, long enough for any test.
+constexpr const char* kWorldScene = R"(<scene>
+  <description text="a falling square"/>
+  <duration time="1000.0"/>
+  <rigidbodyintegrator type="explicit-euler" dt="0.005"/>
+  <rigidbodyvertex x="0" y="0" m="1"/><rigidbodyvertex x="1" y="0" m="1"/>
+  <rigidbodyvertex x="1" y="1" m="1"/><rigidbodyvertex x="0" y="1" m="1"/>
+  <rigidbody p="0" p="1" p="2" p="3" vx="1.5" vy="2.0" omega="0.7" r="0.1"/>
+  <rigidbodygravityforce fx="0.0" fy="-9.81"/>
+</scene>)";
+
+class WorldsTest : public SimulationServicesTest {
+ protected:
+  void SetUp() override {
+    namespace fs = std::filesystem;
+    root_ = fs::path(::testing::TempDir()) / test::node_name("rbsim_worlds");
+    folder_ = root_ / "worlds";
+    fs::remove_all(root_);
+    fs::create_directories(folder_);
+    write_file(folder_ / "square.xml", kWorldScene);
+    write_file(folder_ / "control.xml", test::control_scene_text());
+    write_file(folder_ / "odd.xml", std::string(kWorldScene).replace(8, 0, "<gadget/>\n"));
+    write_file(folder_ / "bad.xml", "<scene>\n<rigidbodyvertex x=\"0\"/>\n</scene>\n");
+    write_file(folder_ / "notes.txt", "not a world");
+    write_file(root_ / "outside.xml", kWorldScene);
+    fs::create_symlink(root_ / "outside.xml", folder_ / "link.xml");
+    SimulationServicesTest::SetUp();
+  }
+  void TearDown() override {
+    SimulationServicesTest::TearDown();
+    std::error_code ec;
+    std::filesystem::remove_all(root_, ec);
+  }
+  void configure(NodeServicesOptions& options) override { options.worlds = {folder_.string()}; }
+
+  sim::LoadWorldResponse load(std::string uri, std::string text = {}, bool strict = false) {
+    sim::LoadWorldRequest req;
+    req.world_resource.uri = std::move(uri);
+    req.world_resource.resource_string = std::move(text);
+    req.fail_on_unsupported_element = strict;
+    return call<sim::LoadWorldResponse>("load_world", req);
+  }
+  sim::GetCurrentWorldResponse current() {
+    return call<sim::GetCurrentWorldResponse>("get_current_world", sim::GetCurrentWorldRequest{});
+  }
+
+  std::filesystem::path root_, folder_;
+};
+
+TEST_P(WorldsTest, ALoadedWorldIsStoppedAtStepZeroAndReSimulatesExactly) {
+  ASSERT_EQ(set_state(State::Paused).result, SimResult::kOk);
+  ASSERT_EQ(step(10).result, SimResult::kOk);
+  EXPECT_EQ(current().world.name, "control");
+  const auto loaded = load("square.xml");
+  ASSERT_EQ(loaded.result.result, SimResult::kOk) << loaded.result.error_message;
+  EXPECT_EQ(loaded.world.name, "square");
+  EXPECT_EQ(loaded.world.world_resource.uri, "square.xml");
+  EXPECT_EQ(loaded.world.description, "a falling square");
+  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::Stopped));
+  EXPECT_EQ(entities({}), std::vector<std::string>{"body_0"});
+  const auto now = current();
+  ASSERT_EQ(now.result.result, SimResult::kOk) << now.result.error_message;
+  EXPECT_EQ(now.world, loaded.world);
+  // Played from its step 0 as the scene alone would be.
+  ASSERT_EQ(step(25).result, SimResult::kOk);
+  const auto live = states();
+  ASSERT_EQ(live.states.size(), 1u);
+  const World alone = stepped(test::scene_from(kWorldScene), 25);
+  EXPECT_EQ(live.states[0].position.x, alone.x()[0]);
+  EXPECT_EQ(live.states[0].linear_velocity.y, alone.vy()[0]);
+  // Back to the first world, as text; the session's commands re-run with no file.
+  const auto back = load("", test::control_scene_text());
+  ASSERT_EQ(back.result.result, SimResult::kOk) << back.result.error_message;
+  EXPECT_EQ(back.world.world_resource.uri, "");
+  ASSERT_EQ(step(7).result, SimResult::kOk);
+  const auto again = states();
+  ASSERT_EQ(again.states.size(), 2u);
+  std::filesystem::remove_all(folder_);
+  const test::Snapshot rerun = resimulated();
+  ASSERT_EQ(rerun.step, 7);
+  expect_states_equal(again, rerun);
+}
+
+TEST_P(WorldsTest, EveryLoadWorldCodeIsReachedAndTheRunningWorldStaysUntouched) {
+  using Res = sim::LoadWorldResponse;
+  const auto code = [](const Res& r) { return r.result.result; };
+  EXPECT_EQ(code(load("", "")), Res::kNoResource);
+  EXPECT_EQ(code(load("missing.xml", kWorldScene)), Res::kNoResource) << "the text is ignored beside a uri";
+  EXPECT_EQ(code(load("missing.xml")), Res::kNoResource);
+  EXPECT_EQ(code(load("../outside.xml")), Res::kNoResource);
+  EXPECT_EQ(code(load((root_ / "outside.xml").string())), Res::kNoResource);
+  const auto link = load("link.xml");
+  EXPECT_EQ(code(link), Res::kNoResource);
+  EXPECT_NE(link.result.error_message.find("symbolic link"), std::string::npos) << link.result.error_message;
+  EXPECT_EQ(code(load("notes.txt")), Res::kUnsupportedFormat);
+  EXPECT_EQ(code(load("/dev/null.xml")), Res::kNoResource);
+  const auto bad = load("bad.xml");
+  EXPECT_EQ(code(bad), Res::kResourceParseError);
+  EXPECT_NE(bad.result.error_message.find("bad.xml:2:"), std::string::npos) << bad.result.error_message;
+  const auto bad_text = load("", "<scene><rigidbody p=\"0\"/></scene>");
+  EXPECT_EQ(code(bad_text), Res::kResourceParseError);
+  EXPECT_NE(bad_text.result.error_message.find("resource_string:1:"), std::string::npos)
+      << bad_text.result.error_message;
+  const auto odd = load("odd.xml", "", /*strict=*/true);
+  EXPECT_EQ(code(odd), Res::kUnsupportedElements);
+  EXPECT_NE(odd.result.error_message.find("gadget"), std::string::npos) << odd.result.error_message;
+  const auto huge = load("", std::string((64u << 20) + 1, ' '));  // past the 64 MiB a world may have
+  EXPECT_EQ(code(huge), Res::kResourceParseError);
+  // None of it touched the world, nor was any of it a command.
+  EXPECT_EQ(current().world.name, "control");
+  EXPECT_EQ(entities({}), (std::vector<std::string>{"body_0", "body_1"}));
+  EXPECT_TRUE(applied().empty());
+  // Unknown elements ignored when not asked to fail on them, as the scene loader does.
+  EXPECT_EQ(code(load("odd.xml")), SimResult::kOk);
+}
+
+TEST_P(WorldsTest, UnloadLeavesNoWorldUntilALoad) {
+  using UnloadRes = sim::UnloadWorldResponse;
+  ASSERT_EQ(call<UnloadRes>("unload_world", sim::UnloadWorldRequest{}).result.result, SimResult::kOk);
+  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::NoWorld));
+  EXPECT_EQ(current().result.result, sim::GetCurrentWorldResponse::kNoWorldLoaded);
+  EXPECT_EQ(call<UnloadRes>("unload_world", sim::UnloadWorldRequest{}).result.result,
+            UnloadRes::kNoWorldLoaded);
+  EXPECT_EQ(set_state(State::Playing).result, SetRes::kStateTransitionError);
+  EXPECT_EQ(step(1).result, SimResult::kOperationFailed);
+  EXPECT_TRUE(entities({}).empty());
+  EXPECT_EQ(set_state(State::NoWorld).result, SetRes::kIncorrectTransition);
+  ASSERT_EQ(load("square.xml").result.result, SimResult::kOk);
+  EXPECT_EQ(state(), static_cast<std::uint8_t>(State::Stopped));
+  ASSERT_EQ(set_state(State::Playing).result, SimResult::kOk);
+}
+
+TEST_P(WorldsTest, GetAvailableWorldsListsTheFoldersScenes) {
+  const auto all =
+      call<sim::GetAvailableWorldsResponse>("get_available_worlds", sim::GetAvailableWorldsRequest{});
+  ASSERT_EQ(all.result.result, SimResult::kOk) << all.result.error_message;
+  std::vector<std::string> names;
+  for (const sim::WorldResource& w : all.worlds) names.push_back(w.name + "=" + w.world_resource.uri);
+  EXPECT_EQ(names, (std::vector<std::string>{"control=control.xml", "odd=odd.xml", "square=square.xml"}));
+  EXPECT_EQ(all.worlds[2].description, "a falling square");
+  EXPECT_NE(all.result.error_message.find("left out bad.xml:2:"), std::string::npos)
+      << all.result.error_message;
+  sim::GetAvailableWorldsRequest tagged;
+  tagged.filter.tags = {"outdoor"};
+  EXPECT_EQ(call<sim::GetAvailableWorldsResponse>("get_available_worlds", tagged).result.result,
+            SimResult::kFeatureUnsupported);
+  const auto features =
+      call<sim::GetSimulatorFeaturesResponse>("get_simulator_features", sim::GetSimulatorFeaturesRequest{});
+  const auto& listed = features.features.features;
+  EXPECT_NE(
+      std::find(listed.begin(), listed.end(), static_cast<std::uint16_t>(sim::Feature::AvailableWorlds)),
+      listed.end());
+}
+
+INSTANTIATE_TEST_SUITE_P(Middleware, WorldsTest, ::testing::Values("dds", "memory"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace

@@ -92,7 +92,7 @@ class GetTypeDescriptionService : public ::testing::TestWithParam<std::string> {
     client_.emplace(participant(node_ + "_client"));
   }
   void start_services(bool type_description) {
-    NodeServicesOptions options{"/" + node_, scene_.world.dt};
+    NodeServicesOptions options{"/" + node_};
     options.start_type_description_service = type_description;
     auto services = NodeServices::create(*server_, controller_, options);
     ASSERT_TRUE(services.ok()) << services.error().message;

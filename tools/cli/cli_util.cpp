@@ -6,6 +6,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 
 #include "rbsim/counts.hpp"
 #include "rbsim/print.hpp"
@@ -42,6 +43,16 @@ void request_stop() {
 }
 int stop_signal() {
   return g_stop_signal.load(std::memory_order_relaxed);
+}
+
+std::string bundled_path(const std::string& installed, const std::string& source) {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path beside = exe.parent_path().parent_path() / "share/rbsim" / installed;
+    if (std::filesystem::exists(beside, ec)) return beside.string();
+  }
+  return (std::filesystem::path(RBSIM_SOURCE_SHARE) / source).string();
 }
 
 std::string format_seconds(double seconds) {

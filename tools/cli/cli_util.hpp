@@ -43,6 +43,10 @@ class Progress {
 
 std::string format_seconds(double seconds);
 
+// A file or folder rbsim ships: installed beside the binary (<prefix>/share/rbsim/<installed>, cmake
+// --install and the Debian package), else in the source tree the binary was built from (<source>).
+std::string bundled_path(const std::string& installed, const std::string& source);
+
 // --compression NAME with --compression-level LEVEL (0: the codec's default) as one codec choice;
 // the error names the option that is wrong.
 Result<mcap::Compression> compression_option(const std::string& name, int level = 0);

@@ -3,35 +3,13 @@
 // person where to point Foxglove.
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
-#include <system_error>
 
+#include "cli_util.hpp"
 #include "commands.hpp"
 #include "rbsim/counts.hpp"
 #include "rbsim/print.hpp"
 
-#ifndef RBSIM_FOXGLOVE_LAYOUT
-#define RBSIM_FOXGLOVE_LAYOUT "docs/foxglove-layout.json"
-#endif
-
 namespace rbsim::cli {
-
-namespace {
-
-// Where the layout is: installed beside the binary (<prefix>/share/rbsim, cmake --install and the
-// Debian package), else in the source tree this binary was built from.
-std::string layout_path() {
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const std::filesystem::path installed =
-        exe.parent_path().parent_path() / "share/rbsim/foxglove-layout.json";
-    if (std::filesystem::exists(installed, ec)) return installed.string();
-  }
-  return RBSIM_FOXGLOVE_LAYOUT;
-}
-
-}  // namespace
 
 CLI::Option* add_foxglove_option(CLI::App* app, FoxgloveArgs& args, bool required) {
   CLI::Option* o = app->add_option(
@@ -137,7 +115,7 @@ Result<std::unique_ptr<foxglove::Server>> start_foxglove(const char* command, co
   if (!options.token.empty() && args.print_token) url = foxglove::url_with_token(url, options.token);
   RBSIM_LOG(Info, "%s: foxglove: open %s\n", command, foxglove::foxglove_app_link(url).c_str());
   RBSIM_LOG(Info, "%s: foxglove: layout %s (Foxglove: Layouts > Import from file)\n", command,
-            layout_path().c_str());
+            bundled_path("foxglove-layout.json", "docs/foxglove-layout.json").c_str());
   return server;
 }
 

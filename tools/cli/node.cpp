@@ -28,6 +28,8 @@ struct NodeArgs {
   std::string topics;
   FoxgloveArgs foxglove;   // --foxglove [ADDR:]PORT and its access options
   std::string spawnables;  // --spawnables DIR
+  std::string worlds;      // --worlds DIR (default: the bundled scenes)
+  bool no_worlds = false;  // --no-worlds
 };
 
 std::vector<std::string>& ros_args() {
@@ -126,19 +128,20 @@ void follow_settings(control::Controller& controller, node::Pacer& pacer, node::
 }
 
 // Every applied command goes out on /<ns>/commands over DDS (the node's services) and to viewers;
-// a reset's new time goes out on /clock at once.
+// a reset's new time goes out on /clock at once. Stamps are the world's (its dt, a loaded world's own).
 void publish_commands(control::Controller& controller, node::NodeServices& services, node::DdsSink& sink,
-                      const NodeFoxglove& fox, double dt) {
-  controller.on_command([&applied = services, &sink, &server = fox.server,
-                         commands_channel = fox.commands_channel,
-                         dt](const control::Command& c, const control::CommandResult& r) {
-    applied.command_applied(c, r);
-    if (c.kind == control::CommandKind::Reset && r.successful) sink.time_reset();
-    if (server && commands_channel != 0) {
-      server->publish(commands_channel, msgs::sim_time_ns(r.step >= 0 ? r.step : 0, dt),
-                      applied.last_command());
-    }
-  });
+                      const NodeFoxglove& fox) {
+  controller.on_command(
+      [&controller, &applied = services, &sink, &server = fox.server,
+       commands_channel = fox.commands_channel](const control::Command& c, const control::CommandResult& r) {
+        applied.command_applied(c, r);
+        if (c.kind == control::CommandKind::Reset && r.successful) sink.time_reset();
+        if (server && commands_channel != 0) {
+          server->publish(commands_channel,
+                          msgs::sim_time_ns(r.step >= 0 ? r.step : 0, controller.world_info().dt),
+                          applied.last_command());
+        }
+      });
 }
 
 // One begin()/run() pass, or one per loop with --loop until a stop; the exit status of a pass
@@ -220,7 +223,6 @@ int node_command(const NodeArgs& a) {
   // so the server stops (its calls answered or dropped) before the handlers go.
   node::NodeServicesOptions service_options;
   service_options.node = name->fully_qualified();
-  service_options.dt = scene.world.dt;
   // STATE_QUITTING: the node ends as on SIGINT (outputs finished, the end line, exit 0).
   service_options.quit = [quiet = a.quiet] {
     if (!quiet) RBSIM_LOG(Info, "rbsim node: quitting (set_simulation_state STATE_QUITTING)\n");
@@ -229,6 +231,7 @@ int node_command(const NodeArgs& a) {
   service_options.start_type_description_service = settings.start_type_description_service;
   service_options.introspection = settings.service_introspection;  // -p service_configure_introspection:=...
   if (!a.spawnables.empty()) service_options.spawnables = {a.spawnables};
+  if (!a.no_worlds) service_options.worlds = {a.worlds.empty() ? bundled_path("scenes", "scenes") : a.worlds};
   auto services = node::NodeServices::create(participant.value(), controller, service_options);
   if (!services) return fail("node", services.error().message);
   // The Foxglove server serves beside DDS, steered through the controller. The pacer releases
@@ -264,7 +267,7 @@ int node_command(const NodeArgs& a) {
   if (foxglove.sink) driver.add(*foxglove.sink);
   driver.add(*sink.value());
   follow_settings(controller, pacer, *sink.value(), foxglove.sink.get());
-  publish_commands(controller, *services.value(), *sink.value(), foxglove, scene.world.dt);
+  publish_commands(controller, *services.value(), *sink.value(), foxglove);
   DriverOptions options;
   options.steps = steps;
   options.allow_nonfinite = a.allow_nonfinite;
@@ -323,6 +326,14 @@ Subcommand add_node_command(CLI::App& parent) {
          "absolute path or file:// URI inside it; no '..', no symbolic links, regular files of at "
          "most 1 MiB), and get_spawnables lists them. Without it the node reads no files")
       ->check(existing_folder());
+  app->add_option("--worlds", a->worlds,
+                  "A folder of worlds (FOSSSim scenes, *.xml): simulation_interfaces' load_world takes a uri "
+                  "naming a file in it (the same rules as --spawnables, files of at most 64 MiB), and "
+                  "get_available_worlds lists them (default: the bundled scenes)")
+      ->check(existing_folder());
+  app->add_flag("--no-worlds", a->no_worlds,
+                "No worlds folder: load_world takes a scene's text (resource_string) only")
+      ->excludes(app->get_option("--worlds"));
   app->add_flag("-q,--quiet", a->quiet,
                 "No start and end lines (--foxglove's listening line is always printed)");
   app->footer(

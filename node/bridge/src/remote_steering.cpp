@@ -104,6 +104,8 @@ Result<Request> request_for(const Command& command, const RemoteSteeringOptions&
     case CommandKind::Spawn:
     case CommandKind::Delete:
     case CommandKind::ResetSpawned:
+    case CommandKind::LoadWorld:
+    case CommandKind::UnloadWorld:
       return Error{std::string(control::to_string(command.kind)) +
                    " is not relayed: call the node's simulation_interfaces service"};
   }
@@ -194,6 +196,8 @@ CommandResult result_of(const Command& command, std::span<const std::byte> reply
     case CommandKind::Spawn:
     case CommandKind::Delete:
     case CommandKind::ResetSpawned:
+    case CommandKind::LoadWorld:
+    case CommandKind::UnloadWorld:
       break;  // never sent (make_request refuses them)
   }
   return failed("unknown command");

@@ -82,6 +82,7 @@ struct NodeServices::Impl {
   std::atomic<std::uint64_t> event_count{0};
   std::atomic<std::uint64_t> command_count{0};
   ResourceFolders spawnables;                      // options.spawnables, opened by create()
+  ResourceFolders worlds;                          // options.worlds, the same
   std::unique_ptr<SimulationServices> simulation;  // simulation_interfaces' services
   std::unique_ptr<SimulateSteps> simulate_steps;   // and its action
   // simulation_interfaces' services in collect()'s list: [first, end); their entries (handlers
@@ -102,7 +103,7 @@ struct NodeServices::Impl {
     simulation = std::make_unique<SimulationServices>(
         controller, [this](Command c) { return apply(std::move(c)); },
         [this](std::vector<Command> c) { return apply_all(std::move(c)); }, options.apply_timeout_s,
-        options.dt, spawnables, options.quit);
+        spawnables, worlds, options.quit);
     simulation_first = all.size();
     simulation->add(all);
     simulation_end = all.size();
@@ -305,6 +306,9 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
   Result<ResourceFolders> spawnables = ResourceFolders::open(options.spawnables, "spawnables folder");
   if (!spawnables) return spawnables.error();
   impl->spawnables = std::move(spawnables.value());
+  Result<ResourceFolders> worlds = ResourceFolders::open(options.worlds, "worlds folder");
+  if (!worlds) return worlds.error();
+  impl->worlds = std::move(worlds.value());
   std::vector<std::tuple<std::string, std::string, ServiceServer::Handler>> services = impl->collect();
   impl->simulation_entries.assign(services.begin() + static_cast<std::ptrdiff_t>(impl->simulation_first),
                                   services.begin() + static_cast<std::ptrdiff_t>(impl->simulation_end));
@@ -334,8 +338,9 @@ Result<std::unique_ptr<NodeServices>> NodeServices::create(const Participant& pa
 void NodeServices::command_applied(const Command& command, const CommandResult& result) {
   // Every command, applied or refused, as data on /<ns>/commands, numbered without gaps.
   impl_->command_cdr.clear();
-  msgs::encode(control::to_message(command, result, impl_->next_sequence++, impl_->options.dt),
-               impl_->command_cdr);
+  msgs::encode(
+      control::to_message(command, result, impl_->next_sequence++, impl_->controller.world_info().dt),
+      impl_->command_cdr);
   if (impl_->commands->publish(impl_->command_cdr)) ++impl_->command_count;
   for (const msgs::Parameter& p : result.changed) {
     if (p.name != kIntrospectionParameter) continue;
@@ -349,7 +354,7 @@ void NodeServices::command_applied(const Command& command, const CommandResult& 
   if (result.changed.empty() || result.step < 0) return;
   msgs::ParameterEvent event;
   event.node = impl_->options.node;
-  event.stamp = msgs::sim_time(result.step, impl_->options.dt);
+  event.stamp = msgs::sim_time(result.step, impl_->controller.world_info().dt);
   event.changed_parameters = result.changed;
   impl_->event_cdr.clear();
   msgs::encode(event, impl_->event_cdr);

@@ -26,9 +26,9 @@ using sim::Result;
 // What GetSimulatorFeatures lists: exactly what these services do, and SPAWNABLES when the node
 // has a spawnables folder (--spawnables). Not listed, and answered RESULT_FEATURE_UNSUPPORTED: tags
 // and convex-hull filters, resetting time or state alone (rbsim's time is its step index, part of
-// its state), worlds, setting an acceleration. (QUITTING has no feature of its own: rbsim node
+// its state), world tags, setting an acceleration. (QUITTING has no feature of its own: rbsim node
 // supports it, SIMULATION_STATE_SETTING. Spawning from a uri has none either: SPAWNING's, with a
-// folder.)
+// folder; nor loading a world from one: WORLD_LOADING's.) AVAILABLE_WORLDS with a worlds folder.
 constexpr sim::Feature kFeatures[] = {
     sim::Feature::Spawning,
     sim::Feature::Deleting,
@@ -48,6 +48,10 @@ constexpr sim::Feature kFeatures[] = {
     sim::Feature::StepSimulationSingle,
     sim::Feature::StepSimulationMultiple,
     sim::Feature::StepSimulationAction,
+    sim::Feature::WorldLoading,
+    sim::Feature::WorldResourceString,
+    sim::Feature::WorldUnloading,
+    sim::Feature::WorldInfoGetting,
 };
 // GetSimulatorFeatures.spawn_formats: a FOSSSim scene fragment of one body (rbsim/scene.hpp's
 // parse_fragment), as resource_string or a uri (spawning.cpp).
@@ -262,19 +266,25 @@ void SimulationServices::add(std::vector<Entry>& out) {
               res.features.features.push_back(static_cast<std::uint16_t>(f));
             if (!spawnables_.empty())
               res.features.features.push_back(static_cast<std::uint16_t>(sim::Feature::Spawnables));
+            if (!worlds_.empty())
+              res.features.features.push_back(static_cast<std::uint16_t>(sim::Feature::AvailableWorlds));
             res.features.spawn_formats.emplace_back(kSpawnFormat);
             res.features.custom_info =
                 "rbsim: every body is an entity (CATEGORY_DYNAMIC_OBJECT), a scene's named body_<id>, a "
                 "spawned one as spawned; spawn_formats: a FOSSSim scene fragment of one body as "
                 "resource_string, or as a uri naming a file of the node's spawnables folder (rbsim node "
-                "--spawnables DIR; get_spawnables lists them); state changes, spawns and deletes are "
-                "recorded on <node>/commands (a fragment's text, not its path) and re-simulate exactly";
+                "--spawnables DIR; get_spawnables lists them); worlds: FOSSSim scenes, as "
+                "resource_string or a uri naming a file of the node's worlds folder (rbsim node --worlds "
+                "DIR, the bundled scenes by default; get_available_worlds lists them); state changes, "
+                "spawns, deletes and world loads are recorded on <node>/commands (a fragment's or scene's "
+                "text, not its path) and re-simulate exactly";
             return res;
           },
           [](const Error&) { return std::optional<sim::GetSimulatorFeaturesResponse>(); }));
   add_state(out);
   add_entities(out);
   add_spawning(out);
+  add_worlds(out);
 }
 
 // Simulation state, reset and stepping. The state is read at a boundary: STOPPED while stopped_ is
@@ -283,7 +293,9 @@ void SimulationServices::add_state(std::vector<Entry>& out) {
   const auto state_now = [this]() -> std::optional<sim::State> {
     // Quitting, the loop may be gone: no boundary to wait for.
     if (quitting_.load()) return sim::State::Quitting;
+    if (loading_.load()) return sim::State::LoadingWorld;
     return at_boundary(controller_, timeout_s_, [this](const World& world) {
+      if (!controller_.world_info().loaded) return sim::State::NoWorld;
       const bool paused = controller_.settings().paused;
       if (paused && world.step_index() == 0 && stopped_.load()) return sim::State::Stopped;
       return paused ? sim::State::Paused : sim::State::Playing;
@@ -351,7 +363,8 @@ void SimulationServices::add_state(std::vector<Entry>& out) {
 // at step 0, no step taken), to STOPPED a pause and a reset to step 0; the same state again
 // ALREADY_IN_TARGET_STATE; QUITTING ends the node as a SIGINT does (the reply goes out first), after
 // which every other state is INCORRECT_TRANSITION; NO_WORLD, LOADING_WORLD and unknown values are
-// INCORRECT_TRANSITION.
+// INCORRECT_TRANSITION. With no world, PLAYING and STOPPED fail (STATE_TRANSITION_ERROR: nothing
+// to run or reset) and PAUSED is ALREADY_IN_TARGET_STATE's or a pause.
 Result SimulationServices::set_state(std::uint8_t target, const StateNow& state_now, const Run& command) {
   using R = sim::SetSimulationStateResponse;
   const auto to = static_cast<sim::State>(target);
@@ -365,8 +378,10 @@ Result SimulationServices::set_state(std::uint8_t target, const StateNow& state_
   }
   if (quitting_.load()) return failure(R::kIncorrectTransition, "the node is quitting");
   if (to != sim::State::Playing && to != sim::State::Paused && to != sim::State::Stopped)
-    return failure(R::kIncorrectTransition,
-                   "state " + std::to_string(target) + ": rbsim has one world, always loaded");
+    return failure(
+        R::kIncorrectTransition,
+        "state " + std::to_string(target) +
+            ": not a state to set (NO_WORLD and LOADING_WORLD come of unload_world and load_world)");
   const std::optional<sim::State> now = state_now();
   if (!now) return unanswered(timeout_s_);
   if (*now == to) return failure(R::kAlreadyInTargetState, "already in the target state");
@@ -397,7 +412,8 @@ Result SimulationServices::step(std::uint64_t steps) {
   const std::int64_t target = r.step + static_cast<std::int64_t>(steps);
   // Stepping takes its own time: at most the run's pace for these steps, on top of the wait.
   const control::RunSettings settings = controller_.settings();
-  const double pace = settings.rate > 0.0 ? static_cast<double>(steps) * dt_ / settings.rate : 0.0;
+  const double dt = controller_.world_info().dt;
+  const double pace = settings.rate > 0.0 ? static_cast<double>(steps) * dt / settings.rate : 0.0;
   const std::optional<std::int64_t> reached = at_boundary(
       controller_, timeout_s_ + 2.0 * pace, [](const World& w) { return w.step_index(); }, target);
   if (!reached) return unanswered(timeout_s_ + 2.0 * pace);

@@ -2,7 +2,8 @@
 // under the node's name as Gazebo serves them under /gzserver/): simulator features, simulation
 // state, reset, stepping, and the entities (every body is one, named body_<i> as its /tf child
 // frame without the namespace), spawning and deleting them (spawning.cpp; a spawn's uri read from
-// the spawnables folders, resource_folder.hpp). State changes go through control::Commands, as the
+// the spawnables folders, resource_folder.hpp), and worlds (world_services.cpp: loaded from the
+// worlds folders or as text). State changes go through control::Commands, as the
 // node's own services do, so they are recorded on <node>/commands and re-simulated; reads of the
 // world run on the loop's thread at a step boundary (Controller::read).
 #pragma once
@@ -25,6 +26,8 @@ namespace rbsim::node {
 
 // What the simulation_interfaces services' files share (simulation_services.cpp, spawning.cpp).
 namespace simulation_detail {
+// A world's text, as a file or a resource_string: larger ones are refused before they are parsed.
+constexpr std::size_t kMaxWorldBytes = 64u << 20;
 inline msgs::simulation::Result ok() {
   return msgs::simulation::Result{msgs::simulation::Result::kOk, {}};
 }
@@ -55,17 +58,17 @@ class SimulationServices {
   using ApplyAll = std::function<std::vector<control::CommandResult>(std::vector<control::Command>)>;
   // `apply` submits a command and waits (bounded) for its result, as NodeServices does for its own
   // services, `apply_all` several at one boundary; reads wait up to `timeout_s` for their boundary.
-  // `dt`: the scene's step (s). `spawnables`: the folders a spawn's uri may name and GetSpawnables
-  // lists (none: uris refused, GetSpawnables unsupported). `quit` ends the node (STATE_QUITTING);
-  // empty: QUITTING is unsupported.
+  // `spawnables`: the folders a spawn's uri may name and GetSpawnables lists (none: uris refused,
+  // GetSpawnables unsupported); `worlds` the same for LoadWorld and GetAvailableWorlds. `quit`
+  // ends the node (STATE_QUITTING); empty: QUITTING is unsupported.
   SimulationServices(control::Controller& controller, Apply apply, ApplyAll apply_all, double timeout_s,
-                     double dt, ResourceFolders spawnables, std::function<void()> quit = {})
+                     ResourceFolders spawnables, ResourceFolders worlds, std::function<void()> quit = {})
       : controller_(controller),
         apply_(std::move(apply)),
         apply_all_(std::move(apply_all)),
         timeout_s_(timeout_s),
-        dt_(dt),
         spawnables_(std::move(spawnables)),
+        worlds_(std::move(worlds)),
         quit_(std::move(quit)) {}
 
   // The services, as (name under the node, type, handler).
@@ -81,8 +84,9 @@ class SimulationServices {
   Apply apply_;
   ApplyAll apply_all_;
   double timeout_s_;
-  double dt_;
   ResourceFolders spawnables_;
+  ResourceFolders worlds_;
+  std::atomic<bool> loading_{false};  // a load_world read, parsed or applied: STATE_LOADING_WORLD
   // STOPPED: set by a stop (and at start), cleared by a play or a pause; the state reads STOPPED
   // while it is set and the world is paused at step 0.
   std::atomic<bool> stopped_{true};
@@ -102,6 +106,13 @@ class SimulationServices {
   msgs::simulation::SpawnEntitiesResponse spawn_entities(const msgs::simulation::SpawnEntitiesRequest& req);
   msgs::simulation::GetSpawnablesResponse get_spawnables(
       const msgs::simulation::GetSpawnablesRequest& req) const;
+  // Worlds (world_services.cpp).
+  void add_worlds(std::vector<Entry>& out);
+  msgs::simulation::LoadWorldResponse load_world(const msgs::simulation::LoadWorldRequest& req);
+  msgs::simulation::UnloadWorldResponse unload_world();
+  msgs::simulation::GetCurrentWorldResponse current_world() const;
+  msgs::simulation::GetAvailableWorldsResponse available_worlds(
+      const msgs::simulation::GetAvailableWorldsRequest& req) const;
 };
 
 }  // namespace rbsim::node

@@ -178,6 +178,7 @@ Result outcome(const CommandResult& r) {
       return failure(Codes::kMissingAssets, r.message);  // a spring names a body the world does not have
     case control::Refusal::BadResource:
       return failure(Codes::kResourceParseError, r.message);
+    case control::Refusal::NoWorld:  // no world to spawn into: the operation, not the request
     case control::Refusal::Other:
       break;
   }
@@ -215,6 +216,8 @@ sim::Bounds hull_box(const BodyDef& body) {
 std::size_t SimulationServices::max_request_bytes(std::string_view service) {
   if (service == "spawn_entities") return kMaxCallFragmentBytes;
   if (service == "spawn_entity") return 2 * FragmentLimits{}.max_bytes;
+  if (service == "load_world")
+    return simulation_detail::kMaxWorldBytes + (64u << 10);  // and the other fields
   return ServiceOptions{}.max_request_bytes;
 }
 

@@ -35,6 +35,7 @@ Entities entities_of(const Scene& scene) {
   for (std::int32_t b = 0; b < n; ++b) e.body_names.push_back(scene_body_name(b));
   e.body_colors = scene.body_colors;
   e.spring_colors = scene.spring_colors;
+  e.scene = &scene;
   return e;
 }
 

@@ -25,6 +25,8 @@ static_assert(static_cast<int>(CommandKind::StopStepping) == msgs::CommandMessag
 static_assert(static_cast<int>(CommandKind::Spawn) == msgs::CommandMessage::SpawnEntity);
 static_assert(static_cast<int>(CommandKind::Delete) == msgs::CommandMessage::DeleteEntity);
 static_assert(static_cast<int>(CommandKind::ResetSpawned) == msgs::CommandMessage::ResetSpawned);
+static_assert(static_cast<int>(CommandKind::LoadWorld) == msgs::CommandMessage::LoadWorld);
+static_assert(static_cast<int>(CommandKind::UnloadWorld) == msgs::CommandMessage::UnloadWorld);
 
 // SetEntityState's values travel as named float64 parameters (the message's layout predates the
 // kind, and recordings made before it stay readable): x, y, theta for a pose, vx, vy, omega for a
@@ -143,6 +145,18 @@ Status spawn_args(const std::vector<Parameter>& parameters, const std::string& w
   return Ok{};
 }
 
+// load_world's: the scene's text and where it came from.
+Status world_args(const std::vector<Parameter>& parameters, const std::string& which, WorldArgs& a) {
+  const NamedParameters named(parameters, which + ": load_world");
+  ParameterValue resource, uri;
+  if (Status st = named.take("resource", ParameterType::String, resource); !st) return st;
+  if (Status st = named.take("uri", ParameterType::String, uri); !st) return st;
+  if (Status st = named.only({"resource", "uri"}); !st) return st;
+  a.resource = resource.string_value;
+  a.uri = uri.string_value;
+  return Ok{};
+}
+
 }  // namespace
 
 msgs::CommandMessage to_message(const Command& command, const CommandResult& result, std::uint64_t sequence,
@@ -163,6 +177,10 @@ msgs::CommandMessage to_message(const Command& command, const CommandResult& res
       break;
     case CommandKind::Delete:
       m.parameters = {{"name", ParameterValue::of_string(command.entity)}};
+      break;
+    case CommandKind::LoadWorld:
+      m.parameters = {{"resource", ParameterValue::of_string(command.world.resource)},
+                      {"uri", ParameterValue::of_string(command.world.uri)}};
       break;
     default:
       m.parameters = command.parameters;
@@ -188,8 +206,8 @@ msgs::CommandMessage to_message(const Command& command, const CommandResult& res
 
 Result<Command> from_message(const msgs::CommandMessage& m) {
   const std::string which = "command " + std::to_string(m.seq);
-  if (m.kind > msgs::CommandMessage::ResetSpawned) {
-    return Error{which + ": unknown kind " + std::to_string(m.kind) + " (rbsim_msgs/msg/Command has 0..10)",
+  if (m.kind > msgs::CommandMessage::UnloadWorld) {
+    return Error{which + ": unknown kind " + std::to_string(m.kind) + " (rbsim_msgs/msg/Command has 0..12)",
                  ErrorCode::Malformed};
   }
   if (m.step > static_cast<std::uint64_t>(INT64_MAX) || m.steps > static_cast<std::uint64_t>(INT64_MAX)) {
@@ -220,8 +238,12 @@ Result<Command> from_message(const msgs::CommandMessage& m) {
     if (Status st = named.only({"name"}); !st) return st.error();
     c.entity = name.string_value;
   }
-  if (c.kind == CommandKind::ResetSpawned && !m.parameters.empty()) {
-    return Error{which + ": reset_spawned takes no parameters", ErrorCode::Malformed};
+  if (c.kind == CommandKind::LoadWorld) {
+    c.parameters.clear();
+    if (Status st = world_args(m.parameters, which, c.world); !st) return st.error();
+  }
+  if ((c.kind == CommandKind::ResetSpawned || c.kind == CommandKind::UnloadWorld) && !m.parameters.empty()) {
+    return Error{which + ": " + to_string(c.kind) + " takes no parameters", ErrorCode::Malformed};
   }
   c.source = m.source;
   return c;

@@ -75,17 +75,27 @@ const char* to_string(CommandKind kind) {
       return "delete_entity";
     case CommandKind::ResetSpawned:
       return "reset_spawned";
+    case CommandKind::LoadWorld:
+      return "load_world";
+    case CommandKind::UnloadWorld:
+      return "unload_world";
   }
   return "?";
 }
 
 Controller::Controller(const Scene& scene, std::int64_t steps, RunSettings settings)
-    : scene_(scene),
+    : scene_(&scene),
       steps_(steps),
       published_(scene, steps, settings),
       published_settings_(settings),
       table_(scene, steps, settings),
-      settings_(settings) {}
+      settings_(settings) {
+  world_info_.name = scene.name;
+  world_info_.path = scene.path;
+  world_info_.description = scene.description;
+  world_info_.dt = scene.world.dt;
+  published_world_ = world_info_;
+}
 
 Controller::~Controller() {
   close("the run ended");
@@ -225,6 +235,11 @@ ListParametersResult Controller::list(const std::vector<std::string>& prefixes, 
   return published_.list(prefixes, depth);
 }
 
+WorldInfo Controller::world_info() const {
+  const std::lock_guard lock(mutex_);
+  return published_world_;
+}
+
 RunSettings Controller::settings() const {
   const std::lock_guard lock(mutex_);
   return published_settings_;
@@ -240,6 +255,7 @@ void Controller::publish_values(const World& world) {
   const std::lock_guard lock(mutex_);
   published_ = table_;
   published_settings_ = settings_;
+  published_world_ = world_info_;
 }
 
 void Controller::start(World& world) {
@@ -389,7 +405,7 @@ CommandResult Controller::reset(World& world, Boundary& boundary) {
   const std::int64_t now = world.step_index();
   CommandResult r;
   r.successful = true;
-  Result<World> fresh = World::create(scene_.world);
+  Result<World> fresh = World::create(scene_->world);
   if (!fresh) return failed("reset: " + fresh.error().message);
   // Bodies spawned or deleted since the world was made: the outputs follow it back.
   const bool edited = structure_edited_;
@@ -419,6 +435,7 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
   const std::int64_t now = world.step_index();
   CommandResult r;
   r.successful = true;
+  if (std::optional<CommandResult> refused = needs_world(command)) return *refused;
   switch (command.kind) {
     case CommandKind::SetParameters:
       return set_parameters(command, world, boundary);
@@ -481,15 +498,19 @@ CommandResult Controller::execute(Command& command, World& world, Boundary& boun
     }
     case CommandKind::Spawn:
     case CommandKind::Delete:
-    case CommandKind::ResetSpawned: {
+    case CommandKind::ResetSpawned:
+    case CommandKind::LoadWorld:
+    case CommandKind::UnloadWorld: {
       if (!structure_allowed_) {
         return failed(std::string(to_string(command.kind)) +
                       ": this run's outputs cannot follow a world whose bodies change");
       }
       const std::uint32_t epoch = entities_.epoch;
-      CommandResult applied = command.kind == CommandKind::Spawn    ? spawn(command, world)
-                              : command.kind == CommandKind::Delete ? remove(command, world)
-                                                                    : reset_spawned(world);
+      CommandResult applied = command.kind == CommandKind::Spawn       ? spawn(command, world)
+                              : command.kind == CommandKind::Delete    ? remove(command, world)
+                              : command.kind == CommandKind::LoadWorld ? load_world(command, world, boundary)
+                              : command.kind == CommandKind::UnloadWorld ? unload_world(world, boundary)
+                                                                         : reset_spawned(world);
       boundary.state_changed |= applied.successful;
       boundary.structure_changed |= entities_.epoch != epoch;
       return applied;

@@ -78,8 +78,9 @@ void Controller::renew(World& world, std::int32_t next_body_id, std::int32_t nex
   spawned_springs_.clear();
   structure_edited_ = false;
   const std::uint32_t epoch = entities_.epoch;
-  entities_ = entities_of(scene_);
+  entities_ = entities_of(*scene_);
   entities_.epoch = epoch;
+  entities_.world = world_info_.number;
 }
 
 Status Controller::remove_dense(World& world, std::int32_t dense,

@@ -63,12 +63,13 @@ Result<std::unique_ptr<OfflineRun>> OfflineRun::prepare(const OfflineRunDef& def
     if (!read) return read.error();
     commands = std::move(read.value());
   }
+  // The first command that changes the structure, a world load before any other (it asks more of
+  // the outputs).
   std::optional<ScriptedCommand> structural;
   for (const ScriptedCommand& c : commands) {
-    if (c.expect_success && changes_structure(c.command.kind)) {
+    if (!c.expect_success || !changes_structure(c.command.kind)) continue;
+    if (!structural || (replaces_world(c.command.kind) && !replaces_world(structural->command.kind)))
       structural = c;
-      break;
-    }
   }
   Result<Driver> driver = Driver::create(run->scene_);
   if (!driver) return with_context(run->scene_.path + ": ", driver.error());
@@ -97,7 +98,16 @@ Status OfflineRun::make_sinks(const OfflineRunDef& def, const std::optional<Scri
   }
   // A script that spawns or deletes needs outputs that follow the changed world: refused here,
   // before any output is opened, rather than at its step.
+  // A world loaded starts its steps again at 0, which only a recording holds.
+  const bool loads = structural && replaces_world(structural->command.kind);
   for (std::size_t k = 0; structural && k < sinks_.size(); ++k) {
+    if (loads && paths[k] != def.record.path) {
+      return Error{structural->origin + ": " + to_string(structural->command.kind) + ": the output " +
+                       paths[k] +
+                       " cannot follow a world loaded during the run (its steps start again at 0): record it "
+                       "(--record) instead",
+                   ErrorCode::InvalidArgument};
+    }
     if (sinks_[k]->follows_structure()) continue;
     return Error{structural->origin + ": " + to_string(structural->command.kind) + ": the output " +
                      paths[k] +

@@ -31,11 +31,11 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
   }
   Result<std::vector<msgs::CommandMessage>> recorded = recordings::read_commands(*recording.value());
   if (!recorded) return recorded.error();
-  std::uint32_t epoch = 0;  // resets applied so far, in the order the node applied its commands
+  std::uint32_t epoch = 0;  // restarts applied so far (resets, world loads), in the node's order
   for (const msgs::CommandMessage& m : recorded.value()) {
     Result<Command> c = from_message(m);
     if (!c) return with_context(path + ": ", c.error());
-    const bool reset = c.value().kind == CommandKind::Reset && m.success;
+    const bool reset = restarts_steps(c.value().kind) && m.success;
     out.push_back({std::move(c.value()), m.success, path + ": command " + std::to_string(m.seq), epoch});
     if (reset) ++epoch;
   }
@@ -53,12 +53,11 @@ ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<Scr
   if (!epochs_.empty()) submit_epoch(0);
 }
 
-// Submits the commands of epoch `e`; the reset that ends it submits the next one from its
-// boundary, where the controller applies those due at once (a resume at step 0 right after it).
+// Submits the commands of epoch `e`; the restart (a reset, a world load) that ends it submits the next one
+// from its boundary, where the controller applies those due at once (a resume at step 0 right after it).
 void ScriptedRun::submit_epoch(std::size_t e) {
   for (ScriptedCommand& s : epochs_[e]) {
-    const bool ends_epoch =
-        s.command.kind == CommandKind::Reset && s.expect_success && e + 1 < epochs_.size();
+    const bool ends_epoch = restarts_steps(s.command.kind) && s.expect_success && e + 1 < epochs_.size();
     controller_.submit(std::move(s.command), [this, origin = s.origin, expect = s.expect_success, ends_epoch,
                                               e](const CommandResult& r) {
       ++answered_;
@@ -74,7 +73,7 @@ void ScriptedRun::submit_epoch(std::size_t e) {
 void ScriptedRun::record_to(recordings::McapSink& sink) {
   controller_.on_command([this, &sink](const Command& c, const CommandResult& r) {
     cdr_.clear();
-    msgs::encode(to_message(c, r, seq_++, scene_.world.dt), cdr_);
+    msgs::encode(to_message(c, r, seq_++, controller_.world_info().dt), cdr_);
     if (Status st = sink.record_command(cdr_, r.step); !st && recorded_) recorded_ = st;
   });
 }

@@ -189,6 +189,7 @@ Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene), ns_(
 }
 
 void Encoder::restructure(const Entities& entities) {
+  if (entities.scene != nullptr) scene_ = entities.scene;  // a world loaded: its own name, forces, ...
   entities_ = entities;
   frames_.clear();
   frames_.reserve(entities.body_names.size());

@@ -76,8 +76,11 @@ class McapFileSink final : public McapSink {
   // Bodies came or went at this step's boundary: the scene description and markers again (the
   // markers led by a DELETEALL), then this step's per-step topics with the new arrays, at this
   // step's time, as the node's DDS sink publishes them, so a re-run records the live bytes.
+  // A world loaded (Entities::world) is recorded the same way, from its step 0: its scene
+  // description starts the epoch, at a step lower than the last one's.
   Status restructure(const World& world, const Entities& entities) override {
     encoder_->restructure(entities);
+    dt_ = world.dt();
     return record(world, true);
   }
 

@@ -51,7 +51,8 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
         sinks_.begin(), sinks_.end(), [](const Sink* sink) { return sink->follows_structure(); }));
     options.control->start(world);
   }
-  while (world.step_index() < options.steps) {
+  std::int64_t steps = options.steps;
+  while (world.step_index() < steps) {
     if (options.pace) options.pace(world);
     if (options.stop != nullptr && options.stop()) return PassEnd::Stopped;
     if (options.control != nullptr) {
@@ -67,6 +68,11 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
       if (boundary.structure_changed) {
         const Entities* entities = options.control->entities();
         RBSIM_ASSERT(entities != nullptr, "a hook that changes the structure names what it holds");
+        if (entities->world != world_number_) {  // a world loaded: its scene, and its length, from now on
+          world_number_ = entities->world;
+          if (entities->scene != nullptr) scene_ = entities->scene;
+          steps = options.control->loaded_steps();
+        }
         for (Sink* sink : sinks_) {
           if (Status st = sink->restructure(world, *entities); !st) return st.error();
         }
@@ -74,7 +80,7 @@ Result<PassEnd> Driver::run(const DriverOptions& options) {
       if (boundary.timeline_changed) {
         for (Sink* sink : sinks_) sink->rebase(world);
       }
-      if (world.step_index() >= options.steps) break;
+      if (world.step_index() >= steps) break;
       if (boundary.hold) continue;
     }
     world.step();

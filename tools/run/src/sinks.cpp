@@ -30,9 +30,15 @@ class CsvSink : public Sink {
   }
   Status finish() override { return csv_.commit(); }
   // Rows name bodies by id (World::body_id), so a changed world needs no new header: this step's
-  // rows are written again with the bodies it now has, and later steps' hold them too.
+  // rows are written again with the bodies it now has, and later steps' hold them too. A world
+  // loaded starts again at step 0 with other bodies: one CSV cannot hold two worlds.
   bool follows_structure() const override { return true; }
-  Status restructure(const World& world, const Entities&) override {
+  Status restructure(const World& world, const Entities& entities) override {
+    if (entities.world != 0) {
+      return Error{path_ +
+                   ": a CSV output cannot follow a world loaded during the run (its steps start "
+                   "again at 0): record the run (--record) and export each world from it"};
+    }
     csv_.rows().resize(step_rows_);
     rows(world, csv_.rows());
     return Ok{};

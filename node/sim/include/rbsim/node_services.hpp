@@ -25,7 +25,6 @@ namespace rbsim::node {
 
 struct NodeServicesOptions {
   std::string node = "/rbsim";  // the node's fully qualified name: services are <node>/<name>
-  double dt = 0.01;             // the scene's step (s): /parameter_events stamps are simulated time
   // How long a request waits for its step boundary before it is answered unsuccessfully (a run
   // that ended, or one stopped by Ctrl-C, answers at once).
   double apply_timeout_s = 10.0;
@@ -41,6 +40,10 @@ struct NodeServicesOptions {
   // and get_spawnables lists (rbsim node --spawnables DIR): each must be a directory. Empty: a uri
   // is refused and get_spawnables answers RESULT_FEATURE_UNSUPPORTED.
   std::vector<std::string> spawnables = {};
+  // The same for load_world's uri and get_available_worlds (rbsim node --worlds DIR, the bundled
+  // scenes by default). Empty: a uri is refused and get_available_worlds answers
+  // RESULT_FEATURE_UNSUPPORTED; a resource_string still loads.
+  std::vector<std::string> worlds = {};
   // REP 2012 introspection of the services from the start (the parameter
   // service_configure_introspection as the run starts; later changes of it turn it on and off).
   IntrospectionState introspection = IntrospectionState::Off;

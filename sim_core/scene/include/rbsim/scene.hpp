@@ -124,14 +124,20 @@ Color default_spring_color();
 // World's arrays): what outputs name and colour them. A scene's bodies are body_<id>, coloured as
 // it says; a spawned body has its own name and its fragment's colours (default_body_color(id),
 // default_spring_color() when it gives none). `epoch` counts the structural changes of the
-// session (0: the world as loaded), so an output knows a change from the start.
+// session (0: the world as loaded), so an output knows a change from the start. A world loaded in
+// the session (simulation_interfaces' LoadWorld, UnloadWorld: rbsim/control.hpp) brings a scene of
+// its own: `scene` is the world's (its name, duration, forces, viewport), `world` counts the worlds
+// loaded (0: the first; an output that cannot follow a world whose steps start again at 0 refuses a
+// change that raises it).
 struct Entities {
   std::vector<std::string> body_names;
   std::vector<Color> body_colors;
   std::vector<Color> spring_colors;
   std::uint32_t epoch = 0;
+  std::uint32_t world = 0;
+  const Scene* scene = nullptr;  // outlives every output told of it (the Controller keeps it)
 };
-// A scene's entities as loaded (epoch 0).
+// A scene's entities as loaded (epoch 0, world 0, `scene` it).
 Entities entities_of(const Scene& scene);
 // The one rule for a scene body's name: body_<id>.
 std::string scene_body_name(std::int32_t id);

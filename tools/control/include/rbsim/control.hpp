@@ -39,7 +39,8 @@ namespace rbsim::control {
 // StopStepping ends a `step N` in progress at its boundary, the run staying paused there (the
 // SimulateSteps action's cancel; a Pause leaves the stepping alone); not stepping, it does nothing.
 // Spawn, Delete and ResetSpawned change the world's structure (simulation_interfaces' SpawnEntity,
-// DeleteEntity and ResetSimulation with SCOPE_SPAWNED); see SpawnArgs.
+// DeleteEntity and ResetSimulation with SCOPE_SPAWNED); see SpawnArgs. LoadWorld and UnloadWorld
+// replace the world (simulation_interfaces' LoadWorld, UnloadWorld); see WorldArgs.
 enum class CommandKind : std::uint8_t {
   SetParameters,
   Pause,
@@ -51,14 +52,18 @@ enum class CommandKind : std::uint8_t {
   StopStepping,
   Spawn,
   Delete,
-  ResetSpawned
+  ResetSpawned,
+  LoadWorld,
+  UnloadWorld
 };
 // "set_parameters", "pause", "resume", "step", "reset", "apply_impulse", "set_entity_state",
-// "stop_stepping", "spawn_entity", "delete_entity", "reset_spawned"
+// "stop_stepping", "spawn_entity", "delete_entity", "reset_spawned", "load_world", "unload_world"
 const char* to_string(CommandKind kind);
-// Spawn, Delete or ResetSpawned: the kinds only a run whose outputs follow may apply.
+// Spawn, Delete, ResetSpawned, LoadWorld or UnloadWorld: the kinds only a run whose outputs follow
+// may apply.
 constexpr bool changes_structure(CommandKind kind) {
-  return kind == CommandKind::Spawn || kind == CommandKind::Delete || kind == CommandKind::ResetSpawned;
+  return kind == CommandKind::Spawn || kind == CommandKind::Delete || kind == CommandKind::ResetSpawned ||
+         kind == CommandKind::LoadWorld || kind == CommandKind::UnloadWorld;
 }
 
 // A linear impulse J (N s, world axes) at the point p (m, body frame, relative to the centre of
@@ -101,12 +106,46 @@ struct SpawnArgs {
   std::shared_ptr<const Fragment> fragment;
 };
 
+// A world loaded in place of the running one: a FOSSSim scene's XML text (what a recording keeps,
+// so a re-run needs no file), parsed by parse_scene. The world starts at step 0, paused (ROS 2's
+// STATE_STOPPED), its parameters the scene's; the session's ids and used names go on. Unloading
+// leaves an empty world that does not step (no world: STATE_NO_WORLD) until a load.
+struct WorldArgs {
+  std::string resource;  // the scene's XML text
+  std::string uri;       // where the text came from, as the request gave it (the world's uri, messages)
+  // The scene already parsed off the loop's thread (a service's), from `resource`; null: the
+  // controller parses `resource` when the command applies (a re-run).
+  std::shared_ptr<const Scene> scene;
+};
+
+// The world a Controller steps, as last published: what GetCurrentWorld answers.
+struct WorldInfo {
+  bool loaded = true;  // false after an unload_world, until a load_world
+  std::string name;    // the scene's name (its file stem; a resource string's <scenetag>, else "world")
+  std::string uri;     // as loaded ("" for the world the run started with: `path` says)
+  std::string path;    // the scene file the run started with, or the uri
+  std::string description;
+  double dt = 0.0;
+  std::uint32_t number = 0;  // worlds loaded before it in the session
+};
+
+// LoadWorld or UnloadWorld: a new world, whose steps start again at 0 (only a recording follows).
+constexpr bool replaces_world(CommandKind kind) {
+  return kind == CommandKind::LoadWorld || kind == CommandKind::UnloadWorld;
+}
+// Reset, LoadWorld or UnloadWorld: applied, the world starts again at step 0, so the commands
+// recorded after it are for the steps of that new start (a re-run's epochs, ScriptedRun).
+constexpr bool restarts_steps(CommandKind kind) {
+  return kind == CommandKind::Reset || replaces_world(kind);
+}
+
 // Why a command was refused, where a caller answers differently (simulation_interfaces' codes).
 enum class Refusal : std::uint8_t {
   Other,
   NameTaken,     // spawn: the name is in use or was used, and renaming is not allowed
   NoSuchEntity,  // delete, or a spring naming a body: no body of that name
-  BadResource,   // spawn: the fragment does not parse
+  BadResource,   // spawn: the fragment does not parse; load_world: the scene does not
+  NoWorld,       // unload_world (and the commands that need one) with no world loaded
 };
 
 // One control input as data (issue 23 records these as rbsim_msgs/msg/Command).
@@ -126,6 +165,7 @@ struct Command {
   StateArgs state;                    // SetState
   SpawnArgs spawn;                    // Spawn
   std::string entity;                 // Delete: the body's name
+  WorldArgs world;                    // LoadWorld
   std::string source;                 // "ros2 service", "foxglove", "script", ...
 };
 
@@ -190,7 +230,8 @@ class Steering {
 class Controller final : public StepHook, public Steering {
  public:
   // `scene` holds the run's initial parameters (apply_overrides) and outlives the controller:
-  // reset goes back to its step 0. `steps` is the pass length (the `steps` parameter).
+  // reset goes back to its step 0 (a loaded world's, once one is). `steps` is the pass length (the
+  // `steps` parameter; a loaded world's is its scene's, Scene::step_count).
   Controller(const Scene& scene, std::int64_t steps, RunSettings settings);
   ~Controller() override;
   Controller(const Controller&) = delete;
@@ -227,6 +268,9 @@ class Controller final : public StepHook, public Steering {
   void read(std::function<void(const World*)> reader, std::int64_t at_step = 0);
   RunSettings settings() const;
   ControlCounters counters() const;
+  // The world as of the last boundary (simulation_interfaces' GetCurrentWorld, GetSimulationState's
+  // STATE_NO_WORLD, the stamps of a world whose dt changed).
+  WorldInfo world_info() const;
   // Answers every queued command with failure (`reason`) and refuses later ones at once. A
   // running loop ends its pass as stopped at its next boundary; a paused one is woken to do so.
   void close(const std::string& reason);
@@ -255,6 +299,7 @@ class Controller final : public StepHook, public Steering {
   // naming why).
   void outputs_follow_structure(bool yes) override { structure_allowed_ = yes; }
   const Entities* entities() const override { return &entities_; }
+  std::int64_t loaded_steps() const override { return steps_; }
   Boundary boundary(World& world, bool (*stop)()) override;
 
  private:
@@ -277,6 +322,13 @@ class Controller final : public StepHook, public Steering {
   CommandResult spawn(const Command& command, World& world);
   CommandResult remove(const Command& command, World& world);
   CommandResult reset_spawned(World& world);
+  // Worlds (src/worlds.cpp): `world` replaced by a scene's (or by none), stopped at its step 0.
+  CommandResult load_world(const Command& command, World& world, Boundary& boundary);
+  CommandResult unload_world(World& world, Boundary& boundary);
+  void replace_world(std::shared_ptr<const Scene> scene, World fresh, std::int64_t steps, World& world,
+                     Boundary& boundary, CommandResult& r);
+  // A command that needs a world, refused while there is none (after unload_world).
+  std::optional<CommandResult> needs_world(const Command& command) const;
   // Removes body `dense` and its springs from the world and from entities_.
   Status remove_dense(World& world, std::int32_t dense, std::vector<std::int32_t>& removed_springs);
   // The session's state after a new world (a reset, a pass's start): ids continued, spawned
@@ -296,8 +348,10 @@ class Controller final : public StepHook, public Steering {
   std::vector<std::pair<Pending, CommandResult>> answered_;  // run loop thread only
   void publish_values(const World& world);
 
-  const Scene& scene_;
+  const Scene* scene_;                         // the world's scene: the run's, or loaded_scene_
+  std::shared_ptr<const Scene> loaded_scene_;  // the world loaded last (null: none yet)
   std::int64_t steps_;
+  WorldInfo world_info_;  // the loop thread's; published_world_ is what readers see
 
   mutable std::mutex mutex_;  // guards the members down to closed_
   std::condition_variable wake_;
@@ -309,6 +363,7 @@ class Controller final : public StepHook, public Steering {
   std::vector<Read> reads_;   // read()
   ParameterTable published_;  // what readers see: the table as of the last boundary
   RunSettings published_settings_;
+  WorldInfo published_world_;
   mutable ControlCounters counters_;
   bool closed_ = false;
   std::string close_reason_;

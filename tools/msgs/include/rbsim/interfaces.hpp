@@ -124,10 +124,13 @@ struct CommandMessage {
     StopStepping = 7,
     // Nor these, the living world's: spawn_entity (its arguments as named parameters: the
     // fragment's text `resource`, `uri`, `name`, `allow_renaming`, the pose `x`, `y`, `theta`),
-    // delete_entity (`name`) and reset_spawned (none).
+    // delete_entity (`name`) and reset_spawned (none); load_world (the scene's text `resource`, its
+    // `uri`) and unload_world (none).
     SpawnEntity = 8,
     DeleteEntity = 9,
-    ResetSpawned = 10
+    ResetSpawned = 10,
+    LoadWorld = 11,
+    UnloadWorld = 12
   };
   std::uint64_t seq = 0;  // the sequence number (`sequence` is an IDL keyword)
   std::uint64_t step = 0;

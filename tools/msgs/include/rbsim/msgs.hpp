@@ -231,7 +231,8 @@ class Encoder {
   void encode(TopicId id, const World& world, Bytes& out) const;
   // The world's bodies or springs changed (Sink::restructure): their names and colours from now on.
   // The ids messages carry are the world's (World::body_id); after a change (epoch > 0) the
-  // markers start with a DELETEALL, so a viewer drops the bodies that went.
+  // markers start with a DELETEALL, so a viewer drops the bodies that went. A loaded world's
+  // entities bring its scene (Entities::scene), described from then on.
   void restructure(const Entities& entities);
 
  private:

@@ -51,6 +51,9 @@ class StepHook {
   // The names and colours of the world's bodies and springs as they stand, after a boundary that
   // changed them (Boundary::structure_changed); nullptr from a hook that never does.
   virtual const Entities* entities() const { return nullptr; }
+  // After a boundary that loaded a world (Entities::world raised): the loaded world's pass length,
+  // which the pass runs to from then on (its step 0 is the world's).
+  virtual std::int64_t loaded_steps() const { return 0; }
   // Before `world` takes its next step. May change the world between steps (a parameter, an
   // impulse, a reset to step 0) and may block while the run is paused, in bounded waits that
   // poll `stop` (may be null).
@@ -81,7 +84,7 @@ enum class PassEnd { Done, Stopped, Diverged };
 class Driver {
  public:
   // Makes the World of `scene` (the error is World::create's). The scene, and the sinks added,
-  // must outlive the driver.
+  // must outlive the driver. A world loaded by the hook replaces the scene, for the next passes too.
   static Result<Driver> create(const Scene& scene);
 
   // Sinks get begin/write/finish in the order added.
@@ -113,6 +116,7 @@ class Driver {
   std::optional<World> world_;
   bool fresh_ = true;  // world_ is at step 0 and no pass has begun with it
   std::vector<Sink*> sinks_;
+  std::uint32_t world_number_ = 0;  // Entities::world of the world the pass steps
   std::int64_t steps_done_ = 0;
   Divergence divergence_;
 };
