@@ -8,7 +8,10 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "control_test_util.hpp"
@@ -436,6 +439,46 @@ TEST(Player, RepublishesEveryRecordedMessageByteForByte) {
   for (auto& [name, sub] : subs) received[name] = take_all(sub);
   EXPECT_EQ(received, recorded);
   EXPECT_EQ(replay.value()->published(), total(recorded));
+}
+
+// rbsim replay --foxglove's tap: a pass starts a session with the simulated time playing starts at
+// (--start-offset's step), before any message, latched ones included (stamped where the scene
+// began), so a viewer joining the paused replay learns where it stands; per-step messages then
+// start at that time.
+TEST(Player, TheTapStartsASessionWithTheTimePlayingStartsAt) {
+  test::TempDir dir;
+  const std::string path = record_offline(dir, test::control_scene());  // dt 0.01 s
+  for (const auto& [offset, start] : {std::pair{0.0, 0ull}, std::pair{0.1, 100'000'000ull}}) {
+    auto network = std::make_shared<MemoryNetwork>();
+    Participant player = participant(network, "rbsim_player");
+    PlayOptions options;
+    options.path = path;
+    options.rate = 0.0;
+    options.services = false;
+    options.start_offset = offset;
+    Result<std::unique_ptr<Player>> replay = Player::open(player, options);
+    ASSERT_TRUE(replay.ok()) << replay.error().message;
+    std::vector<std::optional<std::uint64_t>> passes;
+    std::vector<std::pair<bool, std::uint64_t>> messages;  // latched, simulated time
+    Player::Tap tap;
+    tap.pass = [&](std::optional<std::uint64_t> at) {
+      EXPECT_TRUE(messages.empty()) << "a session starts before its messages";
+      passes.push_back(at);
+    };
+    tap.message = [&](std::size_t output, std::uint64_t t, std::span<const std::byte>) {
+      messages.emplace_back(replay.value()->outputs().at(output).latched, t);
+    };
+    Result<bool> played = replay.value()->play(
+        +[] { return false; }, &tap);
+    ASSERT_TRUE(played.ok()) << played.error().message;
+    ASSERT_EQ(passes.size(), 1u) << offset;
+    EXPECT_EQ(passes[0], std::optional(start)) << offset;
+    ASSERT_GT(messages.size(), 2u);
+    EXPECT_TRUE(messages[0].first && messages[1].first) << "the scene description and markers first";
+    EXPECT_EQ(messages[0].second, 0u);
+    EXPECT_FALSE(messages[2].first);
+    EXPECT_EQ(messages[2].second, start) << offset;
+  }
 }
 
 TEST(Player, ServesThePlayersServicesOnTheNetwork) {

@@ -1,8 +1,8 @@
 // The Foxglove server over real sockets on 127.0.0.1 (port 0: a free port), with the minimal
 // client of ws_client.hpp: handshake and subprotocols, serverInfo/advertise, latched delivery to
-// new subscriptions, per-step data, sessions, hostile input, a stalled client (the producer is not
-// slowed, others lose nothing, the staller is disconnected), the sink, connect/disconnect churn.
-// Every wait is bounded in count and time.
+// new subscriptions, the last time to a new client, per-step data, sessions, hostile input, a stalled client
+// (the producer is not slowed, others lose nothing, the staller is disconnected), the sink,
+// connect/disconnect churn. Every wait is bounded in count and time.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -109,6 +109,15 @@ bool eventually(P pred, std::chrono::milliseconds limit = std::chrono::milliseco
   return ::testing::AssertionFailure() << "16 frames without the probe's status reply";
 }
 
+// The next frame, a time message: its time (nullopt: another frame or none).
+std::optional<std::uint64_t> time_of(WsClient& c) {
+  auto f = c.read();
+  if (!f || f->opcode != 2 || f->data.size() != 9 || f->data[0] != '\x02') return std::nullopt;
+  std::uint64_t t = 0;
+  std::memcpy(&t, f->data.data() + 1, 8);
+  return t;
+}
+
 TEST(FoxgloveServer, AnswersEitherSubprotocolWithServerInfoAndAdvertise) {
   auto server = start();
   ASSERT_TRUE(server);
@@ -180,11 +189,13 @@ TEST(FoxgloveServer, LatchedGoesToEveryNewSubscriptionAndPerStepToSubscribers) {
   std::memcpy(&t, f->data.data() + 1, 8);
   EXPECT_EQ(t, 110u);
 
-  // A second client subscribing later gets the newest latched message at once.
+  // A second client subscribing later gets the last time message, then the newest latched
+  // message at once.
   server->publish(1, 7, bytes("scene-2"));
   WsClient late;
   handshake(late, server->port(), "foxglove.sdk.v1");
   ASSERT_TRUE(late.send_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":1}]})"));
+  EXPECT_EQ(time_of(late), 110u);
   f = late.read();
   ASSERT_TRUE(f);
   d = as_data(*f);
@@ -216,6 +227,39 @@ TEST(FoxgloveServer, NewSessionSendsANewServerInfoAndForgetsLatched) {
   auto d = as_data(*f);
   ASSERT_TRUE(d);
   EXPECT_EQ(d->payload, "new scene");
+}
+
+// A client that connects gets the session's last time message right after the advertisements,
+// before what it subscribes to: a viewer joining a paused stream (a paused replay sends nothing)
+// learns where it stands before its latched messages. A new session has no time until one is sent.
+TEST(FoxgloveServer, AClientThatConnectsGetsTheLastTimeBeforeItsLatchedMessages) {
+  auto server = start();
+  ASSERT_TRUE(server);
+  server->time(42);
+  server->publish(1, 5, bytes("scene"));
+  server->time(77);
+  WsClient c;
+  handshake(c, server->port());
+  ASSERT_TRUE(c.send_text(R"({"op":"subscribe","subscriptions":[{"id":3,"channelId":1}]})"));
+  EXPECT_EQ(time_of(c), 77u);
+  auto f = c.read();
+  ASSERT_TRUE(f);
+  auto d = as_data(*f);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->payload, "scene");
+
+  server->new_session();
+  server->publish(1, 6, bytes("scene-2"));
+  WsClient fresh;
+  handshake(fresh, server->port());
+  ASSERT_TRUE(fresh.send_text(R"({"op":"subscribe","subscriptions":[{"id":4,"channelId":1}]})"));
+  f = fresh.read();
+  ASSERT_TRUE(f);
+  d = as_data(*f);
+  ASSERT_TRUE(d) << "a new session's first frame is its latched message, no time of the old one";
+  EXPECT_EQ(d->payload, "scene-2");
+  server->time(80);
+  EXPECT_EQ(time_of(fresh), 80u);
 }
 
 TEST(FoxgloveServer, HostileInputGetsAStatusAndTheConnectionKeepsWorking) {
@@ -469,11 +513,13 @@ TEST(FoxgloveSink, PublishesTheSceneLatchedAndSubscribedStepsAtSimulatedTime) {
     EXPECT_EQ(m.bodies.size(), 2u);
   }
 
-  // A late subscriber to the scene gets the run's scene description, byte for byte.
+  // A late subscriber to the scene gets the time of the last step, then the run's scene
+  // description, byte for byte.
   WsClient late;
   handshake(late, server->port());
   ASSERT_TRUE(late.send_text(R"({"op":"subscribe","subscriptions":[{"id":9,"channelId":)" +
                              std::to_string(scene_ch) + "}]}"));
+  EXPECT_EQ(time_of(late), 40'000'000u);
   auto f = late.read();
   ASSERT_TRUE(f);
   auto data = as_data(*f);

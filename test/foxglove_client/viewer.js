@@ -1,9 +1,10 @@
 #!/usr/bin/env node
 "use strict";
 // The real viewer: Foxglove Studio's last open-source web build (npm @foxglove/studio-base 1.48.0)
-// in Debian's headless Chromium with software WebGL, connected to a live `rbsim node --foxglove`
+// in Debian's headless Chromium with software WebGL, connected to a live `rbsim node --foxglove` (or
+// `rbsim replay --foxglove`)
 // with docs/foxglove-layout.json, driven over the DevTools protocol (playwright-core, Chromium
-// started from /usr/bin/chromium). Both cases first wait for the sidebar to list every advertised
+// started from /usr/bin/chromium). Every case first waits for the sidebar to list every advertised
 // topic. Cases:
 //   colours     the 3D panel shows the body colours of the scene's XML, and the Parameters panel
 //               lists parameters (foxglove_client.viewer, wind-garden);
@@ -15,16 +16,22 @@
 //   changes     a body spawned through the node's spawn_entity service (called by an independent
 //               client) appears in the 3D panel in its fragment's colour, and the scene's square,
 //               deleted through delete_entity, disappears, without a reload
-//               (foxglove_client.viewer_changes).
+//               (foxglove_client.viewer_changes);
+//   replay_changes  the same changes from a recording (`rbsim run --commands --record`) played by
+//               `rbsim replay --foxglove --start-paused` in exact bursts through its player
+//               services: the orange square alone before the spawn, both after it, the blue one
+//               alone after the delete, in the 3D panel and in the body states an independent
+//               client receives; a client joining at each stage gets the latest scene description
+//               and markers (foxglove_client.viewer_replay_changes).
 //
-//   viewer.js --case colours|parameters --rbsim BUILD/rbsim --source-dir SRC --workdir DIR
+//   viewer.js --case colours|parameters|changes|replay_changes --rbsim BUILD/rbsim --source-dir SRC --workdir DIR
 //             --npm BUILD/npm --index N [--scene FILE] [--screenshot PNG]
 //   (--screenshot: also write the page of case colours there)
 const fs = require("fs");
 const http = require("http");
 const path = require("path");
 const lib = require("./lib");
-const { Failure, until, startServer, Client, runMain } = lib;
+const { Failure, until, Proc, startServer, Client, runMain } = lib;
 
 const { A, workdir } = lib.caseArgs(["case", "rbsim", "source-dir", "workdir", "npm", "index"]);
 const need = lib.npmModules(A.npm);
@@ -33,6 +40,7 @@ const CASES = {
   colours: ["foxglove_client.viewer", caseColours],
   parameters: ["foxglove_client.viewer_parameters", caseParameters],
   changes: ["foxglove_client.viewer_changes", caseChanges],
+  replay_changes: ["foxglove_client.viewer_replay_changes", caseReplayChanges],
 };
 if (!CASES[A.case]) throw new Error(`unknown --case ${A.case}`);
 const log = lib.log;
@@ -103,16 +111,17 @@ function centroid(png, colour, tol) {
   return { n, x: sx / n, y: sy / n };
 }
 
-// Starts the node on `sceneFile` (namespace rbsim, the layout's) and Studio on it, waits for every
-// advertised topic in the sidebar, runs body({ page, url, PNG, canvas }) and closes everything.
-async function withStudio(check, sceneFile, nodeArgs, body) {
+// Starts `rbsim ARGS --domain D --foxglove 127.0.0.1:0` (a node on a scene, in namespace rbsim, the
+// layout's, or a replay of a recording made in it) and Studio on it, waits for every advertised
+// topic in the sidebar, runs body({ page, url, PNG, canvas }) and closes everything.
+async function withStudio(check, args, body) {
   if (!fs.existsSync(CHROMIUM)) throw new Failure(`${CHROMIUM} not found: run scripts/setup`);
   const { chromium } = need("playwright-core");
   const { PNG } = need("pngjs");
   need("@foxglove/studio-base/package.json");
   need("react-dom/package.json");
-  const [node, url] = await startServer(A.rbsim, ["node", sceneFile, ...nodeArgs,
-    "--domain", lib.domainFor(Number(A.index)), "--namespace", "rbsim"], { logDir: workdir });
+  const [node, url] = await startServer(A.rbsim, [...args, "--domain", lib.domainFor(Number(A.index))],
+    { name: args[0], logDir: workdir });
   // The topics the server advertises, seen by an independent client.
   const probe = await new Client(need, url, { name: "probe", subscribeAll: false }).ready();
   const topics = probe.topics();
@@ -159,9 +168,12 @@ async function withStudio(check, sceneFile, nodeArgs, body) {
     await browser.close();
     web.close();
     node.kill("SIGINT");
-    check((await node.wait(15000)) === 0, `node exited with ${node.code}\n${node.output()}`);
+    check((await node.wait(15000)) === 0, `${args[0]} exited with ${node.code}\n${node.output()}`);
   }
 }
+
+// `rbsim node SCENE ARGS` in the layout's namespace.
+const nodeArgs = (sceneFile, ...args) => ["node", sceneFile, ...args, "--namespace", "rbsim"];
 
 async function caseColours(check) {
   const sceneFile = path.resolve(A.scene ?? path.join(src, "scenes", "creative", "wind-garden.xml"));
@@ -169,7 +181,7 @@ async function caseColours(check) {
   if (!colours.length) throw new Failure(`${sceneFile} has no <rigidbodycolor>`);
   // 50 Hz for the scene's 2 ms steps, a viewer's pace: Chromium's single main thread, with software
   // WebGL, on a busy 2-core machine, falls behind every step's messages and then never paints.
-  await withStudio(check, sceneFile, ["--rate", 1, "--loop", "--publish-every", 10], async ({ page, PNG, canvas }) => {
+  await withStudio(check, nodeArgs(sceneFile, "--rate", 1, "--loop", "--publish-every", 10), async ({ page, PNG, canvas }) => {
     // The layout's Parameters panel lists the node's parameters (got over the protocol's parameters
     // capability); the Service Call buttons are newer than Studio 1.48 (it shows them as unknown).
     let params = [];
@@ -205,7 +217,7 @@ async function caseColours(check) {
 async function caseParameters(check) {
   const sceneFile = path.join(__dirname, "viewer", "drift.xml");
   const [colour] = expectedColours(sceneFile);
-  await withStudio(check, sceneFile, ["--rate", 1, "--publish-every", 10], async ({ page, url, PNG, canvas }) => {
+  await withStudio(check, nodeArgs(sceneFile, "--rate", 1, "--publish-every", 10), async ({ page, url, PNG, canvas }) => {
     // An independent client: the parameter names the server sends, and /rbsim/commands.
     const c = new Client(need, url, { name: "params", subscribeAll: false });
     const values = [];
@@ -278,44 +290,62 @@ const BLUE_SQUARE = `<scene>
   <rigidbody p="0" p="1" p="2" p="3" vx="0" vy="0" omega="0" r="0.05"/>
   <rigidbodycolor body="0" r="0.1" g="0.35" b="0.95"/>
 </scene>`;
+const BLUE = [0.1, 0.35, 0.95].map((v) => Math.round(v * 255));
+
+// An independent client's json calls of the server's services named `${prefix}/NAME`; made before
+// the client is ready (the services are advertised once, with serverInfo).
+function serviceCaller(c, prefix) {
+  let services;
+  const replies = new Map();
+  c.client.on("advertiseServices", (s) => (services = s));
+  c.client.on("serviceCallResponse", (r) => replies.set(r.callId, r));
+  c.client.on("serviceCallFailure", (f) => replies.set(f.callId, f));
+  let callId = 0;
+  return async (name, request) => {
+    await until("advertiseServices", 5000, () => services);
+    const s = services.find((x) => x.name === `${prefix}/${name}`);
+    if (!s) throw new Failure(`no service ${prefix}/${name}: ${services.map((x) => x.name)}`);
+    const id = ++callId;
+    const data = new TextEncoder().encode(JSON.stringify(request));
+    c.client.sendServiceCallRequest({ serviceId: s.id, callId: id, encoding: "json",
+      data: new DataView(data.buffer, data.byteOffset, data.byteLength) });
+    const r = await until(`the answer to ${name}`, 15000, () => replies.get(id));
+    if (!r.data) throw new Failure(`${prefix}/${name}: ${r.message}`);
+    return JSON.parse(new TextDecoder().decode(r.data));
+  };
+}
+
+// The 3D panel's pixels of each of `colours` ({ name: [r, g, b] }): look() counts them once;
+// seen(what, want) looks until want(counts) holds (bounded: software WebGL on a busy machine
+// paints late), then logs and checks it.
+function painter(check, { page, PNG, canvas }, colours) {
+  const look = async () => {
+    const png = PNG.sync.read(await page.screenshot({ clip: canvas }));
+    return Object.fromEntries(Object.entries(colours).map(([k, c]) => [k, centroid(png, c, 10).n]));
+  };
+  const seen = async (what, want) => {
+    let counts;
+    for (const deadline = Date.now() + 30000; ; ) {
+      counts = await look();
+      if (want(counts) || Date.now() >= deadline) break;
+      await page.waitForTimeout(250);
+    }
+    log(`${what}: ${JSON.stringify(counts)} pixels`);
+    if (!want(counts)) await page.screenshot({ path: path.join(workdir, "failed.png") });
+    return check(want(counts), `${what}: ${JSON.stringify(counts)} pixels (the page: failed.png)`);
+  };
+  return { look, seen };
+}
 
 async function caseChanges(check) {
   const sceneFile = path.join(__dirname, "viewer", "drift.xml");
   const [orange] = expectedColours(sceneFile);
-  const blue = [0.1, 0.35, 0.95].map((v) => Math.round(v * 255));
-  await withStudio(check, sceneFile, ["--rate", 1, "--publish-every", 10], async ({ page, url, PNG, canvas }) => {
+  await withStudio(check, nodeArgs(sceneFile, "--rate", 1, "--publish-every", 10), async (studio) => {
     // The node's services, called in json by an independent client.
-    const c = new Client(need, url, { name: "changes", subscribeAll: false });
-    let services;
-    const responses = new Map();
-    c.client.on("advertiseServices", (s) => (services = s));
-    c.client.on("serviceCallResponse", (r) => responses.set(r.callId, r));
+    const c = new Client(need, studio.url, { name: "changes", subscribeAll: false });
+    const call = serviceCaller(c, "/rbsim");
     await c.ready();
-    await until("advertiseServices", 5000, () => services);
-    let callId = 0;
-    const call = async (name, request) => {
-      const s = services.find((x) => x.name === `/rbsim/${name}`);
-      if (!s) throw new Failure(`no service /rbsim/${name}: ${services.map((x) => x.name)}`);
-      const id = ++callId;
-      const data = new TextEncoder().encode(JSON.stringify(request));
-      c.client.sendServiceCallRequest({ serviceId: s.id, callId: id, encoding: "json",
-        data: new DataView(data.buffer, data.byteOffset, data.byteLength) });
-      const r = await until(`the answer to ${name}`, 10000, () => responses.get(id));
-      return JSON.parse(new TextDecoder().decode(r.data));
-    };
-    // Pixels of a colour in the 3D panel, looked at until `want` holds (bounded: software WebGL on
-    // a busy machine paints late).
-    const seen = async (what, want) => {
-      let counts;
-      for (const deadline = Date.now() + 30000; ; ) {
-        const png = PNG.sync.read(await page.screenshot({ clip: canvas }));
-        counts = { orange: centroid(png, orange, 10).n, blue: centroid(png, blue, 10).n };
-        if (want(counts) || Date.now() >= deadline) break;
-        await page.waitForTimeout(250);
-      }
-      log(`${what}: ${JSON.stringify(counts)} pixels`);
-      return check(want(counts), `${what}: ${JSON.stringify(counts)} pixels`);
-    };
+    const { seen } = painter(check, studio, { orange, blue: BLUE });
     if (!(await seen("the scene's orange square alone", (n) => n.orange >= 200 && n.blue < 20))) return;
     const spawned = await call("spawn_entity", {
       name: "blue", allow_renaming: false, entity_namespace: "",
@@ -328,7 +358,139 @@ async function caseChanges(check) {
     const deleted = await call("delete_entity", { entity: "body_0" });
     check(deleted.result?.result === 1, `delete_entity: ${JSON.stringify(deleted)}`);
     await seen("deleted: the blue square alone", (n) => n.orange < 20 && n.blue >= 200);
-    await page.screenshot({ path: path.join(workdir, "viewer.png") });
+    await studio.page.screenshot({ path: path.join(workdir, "viewer.png") });
+    c.close();
+  });
+}
+
+// The recording of case replay_changes: drift.xml's orange square alone, the blue square spawned 3 m
+// right of it at step 2000 (t = 4 s), the orange one deleted at step 3000 (t = 6 s), 8 s in all;
+// every 20th step recorded, uncompressed (read back here by the official reader).
+const START_STEP = 500; // --start-offset 1 (s): Studio's first clock is not 0 (see caseReplayChanges)
+const SPAWN_STEP = 2000;
+const DELETE_STEP = 3000;
+const RECORD_EVERY = 20;
+
+async function recordChanges(sceneFile) {
+  fs.writeFileSync(path.join(workdir, "blue.xml"), BLUE_SQUARE);
+  const script = path.join(workdir, "changes.yaml");
+  fs.writeFileSync(script, `- {step: ${SPAWN_STEP}, spawn: {file: blue.xml, name: blue, x: [-3, 0], theta: 0}}\n` +
+    `- {step: ${DELETE_STEP}, delete: body_0}\n`);
+  const recording = path.join(workdir, "changes.mcap");
+  const run = new Proc("run", [A.rbsim, "run", sceneFile, "--duration", 8, "--commands", script, "--record", recording,
+    "--record-every", RECORD_EVERY, "--compression", "none"].map(String), { logDir: workdir });
+  if ((await run.wait(60000)) !== 0) throw new Failure(`rbsim run exited with ${run.code}\n${run.output()}`);
+  return recording;
+}
+
+// What `burst` counts in the replay of `recording` from log time `start` (ns, --start-offset): every
+// message from there in log-time order but the scene description and markers sent before them.
+// played(step): how many there are up to the body states of `step` (its log time) inclusive.
+function replayOrder(recording, start) {
+  const topics = lib.readMcap(need, recording);
+  const { parse } = need("@foxglove/rosmsg");
+  const { MessageReader } = need("@foxglove/rosmsg2-serialization");
+  const states = topics.get("/rbsim/body_states");
+  const reader = new MessageReader(parse(states.channel.schema, { ros2: true }));
+  const timeOf = new Map(states.messages.map((m) => [Number(reader.readMessage(m.data).step), m.time]));
+  const all = [...topics].flatMap(([topic, t]) => t.messages.map((m) => ({ topic, time: m.time })));
+  const latched = new Set(["/rbsim/scene", "/rbsim/markers"]);
+  const counted = all.filter((m) => m.time > start || (m.time === start && !latched.has(m.topic)));
+  return (step) => {
+    if (!timeOf.has(step)) throw new Failure(`step ${step} is not in ${recording}`);
+    return counted.filter((m) => m.time <= timeOf.get(step)).length;
+  };
+}
+
+// What a client that joins now gets: its first time message (s), the scene description's bodies
+// (their colours, rgb bytes) and stamp (s), and the markers' body frames and whether they start
+// with a DELETEALL.
+async function lateJoiner(url, name) {
+  const c = new Client(need, url, { name, subscribeAll: false });
+  await c.ready();
+  for (const ch of c.channels.values()) if (["/rbsim/scene", "/rbsim/markers"].includes(ch.topic)) c.subscribe(ch);
+  const got = (topic) => c.messages.find((m) => m.topic === topic)?.decoded;
+  await until(`${name}: the scene description and markers`, 5000, () => got("/rbsim/scene") && got("/rbsim/markers"));
+  const [scene, markers] = [got("/rbsim/scene"), got("/rbsim/markers")];
+  c.close();
+  return {
+    time: c.times.length ? Number(c.times[0]) / 1e9 : undefined,
+    colours: scene.bodies.map((b) => [b.color.r, b.color.g, b.color.b].map((v) => Math.round(v * 255)).join(",")),
+    stamp: scene.header.stamp.sec + scene.header.stamp.nanosec * 1e-9,
+    frames: [...new Set(markers.markers.map((m) => m.header.frame_id).filter((f) => f !== "world"))].sort(),
+    deleteAll: markers.markers[0]?.action === 3,
+  };
+}
+
+// `rbsim replay --foxglove` of a recording whose bodies change (made by `rbsim run --commands
+// --record`), started paused; the player's burst service (an independent client) plays it on in
+// exact message counts while Studio watches: a recorded step at a time until the orange square is
+// drawn (Studio subscribed and painted; before the spawn), then to step 2500 (both squares), then
+// to step 3500 (the blue one alone), each state seen in the 3D panel and in the body states the
+// client receives; at each, a client that joins late gets the time the replay stands at and the
+// latest scene description and markers. It starts at step 500 (--start-offset), so Studio's first
+// clock is the 1 s the server gives a new client (the replay starts each session with the time it
+// plays from), not 0: Studio 1.48 may drop what it was given at clock 0 when its clock first moves
+// (its first "seek" clears the 3D panel).
+async function caseReplayChanges(check) {
+  const sceneFile = path.join(__dirname, "viewer", "drift.xml");
+  const [orange] = expectedColours(sceneFile);
+  const recording = await recordChanges(sceneFile);
+  const played = replayOrder(recording, BigInt(START_STEP) * 2000000n);
+  await withStudio(check, ["replay", recording, "--start-paused", "--start-offset", START_STEP * 0.002], async (studio) => {
+    const c = new Client(need, studio.url, { name: "player", subscribeAll: false });
+    const call = serviceCaller(c, "/rbsim_player");
+    await c.ready();
+    const states = [...c.channels.values()].find((ch) => ch.topic === "/rbsim/body_states");
+    if (!states) throw new Failure(`no /rbsim/body_states channel: ${c.topics()}`);
+    c.subscribe(states);
+    check((await call("is_paused", {})).paused === true, "is_paused: want true (--start-paused)");
+    // Plays on to `step` (all its messages) and returns the ids of the bodies its body states hold.
+    let at = 0;
+    const playTo = async (step) => {
+      const n = played(step) - at;
+      const r = await call("burst", { num_messages: n });
+      if (!check(Number(r.actually_burst) === n, `burst ${n} to step ${step}: ${JSON.stringify(r)}`)) return [];
+      at += n;
+      const last = await until(`the body states of step ${step}`, 10000, () => {
+        const m = c.messages.filter((x) => x.topic === "/rbsim/body_states").at(-1);
+        return m && Number(m.decoded.step) === step && m;
+      });
+      return last.decoded.bodies.map((b) => b.id);
+    };
+    const { look, seen } = painter(check, studio, { orange, blue: BLUE });
+    let step = START_STEP;
+    let ids = await playTo(step);
+    for (let counts = await look(); counts.orange < 200 && step + RECORD_EVERY < SPAWN_STEP; counts = await look()) {
+      step += RECORD_EVERY;
+      ids = await playTo(step);
+    }
+    log(`played to step ${step} a recorded step per burst, until the orange square was drawn`);
+    check(JSON.stringify(ids) === "[0]", `step ${step}: body states of ids ${ids}, want [0]`);
+    if (!(await seen(`step ${step}, before the spawn: the orange square alone`,
+      (n) => n.orange >= 200 && n.blue < 20))) return;
+    const expect = async (when, want) => {
+      const got = await lateJoiner(studio.url, `late joiner at ${when}`);
+      log(`a late joiner at ${when}: ${JSON.stringify(got)}`);
+      check(JSON.stringify(got) === JSON.stringify(want), `a late joiner at ${when}: ${JSON.stringify(got)}, want ${
+        JSON.stringify(want)}`);
+    };
+    const [rgbOrange, rgbBlue] = [orange.join(","), BLUE.join(",")];
+    await expect(`step ${step}`, { time: step * 0.002, colours: [rgbOrange], stamp: 0, frames: ["rbsim/body_0"],
+      deleteAll: false });
+
+    ids = await playTo(2500);
+    check(JSON.stringify(ids) === "[0,1]", `step 2500: body states of ids ${ids}, want [0,1]`);
+    if (!(await seen("step 2500, after the spawn: both squares", (n) => n.orange >= 200 && n.blue >= 200))) return;
+    await expect("step 2500", { time: 5, colours: [rgbOrange, rgbBlue], stamp: 4, frames: ["rbsim/blue", "rbsim/body_0"],
+      deleteAll: true });
+
+    ids = await playTo(3500);
+    check(JSON.stringify(ids) === "[1]", `step 3500: body states of ids ${ids}, want [1]`);
+    await seen("step 3500, after the delete: the blue square alone", (n) => n.orange < 20 && n.blue >= 200);
+    await expect("step 3500", { time: 7, colours: [rgbBlue], stamp: 6, frames: ["rbsim/blue"], deleteAll: true });
+    check((await call("is_paused", {})).paused === true, "is_paused at the end: want true");
+    await studio.page.screenshot({ path: path.join(workdir, "viewer.png") });
     c.close();
   });
 }

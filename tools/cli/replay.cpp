@@ -150,7 +150,7 @@ int replay_command(ReplayArgs a) {
     ~ClosePlayer() { replay.close_player(); }
   } close_player{replay};
   bag::Player::Tap tap;
-  std::uint64_t last_time = 0;
+  std::optional<std::uint64_t> last_time;  // the last time message sent (none yet this session)
   if (a.foxglove.address) {
     auto started = start_foxglove("rbsim replay", a.foxglove, foxglove_channels(replay), nullptr,
                                   participant.value().node().fully_qualified(),
@@ -158,12 +158,16 @@ int replay_command(ReplayArgs a) {
     if (!started) return fail("replay", started.error().message, foxglove_exit_status(started.error()));
     server = std::move(started.value());
     foxglove::Server* srv = server.get();
-    tap.pass = [srv, &last_time] {
+    // A session starts with the time playing starts at, before the latched messages (stamped
+    // where the scene began): a viewer joining the replay while it is paused there gets that time
+    // first (Server::time), not a clock of 0 that the first step would jump away from.
+    tap.pass = [srv, &last_time](std::optional<std::uint64_t> at) {
       srv->new_session();
-      last_time = 0;
+      last_time = at;
+      if (at) srv->time(*at);
     };
     tap.message = [srv, &last_time](std::size_t output, std::uint64_t t, std::span<const std::byte> cdr) {
-      if (t > last_time) {
+      if (!last_time || t > *last_time) {
         srv->time(t);
         last_time = t;
       }

@@ -50,9 +50,13 @@ struct Player::Impl {
   Status send_latched(std::uint64_t start, std::set<std::uint16_t>& sent_early,
                       std::map<std::uint16_t, mcap::Message>& latched,
                       const std::function<void(std::uint16_t, const mcap::Message&)>& sent, bool (*stop)());
-  // The log time a seek to simulated time `sim_ns` lands at: the first message of a per-step
-  // channel stamped at or after it (nullopt: past the end).
-  Result<std::optional<std::uint64_t>> seek_position(std::uint64_t sim_ns);
+  // Where playing goes on from log time `from` (a pass's start) or to simulated time `sim_ns` (a
+  // seek): the first message of a per-step channel at or after `from` stamped at or after
+  // `sim_ns`, its log time and simulated time (nullopt: past the end).
+  struct StepAt {
+    std::uint64_t log_time = 0, sim_time = 0;
+  };
+  Result<std::optional<StepAt>> first_step(std::uint64_t from, std::uint64_t sim_ns);
   // Where a pass starts: --start-offset seconds of log time after the first message.
   std::uint64_t start_of(std::uint64_t first_log_time) const;
   // Where a pass ends: --playback-duration (log time from `start`) and --playback-until (simulated
@@ -305,15 +309,16 @@ Status Player::Impl::send_latched(std::uint64_t start, std::set<std::uint16_t>& 
   return Ok{};
 }
 
-Result<std::optional<std::uint64_t>> Player::Impl::seek_position(std::uint64_t sim_ns) {
-  std::optional<std::uint64_t> found;
-  Status st = recording->read_messages({topics}, [&](const recordings::RecordedMessage& rm) {
+Result<std::optional<Player::Impl::StepAt>> Player::Impl::first_step(std::uint64_t from,
+                                                                     std::uint64_t sim_ns) {
+  std::optional<StepAt> found;
+  Status st = recording->read_messages({topics, from}, [&](const recordings::RecordedMessage& rm) {
     const mcap::Message& m = *rm.message;
     const auto id = topic_of.find(m.channel_id);
     if (id == topic_of.end() || !msgs::topic(id->second).per_step) return true;
     const std::optional<std::uint64_t> t = sim_time(m.channel_id, m.data);
     if (!t || *t < sim_ns) return true;
-    found = m.log_time;
+    found = StepAt{m.log_time, *t};
     return false;
   });
   if (!st) return with_context("cannot read ", st.error());
@@ -486,17 +491,18 @@ Status Player::Impl::Pass::seek() {
     fresh = false;
     return Ok{};
   }
-  auto position = im.seek_position(*target);
+  auto position = im.first_step(0, *target);
   if (!position) return position.error();
   if (!position.value()) {
     control.seek_done(false, 0);
     fresh = false;
     return Ok{};
   }
-  from = *position.value();
+  from = position.value()->log_time;
   skip_at_from = 0;
   fresh = true;
-  if (tap != nullptr && tap->pass) tap->pass();  // a second output starts afresh there too
+  if (tap != nullptr && tap->pass)
+    tap->pass(position.value()->sim_time);  // a second output starts afresh there too
   if (im.clock_publisher) {
     if (Status s = publish_clock(from); !s) return s.error();
     last_clock = from;
@@ -508,12 +514,17 @@ Status Player::Impl::Pass::seek() {
 Result<bool> Player::play(bool (*stop)(), const Tap* tap) {
   Impl& im = *impl_;
   PlayerClock& control = *im.control;
-  if (tap != nullptr && tap->pass) tap->pass();
+  const std::uint64_t start = im.start_of(first_log_time_);
+  if (tap != nullptr && tap->pass) {
+    auto at = im.first_step(start, 0);
+    if (!at) return at.error();
+    tap->pass(at.value() ? std::optional(at.value()->sim_time) : std::nullopt);
+  }
   if (!im.delayed && im.options.delay > 0.0) {
     im.delayed = true;
     if (!sleep_until_or_stop(monotonic_ns() + seconds_to_ns_clamped(im.options.delay), stop)) return false;
   }
-  Impl::Pass pass(*this, im, stop, tap, im.start_of(first_log_time_));
+  Impl::Pass pass(*this, im, stop, tap, start);
   const auto latched_sent = [&pass](std::uint16_t ch, const mcap::Message& m) { pass.latched_sent(ch, m); };
   while (true) {
     if (pass.fresh) {

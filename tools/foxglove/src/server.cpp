@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -97,7 +98,12 @@ struct Server::Impl {
     std::vector<std::byte> payload;
   };
   std::vector<Latched> latched;  // by channel - 1
-  ServerStats totals;            // of closed clients, plus the counters kept here
+  // The session's last time message (kNoTime: none yet): a client that connects gets it after the
+  // advertisements, so it knows where a paused stream stands before its first latched message.
+  // Atomic (sequentially consistent) with client_count: time() skips the lock without clients.
+  static constexpr std::uint64_t kNoTime = std::numeric_limits<std::uint64_t>::max();
+  std::atomic<std::uint64_t> last_time{kNoTime};
+  ServerStats totals;  // of closed clients, plus the counters kept here
   std::atomic<std::size_t> client_count{0};
   std::unique_ptr<std::atomic<std::uint32_t>[]> subscribers;  // by channel - 1
 
@@ -138,6 +144,7 @@ struct Server::Impl {
     server_info = server_info_json(options.name, std::to_string(ms) + "-" + std::to_string(sessions),
                                    options.steering != nullptr, !services.empty());
     for (Latched& l : latched) l.has = false;
+    last_time = kNoTime;
   }
 
   void opened(detail::ConnectionId id) {
@@ -150,6 +157,7 @@ struct Server::Impl {
       c->queue.push_text(server_info);
       c->queue.push_text(advertise);
       if (!services.empty()) c->queue.push_text(advertise_services);
+      if (const std::uint64_t t = last_time; t != kNoTime) c->queue.push_time(t);
       c->last_progress_ns = monotonic_ns();
       ++totals.clients;
       clients.push_back(std::move(c));
@@ -639,7 +647,8 @@ void Server::publish(ChannelId channel, std::uint64_t log_time_ns, std::span<con
 
 void Server::time(std::uint64_t time_ns) {
   Impl& im = *impl_;
-  if (im.client_count.load(std::memory_order_relaxed) == 0) return;
+  im.last_time = time_ns;
+  if (im.client_count == 0) return;
   {
     std::lock_guard lock(im.mu);
     for (auto& c : im.clients) c->queue.push_time(time_ns);

@@ -77,10 +77,12 @@ class Player {
   // A second consumer of what is published (rbsim replay --foxglove): `message` gets every message
   // as it is published, with the index of its output (outputs()) and its simulated time (the
   // message's own stamp; the log time for messages without one), `pass` is called at the start of
-  // every play() and after every seek (a new session: the timeline jumped). Called on the thread that plays;
-  // must not block.
+  // every play() and after every seek (a new session: the timeline jumped), before the latched
+  // messages, with the simulated time playing starts at (the first per-step message it will play;
+  // nullopt: none left), so a viewer knows where a paused replay stands. Called on the thread that
+  // plays; must not block.
   struct Tap {
-    std::function<void()> pass;
+    std::function<void(std::optional<std::uint64_t> start_sim_time_ns)> pass;
     std::function<void(std::size_t output, std::uint64_t sim_time_ns, std::span<const std::byte> cdr)>
         message;
   };

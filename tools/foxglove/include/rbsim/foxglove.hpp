@@ -418,7 +418,9 @@ class Server {
   // Queues a message for the subscribers of `channel` (1-based); a latched channel also keeps it
   // for later subscriptions.
   void publish(ChannelId channel, std::uint64_t log_time_ns, std::span<const std::byte> payload);
-  // Queues a time message for every client.
+  // Queues a time message for every client; the session's last one also goes to a client that
+  // connects later (after the advertisements, before anything it subscribes to), so a viewer
+  // joining a paused stream knows where it stands.
   void time(std::uint64_t time_ns);
   std::size_t client_count() const;
   ServerStats stats() const;
