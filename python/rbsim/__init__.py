@@ -65,7 +65,9 @@ def run(scene, *, steps=None, duration=None, csv=None, energy_csv=None, fosssim_
 class Table:
     """Columns of one recorded topic, as NumPy arrays: by attribute (``t.x``) or by name (``t["x"]``).
 
-    ``step`` and ``t`` (``step * dt``, the CSV's t) have one entry per recorded step; per-body and
+    ``step``, ``t`` (``step * dt``, the CSV's t, with the dt of the step's world) and ``segment`` (0,
+    then one more each time the steps start again at 0: a reset, a world loaded) have one entry per
+    recorded step, in the session's order; per-body and
     per-spring columns are steps x bodies (or springs), scene-wide ones one per step. ``ids`` names
     the bodies (springs) of the columns: every id the recording holds, increasing (a scene's own
     0..n-1); where bodies came or went (spawned, deleted) a column is NaN at the steps its body was

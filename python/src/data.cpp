@@ -275,7 +275,8 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
   const std::size_t first_width = id == msgs::TopicId::BodyStates     ? scene.bodies.size()
                                   : id == msgs::TopicId::SpringStates ? scene.springs.size()
                                                                       : 1;
-  std::vector<std::uint64_t> steps;
+  std::vector<std::uint64_t> steps, segments;
+  std::vector<double> t;  // World::time() of each step: step * its world's dt
   steps.reserve(expected);
   for (Column& c : columns) c.values.reserve(expected * std::max<std::size_t>(first_width, 1));
   EntityAxis axis;  // bodies or springs by id (a recording of a world whose bodies change)
@@ -288,6 +289,8 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
                                                                 : static_cast<const void*>(s.energy);
       if (message == nullptr) return Ok{};  // a step only the other topic has (a lost message)
       steps.push_back(s.step);
+      segments.push_back(s.segment);
+      t.push_back(static_cast<double>(s.step) * (s.scene != nullptr ? s.scene->dt : scene.dt));
       append_row(id, s, scene, columns, axis.ids);
       if (per_entity) axis.end_row();
       return Ok{};
@@ -300,11 +303,10 @@ nb::dict read_topic(const std::string& path, const std::string& ns, const std::s
     width = axis.spread(rows, columns);
     out_ids = axis.columns;
   }
-  std::vector<double> t(rows);
-  for (std::size_t i = 0; i < rows; ++i) t[i] = static_cast<double>(steps[i]) * scene.dt;  // World::time()
   nb::dict out;
   if (per_entity) out["id"] = to_numpy(std::move(out_ids), width);
   out["step"] = to_numpy(std::move(steps), rows);
+  out["segment"] = to_numpy(std::move(segments), rows);
   out["t"] = to_numpy(std::move(t), rows);
   for (Column& c : columns) out[c.name.c_str()] = to_numpy(std::move(c.values), rows, width);
   return out;

@@ -195,11 +195,62 @@ TEST(RunCommands, AWorldLoadedInTheSessionRerunsToTheSameBytes) {
                                   })
                   .ok());
   EXPECT_EQ(names, (std::vector<std::string>{"chain", "other"}));
+  // Read step by step: the chain's steps 0..6 (segment 0), then the other world's 0..50 (segment
+  // 1), each with its own scene description; log times never go back.
+  std::vector<std::string> seen;
+  mcap::Timestamp last_log = 0;
+  bool monotonic = true;
+  ASSERT_TRUE(rec.value()
+                  ->read_steps([&](const recordings::RecordedStep& st) {
+                    seen.push_back(std::to_string(st.segment) + ":" + std::to_string(st.step) + ":" +
+                                   st.scene->name + ":" + std::to_string(st.body_states->bodies.size()));
+                    monotonic &= st.log_time.body_states >= last_log;
+                    last_log = st.log_time.body_states;
+                    return Status(Ok{});
+                  })
+                  .ok());
+  EXPECT_TRUE(monotonic);
+  ASSERT_EQ(seen.size(), 7u + 51u);
+  EXPECT_EQ(seen[0], "0:0:chain:" + std::to_string(rec.value()->scene()->bodies.size()));
+  EXPECT_EQ(seen[6].substr(0, 10), "0:6:chain:");
+  EXPECT_EQ(seen[7].substr(0, 10), "1:0:other:");
+  EXPECT_EQ(seen.back().substr(0, 11), "1:50:other:");
+  const Outcome exported =
+      rbsim({"log", "export", (dir / "a.mcap").string(), "--csv", (dir / "a.csv").string()});
+  EXPECT_EQ(exported.exit_code, 0) << exported.err;
   const Outcome csv = rbsim({"run", scene, "--steps", "40", "--commands", (dir / "a.mcap").string(), "--csv",
                              (dir / "out.csv").string()});
   EXPECT_EQ(csv.exit_code, 2) << csv.err;
   EXPECT_NE(csv.err.find("cannot follow a world loaded during the run"), std::string::npos) << csv.err;
   EXPECT_FALSE(fs::exists(dir / "out.csv"));
+}
+
+// A reset is recorded as a restart: the scene description and step 0 again, then the steps from 1,
+// so the recording reads as two segments, each from step 0, and re-runs to the same bytes.
+TEST(RunCommands, AResetStartsTheRecordingsNextSegment) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/chain.xml");
+  write_text(dir / "c.yaml", "- {step: 12, reset: true}\n");
+  const Outcome a = rbsim({"run", scene, "--steps", "20", "--commands", (dir / "c.yaml").string(), "--record",
+                           (dir / "a.mcap").string()});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  Result<std::unique_ptr<recordings::Recording>> rec = recordings::Recording::open((dir / "a.mcap").string());
+  ASSERT_TRUE(rec.ok()) << rec.error().message;
+  std::vector<std::pair<std::uint32_t, std::uint64_t>> seen;
+  ASSERT_TRUE(rec.value()
+                  ->read_steps([&](const recordings::RecordedStep& st) {
+                    seen.emplace_back(st.segment, st.step);
+                    return Status(Ok{});
+                  })
+                  .ok());
+  std::vector<std::pair<std::uint32_t, std::uint64_t>> want;
+  for (std::uint64_t k = 0; k <= 12; ++k) want.emplace_back(0, k);
+  for (std::uint64_t k = 0; k <= 20; ++k) want.emplace_back(1, k);
+  EXPECT_EQ(seen, want);
+  const Outcome b = rbsim({"run", scene, "--steps", "20", "--commands", (dir / "a.mcap").string(), "--record",
+                           (dir / "b.mcap").string()});
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(read_bytes(dir / "a.mcap"), read_bytes(dir / "b.mcap"));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@ import json
 import math
 import os
 import re
+import shutil
 import signal
 import sys
 import time
@@ -249,10 +250,11 @@ def case_services(ctx):
     return with_node(ctx, body)
 
 
-def recorded_node(ctx, net, scene, duration, live, expected):
+def recorded_node(ctx, net, scene, duration, live, expected, *node_extra):
     """`rbsim record` of `expected` messages into `live`, and `rbsim node` on `scene` waiting for it."""
     rec = net.rb("record", "a", *e2e.record_args(ctx, live, "--max-messages", expected, "--wall-duration", 120))
-    node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1))
+    node = net.rb("node", "a", *e2e.node_args(ctx, scene, "--duration", duration, "--wait-for-subscribers", 1,
+                                              *node_extra))
     return rec, node
 
 
@@ -837,6 +839,92 @@ def case_spawn(ctx):
     return 0
 
 
+# A world of one body in the wind, 0.05 s long at the chain's dt.
+WIND = ('<scene>\n  <description text="a square in the wind"/>\n  <duration time="0.05"/>\n'
+        '  <rigidbodyintegrator type="symplectic-euler" dt="0.001"/>\n'
+        '  <rigidbodyvertex x="0" y="0" m="1"/><rigidbodyvertex x="1" y="0" m="1"/>\n'
+        '  <rigidbodyvertex x="1" y="1" m="1"/><rigidbodyvertex x="0" y="1" m="1"/>\n'
+        '  <rigidbody p="0" p="1" p="2" p="3" vx="0.5" vy="1.0" omega="0.3" r="0.1"/>\n'
+        '  <rigidbodygravityforce fx="0.0" fy="-9.81"/>\n'
+        '  <rigidbodywindforce beta="0.2" fx="1.0" fy="0.5" pointsperedge="3"/>\n</scene>\n')
+
+
+def case_worlds(ctx):
+    """Spawns (a fragment as resource_string and one by uri from --spawnables), a state set, then
+    LoadWorld of another world by uri from --worlds (stopped at its step 0, listed by
+    GetAvailableWorlds, named by GetCurrentWorld), 5 steps in it, and back to the first world (by
+    uri too: RustDDS panics writing a LoadWorld request whose resource_string holds the chain's
+    2.6 kB, in write_to_vec_fast's length assertion; the text form is test/sim's, over Cyclone), 3 steps and play, all through ros2-client while `rbsim record` records; the session
+    re-simulated from its recorded commands (no file needed) equals it, every message, and `log
+    export` reads the recording, both worlds."""
+    if not PEER or not os.access(PEER, os.X_OK):
+        raise e2e.Failure(f"RBSIM_ROS2_PEER={PEER!r} is not an executable: build the rbsim_ros2_peer target")
+    duration, steps = 0.5, 500
+    first, spawnables, worlds = ctx.path("first.xml"), ctx.path("spawnables"), ctx.path("worlds")
+    os.makedirs(spawnables)
+    os.makedirs(worlds)
+    with open(ctx.scene("chain.xml")) as f:
+        chain = f.read()
+    first_text = re.sub(r'<duration time="[^"]*"/>', f'<duration time="{duration}"/>', chain)
+    for path, text in ((first, first_text), (os.path.join(worlds, "first.xml"), first_text),
+                       (os.path.join(spawnables, "ball.xml"), BALL), (os.path.join(worlds, "wind.xml"), WIND)):
+        with open(path, "w") as f:
+            f.write(text)
+    latched, per_step, commands = len(e2e.LATCHED), len(e2e.PER_STEP), 8
+    # Step 0, two spawns and two loads each write every topic again; 5 steps, 3 steps, then the rest.
+    expected = 5 * latched + (1 + 2 + 1 + 5 + 1 + 3 + (steps - 3)) * per_step + commands
+    live = ctx.path("live.mcap")
+    with PeerNet(ctx) as net:
+        if net.skip:
+            print(f"SKIP: {net.skip}")
+            return e2e.SKIP
+        rec, node = recorded_node(ctx, net, first, duration, live, expected, "--spawnables", spawnables,
+                                  "--worlds", worlds, "--ros-args", "-p", "paused:=true")
+        try:
+            g = sim(ctx, net, "sim", ("state",), ("spawn", "ball", "string", ctx.path("spawnables/ball.xml"), 0.5, 2.0, 0.25),
+                    ("spawn", "crate", "uri", "ball.xml", 1.0, 3.0, 0.5), ("set-entity", "ball", "twist", 0.0, 1.0, 2.0),
+                    ("available-worlds",), ("load-world", "uri", "wind.xml"), ("state",), ("current-world",),
+                    ("step", 5), ("entities", "all"), ("load-world", "uri", "first.xml"), ("step", 3),
+                    ("entities", "all"), ("set-state", PLAYING))
+        finally:
+            e2e.exited_ok(ctx, node, 60, "rbsim node")
+            e2e.exited_ok(ctx, rec, 60, "rbsim record")
+    ctx.check(g[0]["state"] == STOPPED, f"started paused at step 0: {g[0]}")
+    expect(ctx, g, 1, result=OK, entity_name="ball")
+    expect(ctx, g, 2, result=OK, entity_name="crate")
+    expect(ctx, g, 3, result=OK)
+    ctx.check(g[4]["result"] == OK and [w["name"] for w in g[4]["worlds"]] == ["first", "wind"]
+              and g[4]["worlds"][1]["description"] == "a square in the wind", f"available worlds: {g[4]}")
+    expect(ctx, g, 5, result=OK)
+    ctx.check(g[5]["world"]["name"] == "wind" and g[5]["world"]["uri"] == "wind.xml", f"loaded: {g[5]}")
+    ctx.check(g[6]["state"] == STOPPED, f"a loaded world is stopped: {g[6]}")
+    ctx.check(g[7]["result"] == OK and g[7]["world"]["name"] == "wind", f"current world: {g[7]}")
+    expect(ctx, g, 8, result=OK)
+    ctx.check(g[9]["entities"] == ["body_0"], f"the wind world's entities: {g[9]}")
+    expect(ctx, g, 10, result=OK)
+    expect(ctx, g, 11, result=OK)
+    ctx.check(g[12]["entities"] == [f"body_{i}" for i in range(5)], f"back in the first world, as loaded: {g[12]}")
+    expect(ctx, g, 13, result=OK)
+    # The recording re-simulated from its own commands, the world files gone: every message equal.
+    shutil.rmtree(worlds)
+    shutil.rmtree(spawnables)
+    again = ctx.path("again.mcap")
+    ctx.rbrun("again", "run", first, "--duration", duration, "--commands", live, "--record", again,
+              "--namespace", ctx.ns)
+    e2e.rbsim_check(ctx, live, again, "check-again", live=True)
+    ctx.rbrun("export", "log", "export", live, "--csv", ctx.path("live.csv"))
+    with open(ctx.path("live.csv")) as f:
+        rows = f.read().splitlines()[1:]
+    # The first world never stepped: its step 0 was recorded again by the load, and the last wins.
+    ctx.check(len(rows) == 1 * 6 + 5 * (1 + steps),
+              f"log export: {len(rows)} rows, want the wind world's 0..5 (1 body; the first world's step 0 "
+              f"recorded again as the wind world's, the last recording of the step) and the first world's "
+              f"0..{steps} (5 bodies)")
+    ctx.log("spawned 2 bodies (text, uri), loaded a world by uri and the first again as text; re-simulated from "
+            "the recording with no file: every message equal")
+    return 0
+
+
 def rosbags_hash(ctx, type_name):
     """The RIHS01 hash `rosbags` computes for `type_name` (test/msgs/data/rihs01_rosbags.txt, the
     table test/python/check_type_hashes.py checks against rosbags on every run)."""
@@ -887,7 +975,8 @@ e2e.CASES.update({"tf": case_tf, "graph": case_graph, "rosout": case_rosout, "ki
                   "parameters": case_parameters, "services": case_services, "flood": case_flood,
                   "bad_requests": case_bad_requests, "killed_client": case_killed_client, "steered": case_steered,
                   "simulation_state": case_simulation_state, "simulate_steps": case_simulate_steps,
-                  "entities": case_entities, "spawn": case_spawn, "type_description": case_type_description})
+                  "entities": case_entities, "spawn": case_spawn, "worlds": case_worlds,
+                  "type_description": case_type_description})
 
 if __name__ == "__main__":
     sys.exit(e2e.main())

@@ -13,6 +13,9 @@
 //!                                       SpawnEntity: the fragment FILE's text as resource_string,
 //!                                       or FILE as the uri; the pose (X, Y, 0) and yaw THETA
 //!    | delete NAME
+//!    | load-world string|uri FILE        LoadWorld: the scene FILE's text as resource_string, or FILE as
+//!                                       the uri
+//!    | current-world | available-worlds
 //!    | goal N [cancel-after K]          the action: accepted, feedback, (cancel,) result, status
 //!    | typedesc DDS_TOPIC TYPE          the hash in USER_DATA of the node's endpoint on DDS_TOPIC
 //!                                       (rt/..., rq/...Request, rr/...Reply) as RustDDS's discovery
@@ -162,6 +165,11 @@ messages! {
     name: String, allow_renaming: bool, entity_resource: Resource, entity_namespace: String, initial_pose: PoseStamped
   }
   SpawnResponse { result: SimResult, entity_name: String }
+  WorldResource { name: String, world_resource: Resource, description: String, tags: Vec<String> }
+  LoadWorldRequest { world_resource: Resource, fail_on_unsupported_element: bool, ignore_missing_or_unsupported_assets: bool }
+  WorldResponse { result: SimResult, world: WorldResource }
+  AvailableWorldsRequest { additional_sources: Vec<String>, filter: TagsFilter, offline_only: bool, continue_on_error: bool }
+  AvailableWorldsResponse { result: SimResult, worlds: Vec<WorldResource> }
   Goal { steps: u64 }
   Feedback { completed_steps: u64, remaining_steps: u64 }
   FieldType { type_id: u8, capacity: u64, string_capacity: u64, nested_type_name: String }
@@ -344,6 +352,13 @@ fn set_entity_request(words: &[String]) -> Result<SetEntityRequest, String> {
   Ok(r)
 }
 
+/// A WorldResource as JSON: its name, uri and description.
+fn world_json(w: &WorldResource) -> String {
+  format!(
+    "{{\"name\": {}, \"uri\": {}, \"description\": {}}}",
+    json_string(&w.name), json_string(&w.world_resource.uri), json_string(&w.description))
+}
+
 /// spawn NAME string|uri FILE X Y THETA [rename] [ns NAMESPACE]: the SpawnEntity request.
 fn spawn_request(words: &[String]) -> Result<SpawnRequest, String> {
   let usage = "spawn NAME string|uri FILE X Y THETA [rename] [ns NAMESPACE]";
@@ -479,6 +494,35 @@ fn op(s: &mut Session, words: &[String]) -> Result<String, String> {
       let probe = EntityRequest { entity: String::new() };
       let (r, d): (ResultResponse, _) = s.call_probed("delete_entity", &ty("DeleteEntity"), req, probe)?;
       format!("{}, {}", result_json(&r.result), took(d))
+    }
+    "load-world" => {
+      let [how, file] = rest else { return Err("load-world string|uri FILE".into()) };
+      let world_resource = match how.as_str() {
+        "string" => Resource { uri: String::new(), resource_string: std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"))? },
+        "uri" => Resource { uri: file.clone(), resource_string: String::new() },
+        _ => return Err("load-world string|uri FILE".into()),
+      };
+      let req = LoadWorldRequest { world_resource, fail_on_unsupported_element: false, ignore_missing_or_unsupported_assets: false };
+      // The probe: no resource at all, refused (NO_RESOURCE) before it is a command.
+      let probe = LoadWorldRequest { world_resource: Resource { uri: String::new(), resource_string: String::new() }, ..req.clone() };
+      let (r, d): (WorldResponse, _) = s.call_probed("load_world", &ty("LoadWorld"), req, probe)?;
+      format!("{}, \"world\": {}, {}", result_json(&r.result), world_json(&r.world), took(d))
+    }
+    "current-world" => {
+      let (r, d): (WorldResponse, _) =
+        s.call("get_current_world", &ty("GetCurrentWorld"), Empty { structure_needs_at_least_one_member: 0 })?;
+      format!("{}, \"world\": {}, {}", result_json(&r.result), world_json(&r.world), took(d))
+    }
+    "available-worlds" => {
+      let req = AvailableWorldsRequest {
+        additional_sources: vec![],
+        filter: TagsFilter { tags: vec![], filter_mode: 0 },
+        offline_only: false,
+        continue_on_error: false,
+      };
+      let (r, d): (AvailableWorldsResponse, _) = s.call("get_available_worlds", &ty("GetAvailableWorlds"), req)?;
+      let worlds: Vec<String> = r.worlds.iter().map(world_json).collect();
+      format!("{}, \"worlds\": [{}], {}", result_json(&r.result), worlds.join(", "), took(d))
     }
     "goal" => goal(s, rest)?,
     "announced" => {

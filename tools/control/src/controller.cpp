@@ -415,7 +415,10 @@ CommandResult Controller::reset(World& world, Boundary& boundary) {
   step_budget_ = 0;
   const ParameterTable before = table_;
   follow_structure(world, &r);
-  if (edited) {
+  // Where the outputs follow, the reset is a change they write at once: the world at its step 0
+  // again after a scene description (a recording's next segment, rbsim/recording.hpp), edited
+  // or not.
+  if (edited || structure_allowed_) {
     ++entities_.epoch;
     boundary.structure_changed = true;
   }

@@ -65,8 +65,8 @@ class McapFileSink final : public McapSink {
       if (!channel.ok()) return fail(path_, channel.error());
       channels_[k] = channel.value();
     }
-    const mcap::Timestamp t = msgs::sim_time_ns(step, dt_);
-    if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, t, cdr); !st.ok()) {
+    const mcap::Timestamp sim = msgs::sim_time_ns(step, dt_), t = log_time(sim);
+    if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, sim, cdr); !st.ok()) {
       return fail(path_, st.error());
     }
     return Ok{};
@@ -92,17 +92,27 @@ class McapFileSink final : public McapSink {
 
  private:
   Status record(const World& world, bool first) {
-    const mcap::Timestamp t = msgs::sim_time_ns(world);
+    const mcap::Timestamp sim = msgs::sim_time_ns(world), t = log_time(sim);
     for (msgs::TopicId id : ids_) {  // in topics() order: the latched ones first
       const msgs::TopicSpec& spec = msgs::topic(id);
       if (!spec.per_step && !first) continue;
       encoder_->encode(id, world, buffer_);
       const auto k = static_cast<std::size_t>(id);
-      if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, t, buffer_); !st.ok()) {
+      if (auto st = writer_.write_message(channels_[k], sequence_[k]++, t, sim, buffer_); !st.ok()) {
         return fail(path_, st.error());
       }
     }
     return Ok{};
+  }
+
+  // Log time is the session's simulated time: the world's, plus the time of the worlds before it
+  // when the steps start again (a reset, a world loaded: rbsim/recording.hpp's segments), so log
+  // times never go back and a reader in log-time order reads the session in its order. Publish
+  // time stays the world's own.
+  mcap::Timestamp log_time(mcap::Timestamp sim) {
+    if (sim + offset_ < last_) offset_ = last_ - sim;
+    last_ = sim + offset_;
+    return last_;
   }
 
   std::string path_;
@@ -113,6 +123,7 @@ class McapFileSink final : public McapSink {
   mcap::Writer writer_;
   std::unique_ptr<msgs::Encoder> encoder_;
   double dt_ = 0.0;
+  mcap::Timestamp offset_ = 0, last_ = 0;  // log_time()'s
   std::array<std::uint16_t, msgs::kTopicCount> channels_{};
   std::array<std::uint32_t, msgs::kTopicCount> sequence_{};
   msgs::Bytes buffer_;

@@ -76,10 +76,20 @@ RecordedChannel describe_channel(const mcap::Channel& channel, const mcap::Schem
 
 }  // namespace
 
+// A recorded step's place: its segment (the world's run, one more each time the steps start again
+// at 0: a reset, a world loaded) and its step in it. Steps are passed on in this order.
+struct StepKey {
+  std::uint32_t segment = 0;
+  std::uint64_t step = 0;
+  auto operator<=>(const StepKey&) const = default;
+};
+
 struct Recording::Impl {
   // The messages recorded for one step, as far as they have arrived.
   struct Slot {
+    std::uint32_t segment = 0;
     std::uint64_t step = 0;
+    StepKey key() const { return {segment, step}; }
     std::array<bool, kPerStep.size()> has{};
     msgs::BodyStatesMessage states;
     msgs::SpringStatesMessage springs;
@@ -107,9 +117,11 @@ struct Recording::Impl {
 
   // Steps not passed on yet, by increasing step; spare slots keep their storage for reuse.
   std::vector<std::unique_ptr<Slot>> pending, spare;
-  std::array<std::optional<std::uint64_t>, kPerStep.size()> last;  // last step seen per topic
+  std::array<std::optional<StepKey>, kPerStep.size()> last;  // last step seen per topic
   // The epochs of a pass (RecordedStep). Where they start is known before the pass (the steps of
-  // every scene description, in log-time order, nondecreasing), so neither the epoch of a step nor
+  // every scene description, in log-time order: nondecreasing within a segment, a description at
+  // step 0 after the first starting the next segment, as a step 0 recorded again or a step that
+  // goes back does on a per-step topic), so neither the epoch of a step nor
   // how often a step may be recorded again depends on how the topics' log times interleave (a
   // recorder that fell behind takes a topic's samples in a batch). The first epoch's description
   // is `scene`; later ones are decoded as the pass meets them, and one that no step still to come
@@ -119,9 +131,10 @@ struct Recording::Impl {
     std::uint32_t index = 0;
     msgs::SceneMessage scene;
   };
-  std::vector<std::uint64_t> epoch_starts;  // the step of each scene description
-  std::deque<Epoch> epochs;                 // those after the first, decoded, the oldest still needed first
-  std::uint32_t scenes_seen = 0;            // scene descriptions met in this pass
+  std::vector<StepKey> epoch_starts;   // the segment and step of each scene description
+  std::deque<Epoch> epochs;            // those after the first, decoded, the oldest still needed first
+  std::uint32_t scenes_seen = 0;       // scene descriptions met in this pass
+  std::uint32_t segments_dropped = 0;  // segments of a step 0 only, replaced (drain)
   // How many times each topic's last step came again (up to the epochs that start at it).
   std::array<std::uint32_t, kPerStep.size()> again_count{};
   msgs::BodyStatesMessage scratch_states;
@@ -252,7 +265,7 @@ struct Recording::Impl {
   // Where the epochs start: the step of every scene description, in log-time order (one read of
   // that topic's messages; none when the summary counts a single one).
   Status find_epochs() {
-    epoch_starts.assign(1, scene_step);
+    epoch_starts.assign(1, StepKey{0, scene_step});
     const std::string& topic = topics[static_cast<std::size_t>(msgs::TopicId::SceneDescription)];
     for (const RecordedChannel& c : channels) {
       if (c.channel->topic == topic && c.message_count == 1u) return Ok{};
@@ -263,28 +276,31 @@ struct Recording::Impl {
           msgs::message_step(msgs::TopicId::SceneDescription, e.message.data, scene->dt);
       if (!at) {
         failure = fail(where(e) + ": a scene description without a stamp of dt " + std::to_string(scene->dt));
-      } else if (!epoch_starts.empty() && *at < epoch_starts.back()) {
+      } else if (!epoch_starts.empty() && *at != 0 && *at < epoch_starts.back().step) {
         failure = fail(where(e) + ": a scene description of step " + std::to_string(*at) +
-                       " after one of step " + std::to_string(epoch_starts.back()) +
-                       " (steps must increase: a recording of several runs?)");
+                       " after one of step " + std::to_string(epoch_starts.back().step) +
+                       " (steps increase until a restart's description of step 0)");
       }
       if (!failure) return false;
-      epoch_starts.push_back(*at);
+      // A description of step 0 after the first: the steps start again (a reset, a world loaded).
+      const std::uint32_t segment =
+          epoch_starts.empty() ? 0 : epoch_starts.back().segment + (*at == 0 ? 1u : 0u);
+      epoch_starts.push_back(StepKey{segment, *at});
       return true;
     });
     if (!st) return st;
-    if (epoch_starts.empty()) epoch_starts.push_back(scene_step);
+    if (epoch_starts.empty()) epoch_starts.push_back(StepKey{0, scene_step});
     return Ok{};
   }
 
   // The epoch a step is in: the last whose scene description starts at or before it (the first for
   // a step before every start: a recorder that joined late holds the latest description only).
-  std::uint32_t epoch_index(std::uint64_t step) const {
+  std::uint32_t epoch_index(StepKey step) const {
     const auto after = std::upper_bound(epoch_starts.begin(), epoch_starts.end(), step);
     return after == epoch_starts.begin() ? 0u : static_cast<std::uint32_t>(after - epoch_starts.begin() - 1);
   }
   // How many epochs start at `step` after the first: how often the step may be recorded again.
-  std::uint32_t changes_at(std::uint64_t step) const {
+  std::uint32_t changes_at(StepKey step) const {
     const auto [from, to] = std::equal_range(epoch_starts.begin() + 1, epoch_starts.end(), step);
     return static_cast<std::uint32_t>(to - from);
   }
@@ -309,10 +325,10 @@ struct Recording::Impl {
     return epochs.front().scene;
   }
 
-  Slot& slot_for(std::uint64_t step) {
+  Slot& slot_for(StepKey step) {
     std::size_t pos = pending.size();
-    while (pos > 0 && pending[pos - 1]->step > step) --pos;
-    if (pos > 0 && pending[pos - 1]->step == step) return *pending[pos - 1];
+    while (pos > 0 && pending[pos - 1]->key() > step) --pos;
+    if (pos > 0 && pending[pos - 1]->key() == step) return *pending[pos - 1];
     std::unique_ptr<Slot> s;
     if (spare.empty()) {
       s = std::make_unique<Slot>();
@@ -320,12 +336,13 @@ struct Recording::Impl {
       s = std::move(spare.back());
       spare.pop_back();
     }
-    s->step = step;
+    s->segment = step.segment;
+    s->step = step.step;
     s->has = {};
     s->log_time = {};
     Slot& slot = **pending.insert(pending.begin() + static_cast<std::ptrdiff_t>(pos), std::move(s));
-    RBSIM_ASSERT((pos == 0 || pending[pos - 1]->step < step) &&
-                     (pos + 1 == pending.size() || pending[pos + 1]->step > step),
+    RBSIM_ASSERT((pos == 0 || pending[pos - 1]->key() < step) &&
+                     (pos + 1 == pending.size() || pending[pos + 1]->key() > step),
                  "the steps waiting to be joined are distinct and in order");
     return slot;
   }
@@ -348,17 +365,17 @@ struct Recording::Impl {
     // The step these types carry; decoding checked that the message holds it.
     const std::optional<std::uint64_t> at = msgs::message_step(kPerStep[i], cdr, scene ? scene->dt : 0.0);
     RBSIM_ASSERT(at.has_value(), "a decoded per-step message carries its step");
-    const std::uint64_t step = *at;
+    // The steps start again (a reset, a world loaded: step 0 again, or a step that goes back): the
+    // topic's next segment.
+    StepKey step{last[i] ? last[i]->segment : 0u, *at};
+    if (last[i] && (*at < last[i]->step || (*at == 0 && last[i]->step == 0))) ++step.segment;
     // The step of a change recorded again (once per epoch that starts at it): the last one wins.
     const bool again =
         last[i] && step == *last[i] && !epoch_starts.empty() && again_count[i] < changes_at(step);
     again_count[i] = again ? again_count[i] + 1 : 0;
-    if (last[i] && step <= *last[i] && !again) {
-      const std::string type(msgs::topic(kPerStep[i]).type);
-      if (step == *last[i])
-        return fail(where(e) + ": step " + std::to_string(step) + " has two " + type + " messages");
-      return fail(where(e) + ": step " + std::to_string(step) + " after step " + std::to_string(*last[i]) +
-                  " (steps must increase: a recording of several runs?)");
+    if (last[i] && step == *last[i] && !again) {
+      return fail(where(e) + ": step " + std::to_string(*at) + " has two " +
+                  std::string(msgs::topic(kPerStep[i]).type) + " messages");
     }
     last[i] = step;
     Slot& s = slot_for(step);
@@ -384,9 +401,9 @@ struct Recording::Impl {
   // record it again).
   bool ready(const Slot& s) const {
     for (std::size_t i = 0; i < kPerStep.size(); ++i) {
-      if (present[i] && !(last[i] && *last[i] > s.step)) return false;
+      if (present[i] && !(last[i] && *last[i] > s.key())) return false;
     }
-    return epoch_starts.empty() || epoch_index(s.step) < scenes_seen;  // and its description was met
+    return epoch_starts.empty() || epoch_index(s.key()) < scenes_seen;  // and its description was met
   }
 
   Status check(const Slot& s, const msgs::SceneMessage* described) const {
@@ -430,10 +447,17 @@ struct Recording::Impl {
     while (done < pending.size() && (all || ready(*pending[done]))) {
       const Slot& s = *pending[done];
       ++done;
+      // A world's step 0 replaced before it stepped (a change at step 0, or a restart from there):
+      // as at a later step, the last recording of the step wins, and the segment it ended goes.
+      if (s.step == 0 && done < pending.size() && pending[done]->key() == StepKey{s.segment + 1, 0}) {
+        ++segments_dropped;
+        continue;
+      }
       RecordedStep step;
       step.step = s.step;
+      step.segment = s.segment - segments_dropped;
       if (!epoch_starts.empty()) {
-        step.epoch = epoch_index(s.step);
+        step.epoch = epoch_index(s.key());
         step.scene = &epoch_scene(step.epoch);
       }
       if (result = check(s, step.scene); !result) break;
@@ -585,6 +609,7 @@ Status Recording::read_steps(const std::function<Status(const RecordedStep&)>& o
   im.epoch_starts.clear();
   im.epochs.clear();
   im.scenes_seen = 0;
+  im.segments_dropped = 0;
   const bool any_steps = std::find(im.present.begin(), im.present.end(), true) != im.present.end();
   if (im.scene && any_steps) {
     if (Status st = im.find_epochs(); !st) return st;

@@ -25,6 +25,7 @@ class CsvSink : public Sink {
   Status write(const World& world) override {
     if (Status st = csv_.flush_if_full(); !st) return st;
     step_rows_ = csv_.rows().size();
+    step_ = world.step_index();
     rows(world, csv_.rows());
     return Ok{};
   }
@@ -39,6 +40,8 @@ class CsvSink : public Sink {
                    ": a CSV output cannot follow a world loaded during the run (its steps start "
                    "again at 0): record the run (--record) and export each world from it"};
     }
+    // A reset: step 0's rows again after the step it left, as a reset's later steps follow it.
+    if (world.step_index() != step_) return write(world);
     csv_.rows().resize(step_rows_);
     rows(world, csv_.rows());
     return Ok{};
@@ -50,6 +53,7 @@ class CsvSink : public Sink {
   const char* columns_;
   CsvWriter csv_;
   std::size_t step_rows_ = 0;  // where the current step's rows start in the buffer
+  std::int64_t step_ = 0;      // the step they are of
 };
 
 class BodyCsvSink final : public CsvSink {

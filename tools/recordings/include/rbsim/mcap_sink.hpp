@@ -29,7 +29,9 @@ struct McapSinkOptions {
 // step 0, then every selected per-step topic at step 0 and every k-th step after it. It follows a
 // world whose bodies change: at a change, every selected topic again at that step (the latched
 // ones first), so a recording holds one epoch per scene description (rbsim/recording.hpp).
-// log_time = publish_time = simulated time in ns, so a recording is deterministic.
+// log_time = publish_time = simulated time in ns, so a recording is deterministic; where the steps
+// start again (a reset, a world loaded) log time goes on from where it was (the session's
+// simulated time) and publish time is the world's.
 class McapSink : public Sink {
  public:
   // A steered run's commands: one rbsim_msgs/msg/Command (CDR) on /<ns>/commands at the simulated

@@ -108,8 +108,19 @@ inline RecordingOptions raw_options() {
 // at its step; a step's messages are those of the last epoch that starts at or before it, and of a
 // step recorded again after a change, the last in log-time order. The arrays of each message are
 // in its epoch's order (BodyStates' ids and the scene description's bodies index for index).
+//
+// Segments: where the steps start again at 0 (a reset, a world loaded: rbsim/control.hpp), the
+// recording holds the steps before and after one after the other, each from its own step 0: a
+// segment each. A restart is recorded as a scene description of step 0 followed by step 0's
+// per-step messages again, so on every topic a step 0 recorded again, or a step that goes back,
+// starts the next segment. Steps are passed on in (segment, step) order, which is the order of the
+// session; a step's epoch is the last whose description starts at or before it in that order. A
+// step 0 recorded again before the world stepped (a spawn at step 0, a world loaded at step 0) is,
+// as any step recorded again at a change, taken from its last recording: segments are numbered
+// as passed on, without those that held only a replaced step 0.
 struct RecordedStep {
   std::uint64_t step = 0;
+  std::uint32_t segment = 0;  // 0, then one more each time the steps start again
   // The scene description of the step's epoch (scene() for the first); null without one.
   const msgs::SceneMessage* scene = nullptr;
   std::uint32_t epoch = 0;  // 0, then one more at each later scene description
@@ -141,13 +152,13 @@ class Recording {
   // The topic name read for `id` ("/rbsim/body_states"); empty when the file has none.
   const std::string& topic(msgs::TopicId id) const;
 
-  // Calls `on_step` for every recorded step in increasing step order, with the messages of the
+  // Calls `on_step` for every recorded step in (segment, step) order, with the messages of the
   // read topics that carry it, until the callback fails (its error is returned). A step is passed
   // on once every read topic has moved past it (or the file ends), so messages are held back only
   // as long as the topics' log times interleave, and one step more (it may be recorded again). Fails (naming
-  // the file, the topic and the message's log time) on a malformed message, a step that does not increase on
-  // its topic (a repeat included, unless a scene description came between: an epoch), a scene description
-  // whose step goes back, or a message that does not match its step's scene description. Decoding and
+  // the file, the topic and the message's log time) on a malformed message, a step recorded twice on
+  // its topic (unless a scene description came between: an epoch), a scene description whose step
+  // goes back but to 0, or a message that does not match its step's scene description. Decoding and
   // joining reuse their storage: once warm, they do not allocate for a recording whose topics
   // interleave no more than they did so far. `also` names other topics whose raw messages go to
   // `on_message` in the same pass (log-time order), so a reader of both reads the file once.
