@@ -28,6 +28,11 @@ namespace rbsim::node {
 namespace simulation_detail {
 // A world's text, as a file or a resource_string: larger ones are refused before they are parsed.
 constexpr std::size_t kMaxWorldBytes = 64u << 20;
+// A folder listing (get_spawnables, get_available_worlds): at most this many entries of any kind
+// looked at, and bytes of files read for their descriptions in one call (past it, files are listed
+// by uri alone).
+constexpr std::size_t kMaxFolderEntries = 100000;
+constexpr std::size_t kMaxListingBytes = 16u << 20;
 inline msgs::simulation::Result ok() {
   return msgs::simulation::Result{msgs::simulation::Result::kOk, {}};
 }

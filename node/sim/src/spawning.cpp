@@ -31,12 +31,11 @@ using Codes = sim::SpawnResult;  // SpawnEntity's and SpawnEntities' per-entity 
 // (each a command's copy) add up to at most this. The request itself may be this large.
 constexpr std::size_t kMaxSpawnsPerCall = 1000;
 constexpr std::size_t kMaxCallFragmentBytes = 16u << 20;
-// GetSpawnables: at most this many fragments listed (a folder with more is refused), entries of any
-// kind looked at, and bytes read for their descriptions and bounds in one call (past it, files are
-// listed by uri alone).
+// GetSpawnables: at most this many fragments listed (a folder with more is refused); the entries
+// looked at and bytes read are simulation_detail's listing bounds.
 constexpr std::size_t kMaxSpawnables = 10000;
-constexpr std::size_t kMaxFolderEntries = 100000;
-constexpr std::size_t kMaxListingBytes = 16u << 20;
+using simulation_detail::kMaxFolderEntries;
+using simulation_detail::kMaxListingBytes;
 constexpr std::string_view kFragmentSuffix = ".xml";
 
 // ROS 2's name rules for a spawned entity's name and namespace: tokens of letters, digits and

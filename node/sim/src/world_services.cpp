@@ -27,12 +27,11 @@ using simulation_detail::ok;
 using simulation_detail::refuse_malformed;
 using Load = sim::LoadWorldResponse;
 
+using simulation_detail::kMaxFolderEntries;
+using simulation_detail::kMaxListingBytes;
 using simulation_detail::kMaxWorldBytes;
-// GetAvailableWorlds: at most this many scenes listed, entries of any kind looked at, and bytes read
-// for their descriptions in one call (past it, scenes are listed by name and uri alone).
+// GetAvailableWorlds: at most this many scenes listed.
 constexpr std::size_t kMaxWorlds = 10000;
-constexpr std::size_t kMaxFolderEntries = 100000;
-constexpr std::size_t kMaxListingBytes = 16u << 20;
 constexpr std::string_view kSceneSuffix = ".xml";
 
 // Clears the flag when the load is over, however it ends.
