@@ -920,8 +920,18 @@ def case_worlds(ctx):
               f"log export: {len(rows)} rows, want the wind world's 0..5 (1 body; the first world's step 0 "
               f"recorded again as the wind world's, the last recording of the step) and the first world's "
               f"0..{steps} (5 bodies)")
-    ctx.log("spawned 2 bodies (text, uri), loaded a world by uri and the first again as text; re-simulated from "
-            "the recording with no file: every message equal")
+    # The oracle: each world as loaded steps as its scene run alone, row for row.
+    with open(ctx.path("wind.xml"), "w") as f:
+        f.write(WIND)
+    for name, scene, n, want in (("wind", ctx.path("wind.xml"), 5, rows[:6]),
+                                 ("first", first, steps, rows[6:])):
+        ctx.rbrun(f"alone-{name}", "run", scene, "--steps", n, "--csv", ctx.path(f"alone-{name}.csv"))
+        with open(ctx.path(f"alone-{name}.csv")) as f:
+            alone = f.read().splitlines()[1:]
+        ctx.check(alone == want, f"the {name} world as loaded differs from the scene run alone "
+                                 f"({len(want)} rows vs {len(alone)})")
+    ctx.log("spawned 2 bodies (text, uri), loaded a world by uri and the first again; re-simulated from the "
+            "recording with no file: every message equal; each world as loaded equals its scene run alone")
     return 0
 
 
