@@ -168,6 +168,31 @@ TEST(ControllerSpawn, ChangesAtOneBoundaryAreWrittenOneAtATime) {
   EXPECT_EQ(from_step(live, 6).front().state.size(), 3u * 6u);
 }
 
+// A running loop (rate above 0) steps before a live change that arrived after another held it (here
+// submitted as the first applied), so a client spawning call after call cannot stop the clock; a
+// loop as fast as it goes applies it at once, at the same boundary.
+TEST(ControllerSpawn, ARunningLoopStepsBeforeALiveChangeThatArrivedAfterAnother) {
+  const Scene scene = test::control_scene();
+  for (const double rate : {0.0, 1.0}) {
+    Controller controller(scene, kSteps, RunSettings{rate, 1, false});
+    std::future<CommandResult> second;
+    CommandResult first;
+    controller.submit(spawn_command(Command::kNextStep, "a", {1.5, 6.0}, 0.0), [&](const CommandResult& r) {
+      first = r;
+      second = controller.submit(spawn_command(Command::kNextStep, "b", {-4.0, 6.0}, 0.0));
+    });
+    (void)test::run(scene, kSteps, &controller, nullptr);
+    ASSERT_TRUE(first.successful) << first.message;
+    const CommandResult r = wait(second);
+    ASSERT_TRUE(r.successful) << r.message;
+    if (rate > 0.0) {
+      EXPECT_GT(r.step, first.step);
+    } else {
+      EXPECT_EQ(r.step, first.step);
+    }
+  }
+}
+
 TEST(ControllerSpawn, NamesAreNeverGivenTwiceInASession) {
   const Scene scene = test::control_scene();
   Controller controller(scene, kSteps, RunSettings{0.0, 1, false});

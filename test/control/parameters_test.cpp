@@ -159,6 +159,41 @@ TEST(ParameterTable, FollowStructureKeepsOnePairPerSpringInTheWorldsOrder) {
   EXPECT_EQ(t.value(*t.find("springs.2.k")), ParameterValue::of_double(42.0));
 }
 
+// follow() makes a copy made earlier equal to the table it was copied from, whatever changed since:
+// values stored, springs added, the first removed, the table made again.
+TEST(ParameterTable, FollowMakesAnEarlierCopyEqualToItsTable) {
+  const Scene scene = test::control_scene();
+  ParameterTable t(scene, 200, RunSettings{});
+  ParameterTable published = t;
+  World w = World::create(scene.world).value();
+  const SpringDef extra = w.spring(SpringId{0});
+  const auto expect_equal = [&](const char* what) {
+    published.follow(t);
+    ASSERT_EQ(names(published), names(t)) << what;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      EXPECT_EQ(published.value(i), t.value(i)) << what << ": " << t.descriptor(i).name;
+      EXPECT_EQ(published.descriptor(i), t.descriptor(i)) << what;
+      EXPECT_EQ(published.target(i).index, t.target(i).index) << what;
+      EXPECT_EQ(published.find(t.descriptor(i).name), i) << what;
+    }
+  };
+  expect_equal("unchanged");
+  t.store(*t.find("rate"), V::of_double(3.0));
+  t.store(*t.find("springs.1.l0"), V::of_double(0.25));
+  expect_equal("two values stored");
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(w.add_spring(extra).ok());
+  t.follow_structure(w, nullptr, nullptr);
+  expect_equal("three springs added");
+  ASSERT_TRUE(w.remove_spring(w.spring_id(SpringId{0})).ok());
+  ASSERT_TRUE(w.add_spring(extra).ok());
+  t.follow_structure(w, nullptr, nullptr);
+  t.store(*t.find("springs.3.k"), V::of_double(7.0));
+  expect_equal("the first spring removed, one added, a value stored");
+  EXPECT_FALSE(published.find("springs.0.k").has_value());
+  t = ParameterTable(scene, 200, RunSettings{});
+  expect_equal("a table made again");
+}
+
 TEST(ParameterTableCheck, EveryReadWriteParameterTakesItsTypeInRangeAndRefusesTheRest) {
   const ParameterTable t(test::control_scene(), 200, RunSettings{});
   for (const Case& c : cases()) {

@@ -1,4 +1,6 @@
 // rbsim node: run a scene and stream it over DDS with ROS 2 conventions.
+#include <malloc.h>
+
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -188,6 +190,12 @@ int node_command(const NodeArgs& a) {
   // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
   // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
   install_stop_handlers();
+  // Every change of a large world re-publishes its scene description and markers (megabytes at
+  // 10,000 bodies), each a little larger than the last: above glibc's sliding mmap threshold every
+  // buffer would be mapped afresh, its pages faulted in and unmapped again, twice the cost of the
+  // change (scripts/bench-node-spawn). The heap keeps them instead, and keeps what it grew to.
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   // The node is /<namespace> on the graph: its topics /<namespace>/<name> are its private ones.
   const Result<node::NodeName> name = node::parse_node_name(a.node.ns);
   if (!name) return fail("node", name.error().message, 2);

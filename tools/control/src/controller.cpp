@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <initializer_list>
 #include <limits>
 #include <memory>
@@ -17,6 +18,16 @@ namespace rbsim::control {
 namespace {
 // A paused loop wakes at least this often to poll its stop request (Ctrl-C).
 constexpr auto kIdleWait = std::chrono::milliseconds(20);
+// A running loop spends at most 1 / kChangeShare of its thread's time on changes of the world's
+// bodies (a spawn re-publishes the whole scene description and markers): after one, the live
+// commands that arrived since wait (kChangeShare - 1) times its cost while the steps go on.
+constexpr std::int64_t kChangeShare = 5;
+
+std::int64_t thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
 
 using detail::at;
 using detail::failed;
@@ -253,7 +264,7 @@ ControlCounters Controller::counters() const {
 void Controller::publish_values(const World& world) {
   (void)world;
   const std::lock_guard lock(mutex_);
-  published_ = table_;
+  published_.follow(table_);  // what changed, not a copy of every parameter
   published_settings_ = settings_;
   published_world_ = world_info_;
 }
@@ -262,6 +273,8 @@ void Controller::start(World& world) {
   // A pass (again, with --loop) starts from the scene: what was spawned in an earlier one is gone,
   // but the session's ids and names go on.
   renew(world, next_body_id_, next_spring_id_);
+  change_cpu_ns_ = -1;
+  live_from_ns_ = 0;
   follow_structure(world, nullptr);
   table_.refresh(world, settings_);
   publish_values(world);
@@ -275,6 +288,7 @@ void Controller::take_incoming() {
     has_incoming_.store(false, std::memory_order_release);
   }
   for (Pending& p : arrived) {
+    taken_sequence_ = std::max(taken_sequence_, p.sequence);
     const auto later = [](const Pending& a, const Pending& b) {
       return a.command.step != b.command.step ? a.command.step < b.command.step : a.sequence < b.sequence;
     };
@@ -292,11 +306,24 @@ bool Controller::due(std::int64_t step) const {
   return !schedule_.empty() && schedule_.front().command.step <= step;
 }
 
+std::size_t Controller::next_due(std::int64_t step, bool defer_live) const {
+  for (std::size_t i = 0; i < schedule_.size() && schedule_[i].command.step <= step; ++i) {
+    const Pending& p = schedule_[i];
+    if (!(defer_live && p.command.step == Command::kNextStep && p.sequence > held_sequence_)) return i;
+  }
+  return schedule_.size();
+}
+
 StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
   Boundary b;
+  if (change_cpu_ns_ >= 0) {  // a change held the loop: its cost, the sinks' writing included
+    live_from_ns_ = monotonic_ns() + (kChangeShare - 1) * (thread_cpu_ns() - change_cpu_ns_);
+    change_cpu_ns_ = -1;
+  }
   // The common case, a running loop with nothing queued: two loads and a compare.
   if (!has_incoming_.load(std::memory_order_acquire) && !settings_.paused && !due(world.step_index()))
     return b;
+  const std::int64_t cpu_start = thread_cpu_ns();
   bool idled = false;
   for (;;) {
     bool applied = false;
@@ -308,9 +335,11 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     for (bool more = true; more && !b.structure_changed;) {
       if (has_incoming_.load(std::memory_order_acquire)) take_incoming();
       more = false;
-      while (due(world.step_index()) && !b.structure_changed) {
-        Pending p = std::move(schedule_.front());
-        schedule_.erase(schedule_.begin());
+      const bool defer = !settings_.paused && live_from_ns_ > monotonic_ns();
+      for (std::size_t i;
+           (i = next_due(world.step_index(), defer)) < schedule_.size() && !b.structure_changed;) {
+        Pending p = std::move(schedule_[i]);
+        schedule_.erase(schedule_.begin() + static_cast<std::ptrdiff_t>(i));
         apply_now(p, world, b);
         applied = more = true;
       }
@@ -340,6 +369,10 @@ StepHook::Boundary Controller::boundary(World& world, bool (*stop)()) {
     // Bodies came or went: the sinks show the change now (while paused, not at the next step), then
     // the driver comes back to this boundary for what else is due.
     if (b.structure_changed) {
+      if (!settings_.paused && settings_.rate > 0.0) {  // live commands that arrive from now on wait
+        change_cpu_ns_ = cpu_start;
+        held_sequence_ = taken_sequence_;
+      }
       b.hold = true;
       return b;
     }

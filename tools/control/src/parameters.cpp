@@ -306,6 +306,32 @@ void ParameterTable::follow_structure(const World& world, std::vector<Parameter>
   }
 }
 
+void ParameterTable::follow(const ParameterTable& from) {
+  constexpr std::size_t kPerSpring = 2;
+  const std::size_t first = entries_.size() - kPerSpring * spring_ids_.size();
+  if (first != from.entries_.size() - kPerSpring * from.spring_ids_.size()) {
+    *this = from;  // not a table of the same scene
+    return;
+  }
+  const auto shared =
+      std::mismatch(spring_ids_.begin(), spring_ids_.end(), from.spring_ids_.begin(), from.spring_ids_.end());
+  const std::size_t keep = first + kPerSpring * static_cast<std::size_t>(shared.first - spring_ids_.begin());
+  for (std::size_t i = keep; i < entries_.size(); ++i) index_.erase(entries_[i].descriptor.name);
+  entries_.erase(entries_.begin() + static_cast<std::ptrdiff_t>(keep), entries_.end());
+  for (std::size_t i = 0; i < keep; ++i) {
+    Entry& e = entries_[i];
+    const Entry& f = from.entries_[i];
+    RBSIM_ASSERT(e.descriptor.name == f.descriptor.name, "a table follows one of the same parameters");
+    if (!(e.value == f.value)) e.value = f.value;
+    e.target = f.target;
+  }
+  for (std::size_t i = keep; i < from.entries_.size(); ++i) {
+    index_.emplace(from.entries_[i].descriptor.name, i);
+    entries_.push_back(from.entries_[i]);
+  }
+  spring_ids_.assign(from.spring_ids_.begin(), from.spring_ids_.end());
+}
+
 std::optional<std::size_t> ParameterTable::find(std::string_view name) const {
   const auto it = index_.find(name);
   if (it == index_.end()) return std::nullopt;

@@ -190,10 +190,14 @@ Encoder::Encoder(const Scene& scene, std::string_view ns) : scene_(&scene), ns_(
 
 void Encoder::restructure(const Entities& entities) {
   if (entities.scene != nullptr) scene_ = entities.scene;  // a world loaded: its own name, forces, ...
+  // The frames of the bodies named as before, up to the first change, stay (a spawn appends one).
+  const auto& old = entities_.body_names;
+  const auto& now = entities.body_names;
+  const auto same = std::mismatch(old.begin(), old.end(), now.begin(), now.end()).first - old.begin();
+  frames_.resize(static_cast<std::size_t>(same));
+  for (auto k = static_cast<std::size_t>(same); k < now.size(); ++k)
+    frames_.push_back(body_frame(ns_, now[k]));
   entities_ = entities;
-  frames_.clear();
-  frames_.reserve(entities.body_names.size());
-  for (const std::string& name : entities.body_names) frames_.push_back(body_frame(ns_, name));
   const auto& colors = entities.spring_colors;
   spring_color_.reset();
   if (!colors.empty() &&
@@ -402,6 +406,8 @@ void Encoder::markers(const World& world, Bytes& out) const {
     w.sequence_length(0);
     marker_rest(w);
   }
+  std::vector<std::uint32_t> triangles;
+  std::span<const Vec2> triangulated;  // the hull `triangles` cut: bodies sharing a shape share it
   for (std::int32_t b = 0; b < world.body_count(); ++b) {
     const BodyId id{b};
     const std::int32_t marker = world.body_id(id);  // a body keeps its markers' ids across changes
@@ -409,7 +415,10 @@ void Encoder::markers(const World& world, Bytes& out) const {
     const auto hull = world.hull(id);
     const Color c = entities_.body_colors[b];
     marker_head(w, {stamp, frame, "hulls", marker, kMarkerTriangleList, 1.0, 1.0, 1.0, c, true});
-    const std::vector<std::uint32_t> triangles = triangulate(hull);
+    if (hull.data() != triangulated.data() || hull.size() != triangulated.size()) {
+      triangles = triangulate(hull);
+      triangulated = hull;
+    }
     w.sequence_length(triangles.size());
     for (const std::uint32_t i : triangles) point(w, hull[i]);
     w.sequence_length(0);  // colors: the marker's

@@ -313,6 +313,9 @@ class Controller final : public StepHook, public Steering {
   // Moves the incoming queue into the schedule (step order, then arrival order).
   void take_incoming();
   bool due(std::int64_t step) const;
+  // The schedule's first command due at `step` (its size if none); with `defer_live`, none of the
+  // live commands (kNextStep) taken after the last change held the loop.
+  std::size_t next_due(std::int64_t step, bool defer_live) const;
   CommandResult execute(Command& command, World& world, Boundary& boundary);
   CommandResult set_parameters(const Command& command, World& world, Boundary& boundary);
   CommandResult reset(World& world, Boundary& boundary);
@@ -376,6 +379,11 @@ class Controller final : public StepHook, public Steering {
   std::vector<Pending> schedule_;  // sorted by (step, sequence); kNextStep first
   std::int64_t step_budget_ = 0;   // steps left of a `step N` while paused
   std::optional<std::chrono::steady_clock::time_point> resume_at_;  // a timed pause's end
+  // A running loop's changes of the world's bodies take a bounded share of its time (kChangeShare):
+  std::uint64_t taken_sequence_ = 0;  // the newest command taken into the schedule
+  std::uint64_t held_sequence_ = 0;   // the newest when a change last held the loop
+  std::int64_t change_cpu_ns_ = -1;   // the loop thread's CPU time when that change began (until costed)
+  std::int64_t live_from_ns_ = 0;     // monotonic_ns() from which later live commands apply
   std::function<void(const RunSettings&)> settings_listener_;
   std::vector<std::function<void(const Command&, const CommandResult&)>> observers_;
   // Spawned bodies and springs by id, and every name ever given in the session.

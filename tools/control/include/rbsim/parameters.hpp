@@ -137,6 +137,12 @@ class ParameterTable {
   // named by its id (a scene's springs keep their file index), in spring order, last in the table.
   // The names that appeared go to `added` (with their values), the ones that went to `removed`.
   void follow_structure(const World& world, std::vector<Parameter>* added, std::vector<std::string>* removed);
+  // Makes this table equal to `from`, a table of the same scene (a copy of it, changed since), at
+  // the cost of what changed: each value compared and copied in place if it differs, the springs'
+  // entries kept up to the first spring the two do not share and `from`'s copied from there. The
+  // Controller's published table follows its own this way at a boundary: a spawn into a world of
+  // 10,000 springs compares 20,000 values instead of copying 20,000 entries and their names.
+  void follow(const ParameterTable& from);
   // rclcpp's list_parameters: names under any of `prefixes` (all when empty), at most `depth`
   // levels of '.' below the prefix (kDepthRecursive: any), and the prefixes of those names.
   ListParametersResult list(const std::vector<std::string>& prefixes, std::uint64_t depth) const;
