@@ -146,6 +146,15 @@ void publish_commands(control::Controller& controller, node::NodeServices& servi
       });
 }
 
+// Every change of a large world re-publishes its scene description and markers (megabytes at
+// 10,000 bodies), each a little larger than the last: above glibc's sliding mmap threshold every
+// buffer would be mapped afresh, its pages faulted in and unmapped again, twice the cost of the
+// change (scripts/bench-node-spawn). The heap keeps them instead, and keeps what it grew to.
+void keep_large_buffers() {
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+}
+
 // One begin()/run() pass, or one per loop with --loop until a stop; the exit status of a pass
 // that failed or diverged.
 std::optional<int> run_passes(const NodeArgs& a, Driver& driver, const DriverOptions& options) {
@@ -190,12 +199,7 @@ int node_command(const NodeArgs& a) {
   // Ctrl-C and SIGTERM only raise a flag from here on, before anything a stop must undo exists
   // (a participant, a listener, an output file): a stop at any stage of start-up ends cleanly.
   install_stop_handlers();
-  // Every change of a large world re-publishes its scene description and markers (megabytes at
-  // 10,000 bodies), each a little larger than the last: above glibc's sliding mmap threshold every
-  // buffer would be mapped afresh, its pages faulted in and unmapped again, twice the cost of the
-  // change (scripts/bench-node-spawn). The heap keeps them instead, and keeps what it grew to.
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  keep_large_buffers();
   // The node is /<namespace> on the graph: its topics /<namespace>/<name> are its private ones.
   const Result<node::NodeName> name = node::parse_node_name(a.node.ns);
   if (!name) return fail("node", name.error().message, 2);
