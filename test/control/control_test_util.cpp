@@ -24,6 +24,20 @@ std::string control_scene_text() {
 </scene>)";
 }
 
+std::string square_world_text(const std::string& duration) {
+  return R"(<scene>
+  <simtype type="rigid-body"/>
+  <description text="a falling square"/>
+  <duration time=")" +
+         duration + R"("/>
+  <rigidbodyintegrator type="explicit-euler" dt="0.005"/>
+  <rigidbodyvertex x="0" y="0" m="1"/><rigidbodyvertex x="1" y="0" m="1"/>
+  <rigidbodyvertex x="1" y="1" m="1"/><rigidbodyvertex x="0" y="1" m="1"/>
+  <rigidbody p="0" p="1" p="2" p="3" vx="1.5" vy="2.0" omega="0.7" r="0.1"/>
+  <rigidbodygravityforce fx="0.0" fy="-9.81"/>
+</scene>)";
+}
+
 Scene scene_from(const std::string& text) {
   Result<Scene> scene = parse_scene(text, "control.xml");
   if (!scene) throw std::runtime_error(scene.error().message);

@@ -32,6 +32,10 @@ inline constexpr const char* kFragment = R"(<scene>
   <rigidbodyspringforce i="-1" pix="2.0" piy="6.0" j="0" pjx="0.0" pjy="0.0" k="3.0" l0="0.5"/>
 </scene>)";
 
+// Another world for load_world: a falling square, one body, explicit Euler at dt 0.005, `duration`
+// seconds long.
+std::string square_world_text(const std::string& duration);
+
 // A spawn of kFragment (named `name`, placed at `position`, rotated by `theta`) and a delete, each at
 // `step`, from source "test".
 inline control::Command spawn_command(std::int64_t step, std::string name, Vec2 position, double theta) {

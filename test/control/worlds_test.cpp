@@ -21,16 +21,7 @@ using test::Snapshot;
 constexpr std::int64_t kSteps = 120;
 
 // Another world: one body of its own, another dt and integrator, 30 steps long.
-constexpr const char* kOtherWorld = R"(<scene>
-  <simtype type="rigid-body"/>
-  <description text="a falling square"/>
-  <duration time="0.15"/>
-  <rigidbodyintegrator type="explicit-euler" dt="0.005"/>
-  <rigidbodyvertex x="0" y="0" m="1"/><rigidbodyvertex x="1" y="0" m="1"/>
-  <rigidbodyvertex x="1" y="1" m="1"/><rigidbodyvertex x="0" y="1" m="1"/>
-  <rigidbody p="0" p="1" p="2" p="3" vx="1.5" vy="2.0" omega="0.7" r="0.1"/>
-  <rigidbodygravityforce fx="0.0" fy="-9.81"/>
-</scene>)";
+const std::string kOtherWorld = test::square_world_text("0.15");
 
 Command at(std::int64_t step, CommandKind kind) {
   Command c;

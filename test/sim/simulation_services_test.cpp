@@ -1522,15 +1522,7 @@ void write_file(const std::filesystem::path& path, const std::string& text) {
 }
 
 // A world of one body, its own dt and integrator, long enough for any test.
-constexpr const char* kWorldScene = R"(<scene>
-  <description text="a falling square"/>
-  <duration time="1000.0"/>
-  <rigidbodyintegrator type="explicit-euler" dt="0.005"/>
-  <rigidbodyvertex x="0" y="0" m="1"/><rigidbodyvertex x="1" y="0" m="1"/>
-  <rigidbodyvertex x="1" y="1" m="1"/><rigidbodyvertex x="0" y="1" m="1"/>
-  <rigidbody p="0" p="1" p="2" p="3" vx="1.5" vy="2.0" omega="0.7" r="0.1"/>
-  <rigidbodygravityforce fx="0.0" fy="-9.81"/>
-</scene>)";
+const std::string kWorldScene = test::square_world_text("1000.0");
 
 class WorldsTest : public SimulationServicesTest {
  protected:
