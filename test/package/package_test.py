@@ -63,7 +63,7 @@ def test_install(a, work):
     run(["cmake", "--install", a.build, "--prefix", prefix])
     files = sorted(str(p.relative_to(prefix)) for p in prefix.rglob("*") if p.is_file())
     for need in ["bin/rbsim", "include/rbsim/testing.hpp", "include/rbsim/core.hpp", "include/rbsim/mcap.hpp",
-                 "share/rbsim/foxglove-layout.json"]:
+                 "share/rbsim/foxglove-layout.json", "share/rbsim/scenes/airplane.xml"]:
         if need not in files:
             fail(f"install lacks {need}; installed: {files}")
     cmake_dir = next((p.parent for p in prefix.rglob("rbsimConfig.cmake")), None)
@@ -117,7 +117,7 @@ def test_deb(a, work):
     depends = {re.split(r"[ (]", d.strip())[0] for alt in fields["Depends"].split(",") for d in alt.split("|")}
     contents = run(["dpkg-deb", "-c", deb])
     for need in ["./usr/bin/rbsim", "/usr/include/rbsim/testing.hpp", "/cmake/rbsim/rbsimConfig.cmake",
-                 "./usr/share/rbsim/foxglove-layout.json"]:
+                 "./usr/share/rbsim/foxglove-layout.json", "./usr/share/rbsim/scenes/airplane.xml"]:
         if need not in contents:
             fail(f"{deb.name} lacks {need}")
     root = work / "root"
