@@ -192,6 +192,18 @@ TEST(ParameterTable, FollowMakesAnEarlierCopyEqualToItsTable) {
   EXPECT_FALSE(published.find("springs.0.k").has_value());
   t = ParameterTable(scene, 200, RunSettings{});
   expect_equal("a table made again");
+  // A world loaded: another scene's table, as many parameters under other names (the wind first).
+  std::string text = test::control_scene_text();
+  const std::string gravity = R"(<rigidbodygravityforce fx="0.0" fy="-9.81"/>)";
+  const std::size_t at = text.find(gravity);
+  ASSERT_NE(at, std::string::npos);
+  text.erase(at, gravity.size());
+  text.insert(text.find("<rigidbodyspringforce"), gravity + "\n  ");
+  const Scene other = test::scene_from(text);
+  t = ParameterTable(other, 200, RunSettings{});
+  ASSERT_EQ(t.size(), published.size());
+  ASSERT_NE(names(t), names(published));
+  expect_equal("another scene's table of as many parameters");
 }
 
 TEST(ParameterTableCheck, EveryReadWriteParameterTakesItsTypeInRangeAndRefusesTheRest) {

@@ -309,8 +309,14 @@ void ParameterTable::follow_structure(const World& world, std::vector<Parameter>
 void ParameterTable::follow(const ParameterTable& from) {
   constexpr std::size_t kPerSpring = 2;
   const std::size_t first = entries_.size() - kPerSpring * spring_ids_.size();
-  if (first != from.entries_.size() - kPerSpring * from.spring_ids_.size()) {
-    *this = from;  // not a table of the same scene
+  // Not a table of the same scene (a world loaded: other forces, maybe as many): a copy.
+  const bool same_scene = first == from.entries_.size() - kPerSpring * from.spring_ids_.size() &&
+                          std::equal(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(first),
+                                     from.entries_.begin(), [](const Entry& a, const Entry& b) {
+                                       return a.descriptor.name == b.descriptor.name;
+                                     });
+  if (!same_scene) {
+    *this = from;
     return;
   }
   const auto shared =
