@@ -64,7 +64,8 @@ Status RecordingSink::write(const World& world) {
 }
 
 std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller,
-                          std::vector<Entities>* entities, bool follows) {
+                          std::vector<Entities>* entities, bool follows,
+                          std::vector<std::string>* descriptions) {
   Result<Driver> driver = Driver::create(scene);
   if (!driver) throw std::runtime_error(driver.error().message);
   RecordingSink sink;
@@ -75,6 +76,7 @@ std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Contr
   options.control = controller;
   if (Status st = driver.value().run_pass(options); !st) throw std::runtime_error(st.error().message);
   if (entities != nullptr) *entities = std::move(sink.entities);
+  if (descriptions != nullptr) *descriptions = std::move(sink.scene_descriptions);
   return std::move(sink.snapshots);
 }
 

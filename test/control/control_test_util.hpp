@@ -75,19 +75,25 @@ class RecordingSink final : public Sink {
   bool follows_structure() const override { return follows; }
   Status restructure(const World&, const Entities& e) override {
     entities.push_back(e);
+    // A loaded world's scene lives while the controller keeps it (until the next world): its words
+    // now, and no pointer kept.
+    scene_descriptions.push_back(e.scene != nullptr ? e.scene->description : std::string());
+    entities.back().scene = nullptr;
     return Ok{};
   }
   std::vector<Snapshot> snapshots;
   int rebases = 0;
   bool follows = true;
-  std::vector<Entities> entities;  // at each restructure()
+  std::vector<Entities> entities;               // at each restructure(), `scene` null
+  std::vector<std::string> scene_descriptions;  // the scene's description at each restructure()
 };
 
 // One pass of `scene` for `steps` steps with an optional controller; the snapshots of every step.
 // `entities`, when given, receives the sink's restructure() calls; `follows` says whether the sink
-// follows structural changes.
+// follows structural changes; `descriptions`, when given, the description of each one's scene.
 std::vector<Snapshot> run(const Scene& scene, std::int64_t steps, control::Controller* controller = nullptr,
-                          std::vector<Entities>* entities = nullptr, bool follows = true);
+                          std::vector<Entities>* entities = nullptr, bool follows = true,
+                          std::vector<std::string>* descriptions = nullptr);
 
 // Bit-for-bit equality of two doubles (memcmp: -0.0 differs from 0.0).
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b);

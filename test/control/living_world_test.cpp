@@ -9,6 +9,7 @@
 #include <fstream>
 #include <future>
 #include <string>
+#include <thread>
 
 #include "control_test_util.hpp"
 #include "rbsim/command_script.hpp"
@@ -171,17 +172,34 @@ TEST(ControllerSpawn, ChangesAtOneBoundaryAreWrittenOneAtATime) {
 // A running loop (rate above 0) steps before a live change that arrived after another held it (here
 // submitted as the first applied), so a client spawning call after call cannot stop the clock; a
 // loop as fast as it goes applies it at once, at the same boundary.
+// A running node's changes take a bounded share of its loop: a live spawn that arrives after another
+// waits while the loop steps on (rate > 0), where as fast as possible it applies at once. The run
+// paces each step as a node does (its steps take wall time) and ends when the second spawn applied,
+// so nothing here depends on how fast the machine is; 100,000 steps bound it.
 TEST(ControllerSpawn, ARunningLoopStepsBeforeALiveChangeThatArrivedAfterAnother) {
+  constexpr std::int64_t kLongRun = 100000;
   const Scene scene = test::control_scene();
   for (const double rate : {0.0, 1.0}) {
-    Controller controller(scene, kSteps, RunSettings{rate, 1, false});
-    std::future<CommandResult> second;
+    Controller controller(scene, kLongRun, RunSettings{rate, 1, false});
+    std::promise<CommandResult> second_done;
+    std::future<CommandResult> second = second_done.get_future();
     CommandResult first;
     controller.submit(spawn_command(Command::kNextStep, "a", {1.5, 6.0}, 0.0), [&](const CommandResult& r) {
       first = r;
-      second = controller.submit(spawn_command(Command::kNextStep, "b", {-4.0, 6.0}, 0.0));
+      controller.submit(spawn_command(Command::kNextStep, "b", {-4.0, 6.0}, 0.0),
+                        [&](const CommandResult& b) {
+                          second_done.set_value(b);
+                          controller.close("the second spawn applied");  // the pass ends at the next boundary
+                        });
     });
-    (void)test::run(scene, kSteps, &controller, nullptr);
+    Driver driver = Driver::create(scene).value();
+    test::RecordingSink sink;
+    driver.add(sink);
+    DriverOptions options;
+    options.steps = kLongRun;
+    options.control = &controller;
+    options.pace = [](const World&) { std::this_thread::sleep_for(100us); };
+    ASSERT_TRUE(driver.run_pass(options).ok());
     ASSERT_TRUE(first.successful) << first.message;
     const CommandResult r = wait(second);
     ASSERT_TRUE(r.successful) << r.message;

@@ -49,12 +49,8 @@ struct Steered {
 Steered steered(const Scene& scene, std::vector<ScriptedCommand> commands) {
   ScriptedRun run(scene, kSteps, std::move(commands));
   Steered s;
-  s.snapshots = test::run(scene, kSteps, &run.controller(), &s.entities);
+  s.snapshots = test::run(scene, kSteps, &run.controller(), &s.entities, true, &s.descriptions);
   s.world = run.controller().world_info();
-  for (Entities& e : s.entities) {
-    s.descriptions.push_back(e.scene != nullptr ? e.scene->description : "");
-    e.scene = nullptr;  // the controller keeps the loaded scene no longer than itself
-  }
   (void)run.finish("session");
   s.mismatches = run.mismatches();
   return s;

@@ -135,7 +135,7 @@ struct Entities {
   std::vector<Color> spring_colors;
   std::uint32_t epoch = 0;
   std::uint32_t world = 0;
-  const Scene* scene = nullptr;  // outlives every output told of it (the Controller keeps it)
+  const Scene* scene = nullptr;  // valid until the next world loads (the Controller keeps it)
 };
 // A scene's entities as loaded (epoch 0, world 0, `scene` it).
 Entities entities_of(const Scene& scene);
