@@ -43,7 +43,7 @@ Result<std::vector<ScriptedCommand>> load_commands(const std::string& path, cons
 }
 
 ScriptedRun::ScriptedRun(const Scene& scene, std::int64_t steps, std::vector<ScriptedCommand> commands)
-    : scene_(scene), controller_(scene, steps, RunSettings{0.0, 1, false}) {
+    : controller_(scene, steps, RunSettings{0.0, 1, false}) {
   controller_.end_when_idle(true);
   submitted_ = commands.size();
   for (ScriptedCommand& s : commands) {

@@ -88,7 +88,6 @@ class ScriptedRun {
  private:
   void submit_epoch(std::size_t e);
 
-  const Scene& scene_;
   std::vector<std::vector<ScriptedCommand>> epochs_;  // by ScriptedCommand::epoch
   std::vector<std::string> mismatches_;
   Status recorded_ = Ok{};
